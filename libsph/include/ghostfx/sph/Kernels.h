@@ -1,0 +1,214 @@
+/// @file   Kernels.h
+/// @brief  SPH smoothing kernels as small value objects (no static state).
+/// @details Every kernel has the same interface so solvers take it as a template parameter and
+///          the inner loops inline it:
+///            - `supportRadius()`    radius beyond which W = 0 (m)
+///            - `W(r)`               kernel value at distance r (1/m^3)
+///            - `gradW(xij, r)`      gradient with respect to x_i, xij = x_i - x_j, r = |xij| (1/m^4)
+///            - `dWdr(r)`            radial derivative (1/m^4)
+///          All are normalised in 3-D: the volume integral of W is 1.
+///
+///          - CubicSplineKernel: Monaghan's M4 spline [Monaghan 2005, Sec. 2.2], used by [SB12]
+///            with support radius 3h for particle spacing h (Sec. 3).
+///          - Poly6Kernel, SpikyKernel, ViscosityKernel: Mueller, Charypar, Gross 2003, used by
+///            [RYY15] for density (poly6), pressure gradient (spiky) and viscosity (Laplacian).
+#pragma once
+
+#include "ghostfx/sph/Exceptions.h"
+#include "ghostfx/sph/Types.h"
+
+namespace ghostfx {
+namespace sph {
+
+namespace detail {
+inline Real checkedSupport(Real supportRadius, const char* kernelName)
+{
+    if (!(supportRadius > Real(0)) || !std::isfinite(supportRadius)) {
+        throw ValueError(msg(kernelName, " support radius = ", supportRadius,
+                             " m: expected a finite value > 0"));
+    }
+    return supportRadius;
+}
+} // namespace detail
+
+/// Monaghan's M4 cubic B-spline. With smoothing length s = R/2 and q = r/s:
+///   W = 1/(pi s^3) * (1 - 3/2 q^2 + 3/4 q^3)  for 0 <= q < 1
+///   W = 1/(pi s^3) * 1/4 (2 - q)^3            for 1 <= q < 2, and 0 beyond.
+class CubicSplineKernel
+{
+public:
+    /// Support factor of [SB12] Sec. 3: support radius = 3 x particle spacing.
+    static constexpr Real SB12_SUPPORT_FACTOR = Real(3);
+
+    /// @param supportRadius  radius of support R (m); W vanishes for r >= R
+    explicit CubicSplineKernel(Real supportRadius)
+        : mSupport(detail::checkedSupport(supportRadius, "cubic spline kernel"))
+        , mInvS(Real(2) / supportRadius)
+        , mSigma(Real(1) / (PI * cube(supportRadius / Real(2))))
+    {}
+
+    /// Kernel for particle spacing h (m) with support radius `supportFactor` * h.
+    static CubicSplineKernel fromSpacing(Real spacing, Real supportFactor = SB12_SUPPORT_FACTOR)
+    {
+        return CubicSplineKernel(spacing * supportFactor);
+    }
+
+    Real supportRadius() const { return mSupport; }
+
+    Real W(Real r) const
+    {
+        const Real q = r * mInvS;
+        if (q >= Real(2)) return Real(0);
+        if (q < Real(1)) return mSigma * (Real(1) - Real(1.5) * q * q + Real(0.75) * q * q * q);
+        return mSigma * Real(0.25) * cube(Real(2) - q);
+    }
+
+    Real dWdr(Real r) const
+    {
+        const Real q = r * mInvS;
+        if (q >= Real(2)) return Real(0);
+        if (q < Real(1)) return mSigma * mInvS * (Real(-3) * q + Real(2.25) * q * q);
+        return -mSigma * mInvS * Real(0.75) * sqr(Real(2) - q);
+    }
+
+    Vec3 gradW(const Vec3& xij, Real r) const
+    {
+        if (r <= Real(0) || r >= mSupport) return Vec3(0);
+        return xij * (dWdr(r) / r);
+    }
+
+    Real W(const Vec3& xij) const { return W(xij.length()); }
+    Vec3 gradW(const Vec3& xij) const { return gradW(xij, xij.length()); }
+
+private:
+    Real mSupport; ///< R (m)
+    Real mInvS;    ///< 1 / s = 2 / R (1/m)
+    Real mSigma;   ///< 1 / (pi s^3) (1/m^3)
+};
+
+/// Mueller et al. 2003 poly6: W = 315 / (64 pi R^9) (R^2 - r^2)^3. Smooth at r = 0; used for
+/// density sums. Its gradient vanishes at the centre, so it is not used for pressure.
+class Poly6Kernel
+{
+public:
+    explicit Poly6Kernel(Real supportRadius)
+        : mSupport(detail::checkedSupport(supportRadius, "poly6 kernel"))
+        , mR2(supportRadius * supportRadius)
+        , mCoef(Real(315) / (Real(64) * PI * std::pow(supportRadius, Real(9))))
+    {}
+
+    Real supportRadius() const { return mSupport; }
+
+    Real W(Real r) const
+    {
+        if (r >= mSupport) return Real(0);
+        return mCoef * cube(mR2 - r * r);
+    }
+
+    Real dWdr(Real r) const
+    {
+        if (r >= mSupport) return Real(0);
+        return Real(-6) * mCoef * r * sqr(mR2 - r * r);
+    }
+
+    Vec3 gradW(const Vec3& xij, Real r) const
+    {
+        if (r >= mSupport) return Vec3(0);
+        return xij * (Real(-6) * mCoef * sqr(mR2 - r * r));
+    }
+
+    /// Laplacian: -6 c (R^2 - r^2)(3 R^2 - 7 r^2) with c = 315 / (64 pi R^9).
+    Real laplacianW(Real r) const
+    {
+        if (r >= mSupport) return Real(0);
+        const Real r2 = r * r;
+        return Real(-6) * mCoef * (mR2 - r2) * (Real(3) * mR2 - Real(7) * r2);
+    }
+
+    Real W(const Vec3& xij) const { return W(xij.length()); }
+    Vec3 gradW(const Vec3& xij) const { return gradW(xij, xij.length()); }
+
+private:
+    Real mSupport, mR2, mCoef;
+};
+
+/// Mueller et al. 2003 spiky: W = 15 / (pi R^6) (R - r)^3. Its gradient does not vanish at the
+/// centre, so close particles still repel: used for the pressure force.
+class SpikyKernel
+{
+public:
+    explicit SpikyKernel(Real supportRadius)
+        : mSupport(detail::checkedSupport(supportRadius, "spiky kernel"))
+        , mCoef(Real(15) / (PI * std::pow(supportRadius, Real(6))))
+    {}
+
+    Real supportRadius() const { return mSupport; }
+
+    Real W(Real r) const { return r >= mSupport ? Real(0) : mCoef * cube(mSupport - r); }
+
+    Real dWdr(Real r) const
+    {
+        return r >= mSupport ? Real(0) : Real(-3) * mCoef * sqr(mSupport - r);
+    }
+
+    Vec3 gradW(const Vec3& xij, Real r) const
+    {
+        if (r <= Real(0) || r >= mSupport) return Vec3(0);
+        return xij * (dWdr(r) / r);
+    }
+
+    Real W(const Vec3& xij) const { return W(xij.length()); }
+    Vec3 gradW(const Vec3& xij) const { return gradW(xij, xij.length()); }
+
+private:
+    Real mSupport, mCoef;
+};
+
+/// Mueller et al. 2003 viscosity kernel:
+///   W = 15 / (2 pi R^3) (-r^3 / (2 R^3) + r^2 / R^2 + R / (2 r) - 1),
+/// whose Laplacian 45 / (pi R^6) (R - r) is positive everywhere, so the viscous force only ever
+/// damps relative velocity. W itself is singular (integrably) at r = 0.
+class ViscosityKernel
+{
+public:
+    explicit ViscosityKernel(Real supportRadius)
+        : mSupport(detail::checkedSupport(supportRadius, "viscosity kernel"))
+        , mCoefW(Real(15) / (Real(2) * PI * cube(supportRadius)))
+        , mCoefLap(Real(45) / (PI * std::pow(supportRadius, Real(6))))
+    {}
+
+    Real supportRadius() const { return mSupport; }
+
+    Real W(Real r) const
+    {
+        if (r >= mSupport) return Real(0);
+        const Real R = mSupport;
+        return mCoefW * (-cube(r) / (Real(2) * cube(R)) + r * r / (R * R) + R / (Real(2) * r)
+                         - Real(1));
+    }
+
+    Real dWdr(Real r) const
+    {
+        if (r >= mSupport) return Real(0);
+        const Real R = mSupport;
+        return mCoefW * (Real(-1.5) * r * r / cube(R) + Real(2) * r / (R * R)
+                         - R / (Real(2) * r * r));
+    }
+
+    Vec3 gradW(const Vec3& xij, Real r) const
+    {
+        if (r <= Real(0) || r >= mSupport) return Vec3(0);
+        return xij * (dWdr(r) / r);
+    }
+
+    Real laplacianW(Real r) const { return r >= mSupport ? Real(0) : mCoefLap * (mSupport - r); }
+
+    Real W(const Vec3& xij) const { return W(xij.length()); }
+    Vec3 gradW(const Vec3& xij) const { return gradW(xij, xij.length()); }
+
+private:
+    Real mSupport, mCoefW, mCoefLap;
+};
+
+} // namespace sph
+} // namespace ghostfx

@@ -1,0 +1,94 @@
+/// @file   LevelSet.h
+/// @brief  Queries on an OpenVDB narrow-band level set: signed distance, gradient, normal,
+///         closest point, inside/outside, in world space.
+/// @details The one interface through which the sampler, the ghost-solid layer and the collision
+///          projection see solids, emitters and liquid shapes (DESIGN.md, "Level sets"). This
+///          header keeps OpenVDB's grid headers out of the files that include it; construct a
+///          LevelSet from a grid with LevelSetGrid.h.
+///
+///          Narrow band: OpenVDB stores phi only within `halfWidth` voxels of the surface and
+///          clamps it to +/- the background value beyond. Queries beyond the band therefore see
+///          a constant phi and a zero gradient: `phi()` keeps the correct sign there, and
+///          `projectToSurface()` reports failure instead of walking in a made-up direction.
+///
+///          All methods are const and safe to call from many threads at once (each thread uses
+///          its own cached tree accessor).
+#pragma once
+
+#include "ghostfx/sph/Types.h"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ghostfx {
+namespace sph {
+
+/// Result of a closest-point projection.
+struct SurfaceProjection
+{
+    Vec3 point{0};         ///< the projected point (m); the last iterate if it did not converge
+    Real residual = 0;     ///< |phi(point)| (m)
+    int iterations = 0;    ///< Newton-like steps taken
+    bool converged = false;
+};
+
+class LevelSet
+{
+public:
+    struct Impl;
+
+    /// Use LevelSetGrid.h: `LevelSet(openvdb::FloatGrid::ConstPtr, name)`.
+    explicit LevelSet(std::shared_ptr<const Impl> impl);
+    ~LevelSet();
+    LevelSet(const LevelSet&);
+    LevelSet& operator=(const LevelSet&);
+
+    /// Grid name, for error messages.
+    const std::string& name() const;
+
+    /// Voxel edge length (m); voxels are checked to be uniform cubes.
+    Real voxelSize() const;
+    /// Distance from the surface (m) beyond which phi is clamped: the grid's background value.
+    Real bandWidth() const;
+    /// World-space box enclosing every active voxel (m).
+    Aabb bounds() const;
+
+    /// Signed distance (m), negative inside. Trilinear; clamped to +/- bandWidth() beyond the band.
+    Real phi(const Vec3& x) const;
+    /// Gradient of phi by central differences one voxel apart (unitless, about unit length
+    /// inside the band, zero where the stencil sees only clamped values).
+    Vec3 gradient(const Vec3& x) const;
+    /// Outward unit normal, or zero where the gradient vanishes (beyond the band).
+    Vec3 normal(const Vec3& x) const;
+    /// phi(x) < 0.
+    bool inside(const Vec3& x) const { return phi(x) < Real(0); }
+    /// Whether x is far enough inside the narrow band for phi and its gradient to be exact
+    /// (one voxel short of the clamp).
+    bool inBand(const Vec3& x) const;
+
+    /// Project x onto the zero level set by x <- x - phi(x) n(x), iterated until |phi| falls
+    /// below `tolerance` (m; default 1e-3 voxel) or `maxIterations` steps. Fails (converged =
+    /// false) when x or an iterate is beyond the band, where no direction to the surface is known.
+    SurfaceProjection projectToSurface(const Vec3& x, Real tolerance = Real(-1),
+                                       int maxIterations = 20) const;
+
+    /// Index-space coordinates (i, j, k) of every grid cell [i, i+1] x [j, j+1] x [k, k+1] whose
+    /// 8 corner samples do not all share a sign: the cells the surface passes through. Sorted.
+    std::vector<std::array<std::int32_t, 3>> surfaceCells() const;
+
+    /// World position (m) of a point given in index space (voxel centres at integer coordinates).
+    Vec3 indexToWorld(const Vec3& ijk) const;
+    /// Index-space position of a world point.
+    Vec3 worldToIndex(const Vec3& x) const;
+
+    /// Access to the implementation for code that includes LevelSetGrid.h.
+    const Impl& impl() const { return *mImpl; }
+
+private:
+    std::shared_ptr<const Impl> mImpl;
+};
+
+} // namespace sph
+} // namespace ghostfx

@@ -1,0 +1,201 @@
+/// @file   NeighborGrid.h
+/// @brief  Hashed uniform grid for fixed-radius neighbour queries, rebuilt by a parallel
+///         counting sort.
+/// @details Cells are cubes of side `cellSize` (normally the kernel support radius), so the
+///          neighbours of a particle lie in the 27 cells around it. Cells are not stored densely:
+///          a cell (i, j, k) goes to bucket morton(i, j, k) mod T, where the table size T is a
+///          power of two about twice the particle count. Memory is therefore O(N) however far
+///          apart the particles are (a lone particle 1 km away costs one bucket, not a dense
+///          box), and for any compact region narrower than T^(1/3) cells per axis no two cells
+///          share a bucket and the bucket order is the Z-order of the cells, so sorting by bucket
+///          keeps nearby cells nearby in memory. Buckets that do hold several cells are told
+///          apart by each slot's packed cell key.
+///
+///          `build()` sorts particles by bucket (parallel count, exclusive scan, parallel scatter,
+///          then a per-bucket sort by index so the order never depends on thread timing) and
+///          keeps a sorted copy of the positions, so the inner loops stream through memory.
+///          Reorder the particle set itself with `order()` (see `sortParticles`) to make every
+///          other channel stream too.
+///
+///          Neighbour callbacks receive `(j, xij, rij)`: the particle index, x_i - x_j (m) and
+///          |x_i - x_j| (m). A particle is its own neighbour (j == i, rij == 0), as SPH sums need.
+#pragma once
+
+#include "ghostfx/sph/Types.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace ghostfx {
+namespace sph {
+
+class ParticleSet;
+
+class NeighborGrid
+{
+public:
+    /// Largest |cell coordinate| a particle may have: 2^20 cells from the origin on each axis
+    /// (with 3 cm cells, 31 km). Farther particles are rejected with a ValueError.
+    static constexpr std::int32_t MAX_CELL_COORD = (1 << 20) - 1;
+
+    /// @param cellSize  cell side (m), normally the kernel support radius; queries with a
+    ///                  radius up to `cellSize` visit 27 cells, larger radii more
+    explicit NeighborGrid(Real cellSize);
+
+    Real cellSize() const { return mCellSize; }
+
+    /// Sort `count` positions into the grid. Throws NumericalError on a non-finite position and
+    /// ValueError on a position beyond MAX_CELL_COORD cells.
+    void build(const Vec3* positions, std::size_t count);
+    void build(const std::vector<Vec3>& positions) { build(positions.data(), positions.size()); }
+
+    /// Build from the set's positions, reorder the whole set by cell, and rebuild the index
+    /// mapping as the identity, so neighbour indices are indices into the reordered set.
+    void sortParticles(ParticleSet& particles);
+
+    /// Sorted slot k holds particle `order()[k]`: pass it to ParticleSet::reorder.
+    const std::vector<Index>& order() const { return mIndex; }
+
+    std::size_t size() const { return mPos.size(); }
+    /// Buckets in the hash table (a power of two).
+    std::size_t bucketCount() const { return mBucketStart.empty() ? 0 : mBucketStart.size() - 1; }
+    /// Bytes held by the grid's arrays.
+    std::size_t memoryBytes() const;
+
+    /// Call fn(j, xij, rij) for every particle j with |x_i - x_j| < cellSize, including i.
+    template <typename Fn>
+    void forEachNeighbor(Index i, Fn&& fn) const
+    {
+        const std::uint32_t slot = mSlotOf[i];
+        forEachInRadius(mPos[slot], mCellSize, fn);
+    }
+
+    /// Call fn(j, x - x_j, r) for every particle j with |x - x_j| < radius (m).
+    template <typename Fn>
+    void forEachInRadius(const Vec3& x, Real radius, Fn&& fn) const;
+
+    /// Index of the particle closest to x among those with pred(j) true and distance below
+    /// maxRadius (m), or INVALID_INDEX. Searches rings of cells outward and stops as soon as no
+    /// closer particle can exist. `distance` (optional) receives the distance (m).
+    template <typename Pred>
+    Index nearest(const Vec3& x, Real maxRadius, Pred&& pred, Real* distance = nullptr) const;
+
+    /// Nearest particle of one kind (e.g. the closest liquid particle to a ghost, [SB12] Sec. 4).
+    template <typename KindT>
+    Index nearestOfKind(const Vec3& x, const std::vector<KindT>& kinds, KindT kind,
+                        Real maxRadius, Real* distance = nullptr) const
+    {
+        return nearest(x, maxRadius, [&](Index j) { return kinds[j] == kind; }, distance);
+    }
+
+private:
+    struct Cell { std::int32_t i, j, k; };
+
+    Cell cellOf(const Vec3& x) const
+    {
+        return {std::int32_t(std::floor(x[0] * mInvCellSize)),
+                std::int32_t(std::floor(x[1] * mInvCellSize)),
+                std::int32_t(std::floor(x[2] * mInvCellSize))};
+    }
+    static std::uint64_t packKey(const Cell& c)
+    {
+        constexpr std::int64_t OFFSET = std::int64_t(1) << 20;
+        return (std::uint64_t(c.i + OFFSET) << 42) | (std::uint64_t(c.j + OFFSET) << 21) |
+               std::uint64_t(c.k + OFFSET);
+    }
+    static std::uint64_t spreadBits(std::uint64_t v)
+    {
+        v &= 0x1fffff;
+        v = (v | v << 32) & 0x1f00000000ffffULL;
+        v = (v | v << 16) & 0x1f0000ff0000ffULL;
+        v = (v | v << 8) & 0x100f00f00f00f00fULL;
+        v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+        v = (v | v << 2) & 0x1249249249249249ULL;
+        return v;
+    }
+    std::uint32_t bucketOf(const Cell& c) const
+    {
+        const std::uint64_t m = spreadBits(std::uint64_t(c.i)) << 2 |
+                                spreadBits(std::uint64_t(c.j)) << 1 | spreadBits(std::uint64_t(c.k));
+        return std::uint32_t(m & mTableMask);
+    }
+
+    template <typename Fn>
+    void visitCell(const Cell& c, const Vec3& x, Real radius2, Fn& fn) const;
+
+    Real mCellSize, mInvCellSize;
+    std::uint64_t mTableMask = 0;
+    std::vector<std::uint32_t> mBucketStart; ///< bucket b holds slots [start[b], start[b+1])
+    std::vector<std::uint64_t> mKey;         ///< packed cell key of each sorted slot
+    std::vector<Vec3> mPos;                  ///< positions in sorted order (m)
+    std::vector<Index> mIndex;               ///< particle index of each sorted slot
+    std::vector<std::uint32_t> mSlotOf;      ///< sorted slot of each particle index
+};
+
+// ---------------------------------------------------------------------------------------------
+
+template <typename Fn>
+inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, Fn& fn) const
+{
+    const std::uint32_t b = bucketOf(c);
+    const std::uint32_t end = mBucketStart[b + 1];
+    std::uint32_t k = mBucketStart[b];
+    if (k == end) return;
+    const std::uint64_t key = packKey(c);
+    for (; k < end; ++k) {
+        if (mKey[k] != key) continue;
+        const Vec3 xij = x - mPos[k];
+        const Real r2 = xij.lengthSqr();
+        if (r2 < radius2) fn(mIndex[k], xij, std::sqrt(r2));
+    }
+}
+
+template <typename Fn>
+inline void NeighborGrid::forEachInRadius(const Vec3& x, Real radius, Fn&& fn) const
+{
+    if (mPos.empty()) return;
+    const Cell c = cellOf(x);
+    const int reach = radius <= mCellSize ? 1 : int(std::ceil(radius * mInvCellSize));
+    const Real radius2 = radius * radius;
+    for (int di = -reach; di <= reach; ++di) {
+        for (int dj = -reach; dj <= reach; ++dj) {
+            for (int dk = -reach; dk <= reach; ++dk) {
+                visitCell(Cell{c.i + di, c.j + dj, c.k + dk}, x, radius2, fn);
+            }
+        }
+    }
+}
+
+template <typename Pred>
+inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, Real* distance) const
+{
+    Index best = INVALID_INDEX;
+    Real best2 = maxRadius * maxRadius;
+    if (!mPos.empty()) {
+        const Cell c = cellOf(x);
+        const int maxRing = int(std::ceil(maxRadius * mInvCellSize));
+        auto consider = [&](Index j, const Vec3& xij, Real) {
+            const Real r2 = xij.lengthSqr();
+            if (r2 < best2 && pred(j)) { best2 = r2; best = j; }
+        };
+        for (int ring = 0; ring <= maxRing; ++ring) {
+            // Cells at Chebyshev distance `ring` from c: the shell of the (2 ring + 1)^3 block.
+            for (int di = -ring; di <= ring; ++di) {
+                for (int dj = -ring; dj <= ring; ++dj) {
+                    const bool faceIJ = (di == -ring || di == ring || dj == -ring || dj == ring);
+                    const int stepK = faceIJ || ring == 0 ? 1 : 2 * ring;
+                    for (int dk = -ring; dk <= ring; dk += stepK) {
+                        visitCell(Cell{c.i + di, c.j + dj, c.k + dk}, x, best2, consider);
+                    }
+                }
+            }
+            // Every particle in ring + 1 or beyond is at least ring * cellSize away.
+            if (best != INVALID_INDEX && best2 <= sqr(Real(ring) * mCellSize)) break;
+        }
+    }
+    if (distance) *distance = best == INVALID_INDEX ? Real(-1) : std::sqrt(best2);
+    return best;
+}
+
+} // namespace sph
+} // namespace ghostfx

@@ -1,0 +1,92 @@
+/// @file   Parallel.h
+/// @brief  The one way ghostfx code runs loops in parallel (TBB), with a serial switch and
+///         explicit grain sizes.
+/// @details Shapes, best first (STYLE.md rule 5): gather over destinations with `forEach` /
+///          `forRange` (each iteration writes only what it owns); deterministic reductions with
+///          `sum`, which adds fixed-size blocks in a fixed order so the result is the same at any
+///          thread count. `setSerial(true)` (or GHOSTFX_SERIAL=1 in the environment) runs every
+///          loop on the calling thread, for debugging. `ThreadLimit` caps the TBB worker count.
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace ghostfx {
+namespace parallel {
+
+/// Iterations per task unless a loop says otherwise: large enough to amortise scheduling of
+/// a cheap particle loop body (about 50 ns), small enough to balance 2 to 16 cores.
+constexpr std::size_t DEFAULT_GRAIN = 256;
+
+/// Run every loop serially on the calling thread (true) or with TBB (false, the default unless
+/// the environment variable GHOSTFX_SERIAL is set to a non-zero value).
+void setSerial(bool serial);
+bool isSerial();
+
+/// Caps the number of threads TBB may use while the object lives (RAII). 0 means no cap.
+class ThreadLimit
+{
+public:
+    explicit ThreadLimit(int maxThreads);
+    ~ThreadLimit();
+    ThreadLimit(const ThreadLimit&) = delete;
+    ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+private:
+    std::unique_ptr<tbb::global_control> mControl;
+};
+
+/// Number of threads a parallel loop may use right now.
+int maxThreads();
+
+/// Call `fn(begin, end)` on disjoint sub-ranges covering [begin, end).
+template <typename Fn>
+void forRange(std::size_t begin, std::size_t end, Fn&& fn, std::size_t grain = DEFAULT_GRAIN)
+{
+    if (end <= begin) return;
+    if (isSerial() || end - begin <= grain) {
+        fn(begin, end);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain),
+                      [&fn](const tbb::blocked_range<std::size_t>& r) { fn(r.begin(), r.end()); },
+                      tbb::simple_partitioner());
+}
+
+/// Call `fn(i)` for every i in [begin, end).
+template <typename Fn>
+void forEach(std::size_t begin, std::size_t end, Fn&& fn, std::size_t grain = DEFAULT_GRAIN)
+{
+    forRange(begin, end, [&fn](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) fn(i);
+    }, grain);
+}
+
+/// Deterministic sum of `fn(i)` (converted to double) over [begin, end): blocks of `block`
+/// iterations are summed in parallel, then the block sums are added in index order, so the
+/// result does not depend on the thread count or the scheduling.
+template <typename Fn>
+double sum(std::size_t begin, std::size_t end, Fn&& fn, std::size_t block = 1024)
+{
+    if (end <= begin) return 0.0;
+    const std::size_t nBlocks = (end - begin + block - 1) / block;
+    std::vector<double> partial(nBlocks, 0.0);
+    forEach(0, nBlocks, [&](std::size_t b) {
+        const std::size_t lo = begin + b * block;
+        const std::size_t hi = lo + block < end ? lo + block : end;
+        double s = 0.0;
+        for (std::size_t i = lo; i < hi; ++i) s += double(fn(i));
+        partial[b] = s;
+    }, 1);
+    double total = 0.0;
+    for (double s : partial) total += s;
+    return total;
+}
+
+} // namespace parallel
+} // namespace ghostfx

@@ -1,0 +1,282 @@
+/// @file   LevelSet.cc
+/// @brief  LevelSet queries on an OpenVDB FloatGrid, grid validation, analytic shapes.
+#include "ghostfx/sph/LevelSetGrid.h"
+
+#include "ghostfx/sph/Exceptions.h"
+
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/Prune.h>
+#include <openvdb/tools/SignedFloodFill.h>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <algorithm>
+
+namespace ghostfx {
+namespace sph {
+
+struct LevelSet::Impl
+{
+    using Accessor = openvdb::FloatGrid::ConstAccessor;
+
+    explicit Impl(openvdb::FloatGrid::ConstPtr g, std::string n)
+        : grid(std::move(g))
+        , name(std::move(n))
+        , accessors(grid->getConstAccessor())
+    {
+        voxelSize = Real(grid->voxelSize()[0]);
+        bandWidth = Real(grid->background());
+        const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+        for (int c = 0; c < 8; ++c) {
+            const openvdb::Vec3d corner((c & 1) ? box.max().x() + 0.5 : box.min().x() - 0.5,
+                                        (c & 2) ? box.max().y() + 0.5 : box.min().y() - 0.5,
+                                        (c & 4) ? box.max().z() + 0.5 : box.min().z() - 0.5);
+            bounds.expand(toVec3(grid->transform().indexToWorld(corner)));
+        }
+    }
+
+    Accessor& accessor() const { return accessors.local(); }
+
+    Real sample(const Vec3& x) const
+    {
+        const openvdb::Vec3d ijk = grid->transform().worldToIndex(openvdb::Vec3d(x[0], x[1], x[2]));
+        return Real(openvdb::tools::BoxSampler::sample(accessor(), ijk));
+    }
+
+    openvdb::FloatGrid::ConstPtr grid;
+    std::string name;
+    Real voxelSize = 0;
+    Real bandWidth = 0;
+    Aabb bounds;
+    mutable tbb::enumerable_thread_specific<Accessor> accessors;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+LevelSet::LevelSet(std::shared_ptr<const Impl> impl) : mImpl(std::move(impl)) {}
+LevelSet::~LevelSet() = default;
+LevelSet::LevelSet(const LevelSet&) = default;
+LevelSet& LevelSet::operator=(const LevelSet&) = default;
+
+const std::string& LevelSet::name() const { return mImpl->name; }
+Real LevelSet::voxelSize() const { return mImpl->voxelSize; }
+Real LevelSet::bandWidth() const { return mImpl->bandWidth; }
+Aabb LevelSet::bounds() const { return mImpl->bounds; }
+
+Real LevelSet::phi(const Vec3& x) const { return mImpl->sample(x); }
+
+Vec3 LevelSet::gradient(const Vec3& x) const
+{
+    const Real dx = mImpl->voxelSize;
+    const Real inv2dx = Real(0.5) / dx;
+    Vec3 g;
+    for (int a = 0; a < 3; ++a) {
+        Vec3 e(0);
+        e[a] = dx;
+        g[a] = (mImpl->sample(x + e) - mImpl->sample(x - e)) * inv2dx;
+    }
+    return g;
+}
+
+Vec3 LevelSet::normal(const Vec3& x) const
+{
+    const Vec3 g = gradient(x);
+    const Real len = g.length();
+    return len > Real(1e-6) ? g / len : Vec3(0);
+}
+
+bool LevelSet::inBand(const Vec3& x) const
+{
+    return std::abs(phi(x)) < mImpl->bandWidth - mImpl->voxelSize;
+}
+
+SurfaceProjection LevelSet::projectToSurface(const Vec3& x, Real tolerance, int maxIterations) const
+{
+    const Real tol = tolerance > Real(0) ? tolerance : Real(1e-3) * mImpl->voxelSize;
+    // phi within this much of the background value is treated as clamped (beyond the band).
+    const Real clampLimit = mImpl->bandWidth * Real(0.999);
+    SurfaceProjection result;
+    result.point = x;
+    for (int it = 0; it <= maxIterations; ++it) {
+        const Real p = phi(result.point);
+        result.residual = std::abs(p);
+        result.iterations = it;
+        if (result.residual <= tol) {
+            result.converged = true;
+            return result;
+        }
+        if (result.residual >= clampLimit || it == maxIterations) break;
+        const Vec3 n = normal(result.point);
+        if (n.lengthSqr() == Real(0)) break;
+        // For a signed distance the closest point is exactly x - phi n; trilinear
+        // interpolation makes phi only nearly a distance, hence the iteration.
+        result.point -= p * n;
+    }
+    return result;
+}
+
+std::vector<std::array<std::int32_t, 3>> LevelSet::surfaceCells() const
+{
+    std::vector<std::array<std::int32_t, 3>> cells;
+    const auto& tree = mImpl->grid->tree();
+    auto& acc = mImpl->accessor();
+    for (auto it = tree.cbeginValueOn(); it; ++it) {
+        if (!it.isVoxelValue()) continue;
+        const openvdb::Coord ijk = it.getCoord();
+        bool anyInside = false, anyOutside = false;
+        for (int c = 0; c < 8 && !(anyInside && anyOutside); ++c) {
+            const openvdb::Coord corner = ijk.offsetBy(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+            if (acc.getValue(corner) < 0.f) anyInside = true; else anyOutside = true;
+        }
+        if (anyInside && anyOutside) cells.push_back({ijk.x(), ijk.y(), ijk.z()});
+    }
+    std::sort(cells.begin(), cells.end());
+    return cells;
+}
+
+Vec3 LevelSet::indexToWorld(const Vec3& ijk) const
+{
+    return toVec3(mImpl->grid->transform().indexToWorld(openvdb::Vec3d(ijk[0], ijk[1], ijk[2])));
+}
+
+Vec3 LevelSet::worldToIndex(const Vec3& x) const
+{
+    return toVec3(mImpl->grid->transform().worldToIndex(openvdb::Vec3d(x[0], x[1], x[2])));
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void validateLevelSetGrid(const openvdb::FloatGrid& grid, const std::string& name)
+{
+    const std::string label = "grid '" + name + "'";
+    if (grid.getGridClass() != openvdb::GRID_LEVEL_SET) {
+        throw GridError(msg(label, ": class is '", openvdb::GridBase::gridClassToString(
+                                grid.getGridClass()), "', expected 'level set'"));
+    }
+    if (!grid.transform().isLinear()) {
+        throw GridError(msg(label, ": transform is '", grid.transform().mapType(),
+                            "', expected a linear (affine) transform"));
+    }
+    if (!grid.hasUniformVoxels()) {
+        const openvdb::Vec3d v = grid.voxelSize();
+        throw GridError(msg(label, ": voxel size is (", v.x(), ", ", v.y(), ", ", v.z(),
+                            ") m, expected uniform (cubic) voxels"));
+    }
+    if (!(grid.background() > 0.f)) {
+        throw GridError(msg(label, ": background is ", grid.background(),
+                            ", expected a positive narrow-band width (m)"));
+    }
+    if (grid.activeVoxelCount() == 0) {
+        throw GridError(msg(label, ": has no active voxels, expected a narrow band around a surface"));
+    }
+    for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
+        if (!std::isfinite(*it)) {
+            const openvdb::Vec3d x = grid.transform().indexToWorld(it.getCoord());
+            throw GridError(msg(label, ": value ", *it, " at (", x.x(), ", ", x.y(), ", ", x.z(),
+                                ") m, expected finite signed distances"));
+        }
+    }
+}
+
+LevelSet makeLevelSet(openvdb::FloatGrid::ConstPtr grid, const std::string& name)
+{
+    if (!grid) throw GridError("level set: null grid");
+    const std::string label = name.empty() ? grid->getName() : name;
+    validateLevelSetGrid(*grid, label);
+    return LevelSet(std::make_shared<const LevelSet::Impl>(std::move(grid), label));
+}
+
+openvdb::FloatGrid::ConstPtr gridOf(const LevelSet& levelSet) { return levelSet.impl().grid; }
+
+openvdb::FloatGrid::Ptr levelSetFromSdf(const SignedDistanceFn& sdf, const Aabb& bounds,
+                                        Real voxelSize, Real halfWidthVoxels)
+{
+    if (!(voxelSize > Real(0))) {
+        throw ValueError(msg("level set voxel size = ", voxelSize, " m: expected > 0"));
+    }
+    if (!(halfWidthVoxels >= Real(1))) {
+        throw ValueError(msg("level set half width = ", halfWidthVoxels, " voxels: expected >= 1"));
+    }
+    if (bounds.empty()) throw ValueError("level set from signed distance: empty bounds");
+
+    const float background = float(voxelSize * halfWidthVoxels);
+    auto grid = openvdb::FloatGrid::create(background);
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(double(voxelSize)));
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+
+    const Aabb box = bounds.padded(voxelSize * (halfWidthVoxels + Real(1)));
+    const openvdb::Coord lo = openvdb::Coord::floor(
+        grid->transform().worldToIndex(openvdb::Vec3d(box.min[0], box.min[1], box.min[2])));
+    const openvdb::Coord hi = openvdb::Coord::ceil(
+        grid->transform().worldToIndex(openvdb::Vec3d(box.max[0], box.max[1], box.max[2])));
+    auto acc = grid->getAccessor();
+    openvdb::Coord ijk;
+    for (ijk.x() = lo.x(); ijk.x() <= hi.x(); ++ijk.x()) {
+        for (ijk.y() = lo.y(); ijk.y() <= hi.y(); ++ijk.y()) {
+            for (ijk.z() = lo.z(); ijk.z() <= hi.z(); ++ijk.z()) {
+                const double d = sdf(grid->transform().indexToWorld(ijk));
+                if (std::abs(d) < double(background)) acc.setValue(ijk, float(d));
+                else if (d < 0) acc.setValueOff(ijk, -background);
+            }
+        }
+    }
+    openvdb::tools::signedFloodFill(grid->tree());
+    openvdb::tools::pruneLevelSet(grid->tree());
+    return grid;
+}
+
+openvdb::FloatGrid::Ptr makeSphereLevelSet(const Vec3& center, Real radius, Real voxelSize,
+                                           Real halfWidthVoxels)
+{
+    if (!(radius > Real(0))) throw ValueError(msg("sphere radius = ", radius, " m: expected > 0"));
+    return openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        float(radius), openvdb::Vec3f(float(center[0]), float(center[1]), float(center[2])),
+        float(voxelSize), float(halfWidthVoxels));
+}
+
+openvdb::FloatGrid::Ptr makeBoxLevelSet(const Vec3& min, const Vec3& max, Real voxelSize,
+                                        Real halfWidthVoxels)
+{
+    const openvdb::Vec3d c = 0.5 * (openvdb::Vec3d(min[0], min[1], min[2]) +
+                                    openvdb::Vec3d(max[0], max[1], max[2]));
+    const openvdb::Vec3d half = 0.5 * (openvdb::Vec3d(max[0], max[1], max[2]) -
+                                       openvdb::Vec3d(min[0], min[1], min[2]));
+    if (!(half.x() > 0 && half.y() > 0 && half.z() > 0)) {
+        throw ValueError(msg("box level set: max (", max[0], ", ", max[1], ", ", max[2],
+                             ") must exceed min (", min[0], ", ", min[1], ", ", min[2], ")"));
+    }
+    auto sdf = [c, half](const openvdb::Vec3d& x) {
+        const openvdb::Vec3d q(std::abs(x.x() - c.x()) - half.x(), std::abs(x.y() - c.y()) - half.y(),
+                               std::abs(x.z() - c.z()) - half.z());
+        const openvdb::Vec3d qPos(std::max(q.x(), 0.0), std::max(q.y(), 0.0), std::max(q.z(), 0.0));
+        return qPos.length() + std::min(std::max(q.x(), std::max(q.y(), q.z())), 0.0);
+    };
+    Aabb b;
+    b.expand(min);
+    b.expand(max);
+    return levelSetFromSdf(sdf, b, voxelSize, halfWidthVoxels);
+}
+
+openvdb::FloatGrid::Ptr makeTorusLevelSet(const Vec3& center, Real majorRadius, Real minorRadius,
+                                          Real voxelSize, Real halfWidthVoxels)
+{
+    if (!(minorRadius > Real(0) && majorRadius > minorRadius)) {
+        throw ValueError(msg("torus radii (major ", majorRadius, ", minor ", minorRadius,
+                             ") m: expected major > minor > 0"));
+    }
+    const openvdb::Vec3d c(center[0], center[1], center[2]);
+    const double R = majorRadius, r = minorRadius;
+    auto sdf = [c, R, r](const openvdb::Vec3d& x) {
+        const openvdb::Vec3d d = x - c;
+        const double ring = std::sqrt(d.x() * d.x() + d.z() * d.z()) - R;
+        return std::sqrt(ring * ring + d.y() * d.y()) - r;
+    };
+    Aabb b;
+    b.expand(center - Vec3(majorRadius + minorRadius, minorRadius, majorRadius + minorRadius));
+    b.expand(center + Vec3(majorRadius + minorRadius, minorRadius, majorRadius + minorRadius));
+    return levelSetFromSdf(sdf, b, voxelSize, halfWidthVoxels);
+}
+
+} // namespace sph
+} // namespace ghostfx

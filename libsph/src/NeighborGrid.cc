@@ -1,0 +1,131 @@
+/// @file   NeighborGrid.cc
+/// @brief  Parallel counting sort behind NeighborGrid::build.
+#include "ghostfx/sph/NeighborGrid.h"
+
+#include "ghostfx/sph/Exceptions.h"
+#include "ghostfx/sph/Parallel.h"
+#include "ghostfx/sph/ParticleSet.h"
+
+#include <algorithm>
+#include <atomic>
+#include <memory>
+#include <numeric>
+
+namespace ghostfx {
+namespace sph {
+
+NeighborGrid::NeighborGrid(Real cellSize)
+    : mCellSize(cellSize)
+    , mInvCellSize(Real(1) / cellSize)
+{
+    if (!(cellSize > Real(0)) || !std::isfinite(cellSize)) {
+        throw ValueError(msg("neighbour grid cell size = ", cellSize, " m: expected a finite "
+                             "value > 0 (normally the kernel support radius)"));
+    }
+}
+
+std::size_t NeighborGrid::memoryBytes() const
+{
+    return mBucketStart.capacity() * sizeof(std::uint32_t) +
+           mKey.capacity() * sizeof(std::uint64_t) + mPos.capacity() * sizeof(Vec3) +
+           mIndex.capacity() * sizeof(Index) + mSlotOf.capacity() * sizeof(std::uint32_t);
+}
+
+void NeighborGrid::build(const Vec3* positions, std::size_t count)
+{
+    if (count >= std::size_t(INVALID_INDEX)) {
+        throw ValueError(msg("neighbour grid: ", count, " particles exceed the 32-bit index range"));
+    }
+    // Table size: the smallest power of two >= 2 N (at least 64), so buckets average <= 0.5
+    // particle-cells and a compact block of cells never wraps onto itself.
+    std::size_t tableSize = 64;
+    while (tableSize < 2 * count) tableSize *= 2;
+    mTableMask = tableSize - 1;
+
+    // 1. Cell key and bucket of every particle; reject what the grid cannot represent.
+    std::vector<std::uint32_t> bucket(count);
+    std::vector<std::uint64_t> key(count);
+    std::atomic<std::size_t> badIndex{count};
+    parallel::forEach(0, count, [&](std::size_t i) {
+        const Vec3& x = positions[i];
+        const Real limit = Real(MAX_CELL_COORD) * mCellSize;
+        if (!isFinite(x) || std::abs(x[0]) >= limit || std::abs(x[1]) >= limit ||
+            std::abs(x[2]) >= limit) {
+            std::size_t expected = badIndex.load();
+            while (i < expected && !badIndex.compare_exchange_weak(expected, i)) {}
+            return;
+        }
+        const Cell c = cellOf(x);
+        key[i] = packKey(c);
+        bucket[i] = bucketOf(c);
+    }, 2048);
+    if (badIndex.load() < count) {
+        const std::size_t i = badIndex.load();
+        const Vec3& x = positions[i];
+        if (!isFinite(x)) {
+            throw NumericalError(msg("neighbour grid: particle ", i, " has a non-finite position (",
+                                     x[0], ", ", x[1], ", ", x[2], ")"));
+        }
+        throw ValueError(msg("neighbour grid: particle ", i, " at (", x[0], ", ", x[1], ", ", x[2],
+                             ") m is beyond the grid range of +/-",
+                             Real(MAX_CELL_COORD) * mCellSize, " m for cell size ", mCellSize, " m"));
+    }
+
+    // 2. Histogram of bucket sizes.
+    std::unique_ptr<std::atomic<std::uint32_t>[]> counts(new std::atomic<std::uint32_t>[tableSize]);
+    parallel::forEach(0, tableSize, [&](std::size_t b) {
+        counts[b].store(0, std::memory_order_relaxed);
+    }, 8192);
+    parallel::forEach(0, count, [&](std::size_t i) {
+        counts[bucket[i]].fetch_add(1, std::memory_order_relaxed);
+    }, 4096);
+
+    // 3. Exclusive scan into bucket starts; the counts become scatter cursors.
+    mBucketStart.resize(tableSize + 1);
+    std::uint32_t running = 0;
+    for (std::size_t b = 0; b < tableSize; ++b) {
+        mBucketStart[b] = running;
+        const std::uint32_t c = counts[b].load(std::memory_order_relaxed);
+        counts[b].store(running, std::memory_order_relaxed);
+        running += c;
+    }
+    mBucketStart[tableSize] = running;
+
+    // 4. Scatter particle indices to their bucket's slots.
+    mIndex.resize(count);
+    parallel::forEach(0, count, [&](std::size_t i) {
+        mIndex[counts[bucket[i]].fetch_add(1, std::memory_order_relaxed)] = Index(i);
+    }, 4096);
+
+    // 5. The scatter order inside a bucket depends on thread timing: sort each bucket by index
+    //    (buckets hold a few cells' worth of particles) so the result is deterministic.
+    parallel::forEach(0, tableSize, [&](std::size_t b) {
+        const std::uint32_t lo = mBucketStart[b], hi = mBucketStart[b + 1];
+        if (hi - lo > 1) std::sort(mIndex.begin() + lo, mIndex.begin() + hi);
+    }, 4096);
+
+    // 6. Gather keys and positions in sorted order; inverse map for forEachNeighbor(i).
+    mKey.resize(count);
+    mPos.resize(count);
+    mSlotOf.resize(count);
+    parallel::forEach(0, count, [&](std::size_t k) {
+        const Index i = mIndex[k];
+        mKey[k] = key[i];
+        mPos[k] = positions[i];
+        mSlotOf[i] = std::uint32_t(k);
+    }, 4096);
+}
+
+void NeighborGrid::sortParticles(ParticleSet& particles)
+{
+    build(particles.positions());
+    particles.reorder(mIndex);
+    // The set now is in slot order: particle k sits in slot k.
+    parallel::forEach(0, mIndex.size(), [&](std::size_t k) {
+        mIndex[k] = Index(k);
+        mSlotOf[k] = std::uint32_t(k);
+    }, 8192);
+}
+
+} // namespace sph
+} // namespace ghostfx

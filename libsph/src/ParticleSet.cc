@@ -1,0 +1,220 @@
+/// @file   ParticleSet.cc
+/// @brief  Structure-of-arrays particle storage.
+#include "ghostfx/sph/ParticleSet.h"
+
+#include "ghostfx/sph/Exceptions.h"
+#include "ghostfx/sph/Parallel.h"
+
+#include <algorithm>
+
+namespace ghostfx {
+namespace sph {
+
+const char* kindName(ParticleKind kind)
+{
+    switch (kind) {
+    case ParticleKind::Liquid: return "liquid";
+    case ParticleKind::GhostAir: return "ghost_air";
+    case ParticleKind::GhostSolid: return "ghost_solid";
+    case ParticleKind::Gas: return "gas";
+    case ParticleKind::Boundary: return "boundary";
+    }
+    return "unknown";
+}
+
+namespace {
+
+/// out[k] = in[order[k]], reusing `scratch` as the destination, then swapping.
+template <typename T>
+void permute(std::vector<T>& data, const std::vector<Index>& order, std::vector<T>& scratch)
+{
+    scratch.resize(data.size());
+    parallel::forEach(0, order.size(), [&](std::size_t k) { scratch[k] = data[order[k]]; }, 4096);
+    data.swap(scratch);
+}
+
+template <typename T>
+void compact(std::vector<T>& data, const std::vector<std::uint8_t>& remove)
+{
+    std::size_t out = 0;
+    for (std::size_t i = 0; i < data.size(); ++i) {
+        if (!remove[i]) data[out++] = data[i];
+    }
+    data.resize(out);
+}
+
+std::string joinNames(const std::vector<std::string>& names)
+{
+    if (names.empty()) return "none";
+    std::string s;
+    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+    return s;
+}
+
+} // namespace
+
+template <typename Fn>
+void ParticleSet::forEachChannel(Fn&& fn)
+{
+    fn(mPositions); fn(mVelocities);
+    fn(mMasses); fn(mDensities); fn(mPressures);
+    fn(mKinds); fn(mIds);
+    for (auto& [name, ch] : mScalars) fn(ch.data);
+    for (auto& [name, ch] : mVectors) fn(ch.data);
+}
+
+void ParticleSet::appendDefaults(std::size_t count)
+{
+    const std::size_t n = mPositions.size();
+    mVelocities.resize(n, Vec3(0));
+    mMasses.resize(n, Real(0));
+    mDensities.resize(n, Real(0));
+    mPressures.resize(n, Real(0));
+    mKinds.resize(n, ParticleKind::Liquid);
+    mIds.reserve(n);
+    for (std::size_t k = 0; k < count; ++k) mIds.push_back(mNextId++);
+    for (auto& [name, ch] : mScalars) ch.data.resize(n, ch.defaultValue);
+    for (auto& [name, ch] : mVectors) ch.data.resize(n, ch.defaultValue);
+}
+
+Index ParticleSet::add(const Vec3& x, const Vec3& v, Real m, ParticleKind kind)
+{
+    const Index i = Index(mPositions.size());
+    mPositions.push_back(x);
+    appendDefaults(1);
+    mVelocities[i] = v;
+    mMasses[i] = m;
+    mKinds[i] = kind;
+    return i;
+}
+
+Index ParticleSet::addBatch(const std::vector<Vec3>& xs, Real m, ParticleKind kind)
+{
+    const Index first = Index(mPositions.size());
+    mPositions.insert(mPositions.end(), xs.begin(), xs.end());
+    appendDefaults(xs.size());
+    std::fill(mMasses.begin() + first, mMasses.end(), m);
+    std::fill(mKinds.begin() + first, mKinds.end(), kind);
+    return first;
+}
+
+std::size_t ParticleSet::removeIf(const std::vector<std::uint8_t>& remove)
+{
+    if (remove.size() != size()) {
+        throw ValueError(msg("ParticleSet::removeIf: mask has ", remove.size(),
+                             " entries, expected one per particle (", size(), ")"));
+    }
+    const std::size_t before = size();
+    forEachChannel([&](auto& data) { compact(data, remove); });
+    return before - size();
+}
+
+void ParticleSet::reorder(const std::vector<Index>& order)
+{
+    if (order.size() != size()) {
+        throw ValueError(msg("ParticleSet::reorder: order has ", order.size(),
+                             " entries, expected a permutation of ", size(), " particles"));
+    }
+    std::vector<Vec3> vecScratch;
+    std::vector<Real> realScratch;
+    std::vector<ParticleKind> kindScratch;
+    std::vector<ParticleId> idScratch;
+    permute(mPositions, order, vecScratch);
+    permute(mVelocities, order, vecScratch);
+    permute(mMasses, order, realScratch);
+    permute(mDensities, order, realScratch);
+    permute(mPressures, order, realScratch);
+    permute(mKinds, order, kindScratch);
+    permute(mIds, order, idScratch);
+    for (auto& [name, ch] : mScalars) permute(ch.data, order, realScratch);
+    for (auto& [name, ch] : mVectors) permute(ch.data, order, vecScratch);
+}
+
+void ParticleSet::reserve(std::size_t n)
+{
+    forEachChannel([n](auto& data) { data.reserve(n); });
+}
+
+void ParticleSet::clear()
+{
+    forEachChannel([](auto& data) { data.clear(); });
+}
+
+std::size_t ParticleSet::count(ParticleKind kind) const
+{
+    return std::size_t(std::count(mKinds.begin(), mKinds.end(), kind));
+}
+
+void ParticleSet::setNextId(ParticleId next)
+{
+    const auto maxId = mIds.empty() ? ParticleId(-1) : *std::max_element(mIds.begin(), mIds.end());
+    if (next <= maxId) {
+        throw ValueError(msg("ParticleSet::setNextId(", next, "): expected a value greater than "
+                             "the largest id in the set (", maxId, ")"));
+    }
+    mNextId = next;
+}
+
+std::vector<Real>& ParticleSet::addScalarChannel(const std::string& name, Real value)
+{
+    auto [it, inserted] = mScalars.try_emplace(name, ScalarChannel{{}, value});
+    if (inserted) it->second.data.assign(size(), value);
+    return it->second.data;
+}
+
+std::vector<Vec3>& ParticleSet::addVectorChannel(const std::string& name, const Vec3& value)
+{
+    auto [it, inserted] = mVectors.try_emplace(name, VectorChannel{{}, value});
+    if (inserted) it->second.data.assign(size(), value);
+    return it->second.data;
+}
+
+bool ParticleSet::hasScalarChannel(const std::string& name) const { return mScalars.count(name); }
+bool ParticleSet::hasVectorChannel(const std::string& name) const { return mVectors.count(name); }
+
+std::vector<Real>& ParticleSet::scalarChannel(const std::string& name)
+{
+    return const_cast<std::vector<Real>&>(std::as_const(*this).scalarChannel(name));
+}
+
+const std::vector<Real>& ParticleSet::scalarChannel(const std::string& name) const
+{
+    auto it = mScalars.find(name);
+    if (it == mScalars.end()) {
+        throw ValueError(msg("particle channel '", name, "' (scalar) does not exist; scalar "
+                             "channels: ", joinNames(scalarChannelNames())));
+    }
+    return it->second.data;
+}
+
+std::vector<Vec3>& ParticleSet::vectorChannel(const std::string& name)
+{
+    return const_cast<std::vector<Vec3>&>(std::as_const(*this).vectorChannel(name));
+}
+
+const std::vector<Vec3>& ParticleSet::vectorChannel(const std::string& name) const
+{
+    auto it = mVectors.find(name);
+    if (it == mVectors.end()) {
+        throw ValueError(msg("particle channel '", name, "' (vector) does not exist; vector "
+                             "channels: ", joinNames(vectorChannelNames())));
+    }
+    return it->second.data;
+}
+
+std::vector<std::string> ParticleSet::scalarChannelNames() const
+{
+    std::vector<std::string> names;
+    for (const auto& [name, ch] : mScalars) names.push_back(name);
+    return names;
+}
+
+std::vector<std::string> ParticleSet::vectorChannelNames() const
+{
+    std::vector<std::string> names;
+    for (const auto& [name, ch] : mVectors) names.push_back(name);
+    return names;
+}
+
+} // namespace sph
+} // namespace ghostfx
