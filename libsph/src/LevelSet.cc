@@ -79,6 +79,32 @@ Vec3 LevelSet::gradient(const Vec3& x) const
     return g;
 }
 
+Real LevelSet::phiAndGradient(const Vec3& x, Vec3& grad) const
+{
+    const auto& xf = mImpl->grid->transform();
+    const openvdb::Vec3d ijk = xf.worldToIndex(openvdb::Vec3d(x[0], x[1], x[2]));
+    const openvdb::Coord c = openvdb::Coord::floor(ijk);
+    const double u = ijk.x() - c.x(), v = ijk.y() - c.y(), w = ijk.z() - c.z();
+    auto& acc = mImpl->accessor();
+    double f[2][2][2];
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+            for (int d = 0; d < 2; ++d) f[a][b][d] = acc.getValue(c.offsetBy(a, b, d));
+    // Bilinear blends on each pair of opposite faces give value and partial derivatives.
+    auto lerp = [](double p, double q, double t) { return p + (q - p) * t; };
+    const double x00 = lerp(f[0][0][0], f[1][0][0], u), x10 = lerp(f[0][1][0], f[1][1][0], u);
+    const double x01 = lerp(f[0][0][1], f[1][0][1], u), x11 = lerp(f[0][1][1], f[1][1][1], u);
+    const double y0 = lerp(x00, x10, v), y1 = lerp(x01, x11, v);
+    const double value = lerp(y0, y1, w);
+    const double dw = y1 - y0;
+    const double dv = lerp(x10 - x00, x11 - x01, w);
+    const double du = lerp(lerp(f[1][0][0] - f[0][0][0], f[1][1][0] - f[0][1][0], v),
+                           lerp(f[1][0][1] - f[0][0][1], f[1][1][1] - f[0][1][1], v), w);
+    // Index-space gradient to world space: the inverse Jacobian transpose of the map.
+    grad = toVec3(xf.baseMap()->applyIJT(openvdb::Vec3d(du, dv, dw)));
+    return Real(value);
+}
+
 Vec3 LevelSet::normal(const Vec3& x) const
 {
     const Vec3 g = gradient(x);
@@ -99,7 +125,8 @@ SurfaceProjection LevelSet::projectToSurface(const Vec3& x, Real tolerance, int 
     SurfaceProjection result;
     result.point = x;
     for (int it = 0; it <= maxIterations; ++it) {
-        const Real p = phi(result.point);
+        Vec3 g;
+        const Real p = phiAndGradient(result.point, g);
         result.residual = std::abs(p);
         result.iterations = it;
         if (result.residual <= tol) {
@@ -107,11 +134,11 @@ SurfaceProjection LevelSet::projectToSurface(const Vec3& x, Real tolerance, int 
             return result;
         }
         if (result.residual >= clampLimit || it == maxIterations) break;
-        const Vec3 n = normal(result.point);
-        if (n.lengthSqr() == Real(0)) break;
+        const Real len = g.length();
+        if (!(len > Real(1e-6))) break;
         // For a signed distance the closest point is exactly x - phi n; trilinear
         // interpolation makes phi only nearly a distance, hence the iteration.
-        result.point -= p * n;
+        result.point -= g * (p / len);
     }
     return result;
 }

@@ -58,7 +58,8 @@ public:
     Real W(Real r) const
     {
         const Real q = r * mInvS;
-        if (q >= Real(2)) return Real(0);
+        // r * (2 / R) can round below 2 at r = R: test r itself so W(R) is exactly 0.
+        if (r >= mSupport || q >= Real(2)) return Real(0);
         if (q < Real(1)) return mSigma * (Real(1) - Real(1.5) * q * q + Real(0.75) * q * q * q);
         return mSigma * Real(0.25) * cube(Real(2) - q);
     }
@@ -66,7 +67,7 @@ public:
     Real dWdr(Real r) const
     {
         const Real q = r * mInvS;
-        if (q >= Real(2)) return Real(0);
+        if (r >= mSupport || q >= Real(2)) return Real(0);
         if (q < Real(1)) return mSigma * mInvS * (Real(-3) * q + Real(2.25) * q * q);
         return -mSigma * mInvS * Real(0.75) * sqr(Real(2) - q);
     }

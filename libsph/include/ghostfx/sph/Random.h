@@ -1,0 +1,83 @@
+/// @file   Random.h
+/// @brief  Small, fast, portable random number generator for sampling and seeding.
+/// @details PCG32 (O'Neill 2014, "PCG: a family of simple fast space-efficient statistically
+///          good algorithms for random number generation"), XSH-RR output. Unlike the standard
+///          library's distributions, every draw here is defined by this file alone, so a seed
+///          gives the same particles with any compiler or standard library: sampling is
+///          reproducible and checkpoints can store the generator state.
+#pragma once
+
+#include "ghostfx/sph/Types.h"
+
+#include <algorithm>
+#include <cstdint>
+
+namespace ghostfx {
+namespace sph {
+
+class Rng
+{
+public:
+    /// @param seed    selects the sequence start
+    /// @param stream  selects one of 2^63 independent sequences (e.g. a sweep or a cell index)
+    explicit Rng(std::uint64_t seed = 0, std::uint64_t stream = 0)
+    {
+        mInc = (stream << 1u) | 1u;
+        mState = 0;
+        next();
+        mState += seed + 0x853c49e6748fea9bULL;
+        next();
+    }
+
+    /// Uniform 32-bit integer.
+    std::uint32_t next()
+    {
+        const std::uint64_t old = mState;
+        mState = old * 6364136223846793005ULL + mInc;
+        const std::uint32_t xorShifted = std::uint32_t(((old >> 18u) ^ old) >> 27u);
+        const std::uint32_t rot = std::uint32_t(old >> 59u);
+        return (xorShifted >> rot) | (xorShifted << ((32u - rot) & 31u));
+    }
+
+    /// Uniform integer in [0, n), n > 0 (Lemire's multiply-shift; bias below 2^-32 n).
+    std::uint32_t below(std::uint32_t n)
+    {
+        return std::uint32_t((std::uint64_t(next()) * std::uint64_t(n)) >> 32u);
+    }
+
+    /// Uniform double in [0, 1), 32 random bits.
+    double uniform01() { return double(next()) * (1.0 / 4294967296.0); }
+    /// Uniform Real in [lo, hi).
+    Real uniform(Real lo, Real hi) { return lo + (hi - lo) * Real(uniform01()); }
+
+    /// Uniform direction on the unit sphere: a point drawn uniformly in the cube [-1, 1]^3,
+    /// kept if it falls inside the unit ball (52% of draws) and normalised. Cheaper than the
+    /// trigonometric methods, and exact.
+    Vec3 unitVector()
+    {
+        for (;;) {
+            const double x = 2.0 * uniform01() - 1.0, y = 2.0 * uniform01() - 1.0,
+                         z = 2.0 * uniform01() - 1.0;
+            const double len2 = x * x + y * y + z * z;
+            if (len2 <= 1.0 && len2 > 1e-6) {
+                const double inv = 1.0 / std::sqrt(len2);
+                return Vec3(Real(x * inv), Real(y * inv), Real(z * inv));
+            }
+        }
+    }
+
+    /// Uniform point in the unit ball.
+    Vec3 inUnitBall() { return unitVector() * Real(std::cbrt(uniform01())); }
+
+    /// Generator state, for checkpoints.
+    std::uint64_t state() const { return mState; }
+    std::uint64_t increment() const { return mInc; }
+    void restore(std::uint64_t state, std::uint64_t increment) { mState = state; mInc = increment; }
+
+private:
+    std::uint64_t mState = 0;
+    std::uint64_t mInc = 1;
+};
+
+} // namespace sph
+} // namespace ghostfx

@@ -1,0 +1,459 @@
+/// @file   PoissonSampler.cc
+/// @brief  [SB12] Algorithms 1 and 2, seeded Bridson sampling, and the grid they search.
+#include "ghostfx/sph/PoissonSampler.h"
+
+#include "ghostfx/sph/Exceptions.h"
+#include "ghostfx/sph/Random.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ghostfx {
+namespace sph {
+
+namespace {
+
+/// Streams of the random generator, one per phase, so phases do not share draws.
+enum Stream : std::uint64_t { SURFACE = 1, INTERIOR = 2, SEEDED = 3, RELAX = 16 };
+
+/// Dense grid of cells of side `cellSize` over a box, each cell the head of a linked list of
+/// point entries. Lists stay short (a cell of side r holds at most a few Poisson samples), so
+/// queries cost 27 (radius <= cellSize) or 125 (radius <= 2 cellSize) list heads.
+class PointGrid
+{
+public:
+    /// Largest number of cells the grid may allocate (4 bytes each).
+    static constexpr std::size_t MAX_CELLS = std::size_t(1) << 28;
+
+    PointGrid(const Aabb& bounds, Real cellSize)
+        : mOrigin(bounds.min)
+        , mCellSize(cellSize)
+        , mInvCellSize(Real(1) / cellSize)
+    {
+        const Vec3 extent = bounds.extent();
+        std::size_t total = 1;
+        for (int a = 0; a < 3; ++a) {
+            mDims[a] = std::max<std::int64_t>(1, std::int64_t(std::ceil(extent[a] * mInvCellSize)) + 1);
+            total *= std::size_t(mDims[a]);
+            if (total > MAX_CELLS) {
+                throw SamplingError(msg("sampling region of ", extent[0], " x ", extent[1], " x ",
+                                        extent[2], " m needs more than ", MAX_CELLS,
+                                        " search cells at Poisson radius ", cellSize,
+                                        " m: use a larger spacing or a smaller region"));
+            }
+        }
+        mHead.assign(total, -1);
+    }
+
+    bool contains(const Vec3& x) const
+    {
+        for (int a = 0; a < 3; ++a) {
+            const Real c = (x[a] - mOrigin[a]) * mInvCellSize;
+            if (!(c >= Real(0) && c < Real(mDims[a]))) return false;
+        }
+        return true;
+    }
+
+    /// Add a point (which must be inside); returns its entry id, ids count up from 0.
+    int add(const Vec3& x)
+    {
+        const int id = int(mPos.size());
+        const std::int64_t c = cellIndex(x);
+        mPos.push_back(x);
+        mNext.push_back(mHead[c]);
+        mCell.push_back(c);
+        mHead[c] = id;
+        return id;
+    }
+
+    /// Move entry `id` to x (inside).
+    void move(int id, const Vec3& x)
+    {
+        const std::int64_t c = cellIndex(x);
+        if (c != mCell[id]) {
+            int* link = &mHead[mCell[id]];
+            while (*link != id) link = &mNext[*link];
+            *link = mNext[id];
+            mNext[id] = mHead[c];
+            mHead[c] = id;
+            mCell[id] = c;
+        }
+        mPos[id] = x;
+    }
+
+    std::size_t size() const { return mPos.size(); }
+
+    /// Whether any entry other than `ignore` lies closer than `radius` (<= 2 cellSize) to x.
+    bool anyWithin(const Vec3& x, Real radius, int ignore = -1) const
+    {
+        const Real r2 = radius * radius;
+        bool found = false;
+        visit(x, radius, [&](int id) {
+            if (id != ignore && (mPos[id] - x).lengthSqr() < r2) found = true;
+            return !found;
+        });
+        return found;
+    }
+
+    /// Append the entries other than `ignore` closer than `radius` (<= 2 cellSize) to x.
+    void gather(const Vec3& x, Real radius, int ignore, std::vector<Vec3>& out) const
+    {
+        const Real r2 = radius * radius;
+        visit(x, radius, [&](int id) {
+            if (id != ignore && (mPos[id] - x).lengthSqr() < r2) out.push_back(mPos[id]);
+            return true;
+        });
+    }
+
+private:
+    std::int64_t cellIndex(const Vec3& x) const
+    {
+        std::int64_t c[3];
+        for (int a = 0; a < 3; ++a) {
+            c[a] = std::clamp<std::int64_t>(std::int64_t((x[a] - mOrigin[a]) * mInvCellSize), 0,
+                                            mDims[a] - 1);
+        }
+        return (c[2] * mDims[1] + c[1]) * mDims[0] + c[0];
+    }
+
+    /// Call fn(id) for entries in the cells a ball of `radius` about x touches, until fn
+    /// returns false.
+    template <typename Fn>
+    void visit(const Vec3& x, Real radius, Fn&& fn) const
+    {
+        std::int64_t lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::max<std::int64_t>(
+                0, std::int64_t(std::floor((x[a] - radius - mOrigin[a]) * mInvCellSize)));
+            hi[a] = std::min<std::int64_t>(
+                mDims[a] - 1, std::int64_t(std::floor((x[a] + radius - mOrigin[a]) * mInvCellSize)));
+        }
+        for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
+            for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
+                const std::int64_t row = (k * mDims[1] + j) * mDims[0];
+                for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
+                    for (int id = mHead[row + i]; id >= 0; id = mNext[id]) {
+                        if (!fn(id)) return;
+                    }
+                }
+            }
+        }
+    }
+
+    Vec3 mOrigin;
+    Real mCellSize, mInvCellSize;
+    std::int64_t mDims[3] = {1, 1, 1};
+    std::vector<int> mHead;
+    std::vector<int> mNext;
+    std::vector<std::int64_t> mCell;
+    std::vector<Vec3> mPos;
+};
+
+/// Random unit vector perpendicular to the unit normal n.
+Vec3 randomTangent(Rng& rng, const Vec3& n)
+{
+    for (int attempt = 0; attempt < 8; ++attempt) {
+        const Vec3 u = rng.unitVector();
+        Vec3 d = u - n * u.dot(n);
+        const Real len = d.length();
+        if (len > Real(1e-3)) return d / len;
+    }
+    // n is (numerically) parallel to every draw: fall back to any perpendicular.
+    Vec3 d = std::abs(n[0]) < Real(0.9) ? n.cross(Vec3(1, 0, 0)) : n.cross(Vec3(0, 1, 0));
+    return d.unitSafe();
+}
+
+/// Grid bounds for sampling a level set: its active band, padded by one search cell.
+Aabb samplingBounds(const LevelSet& shape, Real radius)
+{
+    return shape.bounds().padded(radius);
+}
+
+void checkCount(std::size_t count, const PoissonSettings& s, const char* phase)
+{
+    if (count > s.maxSamples) {
+        throw SamplingError(msg(phase, ": more than maxSamples = ", s.maxSamples,
+                                " samples at Poisson radius ", s.radius,
+                                " m: the spacing is too small for the shape"));
+    }
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+PoissonSettings PoissonSettings::forSpacing(Real spacing)
+{
+    if (!(spacing > Real(0)) || !std::isfinite(spacing)) {
+        throw ValueError(msg("particle spacing = ", spacing, " m: expected a finite value > 0"));
+    }
+    PoissonSettings s;
+    s.radius = SB12_RADIUS_FACTOR * spacing;
+    return s;
+}
+
+void PoissonSettings::validate() const
+{
+    auto require = [](bool ok, const char* field, double value, const char* expected) {
+        if (!ok) throw ValueError(msg("sampler setting ", field, " = ", value, ": expected ", expected));
+    };
+    require(radius > Real(0) && std::isfinite(radius), "radius", radius, "a finite value > 0 (m)");
+    require(surfaceAttempts >= 1, "surfaceAttempts", surfaceAttempts, ">= 1");
+    require(surfaceStep > Real(1), "surfaceStep", surfaceStep, "> 1 (steps of e r must clear r)");
+    require(volumeAttempts >= 1, "volumeAttempts", volumeAttempts, ">= 1");
+    require(relaxAttempts >= 1, "relaxAttempts", relaxAttempts, ">= 1");
+    require(surfaceRelaxSweeps >= 0, "surfaceRelaxSweeps", surfaceRelaxSweeps, ">= 0");
+    require(volumeRelaxSweeps >= 0, "volumeRelaxSweeps", volumeRelaxSweeps, ">= 0");
+    require(bandDepth > Real(0), "bandDepth", bandDepth, "> 0 (m), or infinity");
+    require(maxSamples >= 1, "maxSamples", double(maxSamples), ">= 1");
+}
+
+std::size_t SampleSet::surfaceCount() const
+{
+    return std::size_t(std::count(onSurface.begin(), onSurface.end(), std::uint8_t(1)));
+}
+
+PoissonDiskSampler::PoissonDiskSampler(const PoissonSettings& settings) : mSettings(settings)
+{
+    mSettings.validate();
+}
+
+SampleSet PoissonDiskSampler::sampleVolume(const LevelSet& shape) const
+{
+    SampleSet samples = sampleSurface(shape);
+    relax(samples, shape, mSettings.surfaceRelaxSweeps, 0);
+    sampleInterior(samples, shape);
+    relax(samples, shape, mSettings.volumeRelaxSweeps, 1);
+    return samples;
+}
+
+// [SB12] Algorithm 1 ---------------------------------------------------------------------------
+
+SampleSet PoissonDiskSampler::sampleSurface(const LevelSet& shape) const
+{
+    const Real r = mSettings.radius;
+    const int t = mSettings.surfaceAttempts;
+    const auto cells = shape.surfaceCells();
+    if (cells.empty()) {
+        throw SamplingError(msg("level set '", shape.name(), "' has no zero crossing: the shape "
+                                "is empty or smaller than a voxel (", shape.voxelSize(), " m)"));
+    }
+
+    SampleSet samples;
+    PointGrid grid(samplingBounds(shape, r), r);
+    Rng rng(mSettings.seed, SURFACE);
+
+    // Project x to the surface; accept it if it meets the Poisson-disk criterion.
+    auto tryAdd = [&](const Vec3& x, Vec3& accepted) {
+        // Cheap rejection first: projection moves x by about |phi|, so a sample closer than
+        // r - |phi| to x is closer than r to the projected point.
+        const Real p = std::abs(shape.phi(x));
+        if (p < r && grid.anyWithin(x, r - p)) return false;
+        const SurfaceProjection proj = shape.projectToSurface(x);
+        if (!proj.converged || !grid.contains(proj.point)) return false;
+        if (grid.anyWithin(proj.point, r)) return false;
+        grid.add(proj.point);
+        samples.positions.push_back(proj.point);
+        samples.onSurface.push_back(1);
+        accepted = proj.point;
+        return true;
+    };
+
+    for (const auto& cell : cells) {
+        // Lines 2-7: up to t random points of the cell projected to the surface.
+        Vec3 p;
+        bool found = false;
+        for (int a = 0; a < t && !found; ++a) {
+            Vec3 ijk;
+            for (int axis = 0; axis < 3; ++axis) ijk[axis] = Real(cell[axis]) + Real(rng.uniform01());
+            found = tryAdd(shape.indexToWorld(ijk), p);
+        }
+        if (!found) continue;
+        // Lines 10-16: walk along the surface in steps of e r while new samples are found
+        // (each step has t tries at a random tangent direction).
+        for (bool extended = true; extended;) {
+            extended = false;
+            const Vec3 n = shape.normal(p);
+            if (n.lengthSqr() == Real(0)) break;
+            for (int a = 0; a < t && !extended; ++a) {
+                const Vec3 q = p + randomTangent(rng, n) * (mSettings.surfaceStep * r);
+                extended = tryAdd(q, p);
+            }
+        }
+        checkCount(samples.size(), mSettings, "surface sampling");
+    }
+    if (samples.positions.empty()) {
+        throw SamplingError(msg("level set '", shape.name(), "': no surface sample could be "
+                                "projected onto its zero crossing"));
+    }
+    return samples;
+}
+
+// [SB12] Sec. 4.5.2: Bridson 2007 seeded with the existing samples ------------------------------
+
+void PoissonDiskSampler::sampleInterior(SampleSet& samples, const LevelSet& shape) const
+{
+    const Real r = mSettings.radius;
+    const Real depth = mSettings.bandDepth;
+    PointGrid grid(samplingBounds(shape, r), r);
+    std::vector<std::uint32_t> active;
+    active.reserve(samples.size());
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        if (grid.contains(samples.positions[i])) {
+            grid.add(samples.positions[i]);
+            active.push_back(std::uint32_t(i));
+        }
+    }
+    Rng rng(mSettings.seed, INTERIOR);
+    while (!active.empty()) {
+        const std::uint32_t slot = rng.below(std::uint32_t(active.size()));
+        const Vec3 p = samples.positions[active[slot]];
+        bool found = false;
+        for (int a = 0; a < mSettings.volumeAttempts; ++a) {
+            // Bridson 2007: a random direction at a distance uniform in [r, 2r).
+            const Vec3 q = p + rng.unitVector() * (r * Real(1.0 + rng.uniform01()));
+            if (!grid.contains(q)) continue;
+            const Real phi = shape.phi(q);
+            if (!(phi < Real(0)) || phi < -depth) continue;
+            if (grid.anyWithin(q, r)) continue;
+            grid.add(q);
+            active.push_back(std::uint32_t(samples.size()));
+            samples.positions.push_back(q);
+            samples.onSurface.push_back(0);
+            found = true;
+            break;
+        }
+        if (!found) {
+            active[slot] = active.back();
+            active.pop_back();
+        }
+        checkCount(samples.size(), mSettings, "interior sampling");
+    }
+}
+
+// [SB12] Algorithm 2 ---------------------------------------------------------------------------
+
+void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sweeps, int pass) const
+{
+    if (sweeps <= 0 || samples.size() < 2) return;
+    const Real r = mSettings.radius;
+    const Real depth = mSettings.bandDepth;
+    const int t = mSettings.relaxAttempts;
+
+    PointGrid grid(samplingBounds(shape, r), r);
+    std::vector<std::uint8_t> inGrid(samples.size(), 0);
+    std::vector<int> entry(samples.size(), -1);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        if (grid.contains(samples.positions[i])) entry[i] = grid.add(samples.positions[i]);
+    }
+
+    std::vector<Vec3> ball; // B(p): the samples within 2r of p
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+            if (entry[i] < 0) continue;
+            const Vec3 p = samples.positions[i];
+            const bool surface = samples.onSurface[i] != 0;
+            ball.clear();
+            grid.gather(p, Real(2) * r, entry[i], ball);
+            if (ball.empty()) continue;
+
+            // Squared distance from x to B(p), or a value <= `beat` as soon as one is found:
+            // most candidates lose to the current best early, so stop there.
+            auto minDistance2 = [&ball](const Vec3& x, Real beat) {
+                Real d2 = std::numeric_limits<Real>::max();
+                for (const Vec3& q : ball) {
+                    d2 = std::min(d2, (x - q).lengthSqr());
+                    if (d2 <= beat) break;
+                }
+                return d2;
+            };
+            Real d2 = minDistance2(p, Real(0));
+            Vec3 best = p;
+            // Candidates lie within r of p: when p is deeper than r (and above the band limit),
+            // none can leave the shape, and phi need not be looked up per candidate.
+            const Real phiP = shape.phi(p);
+            const bool deep = !surface && phiP < -Real(1.01) * r && phiP > -depth + Real(1.01) * r;
+            // One stream per (pass, sweep, sample): the result does not depend on visiting order
+            // within a sweep beyond the Gauss-Seidel use of already-moved neighbours.
+            Rng rng(mSettings.seed, RELAX + (std::uint64_t(pass) << 40) +
+                                        (std::uint64_t(sweep) << 32) + i);
+            for (int a = 0; a < t; ++a) {
+                const Real tau = Real(t - a) / Real(t);
+                Vec3 cand = p + rng.unitVector() * (r * tau);
+                if (!deep) {
+                    const Real phi = shape.phi(cand);
+                    if (surface || phi > Real(0)) {
+                        // The projection moves cand by about |phi|: skip it when even that
+                        // much could not beat the best distance so far.
+                        const Real reach = std::sqrt(minDistance2(cand, Real(0))) +
+                                           Real(1.05) * std::abs(phi);
+                        if (reach * reach <= d2) continue;
+                        const SurfaceProjection proj = shape.projectToSurface(cand);
+                        if (!proj.converged) continue;
+                        cand = proj.point;
+                    } else if (phi < -depth) {
+                        continue;
+                    }
+                    if (!grid.contains(cand)) continue;
+                }
+                const Real c2 = minDistance2(cand, d2);
+                if (c2 > d2) {
+                    d2 = c2;
+                    best = cand;
+                }
+            }
+            if (best != p) {
+                grid.move(entry[i], best);
+                samples.positions[i] = best;
+            }
+        }
+    }
+}
+
+// [SB12] Sec. 4.5.2: seeded sampling for air layers and emission ------------------------------
+
+std::vector<Vec3> PoissonDiskSampler::sampleFromSeeds(const std::vector<Vec3>& seeds,
+                                                      const std::vector<Vec3>& obstacles,
+                                                      const std::function<bool(const Vec3&)>& accept,
+                                                      const Aabb& bounds) const
+{
+    std::vector<Vec3> added;
+    if (seeds.empty() || bounds.empty()) return added;
+    const Real r = mSettings.radius;
+    const Aabb gridBounds = bounds.padded(Real(2) * r);
+    PointGrid grid(gridBounds, r);
+    for (const Vec3& x : obstacles) {
+        if (grid.contains(x)) grid.add(x);
+    }
+    std::vector<Vec3> active;
+    for (const Vec3& x : seeds) {
+        if (grid.contains(x)) {
+            grid.add(x);
+            active.push_back(x);
+        }
+    }
+    Rng rng(mSettings.seed, SEEDED);
+    while (!active.empty()) {
+        const std::uint32_t slot = rng.below(std::uint32_t(active.size()));
+        const Vec3 p = active[slot];
+        bool found = false;
+        for (int a = 0; a < mSettings.volumeAttempts; ++a) {
+            const Vec3 q = p + rng.unitVector() * (r * Real(1.0 + rng.uniform01()));
+            if (!bounds.contains(q) || grid.anyWithin(q, r) || !accept(q)) continue;
+            grid.add(q);
+            active.push_back(q);
+            added.push_back(q);
+            found = true;
+            break;
+        }
+        if (!found) {
+            active[slot] = active.back();
+            active.pop_back();
+        }
+        checkCount(added.size(), mSettings, "seeded sampling");
+    }
+    return added;
+}
+
+} // namespace sph
+} // namespace ghostfx
