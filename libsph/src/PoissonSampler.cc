@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 namespace ghostfx {
 namespace sph {
@@ -178,6 +179,53 @@ void checkCount(std::size_t count, const PoissonSettings& s, const char* phase)
     }
 }
 
+/// The band limit of solids ([SB12] Sec. 4.5): keep samples within `depth` of the surface.
+/// Where the level set's narrow band is deeper than `depth`, phi decides. Otherwise phi is
+/// clamped before that depth (OpenVDB's default band is 3 voxels, often thinner than a kernel
+/// radius), and the distance to the nearest surface sample decides instead; samples lie about
+/// r apart, so the band is then between `depth` and `depth + r/2` thick.
+class DepthLimit
+{
+public:
+    DepthLimit(const SampleSet& samples, const LevelSet& shape, Real depth, Real radius)
+        : mDepth(depth)
+    {
+        if (!std::isfinite(depth)) {
+            mMode = Mode::None;
+        } else if (depth < shape.bandWidth() - shape.voxelSize()) {
+            mMode = Mode::Phi;
+        } else {
+            mMode = Mode::SurfaceSamples;
+            mReach = depth + Real(0.5) * radius;
+            mSurface = std::make_unique<PointGrid>(samplingBounds(shape, radius), mReach);
+            for (std::size_t i = 0; i < samples.size(); ++i) {
+                if (samples.onSurface[i] && mSurface->contains(samples.positions[i])) {
+                    mSurface->add(samples.positions[i]);
+                }
+            }
+        }
+    }
+
+    bool limited() const { return mMode != Mode::None; }
+
+    /// Whether x (with level-set value phi) is within the band.
+    bool accepts(const Vec3& x, Real phi) const
+    {
+        switch (mMode) {
+        case Mode::None: return true;
+        case Mode::Phi: return phi >= -mDepth;
+        case Mode::SurfaceSamples: return mSurface->anyWithin(x, mReach);
+        }
+        return true;
+    }
+
+private:
+    enum class Mode { None, Phi, SurfaceSamples };
+    Mode mMode = Mode::None;
+    Real mDepth = 0, mReach = 0;
+    std::unique_ptr<PointGrid> mSurface;
+};
+
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -294,7 +342,7 @@ SampleSet PoissonDiskSampler::sampleSurface(const LevelSet& shape) const
 void PoissonDiskSampler::sampleInterior(SampleSet& samples, const LevelSet& shape) const
 {
     const Real r = mSettings.radius;
-    const Real depth = mSettings.bandDepth;
+    const DepthLimit band(samples, shape, mSettings.bandDepth, r);
     PointGrid grid(samplingBounds(shape, r), r);
     std::vector<std::uint32_t> active;
     active.reserve(samples.size());
@@ -314,8 +362,7 @@ void PoissonDiskSampler::sampleInterior(SampleSet& samples, const LevelSet& shap
             const Vec3 q = p + rng.unitVector() * (r * Real(1.0 + rng.uniform01()));
             if (!grid.contains(q)) continue;
             const Real phi = shape.phi(q);
-            if (!(phi < Real(0)) || phi < -depth) continue;
-            if (grid.anyWithin(q, r)) continue;
+            if (!(phi < Real(0)) || grid.anyWithin(q, r) || !band.accepts(q, phi)) continue;
             grid.add(q);
             active.push_back(std::uint32_t(samples.size()));
             samples.positions.push_back(q);
@@ -337,11 +384,10 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
 {
     if (sweeps <= 0 || samples.size() < 2) return;
     const Real r = mSettings.radius;
-    const Real depth = mSettings.bandDepth;
     const int t = mSettings.relaxAttempts;
+    const DepthLimit band(samples, shape, mSettings.bandDepth, r);
 
     PointGrid grid(samplingBounds(shape, r), r);
-    std::vector<std::uint8_t> inGrid(samples.size(), 0);
     std::vector<int> entry(samples.size(), -1);
     for (std::size_t i = 0; i < samples.size(); ++i) {
         if (grid.contains(samples.positions[i])) entry[i] = grid.add(samples.positions[i]);
@@ -369,10 +415,9 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
             };
             Real d2 = minDistance2(p, Real(0));
             Vec3 best = p;
-            // Candidates lie within r of p: when p is deeper than r (and above the band limit),
-            // none can leave the shape, and phi need not be looked up per candidate.
-            const Real phiP = shape.phi(p);
-            const bool deep = !surface && phiP < -Real(1.01) * r && phiP > -depth + Real(1.01) * r;
+            // Candidates lie within r of p: when p is deeper than r and the sampling is not
+            // band-limited, none can leave the shape, and phi need not be looked up per candidate.
+            const bool deep = !surface && !band.limited() && shape.phi(p) < -Real(1.01) * r;
             // One stream per (pass, sweep, sample): the result does not depend on visiting order
             // within a sweep beyond the Gauss-Seidel use of already-moved neighbours.
             Rng rng(mSettings.seed, RELAX + (std::uint64_t(pass) << 40) +
@@ -391,7 +436,7 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
                         const SurfaceProjection proj = shape.projectToSurface(cand);
                         if (!proj.converged) continue;
                         cand = proj.point;
-                    } else if (phi < -depth) {
+                    } else if (!band.accepts(cand, phi)) {
                         continue;
                     }
                     if (!grid.contains(cand)) continue;
