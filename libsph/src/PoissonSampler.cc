@@ -3,6 +3,7 @@
 #include "ghostfx/sph/PoissonSampler.h"
 
 #include "ghostfx/sph/Exceptions.h"
+#include "ghostfx/sph/Parallel.h"
 #include "ghostfx/sph/Random.h"
 
 #include <algorithm>
@@ -393,64 +394,109 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
         if (grid.contains(samples.positions[i])) entry[i] = grid.add(samples.positions[i]);
     }
 
-    std::vector<Vec3> ball; // B(p): the samples within 2r of p
+    // Gauss-Seidel sweeps, run in parallel by colouring: samples are grouped into blocks of
+    // side 8r and the blocks into 8 colours by the parity of their coordinates. A sample reads
+    // and writes the grid within 3r of where it starts (B(p) reaches 2r, a candidate moves at
+    // most r plus a projection of at most r), so two blocks of one colour, at least a block
+    // apart, never touch the same data. Blocks of a colour run in parallel, samples within a
+    // block in index order, colours in order: the result does not depend on the thread count.
+    const Real blockSize = Real(8) * r;
+    const Aabb bounds = samplingBounds(shape, r);
+    struct Item { std::uint64_t key; std::uint32_t index; };
+    std::vector<Item> order;
+    std::vector<std::size_t> blockStart;
+
+    auto relaxOne = [&](std::size_t i, int sweep, std::vector<Vec3>& ball) {
+        const Vec3 p = samples.positions[i];
+        const bool surface = samples.onSurface[i] != 0;
+        ball.clear();
+        grid.gather(p, Real(2) * r, entry[i], ball);
+        if (ball.empty()) return;
+
+        // Squared distance from x to B(p), or a value <= `beat` as soon as one is found:
+        // most candidates lose to the current best early, so stop there.
+        auto minDistance2 = [&ball](const Vec3& x, Real beat) {
+            Real d2 = std::numeric_limits<Real>::max();
+            for (const Vec3& q : ball) {
+                d2 = std::min(d2, (x - q).lengthSqr());
+                if (d2 <= beat) break;
+            }
+            return d2;
+        };
+        Real d2 = minDistance2(p, Real(0));
+        Vec3 best = p;
+        // Candidates lie within r of p: when p is deeper than r and the sampling is not
+        // band-limited, none can leave the shape, and phi need not be looked up per candidate.
+        const bool deep = !surface && !band.limited() && shape.phi(p) < -Real(1.01) * r;
+        // One random stream per (pass, sweep, sample).
+        Rng rng(mSettings.seed, RELAX + (std::uint64_t(pass) << 40) +
+                                    (std::uint64_t(sweep) << 32) + i);
+        for (int a = 0; a < t; ++a) {
+            const Real tau = Real(t - a) / Real(t);
+            Vec3 cand = p + rng.unitVector() * (r * tau);
+            if (!deep) {
+                const Real phi = shape.phi(cand);
+                if (surface || phi > Real(0)) {
+                    // The projection moves cand by about |phi|: skip it when even that
+                    // much could not beat the best distance so far.
+                    const Real reach = std::sqrt(minDistance2(cand, Real(0))) +
+                                       Real(1.05) * std::abs(phi);
+                    if (reach * reach <= d2) continue;
+                    const SurfaceProjection proj = shape.projectToSurface(cand);
+                    // A projection that lands more than 2r away left the neighbourhood this
+                    // step may touch (see the colouring below): reject it.
+                    if (!proj.converged || (proj.point - p).lengthSqr() > Real(4) * r * r) continue;
+                    cand = proj.point;
+                } else if (!band.accepts(cand, phi)) {
+                    continue;
+                }
+                if (!grid.contains(cand)) continue;
+            }
+            const Real c2 = minDistance2(cand, d2);
+            if (c2 > d2) {
+                d2 = c2;
+                best = cand;
+            }
+        }
+        if (best != p) {
+            grid.move(entry[i], best);
+            samples.positions[i] = best;
+        }
+    };
+
     for (int sweep = 0; sweep < sweeps; ++sweep) {
+        // Block and colour of every sample at the start of the sweep.
+        order.clear();
         for (std::size_t i = 0; i < samples.size(); ++i) {
             if (entry[i] < 0) continue;
-            const Vec3 p = samples.positions[i];
-            const bool surface = samples.onSurface[i] != 0;
-            ball.clear();
-            grid.gather(p, Real(2) * r, entry[i], ball);
-            if (ball.empty()) continue;
+            std::uint64_t b[3];
+            for (int a = 0; a < 3; ++a) {
+                b[a] = std::uint64_t((samples.positions[i][a] - bounds.min[a]) / blockSize);
+            }
+            const std::uint64_t colour = (b[0] & 1) | (b[1] & 1) << 1 | (b[2] & 1) << 2;
+            order.push_back({colour << 60 | b[2] << 40 | b[1] << 20 | b[0], std::uint32_t(i)});
+        }
+        std::sort(order.begin(), order.end(), [](const Item& a, const Item& b) {
+            return a.key != b.key ? a.key < b.key : a.index < b.index;
+        });
+        blockStart.clear();
+        for (std::size_t k = 0; k < order.size(); ++k) {
+            if (k == 0 || order[k].key != order[k - 1].key) blockStart.push_back(k);
+        }
+        blockStart.push_back(order.size());
 
-            // Squared distance from x to B(p), or a value <= `beat` as soon as one is found:
-            // most candidates lose to the current best early, so stop there.
-            auto minDistance2 = [&ball](const Vec3& x, Real beat) {
-                Real d2 = std::numeric_limits<Real>::max();
-                for (const Vec3& q : ball) {
-                    d2 = std::min(d2, (x - q).lengthSqr());
-                    if (d2 <= beat) break;
+        for (std::size_t first = 0; first + 1 < blockStart.size();) {
+            // Blocks [first, last) share a colour.
+            const std::uint64_t colour = order[blockStart[first]].key >> 60;
+            std::size_t last = first + 1;
+            while (last + 1 < blockStart.size() && order[blockStart[last]].key >> 60 == colour) ++last;
+            parallel::forEach(first, last, [&](std::size_t block) {
+                std::vector<Vec3> ball; // B(p): the samples within 2r of p
+                for (std::size_t k = blockStart[block]; k < blockStart[block + 1]; ++k) {
+                    relaxOne(order[k].index, sweep, ball);
                 }
-                return d2;
-            };
-            Real d2 = minDistance2(p, Real(0));
-            Vec3 best = p;
-            // Candidates lie within r of p: when p is deeper than r and the sampling is not
-            // band-limited, none can leave the shape, and phi need not be looked up per candidate.
-            const bool deep = !surface && !band.limited() && shape.phi(p) < -Real(1.01) * r;
-            // One stream per (pass, sweep, sample): the result does not depend on visiting order
-            // within a sweep beyond the Gauss-Seidel use of already-moved neighbours.
-            Rng rng(mSettings.seed, RELAX + (std::uint64_t(pass) << 40) +
-                                        (std::uint64_t(sweep) << 32) + i);
-            for (int a = 0; a < t; ++a) {
-                const Real tau = Real(t - a) / Real(t);
-                Vec3 cand = p + rng.unitVector() * (r * tau);
-                if (!deep) {
-                    const Real phi = shape.phi(cand);
-                    if (surface || phi > Real(0)) {
-                        // The projection moves cand by about |phi|: skip it when even that
-                        // much could not beat the best distance so far.
-                        const Real reach = std::sqrt(minDistance2(cand, Real(0))) +
-                                           Real(1.05) * std::abs(phi);
-                        if (reach * reach <= d2) continue;
-                        const SurfaceProjection proj = shape.projectToSurface(cand);
-                        if (!proj.converged) continue;
-                        cand = proj.point;
-                    } else if (!band.accepts(cand, phi)) {
-                        continue;
-                    }
-                    if (!grid.contains(cand)) continue;
-                }
-                const Real c2 = minDistance2(cand, d2);
-                if (c2 > d2) {
-                    d2 = c2;
-                    best = cand;
-                }
-            }
-            if (best != p) {
-                grid.move(entry[i], best);
-                samples.positions[i] = best;
-            }
+            }, 1);
+            first = last;
         }
     }
 }

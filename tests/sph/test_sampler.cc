@@ -4,6 +4,7 @@
 #include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/NeighborGrid.h>
+#include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/Random.h>
 #include <ghostfx/sph/SphDensity.h>
@@ -326,6 +327,12 @@ TEST(Sampler, DeterministicForASeed)
     const SampleSet b = PoissonDiskSampler(settings).sampleVolume(ls);
     ASSERT_EQ(a.size(), b.size());
     EXPECT_TRUE(a.positions == b.positions);
+    // Relaxation runs blocks in parallel by colouring: one thread gives the same samples.
+    {
+        parallel::ThreadLimit oneThread(1);
+        const SampleSet serial = PoissonDiskSampler(settings).sampleVolume(ls);
+        EXPECT_TRUE(serial.positions == a.positions);
+    }
     settings.seed = 12;
     const SampleSet c = PoissonDiskSampler(settings).sampleVolume(ls);
     EXPECT_FALSE(a.size() == c.size() && a.positions == c.positions);

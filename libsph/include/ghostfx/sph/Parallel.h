@@ -44,11 +44,12 @@ private:
 /// Number of threads a parallel loop may use right now.
 int maxThreads();
 
-/// Call `fn(begin, end)` on disjoint sub-ranges covering [begin, end).
+/// Call `fn(begin, end)` on disjoint sub-ranges covering [begin, end). A grain of 0 means 1.
 template <typename Fn>
 void forRange(std::size_t begin, std::size_t end, Fn&& fn, std::size_t grain = DEFAULT_GRAIN)
 {
     if (end <= begin) return;
+    if (grain == 0) grain = 1; // tbb::blocked_range would split a grain-0 range forever
     if (isSerial() || end - begin <= grain) {
         fn(begin, end);
         return;
@@ -69,11 +70,12 @@ void forEach(std::size_t begin, std::size_t end, Fn&& fn, std::size_t grain = DE
 
 /// Deterministic sum of `fn(i)` (converted to double) over [begin, end): blocks of `block`
 /// iterations are summed in parallel, then the block sums are added in index order, so the
-/// result does not depend on the thread count or the scheduling.
+/// result does not depend on the thread count or the scheduling. A block of 0 means 1.
 template <typename Fn>
 double sum(std::size_t begin, std::size_t end, Fn&& fn, std::size_t block = 1024)
 {
     if (end <= begin) return 0.0;
+    if (block == 0) block = 1;
     const std::size_t nBlocks = (end - begin + block - 1) / block;
     std::vector<double> partial(nBlocks, 0.0);
     forEach(0, nBlocks, [&](std::size_t b) {
