@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Runs every benchmark in bench/ and prints the results. Record numbers worth keeping in
+# bench/RESULTS.md together with the machine (lscpu) and this command.
+set -euo pipefail
+build=${1:-build}
+echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; load: $(cut -d' ' -f1-3 /proc/loadavg)"
+"$build/bench/bench_neighbors" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+"$build/bench/bench_sampler" --benchmark_counters_tabular=true
