@@ -115,6 +115,16 @@ void ParticleSet::reorder(const std::vector<Index>& order)
         throw ValueError(msg("ParticleSet::reorder: order has ", order.size(),
                              " entries, expected a permutation of ", size(), " particles"));
     }
+    // A repeated index would duplicate a particle (and its id) and lose another: refuse it.
+    std::vector<std::uint8_t> seen(order.size(), 0);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        if (order[k] >= order.size() || seen[order[k]]) {
+            throw ValueError(msg("ParticleSet::reorder: entry ", k, " = ", order[k],
+                                 " is out of range or repeated: expected a permutation of ",
+                                 size(), " particles"));
+        }
+        seen[order[k]] = 1;
+    }
     std::vector<Vec3> vecScratch;
     std::vector<Real> realScratch;
     std::vector<ParticleKind> kindScratch;

@@ -219,6 +219,21 @@ TEST(ParticleSet, ReorderRejectsOrderOfWrongSize)
     }
 }
 
+TEST(ParticleSet, ReorderRejectsARepeatedIndex)
+{
+    // A repeated index would duplicate one particle's id and drop another particle silently.
+    ParticleSet set = makeFilledSet(4);
+    const std::vector<ParticleId> idsBefore = set.ids();
+    try {
+        set.reorder(std::vector<Index>{0, 1, 1, 3});
+        ADD_FAILURE() << "a non-permutation was accepted";
+    } catch (const ghostfx::ValueError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("entry 2 = 1"));
+        EXPECT_THAT(e.what(), HasSubstr("permutation"));
+    }
+    EXPECT_EQ(set.ids(), idsBefore); // nothing changed
+}
+
 TEST(ParticleSet, IdsAreNeverReusedAfterRemovalOrClear)
 {
     ParticleSet set = makeFilledSet(100);
