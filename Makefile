@@ -27,7 +27,9 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) --parallel $(JOBS)
 
-demo: build
+# The demo needs only the command-line program, not the tests and benchmarks.
+demo: configure
+	@cmake --build $(BUILD_DIR) --parallel $(JOBS) --target ghostfx
 	@./scripts/demo.sh $(BUILD_DIR)
 
 test: build
