@@ -142,11 +142,28 @@ inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, 
     std::uint32_t k = mBucketStart[b];
     if (k == end) return;
     const std::uint64_t key = packKey(c);
-    for (; k < end; ++k) {
-        if (mKey[k] != key) continue;
-        const Vec3 xij = x - mPos[k];
-        const Real r2 = xij.lengthSqr();
-        if (r2 < radius2) fn(mIndex[k], xij, std::sqrt(r2));
+    // Two passes per batch of slots: a branch-free filter that appends every slot of this cell
+    // within the radius to `hit`, then the callbacks, in slot order with the same xij and rij as
+    // a plain loop. Inside a cell the particle order is arbitrary in a running simulation, so a
+    // branch on `r2 < radius2` is mispredicted very often; the filter takes about a third off a
+    // density pass over sorted particles (bench/RESULTS.md, "Neighbour search").
+    constexpr std::uint32_t BATCH = 64;
+    std::uint32_t hit[BATCH];
+    Real hitR2[BATCH];
+    while (k < end) {
+        const std::uint32_t stop = end - k > BATCH ? k + BATCH : end;
+        std::uint32_t n = 0;
+        for (std::uint32_t s = k; s < stop; ++s) {
+            const Real r2 = (x - mPos[s]).lengthSqr();
+            hit[n] = s;
+            hitR2[n] = r2;
+            n += std::uint32_t(r2 < radius2) & std::uint32_t(mKey[s] == key);
+        }
+        for (std::uint32_t h = 0; h < n; ++h) {
+            const std::uint32_t s = hit[h];
+            fn(mIndex[s], x - mPos[s], std::sqrt(hitR2[h]));
+        }
+        k = stop;
     }
 }
 

@@ -1,0 +1,88 @@
+/// @file   bench_sampler.cc
+/// @brief  Poisson-disk sampling rate ([SB12] Sec. 4.5): particles per second for the full
+///         volume pipeline (surface sampling, surface relaxation, interior sampling, volume
+///         relaxation) of a sphere holding about 1e5 particles, and each phase on its own.
+/// @details Run: build/bench/bench_sampler --benchmark_counters_tabular=true
+///          Arg = number of threads (relaxation runs in parallel by block colouring; the
+///          sampling phases are sequential by nature).
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/PoissonSampler.h>
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+using namespace ghostfx::sph;
+
+namespace {
+
+constexpr Real SPACING = Real(0.01); // h (m)
+// Our sampler packs about 0.75 samples per h^3 after relaxation (tests/sph/test_sampler.cc),
+// so a sphere of radius 31.7 h holds about 1e5 particles.
+constexpr Real SPHERE_RADIUS = Real(31.7) * SPACING;
+
+const LevelSet& sphere()
+{
+    static const LevelSet ls = [] {
+        openvdb::initialize();
+        return makeLevelSet(makeSphereLevelSet(Vec3(0), SPHERE_RADIUS, Real(0.5) * SPACING), "sphere");
+    }();
+    return ls;
+}
+
+void reportRate(benchmark::State& state, std::size_t particles)
+{
+    state.counters["particles"] = double(particles);
+    state.counters["particles/s"] =
+        benchmark::Counter(double(particles) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void BM_SampleVolume(benchmark::State& state)
+{
+    parallel::ThreadLimit limit(int(state.range(0)));
+    const PoissonDiskSampler sampler(PoissonSettings::forSpacing(SPACING));
+    std::size_t n = 0;
+    for (auto _ : state) {
+        const SampleSet s = sampler.sampleVolume(sphere());
+        n = s.size();
+        benchmark::DoNotOptimize(s.positions.data());
+    }
+    reportRate(state, n);
+}
+
+void BM_SampleWithoutRelaxation(benchmark::State& state)
+{
+    parallel::ThreadLimit limit(int(state.range(0)));
+    const PoissonDiskSampler sampler(PoissonSettings::forSpacing(SPACING));
+    std::size_t n = 0;
+    for (auto _ : state) {
+        SampleSet s = sampler.sampleSurface(sphere());
+        sampler.sampleInterior(s, sphere());
+        n = s.size();
+        benchmark::DoNotOptimize(s.positions.data());
+    }
+    reportRate(state, n);
+}
+
+void BM_VolumeRelaxationSweep(benchmark::State& state)
+{
+    parallel::ThreadLimit limit(int(state.range(0)));
+    const PoissonDiskSampler sampler(PoissonSettings::forSpacing(SPACING));
+    SampleSet s = sampler.sampleSurface(sphere());
+    sampler.sampleInterior(s, sphere());
+    int pass = 0;
+    for (auto _ : state) {
+        sampler.relax(s, sphere(), 1, ++pass);
+        benchmark::DoNotOptimize(s.positions.data());
+    }
+    reportRate(state, s.size());
+}
+
+} // namespace
+
+BENCHMARK(BM_SampleVolume)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_SampleWithoutRelaxation)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_VolumeRelaxationSweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
+BENCHMARK_MAIN();
