@@ -450,3 +450,36 @@ TEST(NeighborGrid, RejectsNonPositiveOrNonFiniteCellSize)
 }
 
 } // namespace
+
+TEST(NeighborGrid, HugeRadiiAndFarQueryPointsMatchBruteForceWithoutScanningEmptyCells)
+{
+    // A search wider than the particle count in cells sweeps the particles instead of walking
+    // (2 reach + 1)^3 mostly empty cells; a query point far outside the representable range
+    // must not overflow the cell coordinates. Both must agree with brute force.
+    const Real R = 0.03f;
+    const std::vector<Vec3> xs = uniformPoints(500, Vec3(0), Vec3(0.3f), 5);
+    NeighborGrid grid(R);
+    grid.build(xs);
+
+    const Vec3 queries[] = {Vec3(0.1f, 0.2f, 0.15f), Vec3(5e4f, -3e4f, 1e5f), Vec3(-1e9f, 0, 0)};
+    const Real radii[] = {Real(10), Real(1e5), Real(1e10)}; // 333 to 3e11 cells wide
+    for (const Vec3& x : queries) {
+        for (const Real radius : radii) {
+            std::vector<Index> found;
+            grid.forEachInRadius(x, radius, [&](Index j, const Vec3&, Real) { found.push_back(j); });
+            std::sort(found.begin(), found.end());
+            EXPECT_EQ(found, bruteInRadius(xs, x, radius)) << "radius " << radius;
+
+            Real d = 0, dBrute = 0;
+            const Index j = grid.nearest(x, radius, [](Index) { return true; }, &d);
+            const Index jBrute = bruteNearest(xs, x, radius, [](Index) { return true; }, &dBrute);
+            EXPECT_EQ(j, jBrute) << "radius " << radius;
+            EXPECT_EQ(d, dBrute) << "radius " << radius;
+        }
+    }
+    // A non-finite query finds nothing (and does not crash).
+    std::size_t visits = 0;
+    grid.forEachInRadius(Vec3(std::nanf(""), 0, 0), R, [&](Index, const Vec3&, Real) { ++visits; });
+    EXPECT_EQ(visits, 0u);
+    EXPECT_EQ(grid.nearest(Vec3(INFINITY, 0, 0), R, [](Index) { return true; }), INVALID_INDEX);
+}

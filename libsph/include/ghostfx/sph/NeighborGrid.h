@@ -91,11 +91,22 @@ public:
 private:
     struct Cell { std::int32_t i, j, k; };
 
+    /// Cell of a finite point. Coordinates are clamped just beyond the representable range,
+    /// so a query point far outside cannot overflow; no particle lives out there anyway.
     Cell cellOf(const Vec3& x) const
     {
-        return {std::int32_t(std::floor(x[0] * mInvCellSize)),
-                std::int32_t(std::floor(x[1] * mInvCellSize)),
-                std::int32_t(std::floor(x[2] * mInvCellSize))};
+        auto axis = [this](Real v) {
+            const Real limit = Real(MAX_CELL_COORD + 2);
+            return std::int32_t(clamp(std::floor(v * mInvCellSize), -limit, limit));
+        };
+        return {axis(x[0]), axis(x[1]), axis(x[2])};
+    }
+
+    /// Whether a search `reach` cells wide would visit more cells than there are particles:
+    /// then a plain sweep over the particles is cheaper.
+    bool sweepIsCheaper(Real reach) const
+    {
+        return cube(Real(2) * reach + Real(1)) > Real(mPos.size());
     }
     static std::uint64_t packKey(const Cell& c)
     {
@@ -170,10 +181,19 @@ inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, 
 template <typename Fn>
 inline void NeighborGrid::forEachInRadius(const Vec3& x, Real radius, Fn&& fn) const
 {
-    if (mPos.empty()) return;
-    const Cell c = cellOf(x);
-    const int reach = radius <= mCellSize ? 1 : int(std::ceil(radius * mInvCellSize));
+    if (mPos.empty() || !isFinite(x) || !(radius > Real(0))) return;
     const Real radius2 = radius * radius;
+    const Real reachCells = std::ceil(radius * mInvCellSize);
+    if (sweepIsCheaper(reachCells)) {
+        for (std::size_t s = 0; s < mPos.size(); ++s) {
+            const Vec3 xij = x - mPos[s];
+            const Real r2 = xij.lengthSqr();
+            if (r2 < radius2) fn(mIndex[s], xij, std::sqrt(r2));
+        }
+        return;
+    }
+    const Cell c = cellOf(x);
+    const int reach = radius <= mCellSize ? 1 : int(reachCells);
     for (int di = -reach; di <= reach; ++di) {
         for (int dj = -reach; dj <= reach; ++dj) {
             for (int dk = -reach; dk <= reach; ++dk) {
@@ -188,26 +208,38 @@ inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, R
 {
     Index best = INVALID_INDEX;
     Real best2 = maxRadius * maxRadius;
-    if (!mPos.empty()) {
-        const Cell c = cellOf(x);
-        const int maxRing = int(std::ceil(maxRadius * mInvCellSize));
-        auto consider = [&](Index j, const Vec3& xij, Real) {
-            const Real r2 = xij.lengthSqr();
-            if (r2 < best2 && pred(j)) { best2 = r2; best = j; }
-        };
-        for (int ring = 0; ring <= maxRing; ++ring) {
-            // Cells at Chebyshev distance `ring` from c: the shell of the (2 ring + 1)^3 block.
-            for (int di = -ring; di <= ring; ++di) {
-                for (int dj = -ring; dj <= ring; ++dj) {
-                    const bool faceIJ = (di == -ring || di == ring || dj == -ring || dj == ring);
-                    const int stepK = faceIJ || ring == 0 ? 1 : 2 * ring;
-                    for (int dk = -ring; dk <= ring; dk += stepK) {
-                        visitCell(Cell{c.i + di, c.j + dj, c.k + dk}, x, best2, consider);
+    // Equal distances go to the lower index, so the answer does not depend on visiting order.
+    auto consider = [&](Index j, const Vec3& xij, Real) {
+        const Real r2 = xij.lengthSqr();
+        const bool closer = r2 < best2 || (r2 == best2 && best != INVALID_INDEX && j < best);
+        if (closer && pred(j)) { best2 = r2; best = j; }
+    };
+    if (!mPos.empty() && isFinite(x) && maxRadius > Real(0)) {
+        const Real maxRingCells = std::ceil(maxRadius * mInvCellSize);
+        if (sweepIsCheaper(maxRingCells)) {
+            // A search this wide would visit more cells than there are particles.
+            for (std::size_t s = 0; s < mPos.size(); ++s) {
+                const Vec3 xij = x - mPos[s];
+                consider(mIndex[s], xij, Real(0));
+            }
+        } else {
+            const Cell c = cellOf(x);
+            const int maxRing = int(maxRingCells);
+            for (int ring = 0; ring <= maxRing; ++ring) {
+                // Cells at Chebyshev distance `ring` from c: the shell of the (2 ring + 1)^3
+                // block.
+                for (int di = -ring; di <= ring; ++di) {
+                    for (int dj = -ring; dj <= ring; ++dj) {
+                        const bool faceIJ = (di == -ring || di == ring || dj == -ring || dj == ring);
+                        const int stepK = faceIJ || ring == 0 ? 1 : 2 * ring;
+                        for (int dk = -ring; dk <= ring; dk += stepK) {
+                            visitCell(Cell{c.i + di, c.j + dj, c.k + dk}, x, best2, consider);
+                        }
                     }
                 }
+                // Every particle in ring + 1 or beyond is at least ring * cellSize away.
+                if (best != INVALID_INDEX && best2 <= sqr(Real(ring) * mCellSize)) break;
             }
-            // Every particle in ring + 1 or beyond is at least ring * cellSize away.
-            if (best != INVALID_INDEX && best2 <= sqr(Real(ring) * mCellSize)) break;
         }
     }
     if (distance) *distance = best == INVALID_INDEX ? Real(-1) : std::sqrt(best2);
