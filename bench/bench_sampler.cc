@@ -13,6 +13,7 @@
 
 #include <cmath>
 
+using namespace ghostfx;
 using namespace ghostfx::sph;
 
 namespace {
