@@ -373,7 +373,7 @@ TEST(Sampler, SeededSamplingGrowsAnAirLayer)
     const LevelSet ls = makeLevelSet(shape.grid, shape.name);
     PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
     const SampleSet liquid = PoissonDiskSampler(settings).sampleVolume(ls);
-    settings.volumeAttempts = 8; // [SB12] Sec. 4.5.2 for air and emission
+    settings.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS; // [SB12] Sec. 4.5.2
     const Real layer = CubicSplineKernel::fromSpacing(SPACING).supportRadius();
     auto inLayer = [&](const Vec3& x) {
         const double d = shape.sdf(x);

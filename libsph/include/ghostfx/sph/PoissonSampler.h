@@ -37,6 +37,8 @@ struct PoissonSettings
 {
     /// [SB12] Sec. 4.6: Poisson radius as a fraction of the particle spacing.
     static constexpr Real SB12_RADIUS_FACTOR = Real(0.92);
+    /// [SB12] Sec. 4.5.2: attempts per sample for air layers and emission, where speed matters.
+    static constexpr int SB12_SEEDED_ATTEMPTS = 8;
 
     Real radius = Real(0);             ///< Poisson-disk radius r (m); no two samples closer
     int surfaceAttempts = 30;          ///< t of Algorithm 1 (per cell and per walk step)
@@ -92,7 +94,8 @@ public:
 
     /// Seeded sampling, [SB12] Sec. 4.5.2: new samples grown from `seeds` (existing particles)
     /// in annuli [r, 2r], kept where `accept(x)` is true, at least r from every seed, every
-    /// obstacle and every other new sample. Attempts per seed: `volumeAttempts` (use 8).
+    /// obstacle and every other new sample. Attempts per seed: `volumeAttempts` (set it to
+    /// SB12_SEEDED_ATTEMPTS = 8 for air and emission, as [SB12] does).
     /// @param bounds  a box that contains every accepted point (m); sizes the search grid
     /// @return the new samples only
     std::vector<Vec3> sampleFromSeeds(const std::vector<Vec3>& seeds,
