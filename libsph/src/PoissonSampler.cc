@@ -165,6 +165,30 @@ Vec3 randomTangent(Rng& rng, const Vec3& n)
     return d.unitSafe();
 }
 
+/// Bridson 2007 growth: pick a random active point, try up to `attempts` candidates at a
+/// random direction and a distance uniform in [r, 2r); `tryAccept(q)` returns whether it took
+/// q, which then becomes active too. An active point whose tries all fail retires.
+template <typename TryAccept>
+void growFromActive(std::vector<Vec3>& active, Rng& rng, Real r, int attempts, TryAccept&& tryAccept)
+{
+    while (!active.empty()) {
+        const std::uint32_t slot = rng.below(std::uint32_t(active.size()));
+        const Vec3 p = active[slot];
+        bool found = false;
+        for (int a = 0; a < attempts && !found; ++a) {
+            const Vec3 q = p + rng.unitVector() * (r * Real(1.0 + rng.uniform01()));
+            if (tryAccept(q)) {
+                active.push_back(q);
+                found = true;
+            }
+        }
+        if (!found) {
+            active[slot] = active.back();
+            active.pop_back();
+        }
+    }
+}
+
 /// Grid bounds for sampling a level set: its active band, padded by one search cell.
 Aabb samplingBounds(const LevelSet& shape, Real radius)
 {
@@ -345,38 +369,25 @@ void PoissonDiskSampler::sampleInterior(SampleSet& samples, const LevelSet& shap
     const Real r = mSettings.radius;
     const DepthLimit band(samples, shape, mSettings.bandDepth, r);
     PointGrid grid(samplingBounds(shape, r), r);
-    std::vector<std::uint32_t> active;
+    std::vector<Vec3> active;
     active.reserve(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-        if (grid.contains(samples.positions[i])) {
-            grid.add(samples.positions[i]);
-            active.push_back(std::uint32_t(i));
+    for (const Vec3& x : samples.positions) {
+        if (grid.contains(x)) {
+            grid.add(x);
+            active.push_back(x);
         }
     }
     Rng rng(mSettings.seed, INTERIOR);
-    while (!active.empty()) {
-        const std::uint32_t slot = rng.below(std::uint32_t(active.size()));
-        const Vec3 p = samples.positions[active[slot]];
-        bool found = false;
-        for (int a = 0; a < mSettings.volumeAttempts; ++a) {
-            // Bridson 2007: a random direction at a distance uniform in [r, 2r).
-            const Vec3 q = p + rng.unitVector() * (r * Real(1.0 + rng.uniform01()));
-            if (!grid.contains(q)) continue;
-            const Real phi = shape.phi(q);
-            if (!(phi < Real(0)) || grid.anyWithin(q, r) || !band.accepts(q, phi)) continue;
-            grid.add(q);
-            active.push_back(std::uint32_t(samples.size()));
-            samples.positions.push_back(q);
-            samples.onSurface.push_back(0);
-            found = true;
-            break;
-        }
-        if (!found) {
-            active[slot] = active.back();
-            active.pop_back();
-        }
+    growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
+        if (!grid.contains(q)) return false;
+        const Real phi = shape.phi(q);
+        if (!(phi < Real(0)) || grid.anyWithin(q, r) || !band.accepts(q, phi)) return false;
+        grid.add(q);
+        samples.positions.push_back(q);
+        samples.onSurface.push_back(0);
         checkCount(samples.size(), mSettings, "interior sampling");
-    }
+        return true;
+    });
 }
 
 // [SB12] Algorithm 2 ---------------------------------------------------------------------------
@@ -524,25 +535,13 @@ std::vector<Vec3> PoissonDiskSampler::sampleFromSeeds(const std::vector<Vec3>& s
         }
     }
     Rng rng(mSettings.seed, SEEDED);
-    while (!active.empty()) {
-        const std::uint32_t slot = rng.below(std::uint32_t(active.size()));
-        const Vec3 p = active[slot];
-        bool found = false;
-        for (int a = 0; a < mSettings.volumeAttempts; ++a) {
-            const Vec3 q = p + rng.unitVector() * (r * Real(1.0 + rng.uniform01()));
-            if (!bounds.contains(q) || grid.anyWithin(q, r) || !accept(q)) continue;
-            grid.add(q);
-            active.push_back(q);
-            added.push_back(q);
-            found = true;
-            break;
-        }
-        if (!found) {
-            active[slot] = active.back();
-            active.pop_back();
-        }
+    growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
+        if (!bounds.contains(q) || grid.anyWithin(q, r) || !accept(q)) return false;
+        grid.add(q);
+        added.push_back(q);
         checkCount(added.size(), mSettings, "seeded sampling");
-    }
+        return true;
+    });
     return added;
 }
 
