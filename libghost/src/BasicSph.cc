@@ -1,0 +1,94 @@
+/// @file   BasicSph.cc
+/// @brief  The "Basic SPH" baseline of [SB12] Sec. 3, the method Ghost SPH is compared with:
+///         density summed over liquid only, Tait pressure, Becker and Teschner 2007 artificial
+///         viscosity (alpha = 0.0005), Lennard-Jones repulsion from solid particles (Monaghan
+///         1994) and XSPH on the position update (Monaghan 1989, epsilon = 0.5).
+#include "ghostfx/ghost/GhostSolver.h"
+
+#include <ghostfx/sph/Parallel.h>
+
+#include <chrono>
+
+namespace ghostfx {
+namespace ghost {
+
+using namespace sph;
+
+void GhostSolver::stepBasic(Real dt)
+{
+    auto t0 = std::chrono::steady_clock::now();
+    sortAndComputeDensity();
+    mTimings.neighborsAndDensity +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    t0 = std::chrono::steady_clock::now();
+    const std::size_t n = mParticles.size();
+    const auto& m = mParticles.masses();
+    const auto& rho = mParticles.densities();
+    const auto& p = mParticles.pressures();
+    const auto& kind = mParticles.kinds();
+    auto& v = mParticles.velocities();
+    auto& vnew = mParticles.vectorChannel("vstar");
+    const Vec3 g = mSettings.gravity;
+    const Real c = mSettings.soundSpeed();
+    // Becker and Teschner 2007, Eq. 11: Pi_ij = -nu min(v_ij . x_ij, 0) / (|x_ij|^2 + 0.01 s^2),
+    // nu = 2 alpha s c / (rho_i + rho_j), with s the smoothing length (half the support).
+    const Real s = Real(0.5) * mSettings.supportRadius();
+    const Real alpha = mSettings.basicViscosityAlpha;
+    // Monaghan 1994, Eq. 4.3: f = D ((r0 / r)^12 - (r0 / r)^4) x_ij / r^2 for r < r0 = h.
+    const Real r0 = mSettings.spacing;
+    const Real D = mLennardJones;
+
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Liquid) {
+            vnew[i] = v[i];
+            return;
+        }
+        const Real pi = p[i] / sqr(rho[i]);
+        Vec3 a = g;
+        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
+            if (j == i) return;
+            if (kind[j] == ParticleKind::Liquid) {
+                Real term = pi + p[j] / sqr(rho[j]);
+                const Real vx = (v[i] - v[j]).dot(xij);
+                if (vx < Real(0)) {
+                    const Real nu = Real(2) * alpha * s * c / (rho[i] + rho[j]);
+                    term += -nu * vx / (r * r + Real(0.01) * s * s);
+                }
+                a -= m[j] * term * mKernel.gradW(xij, r);
+            } else if (kind[j] == ParticleKind::Boundary && r < r0 && r > Real(0)) {
+                const Real q = r0 / r;
+                const Real q2 = q * q, q4 = q2 * q2;
+                a += (D * (q4 * q4 * q4 - q4) / (r * r)) * xij;
+            }
+        });
+        vnew[i] = v[i] + dt * a;
+    });
+    mTimings.pressureForce +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    // XSPH on positions: x += dt (v + eps sum_j 2 m_j / (rho_i + rho_j) (v_j - v_i) W_ij).
+    t0 = std::chrono::steady_clock::now();
+    const Real eps = mSettings.basicXsphEpsilon;
+    auto& x = mParticles.positions();
+    std::vector<Vec3> xnew(n);
+    parallel::forEach(0, n, [&](std::size_t i) {
+        xnew[i] = x[i];
+        if (kind[i] != ParticleKind::Liquid) return;
+        Vec3 dv(0);
+        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
+            if (j == i || kind[j] != ParticleKind::Liquid) return;
+            dv += (Real(2) * m[j] / (rho[i] + rho[j]) * mKernel.W(r)) * (vnew[j] - vnew[i]);
+        });
+        xnew[i] = x[i] + dt * (vnew[i] + eps * dv);
+    });
+    parallel::forEach(0, n, [&](std::size_t i) {
+        x[i] = xnew[i];
+        if (kind[i] == ParticleKind::Liquid) v[i] = vnew[i];
+    });
+    mTimings.xsphAndBoundary +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace ghost
+} // namespace ghostfx

@@ -1,0 +1,589 @@
+/// @file   GhostSolver.cc
+/// @brief  Ghost SPH [SB12] Algorithm 3: set-up, ghost air and solid layers, the step, collision
+///         projection, time stepping and blow-up detection. Basic SPH is in BasicSph.cc.
+#include "ghostfx/ghost/GhostSolver.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/PoissonSampler.h>
+#include <ghostfx/sph/SphDensity.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+namespace ghostfx {
+namespace ghost {
+
+using namespace sph;
+
+namespace {
+
+/// Names of the solver's particle channels.
+constexpr const char* VSTAR = "vstar";             ///< v* = v + dt a, Algorithm 3 line 14
+constexpr const char* SOLID_NORMAL = "normal";     ///< ghost solid: outward normal of its solid
+constexpr const char* SOLID_VELOCITY = "solid_v";  ///< ghost solid: velocity of its solid (m/s)
+constexpr const char* AIR_WEIGHT = "air_weight";   ///< ghost air: fade weight, mass = weight m
+constexpr const char* AIR_TARGET = "air_target";   ///< ghost air: 1 fading in / kept, 0 fading out
+
+double secondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Tait equation of state ([SB12] Sec. 3, Monaghan 1994): p = k ((rho / rho0)^7 - 1).
+inline Real taitPressure(Real rho, Real rho0, Real k)
+{
+    const Real q = rho / rho0;
+    const Real q2 = q * q;
+    return k * (q2 * q2 * q2 * q - Real(1));
+}
+
+} // namespace
+
+/// A solid: its level set and rigid translation (constant velocity from time 0).
+struct GhostSolver::Solid
+{
+    LevelSet shape;
+    Vec3 velocity;
+
+    Vec3 offset(double time) const { return velocity * Real(time); }
+};
+
+GhostSolver::GhostSolver(const GhostSettings& settings)
+    : mSettings(settings)
+    , mKernel((settings.validate(), settings.supportRadius()))
+    , mGrid(settings.supportRadius())
+{
+    mParticles.addVectorChannel(VSTAR);
+    mParticles.addVectorChannel(SOLID_NORMAL);
+    mParticles.addVectorChannel(SOLID_VELOCITY);
+    mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
+    mParticles.addScalarChannel(AIR_TARGET, Real(1));
+}
+
+GhostSolver::~GhostSolver() = default;
+
+void GhostSolver::setParticleMass(Real mass)
+{
+    if (!(mass > Real(0)) || !std::isfinite(mass)) {
+        throw ValueError(msg("particle mass = ", mass, " kg: expected a finite value > 0"));
+    }
+    mMass = mass;
+    const auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        const bool air = mParticles.kinds()[i] == ParticleKind::GhostAir;
+        mParticles.masses()[i] = air ? weight[i] * mass : mass;
+    }
+}
+
+// Set-up ---------------------------------------------------------------------------------------
+
+void GhostSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
+{
+    if (!isFinite(velocity)) {
+        throw ValueError(msg("solid '", solid.name(), "': velocity is not finite"));
+    }
+    mSolids.push_back(std::make_unique<Solid>(Solid{solid, velocity}));
+
+    // [SB12] Sec. 4.4 / 4.5: ghost solid particles in a band one kernel radius deep, sampled
+    // like liquid (surface, relaxation, interior, relaxation). Basic SPH uses the same layer as
+    // its boundary particles.
+    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+    ps.bandDepth = mSettings.supportRadius();
+    ps.seed = mSettings.seed + 1000003ULL * mSolids.size();
+    const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(solid);
+
+    // Outward normal of each ghost from its nearest surface sample: phi is clamped beyond the
+    // narrow band, which is often thinner than a kernel radius.
+    std::vector<Vec3> surface;
+    std::vector<Vec3> surfaceNormal;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        if (samples.onSurface[i]) {
+            surface.push_back(samples.positions[i]);
+            surfaceNormal.push_back(solid.normal(samples.positions[i]));
+        }
+    }
+    NeighborGrid surfaceGrid(mSettings.supportRadius());
+    surfaceGrid.build(surface);
+
+    const Vec3 offset = mSolids.back()->offset(mTime);
+    const Index first = Index(mParticles.size());
+    std::vector<Vec3> positions(samples.positions);
+    for (Vec3& x : positions) x += offset;
+    const ParticleKind kind =
+        mSettings.method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary;
+    mParticles.addBatch(positions, mMass, kind);
+    auto& normals = mParticles.vectorChannel(SOLID_NORMAL);
+    auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+        const Index s = surfaceGrid.nearest(samples.positions[k], Real(2) * mSettings.supportRadius(),
+                                            [](Index) { return true; });
+        normals[first + k] = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
+        solidV[first + k] = velocity;
+        mParticles.velocities()[first + k] = velocity;
+    }
+}
+
+std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
+{
+    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+    ps.seed = mSettings.seed + 7919ULL * (mParticles.count(ParticleKind::Liquid) + 1);
+    SampleSet samples = PoissonDiskSampler(ps).sampleVolume(shape);
+    // Liquid inside a solid is not liquid: drop what the solids occupy.
+    std::vector<Vec3> kept;
+    kept.reserve(samples.size());
+    for (const Vec3& x : samples.positions) {
+        bool inSolid = false;
+        for (const auto& solid : mSolids) {
+            if (solid->shape.phi(x - solid->offset(mTime)) < Real(0)) { inSolid = true; break; }
+        }
+        if (!inSolid) kept.push_back(x);
+    }
+    addLiquidParticles(kept, velocity);
+    return kept.size();
+}
+
+void GhostSolver::addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity)
+{
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+        if (!isFinite(positions[k])) {
+            throw ValueError(msg("liquid particle ", k, " has a non-finite position"));
+        }
+    }
+    const Index first = mParticles.addBatch(positions, mMass, ParticleKind::Liquid);
+    std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(), velocity);
+}
+
+void GhostSolver::initialize()
+{
+    if (mInitialized) return;
+    if (mParticles.count(ParticleKind::Liquid) == 0) {
+        throw ValueError("liquid solver: no liquid particles (add a liquid body or particles)");
+    }
+    if (mSettings.method == Method::Ghost) resampleAir();
+
+    if (mMass == Real(0)) {
+        // [SB12] Sec. 4.6: scale the mass so the liquid's mean density is rho0, measured with a
+        // ghost air layer in place so every liquid particle has a complete neighbourhood. Basic
+        // SPH gets the same mass (its air layer is sampled for the measurement only), so the
+        // two methods start from the same state and differ only in how they treat the surface.
+        std::vector<Vec3> positions = mParticles.positions();
+        std::vector<std::uint8_t> liquid(positions.size());
+        for (std::size_t i = 0; i < liquid.size(); ++i) {
+            liquid[i] = mParticles.kinds()[i] == ParticleKind::Liquid;
+        }
+        if (mSettings.method == Method::Basic) {
+            GhostSettings probeSettings = mSettings;
+            probeSettings.method = Method::Ghost;
+            GhostSolver probe(probeSettings);
+            for (const auto& solid : mSolids) probe.addSolid(solid->shape, solid->velocity);
+            std::vector<Vec3> liquidOnly;
+            for (std::size_t i = 0; i < liquid.size(); ++i) {
+                if (liquid[i]) liquidOnly.push_back(positions[i]);
+            }
+            probe.addLiquidParticles(liquidOnly);
+            probe.resampleAir();
+            positions = probe.mParticles.positions();
+            liquid.assign(positions.size(), 0);
+            for (std::size_t i = 0; i < liquid.size(); ++i) {
+                liquid[i] = probe.mParticles.kinds()[i] == ParticleKind::Liquid;
+            }
+        }
+        setParticleMass(massForRestDensity(positions, mKernel, mSettings.restDensity, liquid));
+    } else {
+        setParticleMass(mMass);
+    }
+
+    if (mSettings.method == Method::Basic) {
+        mLennardJones = mSettings.lennardJonesStrength;
+        if (mLennardJones == Real(0)) {
+            // Monaghan 1994: D of the order of the largest squared speed, 5 g H.
+            const Real g = mSettings.gravity.length();
+            Real lo = std::numeric_limits<Real>::max(), hi = -lo;
+            const Vec3 up = g > Real(0) ? -mSettings.gravity / g : Vec3(0, 1, 0);
+            for (std::size_t i = 0; i < mParticles.size(); ++i) {
+                if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
+                const Real h = mParticles.positions()[i].dot(up);
+                lo = std::min(lo, h);
+                hi = std::max(hi, h);
+            }
+            mLennardJones = g > Real(0) ? Real(5) * g * std::max(hi - lo, mSettings.spacing)
+                                        : sqr(Real(0.1) * mSettings.soundSpeed());
+        }
+    }
+    mInitialized = true;
+}
+
+// [SB12] Sec. 4.3: ghost air ------------------------------------------------------------------
+
+void GhostSolver::resampleAir()
+{
+    const auto start = std::chrono::steady_clock::now();
+    const Real R = mSettings.supportRadius();
+    const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
+    const double time = mTime;
+
+    std::vector<Vec3> liquid, liquidV;
+    Aabb bounds;
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
+        liquid.push_back(mParticles.positions()[i]);
+        liquidV.push_back(mParticles.velocities()[i]);
+        bounds.expand(mParticles.positions()[i]);
+    }
+    if (liquid.empty()) return;
+    NeighborGrid liquidGrid(R);
+    liquidGrid.build(liquid);
+
+    auto insideSolid = [&](const Vec3& x) {
+        for (const auto& solid : mSolids) {
+            if (solid->shape.phi(x - solid->offset(time)) < Real(0)) return true;
+        }
+        return false;
+    };
+
+    // Keep the air that is still where the layer should be: within a kernel radius of the liquid,
+    // no closer to it than a fraction of r, outside solids. The rest fades out, and new air fades
+    // in, over the steps until the next resampling: replacing the whole layer at once (as [SB12]
+    // Sec. 4.3 describes) makes the surface density jump by a few percent at every resampling,
+    // which with the paper's soft stiffness pumps energy into the liquid; fading is the remedy
+    // [SB12] Sec. 4.7 suggests.
+    const Real minLiquidDistance = mSettings.airKeepFraction * r;
+    auto& target = mParticles.scalarChannel(AIR_TARGET);
+    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
+        if (mParticles.kinds()[i] != ParticleKind::GhostAir) return;
+        const Vec3& x = mParticles.positions()[i];
+        Real d = -1;
+        const Index j = liquidGrid.nearest(x, R, [](Index) { return true; }, &d);
+        if (j == INVALID_INDEX || d < minLiquidDistance || insideSolid(x)) target[i] = Real(0);
+    });
+
+    // Seeds: liquid particles with at least one liquid neighbour, and the kept air. Isolated
+    // liquid particles move ballistically and get no air ([SB12] Sec. 4.5); like the solids they
+    // are obstacles the new air keeps r away from.
+    std::vector<Vec3> seeds, obstacles;
+    for (std::size_t i = 0; i < liquid.size(); ++i) {
+        int n = 0;
+        liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real) { ++n; });
+        (n > 1 ? seeds : obstacles).push_back(liquid[i]);
+    }
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        const ParticleKind k = mParticles.kinds()[i];
+        if (k == ParticleKind::GhostAir && target[i] > Real(0)) seeds.push_back(mParticles.positions()[i]);
+        else if (k != ParticleKind::Liquid) obstacles.push_back(mParticles.positions()[i]);
+    }
+
+    auto accept = [&](const Vec3& x) {
+        return !insideSolid(x) && liquidGrid.nearest(x, R, [](Index) { return true; }) != INVALID_INDEX;
+    };
+    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+    ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
+    ps.seed = mSettings.seed ^ (0x9e3779b97f4a7c15ULL * (mStep + 1));
+    const std::vector<Vec3> air =
+        PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, bounds.padded(R));
+
+    const Index first = mParticles.addBatch(air, mMass, ParticleKind::GhostAir);
+    // The very first layer is there from the start; later ones fade in.
+    const bool fade = mInitialized;
+    auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
+    // Ghost air velocity: the nearest liquid particle's ([SB12] Sec. 4.3).
+    parallel::forEach(first, mParticles.size(), [&](std::size_t i) {
+        weight[i] = fade ? Real(0) : Real(1);
+        mParticles.masses()[i] = weight[i] * mMass;
+        const Index j = liquidGrid.nearest(mParticles.positions()[i], R, [](Index) { return true; });
+        mParticles.velocities()[i] = j == INVALID_INDEX ? Vec3(0) : liquidV[j];
+        mParticles.densities()[i] = mSettings.restDensity;
+    });
+    mTimings.airResampling += secondsSince(start);
+}
+
+void GhostSolver::fadeAir()
+{
+    auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
+    const auto& target = mParticles.scalarChannel(AIR_TARGET);
+    const Real rate = Real(1) / Real(mSettings.airResampleSteps);
+    std::vector<std::uint8_t> remove(mParticles.size(), 0);
+    bool anyRemoved = false;
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        if (mParticles.kinds()[i] != ParticleKind::GhostAir) continue;
+        weight[i] = target[i] > weight[i] ? std::min(target[i], weight[i] + rate)
+                                          : std::max(target[i], weight[i] - rate);
+        mParticles.masses()[i] = weight[i] * mMass;
+        if (weight[i] == Real(0) && target[i] == Real(0)) remove[i] = anyRemoved = true;
+    }
+    if (anyRemoved) mParticles.removeIf(remove);
+}
+
+// Density -----------------------------------------------------------------------------------------
+
+Index GhostSolver::nearestLiquid(const Vec3& x, Real maxRadius) const
+{
+    return mGrid.nearestOfKind(x, mParticles.kinds(), ParticleKind::Liquid, maxRadius);
+}
+
+void GhostSolver::sortAndComputeDensity()
+{
+    mGrid.sortParticles(mParticles);
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& kind = mParticles.kinds();
+    auto& rho = mParticles.densities();
+    const Real rho0 = mSettings.restDensity;
+    const bool ghost = mSettings.method == Method::Ghost;
+    const std::size_t n = mParticles.size();
+
+    // Eq. 1 for liquid particles: Ghost SPH sums over every kind, Basic SPH over liquid only.
+    std::vector<std::uint32_t> neighbours(n, 0);
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Liquid) {
+            rho[i] = rho0;
+            return;
+        }
+        Real sum = 0;
+        std::uint32_t count = 0;
+        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
+            if (ghost || kind[j] == ParticleKind::Liquid) {
+                sum += m[j] * mKernel.W(r);
+                ++count;
+            }
+        });
+        rho[i] = sum;
+        neighbours[i] = count;
+    });
+    const double liquidCount = parallel::sum(0, n, [&](std::size_t i) {
+        return kind[i] == ParticleKind::Liquid ? 1.0 : 0.0;
+    });
+    mMeanNeighbors = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); }) /
+                     std::max(1.0, liquidCount);
+
+    // Algorithm 3 lines 5-7: ghost solid density = density of the nearest liquid particle.
+    if (ghost) {
+        const Real R = mSettings.supportRadius();
+        parallel::forEach(0, n, [&](std::size_t i) {
+            if (kind[i] != ParticleKind::GhostSolid) return;
+            const Index j = nearestLiquid(x[i], R);
+            rho[i] = j == INVALID_INDEX ? rho0 : rho[j];
+        });
+    }
+
+    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0).
+    auto& p = mParticles.pressures();
+    parallel::forEach(0, n, [&](std::size_t i) {
+        p[i] = taitPressure(rho[i], rho0, mSettings.stiffness);
+    });
+}
+
+// The step ---------------------------------------------------------------------------------------
+
+void GhostSolver::step(Real dt)
+{
+    if (!(dt > Real(0)) || !std::isfinite(dt)) {
+        throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
+    }
+    initialize();
+    const auto start = std::chrono::steady_clock::now();
+    if (mSettings.method == Method::Ghost) stepGhost(dt);
+    else stepBasic(dt);
+
+    // Solids move rigidly with their velocity.
+    auto& x = mParticles.positions();
+    const auto& kind = mParticles.kinds();
+    const auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
+    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
+        if (kind[i] == ParticleKind::GhostSolid || kind[i] == ParticleKind::Boundary) {
+            x[i] += dt * solidV[i];
+        }
+    });
+    mTime += double(dt);
+    ++mStep;
+    projectOutOfSolids();
+    checkBlowUp();
+    mTimings.total += secondsSince(start);
+    ++mTimings.steps;
+}
+
+void GhostSolver::stepGhost(Real dt)
+{
+    // Line 1: resample the air every airResampleSteps steps (the first step always has air),
+    // then move every fading air particle's weight one step towards its target.
+    if (mStep > 0 && mStep % std::uint64_t(mSettings.airResampleSteps) == 0) resampleAir();
+    fadeAir();
+
+    auto t0 = std::chrono::steady_clock::now();
+    sortAndComputeDensity();
+    mTimings.neighborsAndDensity += secondsSince(t0);
+
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& rho = mParticles.densities();
+    const auto& p = mParticles.pressures();
+    const auto& kind = mParticles.kinds();
+    auto& v = mParticles.velocities();
+    auto& vstar = mParticles.vectorChannel(VSTAR);
+    const Vec3 g = mSettings.gravity;
+
+    // Lines 11-14: liquid acceleration from gravity and Monaghan's symmetric pressure gradient
+    // over every neighbour, v* = v + dt a.
+    t0 = std::chrono::steady_clock::now();
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Liquid) {
+            vstar[i] = v[i];
+            return;
+        }
+        const Real pi = p[i] / sqr(rho[i]);
+        Vec3 a = g;
+        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
+            if (j == i) return;
+            a -= m[j] * (pi + p[j] / sqr(rho[j])) * mKernel.gradW(xij, r);
+        });
+        vstar[i] = v[i] + dt * a;
+    });
+    mTimings.pressureForce += secondsSince(t0);
+
+    // Lines 15-18: ghost solid velocity, Eq. 3 (free slip) or the solid's velocity (no slip).
+    t0 = std::chrono::steady_clock::now();
+    const Real R = mSettings.supportRadius();
+    const auto& normal = mParticles.vectorChannel(SOLID_NORMAL);
+    const auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
+    const bool freeSlip = mSettings.solidSlip == SolidSlip::Free;
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] != ParticleKind::GhostSolid) return;
+        const Vec3& nrm = normal[i];
+        if (!freeSlip) {
+            vstar[i] = solidV[i];
+            return;
+        }
+        const Index j = nearestLiquid(x[i], R);
+        const Vec3 vl = j == INVALID_INDEX ? solidV[i] : vstar[j];
+        vstar[i] = solidV[i].dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
+    });
+
+    // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid
+    // neighbours only: air would bias the outermost particles ([SB12] Sec. 4.3).
+    const Real eps = mSettings.xsphEpsilon, epsSolid = mSettings.solidEpsilon;
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Liquid) return;
+        Vec3 dv(0);
+        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
+            const ParticleKind kj = kind[j];
+            if (kj == ParticleKind::GhostAir || j == i) return;
+            const Real e = kj == ParticleKind::GhostSolid ? epsSolid : eps;
+            dv += (e * m[j] / rho[j] * mKernel.W(r)) * (vstar[j] - vstar[i]);
+        });
+        v[i] = vstar[i] + dv;
+    });
+
+    // Lines 22-25: air takes the new velocity of its nearest liquid particle (searched up to two
+    // kernel radii: air advects between resamplings and may drift a little).
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] != ParticleKind::GhostAir) return;
+        const Index j = nearestLiquid(x[i], Real(2) * R);
+        if (j != INVALID_INDEX) v[i] = v[j];
+    });
+    // Ghost solids keep their extrapolated velocity for output; their motion is the solid's.
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] == ParticleKind::GhostSolid) v[i] = vstar[i];
+    });
+
+    // Lines 26-28: positions of liquid and air.
+    auto& xw = mParticles.positions();
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] == ParticleKind::Liquid || kind[i] == ParticleKind::GhostAir) xw[i] += dt * v[i];
+    });
+    mTimings.xsphAndBoundary += secondsSince(t0);
+}
+
+// Collisions, time stepping, blow-up ---------------------------------------------------------------
+
+void GhostSolver::projectOutOfSolids()
+{
+    if (mSolids.empty()) return;
+    const auto start = std::chrono::steady_clock::now();
+    auto& x = mParticles.positions();
+    auto& v = mParticles.velocities();
+    const auto& kind = mParticles.kinds();
+    const double time = mTime;
+    // [SB12] Sec. 3 "Solid Collisions": a liquid particle inside a solid goes back to its
+    // surface (level-set closest point) and loses the velocity that points into the solid.
+    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Liquid) return;
+        for (const auto& solid : mSolids) {
+            const Vec3 offset = solid->offset(time);
+            const Vec3 local = x[i] - offset;
+            if (!(solid->shape.phi(local) < Real(0))) continue;
+            const SurfaceProjection proj = solid->shape.projectToSurface(local);
+            if (!proj.converged) continue; // deeper than the band: left for the blow-up check
+            const Vec3 nrm = solid->shape.normal(proj.point);
+            x[i] = proj.point + offset;
+            const Real vn = (v[i] - solid->velocity).dot(nrm);
+            if (vn < Real(0)) v[i] -= vn * nrm;
+        }
+    });
+    mTimings.xsphAndBoundary += secondsSince(start);
+}
+
+void GhostSolver::checkBlowUp() const
+{
+    const Real limit = mSettings.speedLimit();
+    const Real limit2 = limit * limit;
+    const auto& x = mParticles.positions();
+    const auto& v = mParticles.velocities();
+    const std::size_t n = mParticles.size();
+    std::atomic<std::size_t> bad{n};
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (isFinite(x[i]) && isFinite(v[i]) && v[i].lengthSqr() <= limit2) return;
+        std::size_t expected = bad.load();
+        while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
+    }, 4096);
+    const std::size_t i = bad.load();
+    if (i == n) return;
+    const char* kind = kindName(mParticles.kinds()[i]);
+    if (!isFinite(x[i]) || !isFinite(v[i])) {
+        throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep,
+                                 " (t = ", mTime, " s): ", kind, " particle id ", mParticles.ids()[i],
+                                 " has a non-finite position or velocity; reduce the time step "
+                                 "(substeps / cflNumber) or the stiffness"));
+    }
+    throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep, " (t = ",
+                             mTime, " s): ", kind, " particle id ", mParticles.ids()[i], " moves at ",
+                             v[i].length(), " m/s, beyond maxSpeed = ", limit,
+                             " m/s; reduce the time step (substeps / cflNumber) or the stiffness"));
+}
+
+Real GhostSolver::stableTimeStep() const
+{
+    // Acoustic CFL: dt <= cfl h / (c + |v|max); body force: dt <= cfl sqrt(h / |g|).
+    const auto& v = mParticles.velocities();
+    Real vmax = 0;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        if (mParticles.kinds()[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
+    }
+    const Real h = mSettings.spacing;
+    Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
+    const Real g = mSettings.gravity.length();
+    if (g > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / g));
+    return dt;
+}
+
+void GhostSolver::advanceFrame()
+{
+    initialize();
+    const double frameEnd = double(mFrame + 1) / double(mSettings.frameRate);
+    if (mSettings.substeps > 0) {
+        const Real dt = Real(1) / (mSettings.frameRate * Real(mSettings.substeps));
+        for (int s = 0; s < mSettings.substeps; ++s) step(dt);
+    } else {
+        while (mTime < frameEnd - 1e-12) {
+            const Real dt = std::min(stableTimeStep(), Real(frameEnd - mTime));
+            step(dt);
+        }
+    }
+    mTime = frameEnd; // no drift from summing substeps
+    ++mFrame;
+}
+
+} // namespace ghost
+} // namespace ghostfx
