@@ -35,8 +35,10 @@ void GhostSolver::stepBasic(Real dt)
     // nu = 2 alpha s c / (rho_i + rho_j), with s the smoothing length (half the support).
     const Real s = Real(0.5) * mSettings.supportRadius();
     const Real alpha = mSettings.basicViscosityAlpha;
-    // Monaghan 1994, Eq. 4.3: f = D ((r0 / r)^12 - (r0 / r)^4) x_ij / r^2 for r < r0 = h.
-    const Real r0 = mSettings.spacing;
+    // Monaghan 1994, Eq. 4.3: f = D ((r0 / r)^12 - (r0 / r)^4) x_ij / r^2 for r < r0. Liquid
+    // starts half a spacing from solid surfaces (GhostSolver::addLiquid), where the boundary's
+    // surface particles sit, so r0 = h / 2: repulsion begins only closer than that.
+    const Real r0 = Real(0.5) * mSettings.spacing;
     const Real D = mLennardJones;
 
     parallel::forEach(0, n, [&](std::size_t i) {
