@@ -51,6 +51,14 @@ struct GhostSolver::Solid
     Vec3 offset(double time) const { return velocity * Real(time); }
 };
 
+/// A continuous liquid source.
+struct GhostSolver::Emitter
+{
+    LevelSet shape;
+    Vec3 velocity;
+    double start, end;
+};
+
 GhostSolver::GhostSolver(const GhostSettings& settings)
     : mSettings(settings)
     , mKernel((settings.validate(), settings.supportRadius()))
@@ -133,15 +141,10 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
     SampleSet samples = PoissonDiskSampler(ps).sampleVolume(shape);
     // Liquid inside a solid is not liquid, and liquid samples on a surface shared with a solid
     // would sit on top of the solid's own surface samples: keep half a spacing of clearance.
-    const Real clearance = Real(0.5) * mSettings.spacing;
     std::vector<Vec3> kept;
     kept.reserve(samples.size());
     for (const Vec3& x : samples.positions) {
-        bool blocked = false;
-        for (const auto& solid : mSolids) {
-            if (solid->shape.phi(x - solid->offset(mTime)) < clearance) { blocked = true; break; }
-        }
-        if (!blocked) kept.push_back(x);
+        if (!blockedBySolid(x)) kept.push_back(x);
     }
     addLiquidParticles(kept, velocity);
     return kept.size();
@@ -158,11 +161,115 @@ void GhostSolver::addLiquidParticles(const std::vector<Vec3>& positions, const V
     std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(), velocity);
 }
 
+bool GhostSolver::blockedBySolid(const Vec3& x) const
+{
+    // Liquid keeps half a spacing from solid surfaces, where the solid's own surface samples sit.
+    const Real clearance = Real(0.5) * mSettings.spacing;
+    for (const auto& solid : mSolids) {
+        if (solid->shape.phi(x - solid->offset(mTime)) < clearance) return true;
+    }
+    return false;
+}
+
+void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime,
+                             double endTime)
+{
+    if (!isFinite(velocity)) {
+        throw ValueError(msg("emitter '", shape.name(), "': velocity is not finite"));
+    }
+    if (!(endTime > startTime) || !(startTime >= 0)) {
+        throw ValueError(msg("emitter '", shape.name(), "': start ", startTime, " s, end ", endTime,
+                             " s: expected 0 <= start < end"));
+    }
+    mEmitters.push_back(std::make_unique<Emitter>(Emitter{shape, velocity, startTime, endTime}));
+}
+
+void GhostSolver::emit()
+{
+    for (std::size_t e = 0; e < mEmitters.size(); ++e) {
+        const Emitter& em = *mEmitters[e];
+        if (mTime < em.start || mTime >= em.end) continue;
+        const Real R = mSettings.supportRadius();
+        const Aabb box = em.shape.bounds();
+        const Aabb near = box.padded(R);
+
+        // Air inside the emitter gives way to the liquid at once.
+        std::vector<std::uint8_t> remove(mParticles.size(), 0);
+        bool anyAir = false;
+        for (std::size_t i = 0; i < mParticles.size(); ++i) {
+            if (mParticles.kinds()[i] == ParticleKind::GhostAir &&
+                em.shape.phi(mParticles.positions()[i]) < Real(0)) {
+                remove[i] = anyAir = true;
+            }
+        }
+        if (anyAir) mParticles.removeIf(remove);
+
+        // Seeds: liquid already in the emitter; obstacles: every other particle nearby.
+        std::vector<Vec3> seeds, obstacles;
+        for (std::size_t i = 0; i < mParticles.size(); ++i) {
+            const Vec3& x = mParticles.positions()[i];
+            if (!near.contains(x)) continue;
+            if (mParticles.kinds()[i] == ParticleKind::Liquid && em.shape.phi(x) < Real(0)) {
+                seeds.push_back(x);
+            } else {
+                obstacles.push_back(x);
+            }
+        }
+        std::vector<Vec3> fresh;
+        if (seeds.empty()) {
+            // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
+            PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+            ps.seed = mSettings.seed + 31337ULL * (e + 1) + mStep;
+            for (const Vec3& x : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
+                bool clear = !blockedBySolid(x);
+                for (const Vec3& o : obstacles) {
+                    if (!clear) break;
+                    clear = (o - x).lengthSqr() >= sqr(ps.radius);
+                }
+                if (clear) fresh.push_back(x);
+            }
+        } else {
+            PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+            ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
+            ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mStep + 1) + e);
+            auto accept = [&](const Vec3& x) {
+                return em.shape.phi(x) < Real(0) && !blockedBySolid(x);
+            };
+            fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
+        }
+        if (fresh.empty()) continue;
+        const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);
+        std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(), em.velocity);
+        mEmitted += fresh.size();
+    }
+}
+
+void GhostSolver::applyKillBox()
+{
+    const Aabb& box = mSettings.killBox;
+    if (box.empty()) return;
+    std::vector<std::uint8_t> remove(mParticles.size(), 0);
+    std::size_t killed = 0;
+    bool any = false;
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        const ParticleKind k = mParticles.kinds()[i];
+        if ((k == ParticleKind::Liquid || k == ParticleKind::GhostAir) &&
+            !box.contains(mParticles.positions()[i])) {
+            remove[i] = any = true;
+            killed += k == ParticleKind::Liquid;
+        }
+    }
+    if (any) mParticles.removeIf(remove);
+    mKilled += killed;
+}
+
 void GhostSolver::initialize()
 {
     if (mInitialized) return;
+    if (mParticles.count(ParticleKind::Liquid) == 0) emit();
     if (mParticles.count(ParticleKind::Liquid) == 0) {
-        throw ValueError("liquid solver: no liquid particles (add a liquid body or particles)");
+        throw ValueError("liquid solver: no liquid particles (add a liquid body, particles, or an "
+                         "emitter active at the start)");
     }
     if (mSettings.method == Method::Ghost) resampleAir();
 
@@ -420,8 +527,16 @@ void GhostSolver::step(Real dt)
     if (!(dt > Real(0)) || !std::isfinite(dt)) {
         throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
     }
+    const bool fresh = !mInitialized;
     initialize();
     const auto start = std::chrono::steady_clock::now();
+    // Algorithm 3 line 1: new liquid from the emitters (the first step's was added by
+    // initialize(), before the mass scaling).
+    if (!fresh && !mEmitters.empty()) {
+        const auto t0 = std::chrono::steady_clock::now();
+        emit();
+        mTimings.emission += secondsSince(t0);
+    }
     if (mSettings.method == Method::Ghost) stepGhost(dt);
     else stepBasic(dt);
 
@@ -437,6 +552,7 @@ void GhostSolver::step(Real dt)
     mTime += double(dt);
     ++mStep;
     projectOutOfSolids();
+    applyKillBox();
     checkBlowUp();
     mTimings.total += secondsSince(start);
     ++mTimings.steps;

@@ -70,6 +70,9 @@ struct GhostSettings
     /// 0 picks 20 x the speed of sound.
     Real maxSpeed = Real(0);
 
+    /// Domain: liquid and air leaving this box are removed (a kill box). Empty: no limit.
+    sph::Aabb killBox;
+
     std::uint64_t seed = 0;            ///< random seed of all sampling
 
     /// Kernel support radius (m).

@@ -25,6 +25,7 @@
 #include <ghostfx/sph/ParticleSet.h>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -43,6 +44,7 @@ struct PhaseTimings
     double pressureForce = 0;       ///< equation of state + pressure (and Basic viscosity/LJ) forces
     double xsphAndBoundary = 0;     ///< ghost velocities, XSPH, positions, collisions
     double airResampling = 0;       ///< ghost air sampling
+    double emission = 0;            ///< emitter sampling
     double total = 0;
     std::uint64_t steps = 0;
 };
@@ -63,6 +65,14 @@ public:
     /// Sample a liquid body from a level set ([SB12] Sec. 4.5 - 4.6) with initial velocity
     /// `velocity` (m/s). Returns the number of particles added.
     std::size_t addLiquid(const LevelSet& shape, const Vec3& velocity = Vec3(0));
+
+    /// Continuous emission ([SB12] Sec. 4.5.2): from `startTime` to `endTime` (s) the emitter
+    /// volume is kept full of liquid moving at `velocity` (m/s); new particles grow from the
+    /// liquid already there (t = 8 attempts), at least r from every particle, so the new liquid
+    /// joins the old without overlap. The volume emitted per second is the emitter's
+    /// cross-section times the speed.
+    void addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime = 0,
+                    double endTime = std::numeric_limits<double>::infinity());
 
     /// Add liquid particles at given positions (m), e.g. a lattice for a test.
     void addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity = Vec3(0));
@@ -92,10 +102,18 @@ public:
     /// Mean number of neighbours per liquid particle in the last density pass (self included).
     double meanNeighbors() const { return mMeanNeighbors; }
 
+    /// Liquid particles emitted and removed by the kill box since the start.
+    std::size_t emittedCount() const { return mEmitted; }
+    std::size_t killedCount() const { return mKilled; }
+
 private:
     struct Solid;
+    struct Emitter;
 
     void initialize();
+    void emit();
+    void applyKillBox();
+    bool blockedBySolid(const Vec3& x) const;
     void resampleAir();
     void fadeAir();
     void sortAndComputeDensity();
@@ -110,6 +128,8 @@ private:
     ParticleSet mParticles;
     sph::NeighborGrid mGrid;
     std::vector<std::unique_ptr<Solid>> mSolids;
+    std::vector<std::unique_ptr<Emitter>> mEmitters;
+    std::size_t mEmitted = 0, mKilled = 0;
     Real mMass = 0;
     Real mLennardJones = 0;
     bool mInitialized = false;
