@@ -41,6 +41,7 @@ void GhostSolver::stepBasic(Real dt)
     const Real r0 = Real(0.5) * mSettings.spacing;
     const Real D = mLennardJones;
 
+    std::vector<Real> accel(n, Real(0));
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Liquid) {
             vnew[i] = v[i];
@@ -65,7 +66,10 @@ void GhostSolver::stepBasic(Real dt)
             }
         });
         vnew[i] = v[i] + dt * a;
+        accel[i] = a.length();
     });
+    mMaxAcceleration = 0;
+    for (std::size_t i = 0; i < n; ++i) mMaxAcceleration = std::max(mMaxAcceleration, accel[i]);
     mTimings.pressureForce +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 

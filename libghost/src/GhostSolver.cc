@@ -582,6 +582,7 @@ void GhostSolver::stepGhost(Real dt)
     // Lines 11-14: liquid acceleration from gravity and Monaghan's symmetric pressure gradient
     // over every neighbour, v* = v + dt a.
     t0 = std::chrono::steady_clock::now();
+    std::vector<Real> accel(n, Real(0));
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Liquid) {
             vstar[i] = v[i];
@@ -594,7 +595,10 @@ void GhostSolver::stepGhost(Real dt)
             a -= m[j] * (pi + p[j] / sqr(rho[j])) * mKernel.gradW(xij, r);
         });
         vstar[i] = v[i] + dt * a;
+        accel[i] = a.length();
     });
+    mMaxAcceleration = 0;
+    for (std::size_t i = 0; i < n; ++i) mMaxAcceleration = std::max(mMaxAcceleration, accel[i]);
     mTimings.pressureForce += secondsSince(t0);
 
     // Lines 15-18: ghost solid velocity, Eq. 3 (free slip) or the solid's velocity (no slip).
@@ -717,8 +721,10 @@ Real GhostSolver::stableTimeStep() const
     }
     const Real h = mSettings.spacing;
     Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
-    const Real g = mSettings.gravity.length();
-    if (g > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / g));
+    // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration
+    // of the last step (gravity before the first), which covers stiff Lennard-Jones walls.
+    const Real a = std::max(mMaxAcceleration, mSettings.gravity.length());
+    if (a > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / a));
     return dt;
 }
 

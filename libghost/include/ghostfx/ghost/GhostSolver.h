@@ -132,6 +132,7 @@ private:
     std::size_t mEmitted = 0, mKilled = 0;
     Real mMass = 0;
     Real mLennardJones = 0;
+    Real mMaxAcceleration = 0; ///< largest liquid acceleration of the last step (m/s^2)
     bool mInitialized = false;
     double mTime = 0;
     std::uint64_t mStep = 0;
