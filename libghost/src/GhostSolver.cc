@@ -22,8 +22,11 @@ namespace {
 
 /// Names of the solver's particle channels.
 constexpr const char* VSTAR = "vstar";             ///< v* = v + dt a, Algorithm 3 line 14
-constexpr const char* SOLID_NORMAL = "normal";     ///< ghost solid: outward normal of its solid
+constexpr const char* SOLID_NORMAL = "normal";     ///< ghost solid: outward normal, world frame
 constexpr const char* SOLID_VELOCITY = "solid_v";  ///< ghost solid: velocity of its solid (m/s)
+constexpr const char* SOLID_LOCAL = "solid_x";     ///< ghost solid: position in its solid's frame
+constexpr const char* SOLID_LOCAL_NORMAL = "solid_n"; ///< ghost solid: normal in its solid's frame
+constexpr const char* SOLID_INDEX = "solid_index"; ///< ghost solid: which solid (index)
 constexpr const char* AIR_WEIGHT = "air_weight";   ///< ghost air: fade weight, mass = weight m
 constexpr const char* AIR_TARGET = "air_target";   ///< ghost air: 1 fading in / kept, 0 fading out
 
@@ -42,13 +45,22 @@ inline Real taitPressure(Real rho, Real rho0, Real k)
 
 } // namespace
 
-/// A solid: its level set and rigid translation (constant velocity from time 0).
+/// A solid: its level set (in its local frame) and its rigid motion.
 struct GhostSolver::Solid
 {
     LevelSet shape;
-    Vec3 velocity;
+    RigidMotion motion;
 
-    Vec3 offset(double time) const { return velocity * Real(time); }
+    RigidTransform at(double time) const { return motion(time); }
+    /// Level-set value at a world point x at `time`.
+    Real phi(const Vec3& x, double time) const { return shape.phi(at(time).toLocal(x)); }
+    /// Velocity (m/s) of the solid's material point `local` at `time` (central difference).
+    Vec3 velocity(const Vec3& local, double time) const
+    {
+        constexpr double DELTA = 1e-4;
+        const double t0 = std::max(0.0, time - DELTA), t1 = time + DELTA;
+        return (at(t1).toWorld(local) - at(t0).toWorld(local)) / Real(t1 - t0);
+    }
 };
 
 /// A continuous liquid source.
@@ -67,6 +79,9 @@ GhostSolver::GhostSolver(const GhostSettings& settings)
     mParticles.addVectorChannel(VSTAR);
     mParticles.addVectorChannel(SOLID_NORMAL);
     mParticles.addVectorChannel(SOLID_VELOCITY);
+    mParticles.addVectorChannel(SOLID_LOCAL);
+    mParticles.addVectorChannel(SOLID_LOCAL_NORMAL);
+    mParticles.addScalarChannel(SOLID_INDEX, Real(-1));
     mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
     mParticles.addScalarChannel(AIR_TARGET, Real(1));
 }
@@ -93,7 +108,23 @@ void GhostSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
     if (!isFinite(velocity)) {
         throw ValueError(msg("solid '", solid.name(), "': velocity is not finite"));
     }
-    mSolids.push_back(std::make_unique<Solid>(Solid{solid, velocity}));
+    addMovingSolid(solid, [velocity](double t) {
+        RigidTransform xf;
+        xf.translation = velocity * Real(t);
+        return xf;
+    });
+}
+
+void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
+{
+    if (!motion) throw ValueError(msg("solid '", solid.name(), "': no motion given"));
+    mSolids.push_back(std::make_unique<Solid>(Solid{solid, std::move(motion)}));
+    const Solid& body = *mSolids.back();
+    const RigidTransform xf = body.at(mTime);
+    if (!isFinite(xf.translation)) {
+        throw ValueError(msg("solid '", solid.name(), "': motion gives a non-finite placement at t = ",
+                             mTime, " s"));
+    }
 
     // [SB12] Sec. 4.4 / 4.5: ghost solid particles in a band one kernel radius deep, sampled
     // like liquid (surface, relaxation, interior, relaxation). Basic SPH uses the same layer as
@@ -116,21 +147,26 @@ void GhostSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
     NeighborGrid surfaceGrid(mSettings.supportRadius());
     surfaceGrid.build(surface);
 
-    const Vec3 offset = mSolids.back()->offset(mTime);
     const Index first = Index(mParticles.size());
     std::vector<Vec3> positions(samples.positions);
-    for (Vec3& x : positions) x += offset;
+    for (Vec3& x : positions) x = xf.toWorld(x);
     const ParticleKind kind =
         mSettings.method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary;
     mParticles.addBatch(positions, mMass, kind);
     auto& normals = mParticles.vectorChannel(SOLID_NORMAL);
+    auto& localNormals = mParticles.vectorChannel(SOLID_LOCAL_NORMAL);
+    auto& locals = mParticles.vectorChannel(SOLID_LOCAL);
     auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
+    auto& index = mParticles.scalarChannel(SOLID_INDEX);
     for (std::size_t k = 0; k < samples.size(); ++k) {
         const Index s = surfaceGrid.nearest(samples.positions[k], Real(2) * mSettings.supportRadius(),
                                             [](Index) { return true; });
-        normals[first + k] = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
-        solidV[first + k] = velocity;
-        mParticles.velocities()[first + k] = velocity;
+        localNormals[first + k] = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
+        normals[first + k] = xf.rotation * localNormals[first + k];
+        locals[first + k] = samples.positions[k];
+        index[first + k] = Real(mSolids.size() - 1);
+        solidV[first + k] = body.velocity(samples.positions[k], mTime);
+        mParticles.velocities()[first + k] = solidV[first + k];
     }
 }
 
@@ -166,7 +202,7 @@ bool GhostSolver::blockedBySolid(const Vec3& x) const
     // Liquid keeps half a spacing from solid surfaces, where the solid's own surface samples sit.
     const Real clearance = Real(0.5) * mSettings.spacing;
     for (const auto& solid : mSolids) {
-        if (solid->shape.phi(x - solid->offset(mTime)) < clearance) return true;
+        if (solid->phi(x, mTime) < clearance) return true;
     }
     return false;
 }
@@ -287,7 +323,7 @@ void GhostSolver::initialize()
             GhostSettings probeSettings = mSettings;
             probeSettings.method = Method::Ghost;
             GhostSolver probe(probeSettings);
-            for (const auto& solid : mSolids) probe.addSolid(solid->shape, solid->velocity);
+            for (const auto& solid : mSolids) probe.addMovingSolid(solid->shape, solid->motion);
             std::vector<Vec3> liquidOnly;
             for (std::size_t i = 0; i < liquid.size(); ++i) {
                 if (liquid[i]) liquidOnly.push_back(positions[i]);
@@ -348,7 +384,7 @@ void GhostSolver::resampleAir()
 
     auto insideSolid = [&](const Vec3& x) {
         for (const auto& solid : mSolids) {
-            if (solid->shape.phi(x - solid->offset(time)) < Real(0)) return true;
+            if (solid->phi(x, time) < Real(0)) return true;
         }
         return false;
     };
@@ -540,15 +576,26 @@ void GhostSolver::step(Real dt)
     if (mSettings.method == Method::Ghost) stepGhost(dt);
     else stepBasic(dt);
 
-    // Solids move rigidly with their velocity.
-    auto& x = mParticles.positions();
-    const auto& kind = mParticles.kinds();
-    const auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
-    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
-        if (kind[i] == ParticleKind::GhostSolid || kind[i] == ParticleKind::Boundary) {
-            x[i] += dt * solidV[i];
-        }
-    });
+    // Solids move rigidly: every ghost goes to its material point's new place and velocity.
+    if (!mSolids.empty()) {
+        const double t1 = mTime + double(dt);
+        std::vector<RigidTransform> placement;
+        for (const auto& solid : mSolids) placement.push_back(solid->at(t1));
+        auto& x = mParticles.positions();
+        const auto& kind = mParticles.kinds();
+        const auto& local = mParticles.vectorChannel(SOLID_LOCAL);
+        const auto& localNormal = mParticles.vectorChannel(SOLID_LOCAL_NORMAL);
+        const auto& index = mParticles.scalarChannel(SOLID_INDEX);
+        auto& normal = mParticles.vectorChannel(SOLID_NORMAL);
+        auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
+        parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
+            if (kind[i] != ParticleKind::GhostSolid && kind[i] != ParticleKind::Boundary) return;
+            const std::size_t b = std::size_t(index[i]);
+            x[i] = placement[b].toWorld(local[i]);
+            normal[i] = placement[b].rotation * localNormal[i];
+            solidV[i] = mSolids[b]->velocity(local[i], t1);
+        });
+    }
     mTime += double(dt);
     ++mStep;
     projectOutOfSolids();
@@ -664,19 +711,22 @@ void GhostSolver::projectOutOfSolids()
     auto& v = mParticles.velocities();
     const auto& kind = mParticles.kinds();
     const double time = mTime;
+    std::vector<RigidTransform> placement;
+    for (const auto& solid : mSolids) placement.push_back(solid->at(time));
     // [SB12] Sec. 3 "Solid Collisions": a liquid particle inside a solid goes back to its
     // surface (level-set closest point) and loses the velocity that points into the solid.
     parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
         if (kind[i] != ParticleKind::Liquid) return;
-        for (const auto& solid : mSolids) {
-            const Vec3 offset = solid->offset(time);
-            const Vec3 local = x[i] - offset;
-            if (!(solid->shape.phi(local) < Real(0))) continue;
-            const SurfaceProjection proj = solid->shape.projectToSurface(local);
+        for (std::size_t b = 0; b < mSolids.size(); ++b) {
+            const Solid& solid = *mSolids[b];
+            const RigidTransform& xf = placement[b];
+            const Vec3 local = xf.toLocal(x[i]);
+            if (!(solid.shape.phi(local) < Real(0))) continue;
+            const SurfaceProjection proj = solid.shape.projectToSurface(local);
             if (!proj.converged) continue; // deeper than the band: left for the blow-up check
-            const Vec3 nrm = solid->shape.normal(proj.point);
-            x[i] = proj.point + offset;
-            const Real vn = (v[i] - solid->velocity).dot(nrm);
+            const Vec3 nrm = xf.rotation * solid.shape.normal(proj.point);
+            x[i] = xf.toWorld(proj.point);
+            const Real vn = (v[i] - solid.velocity(proj.point, time)).dot(nrm);
             if (vn < Real(0)) v[i] -= vn * nrm;
         }
     });

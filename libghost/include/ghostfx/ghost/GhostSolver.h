@@ -24,7 +24,10 @@
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/ParticleSet.h>
 
+#include <openvdb/math/Mat3.h>
+
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -36,6 +39,21 @@ using sph::Index;
 using sph::LevelSet;
 using sph::ParticleKind;
 using sph::ParticleSet;
+
+/// Placement of a rigid solid: world x = rotation * local + translation, local being the frame
+/// its level set is defined in.
+struct RigidTransform
+{
+    openvdb::math::Mat3<Real> rotation = openvdb::math::Mat3<Real>::identity();
+    Vec3 translation{0};
+
+    Vec3 toWorld(const Vec3& local) const { return rotation * local + translation; }
+    Vec3 toLocal(const Vec3& world) const { return rotation.transpose() * (world - translation); }
+};
+
+/// A solid's placement as a function of time (s); it must be defined for every t >= 0 and be
+/// smooth enough for a central difference of 1e-4 s to give its velocity.
+using RigidMotion = std::function<RigidTransform(double time)>;
 
 /// Seconds spent in each phase of the step, accumulated since the last reset ([SB12] Sec. 5).
 struct PhaseTimings
@@ -61,6 +79,9 @@ public:
     /// Add a static solid, or one moving rigidly with constant `velocity` (m/s). Its ghost
     /// (or boundary) particles are sampled at once, one kernel radius deep.
     void addSolid(const LevelSet& solid, const Vec3& velocity = Vec3(0));
+    /// Add a solid moving rigidly: at time t its level set (given in its local frame) sits at
+    /// `motion(t)`. Its ghosts move with it and carry its velocity ([SB12] Sec. 4.4).
+    void addMovingSolid(const LevelSet& solid, RigidMotion motion);
 
     /// Sample a liquid body from a level set ([SB12] Sec. 4.5 - 4.6) with initial velocity
     /// `velocity` (m/s). Returns the number of particles added.
