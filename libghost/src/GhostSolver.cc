@@ -119,7 +119,32 @@ void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
 {
     if (!motion) throw ValueError(msg("solid '", solid.name(), "': no motion given"));
     mSolids.push_back(std::make_unique<Solid>(Solid{solid, std::move(motion)}));
-    const Solid& body = *mSolids.back();
+    sampleSolid(mSolids.size() - 1);
+}
+
+void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
+{
+    if (solidIndex >= mSolids.size()) {
+        throw ValueError(msg("setSolidShape: solid ", solidIndex, " does not exist (",
+                             mSolids.size(), " solids)"));
+    }
+    // Drop the old ghosts of this solid, then sample the new shape.
+    const auto& index = mParticles.scalarChannel(SOLID_INDEX);
+    std::vector<std::uint8_t> remove(mParticles.size(), 0);
+    for (std::size_t i = 0; i < remove.size(); ++i) {
+        const ParticleKind k = mParticles.kinds()[i];
+        remove[i] = (k == ParticleKind::GhostSolid || k == ParticleKind::Boundary) &&
+                    std::size_t(index[i]) == solidIndex;
+    }
+    mParticles.removeIf(remove);
+    mSolids[solidIndex]->shape = shape;
+    sampleSolid(solidIndex);
+}
+
+void GhostSolver::sampleSolid(std::size_t solidIndex)
+{
+    const Solid& body = *mSolids[solidIndex];
+    const LevelSet& solid = body.shape;
     const RigidTransform xf = body.at(mTime);
     if (!isFinite(xf.translation)) {
         throw ValueError(msg("solid '", solid.name(), "': motion gives a non-finite placement at t = ",
@@ -131,7 +156,7 @@ void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
     // its boundary particles.
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.bandDepth = mSettings.supportRadius();
-    ps.seed = mSettings.seed + 1000003ULL * mSolids.size();
+    ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mStep;
     const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(solid);
 
     // Outward normal of each ghost from its nearest surface sample: phi is clamped beyond the
@@ -164,7 +189,7 @@ void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
         localNormals[first + k] = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
         normals[first + k] = xf.rotation * localNormals[first + k];
         locals[first + k] = samples.positions[k];
-        index[first + k] = Real(mSolids.size() - 1);
+        index[first + k] = Real(solidIndex);
         solidV[first + k] = body.velocity(samples.positions[k], mTime);
         mParticles.velocities()[first + k] = solidV[first + k];
     }

@@ -2,6 +2,7 @@
 /// @brief  Moving solids ([SB12] Sec. 4.4): ghosts follow the rigid motion and carry its
 ///         velocity; liquid is pushed, never left inside.
 #include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 
 #include <gtest/gtest.h>
@@ -69,4 +70,39 @@ TEST(MovingSolid, PaddlePushesLiquidAndLeavesNoneInside)
     EXPECT_LT(worstVelocity, 1e-3);  // central difference of 1e-4 s on a 2 rad/s rotation
     EXPECT_GE(deepest, -0.01 * double(H)); // collision projection tolerance
     EXPECT_GT(momentumX, 0.0);       // the paddle pushed the liquid to the right
+}
+
+TEST(MovingSolid, PerFrameShapeReplacesTheGhosts)
+{
+    // A deforming solid given as one level set per frame: a floor that rises 1 cm. Its ghosts
+    // are resampled from the new shape; no liquid is left inside it.
+    GhostSettings s;
+    s.spacing = H;
+    GhostSolver solver(s);
+    auto floorAt = [](Real top) {
+        return makeLevelSet(makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f), Vec3(0.08f, top, 0.08f),
+                                            H / 2), "floor");
+    };
+    solver.addSolid(floorAt(Real(-0.05)));
+    solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.05f, -0.05f, -0.05f),
+                                                  Vec3(0.05f, 0.0f, 0.05f), H / 2), "pool"));
+    solver.advanceFrame();
+    const std::size_t liquid = solver.count(ParticleKind::Liquid);
+    const LevelSet raised = floorAt(Real(-0.04));
+    solver.setSolidShape(0, raised);
+    solver.advanceFrame();
+    double deepest = 0, highestGhost = -1;
+    for (std::size_t i = 0; i < solver.particles().size(); ++i) {
+        const Vec3& x = solver.particles().positions()[i];
+        if (solver.particles().kinds()[i] == ParticleKind::Liquid) {
+            deepest = std::min(deepest, double(raised.phi(x)));
+        } else if (solver.particles().kinds()[i] == ParticleKind::GhostSolid) {
+            highestGhost = std::max(highestGhost, double(x[1]));
+        }
+    }
+    EXPECT_EQ(solver.count(ParticleKind::Liquid), liquid);
+    EXPECT_GE(deepest, -0.01 * double(H));
+    // The new ghosts reach the new top (-0.04 m) within the trilinear/projection tolerance.
+    EXPECT_NEAR(highestGhost, -0.04, 0.1 * double(H));
+    EXPECT_THROW(solver.setSolidShape(3, raised), ValueError);
 }

@@ -82,6 +82,11 @@ public:
     /// Add a solid moving rigidly: at time t its level set (given in its local frame) sits at
     /// `motion(t)`. Its ghosts move with it and carry its velocity ([SB12] Sec. 4.4).
     void addMovingSolid(const LevelSet& solid, RigidMotion motion);
+    /// Replace the shape of solid `solidIndex` (in the order added), e.g. with this frame's level
+    /// set of a deforming solid: its ghosts are sampled anew, its motion is kept. Solids keep
+    /// their index for the life of the solver.
+    void setSolidShape(std::size_t solidIndex, const LevelSet& shape);
+    std::size_t solidCount() const { return mSolids.size(); }
 
     /// Sample a liquid body from a level set ([SB12] Sec. 4.5 - 4.6) with initial velocity
     /// `velocity` (m/s). Returns the number of particles added.
@@ -132,6 +137,7 @@ private:
     struct Emitter;
 
     void initialize();
+    void sampleSolid(std::size_t solidIndex);
     void emit();
     void applyKillBox();
     bool blockedBySolid(const Vec3& x) const;
