@@ -262,23 +262,24 @@ openvdb::FloatGrid::Ptr makeSphereLevelSet(const Vec3& center, Real radius, Real
         float(voxelSize), float(halfWidthVoxels));
 }
 
+double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo, const openvdb::Vec3d& hi)
+{
+    const openvdb::Vec3d c = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+    const openvdb::Vec3d q(std::abs(x.x() - c.x()) - half.x(), std::abs(x.y() - c.y()) - half.y(),
+                           std::abs(x.z() - c.z()) - half.z());
+    const openvdb::Vec3d qPos(std::max(q.x(), 0.0), std::max(q.y(), 0.0), std::max(q.z(), 0.0));
+    return qPos.length() + std::min(std::max(q.x(), std::max(q.y(), q.z())), 0.0);
+}
+
 openvdb::FloatGrid::Ptr makeBoxLevelSet(const Vec3& min, const Vec3& max, Real voxelSize,
                                         Real halfWidthVoxels)
 {
-    const openvdb::Vec3d c = 0.5 * (openvdb::Vec3d(min[0], min[1], min[2]) +
-                                    openvdb::Vec3d(max[0], max[1], max[2]));
-    const openvdb::Vec3d half = 0.5 * (openvdb::Vec3d(max[0], max[1], max[2]) -
-                                       openvdb::Vec3d(min[0], min[1], min[2]));
-    if (!(half.x() > 0 && half.y() > 0 && half.z() > 0)) {
+    const openvdb::Vec3d lo(min[0], min[1], min[2]), hi(max[0], max[1], max[2]);
+    if (!(hi.x() > lo.x() && hi.y() > lo.y() && hi.z() > lo.z())) {
         throw ValueError(msg("box level set: max (", max[0], ", ", max[1], ", ", max[2],
                              ") must exceed min (", min[0], ", ", min[1], ", ", min[2], ")"));
     }
-    auto sdf = [c, half](const openvdb::Vec3d& x) {
-        const openvdb::Vec3d q(std::abs(x.x() - c.x()) - half.x(), std::abs(x.y() - c.y()) - half.y(),
-                               std::abs(x.z() - c.z()) - half.z());
-        const openvdb::Vec3d qPos(std::max(q.x(), 0.0), std::max(q.y(), 0.0), std::max(q.z(), 0.0));
-        return qPos.length() + std::min(std::max(q.x(), std::max(q.y(), q.z())), 0.0);
-    };
+    auto sdf = [lo, hi](const openvdb::Vec3d& x) { return boxSignedDistance(x, lo, hi); };
     Aabb b;
     b.expand(min);
     b.expand(max);

@@ -22,17 +22,11 @@ constexpr Real H = Real(0.01);
 /// to y = -0.1, open at the bottom, walls 4 h thick.
 openvdb::FloatGrid::Ptr invertedCup()
 {
-    auto box = [](const openvdb::Vec3d& x, const openvdb::Vec3d& lo, const openvdb::Vec3d& hi) {
-        const openvdb::Vec3d c = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
-        const openvdb::Vec3d q(std::abs(x.x() - c.x()) - half.x(), std::abs(x.y() - c.y()) - half.y(),
-                               std::abs(x.z() - c.z()) - half.z());
-        const openvdb::Vec3d qp(std::max(q.x(), 0.0), std::max(q.y(), 0.0), std::max(q.z(), 0.0));
-        return qp.length() + std::min(std::max(q.x(), std::max(q.y(), q.z())), 0.0);
-    };
     const double a = 0.06, wall = 0.04;
     auto sdf = [&](const openvdb::Vec3d& x) {
-        return std::max(box(x, {-a - wall, -0.1, -a - wall}, {a + wall, wall, a + wall}),
-                        -box(x, {-a, -1.0, -a}, {a, 0.0, a}));
+        const double outside = boxSignedDistance(x, {-a - wall, -0.1, -a - wall},
+                                                 {a + wall, wall, a + wall});
+        return std::max(outside, -boxSignedDistance(x, {-a, -1.0, -a}, {a, 0.0, a}));
     };
     return levelSetFromSdf(sdf, Aabb{Vec3(Real(-a - wall), Real(-0.1), Real(-a - wall)),
                                      Vec3(Real(a + wall), Real(wall), Real(a + wall))}, H / 2);

@@ -20,17 +20,11 @@ constexpr Real H = Real(0.01);
 openvdb::FloatGrid::Ptr tankGrid(Real a, Real top)
 {
     const double wall = 4 * double(H);
-    auto box = [](const openvdb::Vec3d& x, const openvdb::Vec3d& lo, const openvdb::Vec3d& hi) {
-        const openvdb::Vec3d c = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
-        const openvdb::Vec3d q(std::abs(x.x() - c.x()) - half.x(), std::abs(x.y() - c.y()) - half.y(),
-                               std::abs(x.z() - c.z()) - half.z());
-        const openvdb::Vec3d qp(std::max(q.x(), 0.0), std::max(q.y(), 0.0), std::max(q.z(), 0.0));
-        return qp.length() + std::min(std::max(q.x(), std::max(q.y(), q.z())), 0.0);
-    };
     const openvdb::Vec3d outerLo(-a - wall, -wall, -a - wall), outerHi(a + wall, top, a + wall);
     const openvdb::Vec3d innerLo(-a, 0, -a), innerHi(a, top + 1, a);
     auto sdf = [&](const openvdb::Vec3d& x) {
-        return std::max(box(x, outerLo, outerHi), -box(x, innerLo, innerHi));
+        return std::max(boxSignedDistance(x, outerLo, outerHi),
+                        -boxSignedDistance(x, innerLo, innerHi));
     };
     Aabb bounds{Vec3(Real(outerLo.x()), Real(outerLo.y()), Real(outerLo.z())),
                 Vec3(Real(outerHi.x()), Real(outerHi.y()), Real(outerHi.z()))};
