@@ -1,0 +1,412 @@
+/// @file   bench_liquid.cc
+/// @brief  Liquid solver scene benchmark ([SB12] Sec. 5, Table 1): time per step, particle counts,
+///         the per-phase breakdown, the air-resampling share, neighbours and the cost per
+///         particle-neighbour pair, for Ghost SPH and the Basic SPH baseline.
+/// @details Two scenes, both with a solid and free surfaces:
+///            - dam break: a liquid block of aspect 1 x 2 x 1 in one corner of an open-top tank
+///              (a solid made by levelSetFromSdf from max(outer box, -inner box), the inner box
+///              reaching above the top); the spacing h is chosen so that the block holds about
+///              `--liquid` particles (the sampler packs about 0.75 particles per h^3);
+///            - sphere: a liquid sphere of about `--sphere-liquid` particles (h = 0.01 m) falling
+///              at 1.5 m/s onto a solid sphere, 2 h above it at the start.
+///          The liquid is sampled once per scene (the Ghost solver's addLiquid) and the same
+///          positions are given to the Basic solver, so both methods start from identical liquid.
+///          Each method then runs `--warmup` steps (the first one includes the initial air layer
+///          and the mass scaling, timed on its own), resets the solver's PhaseTimings and runs
+///          `--steps` measured steps, each timed with std::chrono around GhostSolver::step().
+///          dt is fixed at 1 / (30 * 20) s ([SB12]: 20 steps per frame at 30 frames/s) unless
+///          `--cfl` is given. Basic SPH blows up at that dt in both scenes (bench/RESULTS.md);
+///          its per-step cost comes from `--method basic --cfl 0.4`. Plain main (no Google
+///          Benchmark): one scene run takes a minute, not a loop to repeat. Results and how they
+///          were taken: bench/RESULTS.md.
+///
+///          Run: build/bench/bench_liquid [--liquid 100000] [--steps 30] [--warmup 20]
+#include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/sph/Parallel.h>
+
+#include <CLI/CLI.hpp>
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+using namespace ghostfx;
+using namespace ghostfx::sph;
+using namespace ghostfx::ghost;
+
+namespace {
+
+/// Particles per h^3 the [SB12] sampler produces after relaxation (README, bench_sampler.cc).
+constexpr double SAMPLES_PER_CUBIC_SPACING = 0.75;
+/// [SB12] Table 1 and Sec. 5: 20 steps per frame at 30 frames/s.
+constexpr double PAPER_DT = 1.0 / (30.0 * 20.0);
+
+struct Options
+{
+    double damLiquid = 100000;     ///< dam break: target liquid particle count
+    double sphereLiquid = 20000;   ///< sphere scene: target liquid particle count
+    double sphereSpacing = 0.01;   ///< sphere scene: h (m)
+    int steps = 30;                ///< measured steps
+    int warmup = 20;               ///< steps before the measurement (>= 1)
+    double cfl = 0;                ///< > 0: CFL-limited dt with this number instead of PAPER_DT
+    double stiffness = 0;          ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
+    double lennardJones = 0;       ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
+    int threads = 0;               ///< TBB threads, 0 = all
+    std::string scenes = "all";    ///< dam, sphere or all
+    std::string methods = "both";  ///< ghost, basic or both
+    std::uint64_t seed = 1;
+};
+
+double seconds(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Scenes ------------------------------------------------------------------------------------------
+
+Vec3 toVec3(const openvdb::Vec3d& x) { return Vec3(Real(x.x()), Real(x.y()), Real(x.z())); }
+
+struct Scene
+{
+    std::string name;
+    std::string description;
+    Real spacing;                  ///< h (m)
+    LevelSet solid;
+    LevelSet liquid;
+    Vec3 liquidVelocity;           ///< initial liquid velocity (m/s)
+    Aabb container;                ///< liquid outside this box counts as escaped
+};
+
+/// Dam break: liquid block 0.4 x 0.8 x 0.4 m (scaled with h) in the corner of an open-top tank
+/// whose inside is 3 x 1.25 x 1 block (1.2 x 1.0 x 0.4 m), walls one kernel radius (3 h) thick:
+/// the ghost-solid band is one kernel radius deep ([SB12] Sec. 4.4), so thicker walls would add
+/// particles no liquid ever sees. The block is flush with the walls and the floor; addLiquid drops
+/// the samples closer than h / 2 to the solid (the layer on the shared faces).
+Scene damBreak(double targetLiquid)
+{
+    const double blockX = 0.4, blockY = 0.8, blockZ = 0.4; // m
+    const double h = std::cbrt(SAMPLES_PER_CUBIC_SPACING * blockX * blockY * blockZ / targetLiquid);
+    const double wall = 3 * h, voxel = 0.5 * h;
+    const openvdb::Vec3d innerLo(0, 0, 0), innerHi(3 * blockX, 1.25 * blockY, blockZ);
+    const openvdb::Vec3d outerLo = innerLo - openvdb::Vec3d(wall);
+    const openvdb::Vec3d outerHi(innerHi.x() + wall, innerHi.y(), innerHi.z() + wall);
+    // The inner box reaches above the top, so the tank is open there.
+    const openvdb::Vec3d cutHi(innerHi.x(), innerHi.y() + 1, innerHi.z());
+    auto tankSdf = [=](const openvdb::Vec3d& x) {
+        return std::max(boxSignedDistance(x, outerLo, outerHi),
+                        -boxSignedDistance(x, innerLo, cutHi));
+    };
+    const Vec3 blockLo{0}, blockHi{Real(blockX), Real(blockY), Real(blockZ)};
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "block %.2f x %.2f x %.2f m in an open tank %.2f x %.2f x %.2f m (inside), "
+                  "walls %.4f m, h = %.5f m", blockX, blockY, blockZ, innerHi.x(), innerHi.y(),
+                  innerHi.z(), wall, h);
+    Scene s{"dam_break", text, Real(h),
+            makeLevelSet(levelSetFromSdf(tankSdf, Aabb{toVec3(outerLo), toVec3(outerHi)},
+                                         Real(voxel)), "tank"),
+            makeLevelSet(makeBoxLevelSet(blockLo, blockHi, Real(voxel)), "water"), Vec3(0),
+            Aabb{toVec3(outerLo), toVec3(outerHi)}.padded(Real(2 * h))};
+    return s;
+}
+
+/// Liquid sphere (radius from the target count) 2 h above a solid sphere of radius 0.2 m, its
+/// centre 0.05 m off the solid's axis, falling at 1.5 m/s (as if dropped from 11 cm higher).
+Scene sphereDrop(double targetLiquid, double h)
+{
+    const double volume = targetLiquid / SAMPLES_PER_CUBIC_SPACING * h * h * h;
+    const double radius = std::cbrt(3 * volume / (4 * openvdb::math::pi<double>()));
+    const double solidRadius = 0.2, voxel = 0.5 * h;
+    const Vec3 centre(Real(0.05), Real(solidRadius + radius + 2 * h), 0);
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "liquid sphere r = %.3f m at (%.2f, %.3f, 0) m, v = (0, -1.5, 0) m/s, onto a "
+                  "solid sphere r = %.2f m at the origin, h = %.5f m", radius, double(centre[0]),
+                  double(centre[1]), solidRadius, h);
+    Scene s{"sphere_drop", text, Real(h),
+            makeLevelSet(makeSphereLevelSet(Vec3(0), Real(solidRadius), Real(voxel)), "ball"),
+            makeLevelSet(makeSphereLevelSet(centre, Real(radius), Real(voxel)), "drop"),
+            Vec3(0, Real(-1.5), 0), Aabb{Vec3(Real(-1)), Vec3(Real(1))}};
+    return s;
+}
+
+// Running one method -----------------------------------------------------------------------------
+
+struct RunResult
+{
+    std::string scene;
+    Method method = Method::Ghost;
+    bool ok = false;
+    std::string error;
+    std::size_t liquid = 0, air = 0, solid = 0; ///< at the end of the measurement
+    double solidSampling = 0, liquidSampling = 0, firstStep = 0; ///< s
+    double meanStep = 0, minStep = 0, maxStep = 0;               ///< s, chrono around step()
+    double dt = 0;                                               ///< mean dt (s)
+    PhaseTimings phases;
+    double meanNeighbors = 0;
+    double maxSpeed = 0, maxDensityRatio = 0; ///< at the end (m/s, rho / rho0)
+    std::size_t escaped = 0, insideSolid = 0;
+    int steps = 0; ///< measured steps completed
+};
+
+/// Warm up and measure `solver` (its solid already added). The liquid is `liquidPositions`
+/// (sampled once per scene) unless the solver already holds liquid. A NumericalError (blow-up)
+/// ends the run and is recorded in `out`; the state at the end is recorded either way.
+void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liquidPositions,
+               GhostSolver& solver, const Options& opt, RunResult& out)
+{
+    out.scene = scene.name;
+    out.method = method;
+    double sum = 0, lo = 1e30, hi = 0, nbrs = 0, simulated = 0;
+    bool measuring = false;
+    try {
+        if (solver.count(ParticleKind::Liquid) == 0) {
+            solver.addLiquidParticles(liquidPositions, scene.liquidVelocity);
+        }
+        auto nextDt = [&]() { return opt.cfl > 0 ? solver.stableTimeStep() : Real(PAPER_DT); };
+
+        // Warm-up; the first step also builds the air layer and scales the mass (Sec. 4.6).
+        auto t0 = std::chrono::steady_clock::now();
+        solver.step(nextDt());
+        out.firstStep = seconds(t0);
+        for (int s = 1; s < opt.warmup; ++s) solver.step(nextDt());
+
+        solver.resetTimings();
+        measuring = true;
+        for (int s = 0; s < opt.steps; ++s) {
+            const Real dt = nextDt();
+            t0 = std::chrono::steady_clock::now();
+            solver.step(dt);
+            const double t = seconds(t0);
+            simulated += double(dt);
+            sum += t;
+            lo = std::min(lo, t);
+            hi = std::max(hi, t);
+            nbrs += solver.meanNeighbors();
+            ++out.steps;
+        }
+        out.ok = true;
+    } catch (const NumericalError& e) {
+        out.error = e.what();
+    }
+    if (measuring && out.steps > 0) {
+        // A blown-up run keeps the timings of the steps it completed (its PhaseTimings also hold
+        // the phases of the step that failed, but not that step's total).
+        out.meanStep = sum / out.steps;
+        out.minStep = lo;
+        out.maxStep = hi;
+        out.dt = simulated / out.steps;
+        out.meanNeighbors = nbrs / out.steps;
+        out.phases = solver.timings();
+    }
+
+    const ParticleSet& p = solver.particles();
+    const Real rho0 = solver.settings().restDensity;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Liquid) continue;
+        const Vec3& x = p.positions()[i];
+        out.maxSpeed = std::max(out.maxSpeed, double(p.velocities()[i].length()));
+        out.maxDensityRatio = std::max(out.maxDensityRatio, double(p.densities()[i] / rho0));
+        if (!scene.container.contains(x)) ++out.escaped;
+        if (scene.solid.phi(x) < -Real(0.01) * scene.spacing) ++out.insideSolid;
+    }
+    out.liquid = solver.count(ParticleKind::Liquid);
+    out.air = solver.count(ParticleKind::GhostAir);
+    out.solid = solver.count(method == Method::Ghost ? ParticleKind::GhostSolid
+                                                     : ParticleKind::Boundary);
+}
+
+double percent(double part, double whole) { return whole > 0 ? 100 * part / whole : 0; }
+
+void printRun(const RunResult& r)
+{
+    std::printf("\n--- %s, %s ---\n", r.scene.c_str(), methodName(r.method));
+    if (!r.ok) std::printf("  FAILED: %s\n", r.error.c_str());
+    std::printf("  particles: liquid %zu, ghost air %zu (%.0f %%), %s %zu (%.0f %%), total %zu\n",
+                r.liquid, r.air, percent(double(r.air), double(r.liquid)),
+                r.method == Method::Ghost ? "ghost solid" : "boundary", r.solid,
+                percent(double(r.solid), double(r.liquid)), r.liquid + r.air + r.solid);
+    std::printf("  set-up: solid sampling %.2f s, liquid sampling %.2f s, first step (air layer, "
+                "mass scaling) %.2f s\n", r.solidSampling, r.liquidSampling, r.firstStep);
+    std::printf("  state at the end: max liquid speed %.3f m/s, max rho/rho0 %.3f, %zu liquid "
+                "outside the container, %zu inside the solid\n", r.maxSpeed, r.maxDensityRatio,
+                r.escaped, r.insideSolid);
+    if (r.steps == 0) return;
+    if (!r.ok) {
+        // The phases of the failed step are in r.phases but its total is not: no breakdown.
+        std::printf("  step: mean %.1f ms over the %d measured steps completed before the "
+                    "blow-up\n", 1e3 * r.meanStep, r.steps);
+        return;
+    }
+    const PhaseTimings& t = r.phases;
+    const double n = double(t.steps);
+    std::printf("  step: mean %.1f ms (min %.1f, max %.1f) over %d measured steps, dt = %.6g s; "
+                "solver total %.1f ms/step\n", 1e3 * r.meanStep, 1e3 * r.minStep, 1e3 * r.maxStep,
+                r.steps, r.dt, 1e3 * t.total / n);
+    const double other = t.total - t.neighborsAndDensity - t.pressureForce - t.xsphAndBoundary -
+                         t.airResampling;
+    const struct { const char* name; double s; } rows[] = {
+        {"neighbours + density", t.neighborsAndDensity},
+        {"pressure force", t.pressureForce},
+        {"XSPH + boundary", t.xsphAndBoundary},
+        {"air resampling", t.airResampling},
+        {"other (air fade, solid motion, blow-up check)", other},
+    };
+    for (const auto& row : rows) {
+        std::printf("    %-46s %8.1f ms %6.1f %%\n", row.name, 1e3 * row.s / n,
+                    percent(row.s, t.total));
+    }
+    const double pairs = double(r.liquid) * r.meanNeighbors;
+    std::printf("  mean neighbours %.1f; %.2f ns per particle-neighbour pair; %.1f wall s per "
+                "simulated s\n", r.meanNeighbors, 1e9 * r.meanStep / pairs, r.meanStep / r.dt);
+}
+
+std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
+{
+    std::printf("\n=== scene %s: %s\n", scene.name.c_str(), scene.description.c_str());
+    std::fflush(stdout);
+    GhostSettings settings;
+    settings.spacing = scene.spacing;
+    settings.seed = opt.seed;
+    if (opt.cfl > 0) settings.cflNumber = Real(opt.cfl);
+    if (opt.stiffness > 0) settings.stiffness = Real(opt.stiffness);
+    if (opt.lennardJones > 0) settings.lennardJonesStrength = Real(opt.lennardJones);
+
+    std::vector<RunResult> results;
+    std::vector<Vec3> liquid;
+    double liquidSampling = 0;
+    for (const Method method : {Method::Ghost, Method::Basic}) {
+        if (opt.methods != "both" && opt.methods != methodName(method)) continue;
+        settings.method = method;
+        GhostSolver solver(settings);
+        RunResult r;
+        auto t0 = std::chrono::steady_clock::now();
+        solver.addSolid(scene.solid);
+        r.solidSampling = seconds(t0);
+        if (liquid.empty()) {
+            t0 = std::chrono::steady_clock::now();
+            solver.addLiquid(scene.liquid, scene.liquidVelocity);
+            liquidSampling = seconds(t0);
+            const ParticleSet& p = solver.particles();
+            for (std::size_t i = 0; i < p.size(); ++i) {
+                if (p.kinds()[i] == ParticleKind::Liquid) liquid.push_back(p.positions()[i]);
+            }
+            r.liquidSampling = liquidSampling;
+        }
+        runMethod(scene, method, liquid, solver, opt, r);
+        printRun(r);
+        std::fflush(stdout);
+        results.push_back(r);
+    }
+    return results;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"Liquid solver scene benchmark ([SB12] Sec. 5): Ghost SPH and Basic SPH"};
+    Options opt;
+    app.add_option("--liquid", opt.damLiquid, "dam break: target liquid particle count")
+        ->capture_default_str()->check(CLI::Range(100.0, 1e8));
+    app.add_option("--sphere-liquid", opt.sphereLiquid,
+                   "sphere scene: target liquid particle count")
+        ->capture_default_str()->check(CLI::Range(100.0, 1e8));
+    app.add_option("--sphere-spacing", opt.sphereSpacing, "sphere scene: particle spacing h (m)")
+        ->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_option("--steps", opt.steps, "measured steps")->capture_default_str()
+        ->check(CLI::Range(1, 1000000));
+    app.add_option("--warmup", opt.warmup, "steps before the measurement (the first includes "
+                   "initialisation)")->capture_default_str()->check(CLI::Range(1, 1000000));
+    app.add_option("--cfl", opt.cfl,
+                   "CFL-limited dt with this number (default: fixed dt = 1/600 s)")
+        ->check(CLI::Range(1e-6, 2.0));
+    app.add_option("--stiffness", opt.stiffness, "Tait stiffness k (Pa; default: [SB12] 2000)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--lj", opt.lennardJones, "Basic SPH Lennard-Jones strength D (m^2/s^2; "
+                   "default: 5 g H)")->check(CLI::PositiveNumber);
+    app.add_option("--threads", opt.threads, "TBB threads (0 = all)")->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--scene", opt.scenes, "dam, sphere or all")->capture_default_str()
+        ->check(CLI::IsMember({"dam", "sphere", "all"}));
+    app.add_option("--method", opt.methods, "ghost, basic or both")->capture_default_str()
+        ->check(CLI::IsMember({"ghost", "basic", "both"}));
+    app.add_option("--seed", opt.seed, "random seed of all sampling")->capture_default_str();
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+
+    try {
+        openvdb::initialize();
+        parallel::ThreadLimit limit(opt.threads);
+        std::string command;
+        for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
+        std::printf("command: %s\n", command.c_str());
+        std::printf("threads: %d, Real = %s, dt = %s\n", parallel::maxThreads(),
+                    sizeof(Real) == 4 ? "float" : "double",
+                    opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str() : "1/600 s (fixed)");
+
+        std::vector<RunResult> all;
+        if (opt.scenes != "sphere") {
+            for (const RunResult& r : runScene(damBreak(opt.damLiquid), opt)) all.push_back(r);
+        }
+        if (opt.scenes != "dam") {
+            const Scene scene = sphereDrop(opt.sphereLiquid, opt.sphereSpacing);
+            for (const RunResult& r : runScene(scene, opt)) all.push_back(r);
+        }
+
+        std::printf("\n| scene | method | liquid | ghost air | ghost solid / boundary | ms/step | "
+                    "nbr+density | pressure | XSPH+boundary | air resampling | mean nbrs | "
+                    "ns/pair | wall s / sim s |\n"
+                    "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        bool failed = false;
+        for (const RunResult& r : all) {
+            if (!r.ok) failed = true;
+            if (r.steps == 0) {
+                std::printf("| %s | %s | blew up in the warm-up: see above | | | | | | | | | | |\n",
+                            r.scene.c_str(), methodName(r.method));
+                continue;
+            }
+            if (!r.ok) {
+                std::printf("| %s | %s (blew up after %d measured steps) | %zu | %zu | %zu | %.1f "
+                            "| | | | | %.1f | %.2f | %.0f |\n", r.scene.c_str(),
+                            methodName(r.method), r.steps, r.liquid, r.air, r.solid,
+                            1e3 * r.meanStep, r.meanNeighbors,
+                            1e9 * r.meanStep / (double(r.liquid) * r.meanNeighbors),
+                            r.meanStep / r.dt);
+                continue;
+            }
+            const PhaseTimings& t = r.phases;
+            const double n = double(t.steps);
+            auto cell = [&](double s) {
+                char text[64];
+                std::snprintf(text, sizeof(text), "%.1f (%.0f %%)", 1e3 * s / n,
+                              percent(s, t.total));
+                return std::string(text);
+            };
+            std::printf("| %s | %s | %zu | %zu | %zu | %.1f | %s | %s | %s | %s | %.1f | %.2f | "
+                        "%.0f |\n",
+                        r.scene.c_str(), methodName(r.method), r.liquid, r.air, r.solid,
+                        1e3 * r.meanStep, cell(t.neighborsAndDensity).c_str(),
+                        cell(t.pressureForce).c_str(), cell(t.xsphAndBoundary).c_str(),
+                        cell(t.airResampling).c_str(), r.meanNeighbors,
+                        1e9 * r.meanStep / (double(r.liquid) * r.meanNeighbors), r.meanStep / r.dt);
+        }
+        return failed ? 1 : 0;
+    } catch (const ghostfx::Error& e) {
+        std::fprintf(stderr, "bench_liquid: error: %s\n", e.what());
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_liquid: internal error: %s\n", e.what());
+        return 2;
+    }
+}
