@@ -396,16 +396,37 @@ void GhostSolver::resampleAir()
     const double time = mTime;
 
     std::vector<Vec3> liquid, liquidV;
-    Aabb bounds;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
         if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
         liquid.push_back(mParticles.positions()[i]);
         liquidV.push_back(mParticles.velocities()[i]);
-        bounds.expand(mParticles.positions()[i]);
     }
     if (liquid.empty()) return;
     NeighborGrid liquidGrid(R);
     liquidGrid.build(liquid);
+
+    // The liquid body: particles with at least one liquid neighbour. Isolated particles move
+    // ballistically and get no air ([SB12] Sec. 4.5); like the solids they are obstacles the
+    // new air keeps r away from. Air lives within a kernel radius of the body only, so escaped
+    // spray neither attracts air nor stretches the sampling region.
+    std::vector<Vec3> body, bodyV, obstacles;
+    Aabb bounds;
+    for (std::size_t i = 0; i < liquid.size(); ++i) {
+        int n = 0;
+        liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real) { ++n; });
+        if (n > 1) {
+            body.push_back(liquid[i]);
+            bodyV.push_back(liquidV[i]);
+            bounds.expand(liquid[i]);
+        } else {
+            obstacles.push_back(liquid[i]);
+        }
+    }
+    NeighborGrid bodyGrid(R);
+    bodyGrid.build(body);
+    auto nearBody = [&](const Vec3& x, Real* distance = nullptr) {
+        return bodyGrid.nearest(x, R, [](Index) { return true; }, distance);
+    };
 
     auto insideSolid = [&](const Vec3& x) {
         for (const auto& solid : mSolids) {
@@ -427,7 +448,9 @@ void GhostSolver::resampleAir()
         std::vector<Real> sums(liquid.size());
         parallel::forEach(0, liquid.size(), [&](std::size_t i) {
             Real sum = 0;
-            liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real rij) { sum += mKernel.W(rij); });
+            liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real rij) {
+                sum += mKernel.W(rij);
+            });
             sums[i] = sum;
         });
         std::nth_element(sums.begin(), sums.begin() + sums.size() * 3 / 4, sums.end());
@@ -447,42 +470,60 @@ void GhostSolver::resampleAir()
         return sum > Real(0.5) * n0;
     };
 
-    // Keep the air that is still where the layer should be: within a kernel radius of the liquid,
-    // no closer to it than a fraction of r, outside solids. The rest fades out, and new air fades
-    // in, over the steps until the next resampling: replacing the whole layer at once (as [SB12]
-    // Sec. 4.3 describes) makes the surface density jump by a few percent at every resampling,
-    // which with the paper's soft stiffness pumps energy into the liquid; fading is the remedy
-    // [SB12] Sec. 4.7 suggests.
-    const Real minLiquidDistance = mSettings.airKeepFraction * r;
+    // Keep the air that is still where the layer should be: within a kernel radius of the
+    // liquid body, no closer to it than a fraction of r, outside solids and the liquid, and not
+    // crowded (air advected with converging liquid bunches up: of two air particles closer than
+    // that fraction of r, the later one goes). The rest fades out, and new air fades in, over the
+    // steps until the next resampling: replacing the whole layer at once (as [SB12] Sec. 4.3
+    // describes) makes the surface density jump by a few percent at every resampling, which with
+    // the paper's soft stiffness pumps energy into the liquid; fading is the remedy [SB12]
+    // Sec. 4.7 suggests.
+    const Real keepDistance = mSettings.airKeepFraction * r;
     auto& target = mParticles.scalarChannel(AIR_TARGET);
-    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
-        if (mParticles.kinds()[i] != ParticleKind::GhostAir) return;
+    const std::size_t n = mParticles.size();
+    std::vector<std::uint8_t> keep(n, 0);
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
         const Vec3& x = mParticles.positions()[i];
         Real d = -1;
-        const Index j = liquidGrid.nearest(x, R, [](Index) { return true; }, &d);
-        if (j == INVALID_INDEX || d < minLiquidDistance || insideSolid(x) || insideLiquid(x)) {
-            target[i] = Real(0);
-        }
+        keep[i] = nearBody(x, &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x) &&
+                  !insideLiquid(x);
     });
-
-    // Seeds: liquid particles with at least one liquid neighbour, and the kept air. Isolated
-    // liquid particles move ballistically and get no air ([SB12] Sec. 4.5); like the solids they
-    // are obstacles the new air keeps r away from.
-    std::vector<Vec3> seeds, obstacles;
-    for (std::size_t i = 0; i < liquid.size(); ++i) {
-        int n = 0;
-        liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real) { ++n; });
-        (n > 1 ? seeds : obstacles).push_back(liquid[i]);
+    if (keepDistance > Real(0)) {
+        std::vector<Vec3> airX;
+        std::vector<std::size_t> airIndex;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (keep[i]) { airX.push_back(mParticles.positions()[i]); airIndex.push_back(i); }
+        }
+        NeighborGrid airGrid(keepDistance);
+        airGrid.build(airX);
+        for (std::size_t a = 0; a < airX.size(); ++a) {
+            airGrid.forEachNeighbor(Index(a), [&](Index b, const Vec3&, Real) {
+                if (b < a && keep[airIndex[b]]) keep[airIndex[a]] = 0;
+            });
+        }
     }
-    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+    std::vector<Vec3> seeds = body;
+    for (std::size_t i = 0; i < n; ++i) {
         const ParticleKind k = mParticles.kinds()[i];
-        if (k == ParticleKind::GhostAir && target[i] > Real(0)) seeds.push_back(mParticles.positions()[i]);
-        else if (k != ParticleKind::Liquid) obstacles.push_back(mParticles.positions()[i]);
+        if (k == ParticleKind::GhostAir) {
+            if (keep[i]) {
+                seeds.push_back(mParticles.positions()[i]);
+            } else {
+                // Fading air is no obstacle: the new layer cross-fades with it.
+                target[i] = Real(0);
+            }
+        } else if (k != ParticleKind::Liquid) {
+            obstacles.push_back(mParticles.positions()[i]);
+        }
+    }
+    if (body.empty()) {
+        mTimings.airResampling += secondsSince(start);
+        return;
     }
 
     auto accept = [&](const Vec3& x) {
-        return liquidGrid.nearest(x, R, [](Index) { return true; }) != INVALID_INDEX &&
-               !insideSolid(x) && !insideLiquid(x);
+        return nearBody(x) != INVALID_INDEX && !insideSolid(x) && !insideLiquid(x);
     };
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
@@ -498,8 +539,8 @@ void GhostSolver::resampleAir()
     parallel::forEach(first, mParticles.size(), [&](std::size_t i) {
         weight[i] = fade ? Real(0) : Real(1);
         mParticles.masses()[i] = weight[i] * mMass;
-        const Index j = liquidGrid.nearest(mParticles.positions()[i], R, [](Index) { return true; });
-        mParticles.velocities()[i] = j == INVALID_INDEX ? Vec3(0) : liquidV[j];
+        const Index j = nearBody(mParticles.positions()[i]);
+        mParticles.velocities()[i] = j == INVALID_INDEX ? Vec3(0) : bodyV[j];
         mParticles.densities()[i] = mSettings.restDensity;
     });
     mTimings.airResampling += secondsSince(start);

@@ -68,7 +68,8 @@ TEST(Emitter, EmitsCrossSectionTimesSpeedWithoutOverlap)
                 volume, expected, 100 * (volume - expected) / expected, minSpacing / r,
                 solver.killedCount());
     // Volume per particle m / rho0 holds for liquid at rest density; the sampler fills the
-    // nozzle at its usual packing, and the stream sheds the nozzle's boundary layer: 15 %.
+    // nozzle at its usual packing, and the stream sheds the nozzle's boundary layer. Measured
+    // +4 % to +12 % as the air treatment changed; bound 15 %.
     EXPECT_NEAR(volume / expected, 1.0, 0.15);
     // New particles are placed at least r from every particle, then all move one step (new
     // ones at the emitter speed, old ones slowed a little by the stream's pressure): bound
