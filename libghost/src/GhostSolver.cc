@@ -606,11 +606,14 @@ void GhostSolver::sortAndComputeDensity()
                      std::max(1.0, liquidCount);
 
     // Algorithm 3 lines 5-7: ghost solid density = density of the nearest liquid particle.
+    // The nearest liquid particle is kept for the velocity extrapolation of lines 16-18.
     if (ghost) {
         const Real R = mSettings.supportRadius();
+        mNearestLiquid.assign(n, INVALID_INDEX);
         parallel::forEach(0, n, [&](std::size_t i) {
             if (kind[i] != ParticleKind::GhostSolid) return;
             const Index j = nearestLiquid(x[i], R);
+            mNearestLiquid[i] = j;
             rho[i] = j == INVALID_INDEX ? rho0 : rho[j];
         });
     }
@@ -727,7 +730,7 @@ void GhostSolver::stepGhost(Real dt)
             vstar[i] = solidV[i];
             return;
         }
-        const Index j = nearestLiquid(x[i], R);
+        const Index j = mNearestLiquid[i];
         const Vec3 vl = j == INVALID_INDEX ? solidV[i] : vstar[j];
         vstar[i] = solidV[i].dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
     });

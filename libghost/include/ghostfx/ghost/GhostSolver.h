@@ -160,6 +160,7 @@ private:
     Real mMass = 0;
     Real mLennardJones = 0;
     Real mMaxAcceleration = 0; ///< largest liquid acceleration of the last step (m/s^2)
+    std::vector<Index> mNearestLiquid; ///< per ghost solid, its nearest liquid particle this step
     bool mInitialized = false;
     double mTime = 0;
     std::uint64_t mStep = 0;
