@@ -6,3 +6,6 @@ build=${1:-build}
 echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; load: $(cut -d' ' -f1-3 /proc/loadavg)"
 "$build/bench/bench_neighbors" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 "$build/bench/bench_sampler" --benchmark_counters_tabular=true
+# Liquid scene benchmark ([SB12] Sec. 5): dam break of ~100k liquid particles and a sphere drop,
+# Ghost and Basic SPH (a few minutes, mostly sampling the solids).
+"$build/bench/bench_liquid"
