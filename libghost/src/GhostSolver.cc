@@ -348,7 +348,14 @@ void GhostSolver::initialize()
             GhostSettings probeSettings = mSettings;
             probeSettings.method = Method::Ghost;
             GhostSolver probe(probeSettings);
-            for (const auto& solid : mSolids) probe.addMovingSolid(solid->shape, solid->motion);
+            // The probe shares the solids and takes this solver's boundary particles as its
+            // ghost solids: sampling them again would cost as much as the first time.
+            for (const auto& solid : mSolids) probe.mSolids.push_back(std::make_unique<Solid>(*solid));
+            std::vector<Vec3> boundary;
+            for (std::size_t i = 0; i < positions.size(); ++i) {
+                if (mParticles.kinds()[i] == ParticleKind::Boundary) boundary.push_back(positions[i]);
+            }
+            probe.mParticles.addBatch(boundary, Real(0), ParticleKind::GhostSolid);
             std::vector<Vec3> liquidOnly;
             for (std::size_t i = 0; i < liquid.size(); ++i) {
                 if (liquid[i]) liquidOnly.push_back(positions[i]);
