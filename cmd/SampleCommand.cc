@@ -14,14 +14,17 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 namespace ghostfx {
 namespace cmd {
 
 using namespace sph;
 
-CLI::App* addSampleCommand(CLI::App& app, SampleOptions& o)
+Command addSampleCommand(CLI::App& app)
 {
+    auto options = std::make_shared<SampleOptions>();
+    SampleOptions& o = *options;
     CLI::App* c = app.add_subcommand("sample",
         "Poisson-disk sample a level-set shape ([SB12] Sec. 4.5) and print particle statistics");
     c->add_option("--shape", o.shape, "sphere, box or torus")
@@ -39,7 +42,7 @@ CLI::App* addSampleCommand(CLI::App& app, SampleOptions& o)
         ->check(CLI::PositiveNumber)->capture_default_str();
     c->add_option("--seed", o.seed, "random seed")->capture_default_str();
     c->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
-    return c;
+    return {c, [options] { return runSample(*options); }};
 }
 
 namespace {

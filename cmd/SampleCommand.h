@@ -2,7 +2,7 @@
 /// @brief  `ghostfx sample`: Poisson-disk sampling of a built-in shape, with statistics.
 #pragma once
 
-#include <CLI/CLI.hpp>
+#include "Command.h"
 
 #include <cstdint>
 #include <string>
@@ -21,8 +21,6 @@ struct SampleOptions
     std::uint64_t seed = 0;
     int threads = 0;
 };
-
-CLI::App* addSampleCommand(CLI::App& app, SampleOptions& options);
 
 /// Run the command; returns the process exit code. Throws ghostfx::Error on bad input.
 int runSample(const SampleOptions& options);

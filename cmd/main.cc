@@ -1,10 +1,12 @@
 /// @file   main.cc
 /// @brief  The `ghostfx` command line. Only this file exits; libraries throw (STYLE.md rule 7).
-/// @details Sub-commands so far:
-///            ghostfx sample   Poisson-disk sample a built-in level-set shape ([SB12] Sec. 4.5)
-///                             and print particle statistics.
-///          `run`, `info`, `preview` and `mesh2sdf` arrive with the pipeline (vdbio).
-#include "SampleCommand.h"
+/// @details Sub-commands:
+///            ghostfx run       simulate a scene to a VDB frame sequence (checkpoints, stats, previews)
+///            ghostfx info      describe a .vdb file (grids, classes, voxels, points) or an .h5 file
+///            ghostfx preview   render a density or surface grid to an EXR image
+///            ghostfx mesh2sdf  convert an OBJ/PLY/... triangle mesh to a level set
+///            ghostfx sample    Poisson-disk sample a built-in shape and print statistics
+#include "Command.h"
 
 #include <ghostfx/sph/Exceptions.h>
 
@@ -13,6 +15,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <vector>
 
 int main(int argc, char** argv)
 {
@@ -21,9 +24,10 @@ int main(int argc, char** argv)
                                           openvdb::getLibraryAbiVersionString() + ")");
     app.require_subcommand(1);
 
-    ghostfx::cmd::SampleOptions sampleOptions;
-    CLI::App* sample = ghostfx::cmd::addSampleCommand(app, sampleOptions);
-
+    using namespace ghostfx::cmd;
+    const std::vector<Command> commands = {addRunCommand(app), addInfoCommand(app),
+                                           addPreviewCommand(app), addMesh2SdfCommand(app),
+                                           addSampleCommand(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -32,7 +36,9 @@ int main(int argc, char** argv)
 
     try {
         openvdb::initialize();
-        if (sample->parsed()) return ghostfx::cmd::runSample(sampleOptions);
+        for (const Command& command : commands) {
+            if (command.app->parsed()) return command.run();
+        }
     } catch (const ghostfx::Error& e) {
         std::fprintf(stderr, "ghostfx: error: %s\n", e.what());
         return 1;

@@ -9,7 +9,7 @@ packages=(
     cmake g++ make ninja-build pkg-config ccache
     libopenvdb-dev libboost-iostreams-dev libtbb-dev libeigen3-dev
     libhdf5-dev libopenexr-dev python3-imath
-    libgtest-dev libgmock-dev libbenchmark-dev
+    libgtest-dev libgmock-dev libbenchmark-dev libassimp-dev
     nlohmann-json3-dev libcli11-dev
 )
 
