@@ -1,1 +1,369 @@
-// placeholder: filled in by the pipeline work (issue 4)
+/// @file   JsonReader.cc
+#include <ghostfx/vdbio/JsonReader.h>
+
+#include <ghostfx/sph/Exceptions.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace ghostfx {
+namespace vdbio {
+
+namespace {
+
+/// Short rendering of a value for messages.
+std::string shortDump(const Json& value)
+{
+    std::string text = value.dump();
+    if (text.size() > 60) text = text.substr(0, 57) + "...";
+    return text;
+}
+
+const char* typeWanted(const double*) { return "a number"; }
+const char* typeWanted(const int*) { return "an integer"; }
+const char* typeWanted(const std::int64_t*) { return "an integer"; }
+const char* typeWanted(const std::uint64_t*) { return "an integer >= 0"; }
+const char* typeWanted(const bool*) { return "true or false"; }
+const char* typeWanted(const std::string*) { return "a string"; }
+const char* typeWanted(const std::array<double, 3>*) { return "an array of 3 numbers"; }
+const char* typeWanted(const std::vector<double>*) { return "an array of numbers"; }
+const char* typeWanted(const std::vector<std::string>*) { return "an array of strings"; }
+
+bool convert(const Json& v, double& out)
+{
+    if (!v.is_number()) return false;
+    out = v.get<double>();
+    return std::isfinite(out);
+}
+bool convert(const Json& v, std::int64_t& out)
+{
+    if (v.is_number_integer()) {
+        out = v.get<std::int64_t>();
+        return true;
+    }
+    // 2.0 is accepted as an integer, 2.5 is not.
+    if (v.is_number_float()) {
+        const double d = v.get<double>();
+        if (std::isfinite(d) && d == std::floor(d) && std::abs(d) < 9e15) {
+            out = std::int64_t(d);
+            return true;
+        }
+    }
+    return false;
+}
+bool convert(const Json& v, int& out)
+{
+    std::int64_t wide = 0;
+    if (!convert(v, wide) || wide < std::numeric_limits<int>::min() ||
+        wide > std::numeric_limits<int>::max()) {
+        return false;
+    }
+    out = int(wide);
+    return true;
+}
+bool convert(const Json& v, std::uint64_t& out)
+{
+    if (v.is_number_unsigned()) {
+        out = v.get<std::uint64_t>();
+        return true;
+    }
+    std::int64_t wide = 0;
+    if (!convert(v, wide) || wide < 0) return false;
+    out = std::uint64_t(wide);
+    return true;
+}
+bool convert(const Json& v, bool& out)
+{
+    if (!v.is_boolean()) return false;
+    out = v.get<bool>();
+    return true;
+}
+bool convert(const Json& v, std::string& out)
+{
+    if (!v.is_string()) return false;
+    out = v.get<std::string>();
+    return true;
+}
+bool convert(const Json& v, std::array<double, 3>& out)
+{
+    if (!v.is_array() || v.size() != 3) return false;
+    for (int i = 0; i < 3; ++i) {
+        if (!convert(v[i], out[i])) return false;
+    }
+    return true;
+}
+bool convert(const Json& v, std::vector<double>& out)
+{
+    if (!v.is_array()) return false;
+    out.resize(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        if (!convert(v[i], out[i])) return false;
+    }
+    return true;
+}
+bool convert(const Json& v, std::vector<std::string>& out)
+{
+    if (!v.is_array()) return false;
+    out.resize(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        if (!convert(v[i], out[i])) return false;
+    }
+    return true;
+}
+
+std::size_t editDistance(const std::string& a, const std::string& b)
+{
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diagonal = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t above = row[j];
+            const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                              std::tolower(static_cast<unsigned char>(b[j - 1]));
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+} // namespace
+
+std::string closestKey(const std::string& key, const std::vector<std::string>& candidates)
+{
+    std::string best;
+    std::size_t bestDistance = std::numeric_limits<std::size_t>::max();
+    for (const std::string& c : candidates) {
+        const std::size_t d = editDistance(key, c);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = c;
+        }
+    }
+    // Close means: a few typos, relative to the length of the words.
+    const std::size_t allowed = std::max<std::size_t>(2, std::max(key.size(), best.size()) / 3);
+    return bestDistance <= allowed ? best : std::string();
+}
+
+JsonObject::JsonObject()
+    : mDocument(std::make_shared<const Json>(Json::object())), mValue(mDocument.get())
+{
+}
+
+JsonObject::JsonObject(std::shared_ptr<const Json> document, const Json* value, std::string path,
+                       std::string source)
+    : mDocument(std::move(document)), mValue(value), mPath(std::move(path)), mSource(std::move(source))
+{
+    if (!mValue || !mValue->is_object()) {
+        throw SceneError(msg("scene '", mSource, "': ", mPath.empty() ? "the document" : mPath,
+                             " = ", mValue ? shortDump(*mValue) : "null", ": expected an object { ... }"));
+    }
+}
+
+std::string JsonObject::pathOf(const std::string& key) const
+{
+    return mPath.empty() ? key : mPath + "." + key;
+}
+
+bool JsonObject::has(const std::string& key) const
+{
+    const Json* v = raw(key);
+    return v && !v->is_null();
+}
+
+const Json* JsonObject::raw(const std::string& key) const
+{
+    mKnown.insert(key);
+    auto it = mValue->find(key);
+    return it == mValue->end() ? nullptr : &*it;
+}
+
+void JsonObject::fail(const std::string& key, const std::string& what) const
+{
+    throw SceneError(msg("scene '", mSource, "': ", pathOf(key), ": ", what));
+}
+
+void JsonObject::failValue(const std::string& key, const std::string& what) const
+{
+    const Json* v = raw(key);
+    throw SceneError(msg("scene '", mSource, "': ", pathOf(key), " = ", v ? shortDump(*v) : "null",
+                         ": ", what));
+}
+
+template <typename T>
+T JsonObject::get(const std::string& key, const T& fallback) const
+{
+    const Json* v = raw(key);
+    if (!v || v->is_null()) return fallback;
+    T out{};
+    if (!convert(*v, out)) failValue(key, std::string("expected ") + typeWanted(&out));
+    return out;
+}
+
+template <typename T>
+T JsonObject::require(const std::string& key) const
+{
+    const Json* v = raw(key);
+    T out{};
+    if (!v || v->is_null()) {
+        fail(key, std::string("missing; expected ") + typeWanted(&out));
+    }
+    if (!convert(*v, out)) failValue(key, std::string("expected ") + typeWanted(&out));
+    return out;
+}
+
+template double JsonObject::get(const std::string&, const double&) const;
+template int JsonObject::get(const std::string&, const int&) const;
+template std::int64_t JsonObject::get(const std::string&, const std::int64_t&) const;
+template std::uint64_t JsonObject::get(const std::string&, const std::uint64_t&) const;
+template bool JsonObject::get(const std::string&, const bool&) const;
+template std::string JsonObject::get(const std::string&, const std::string&) const;
+template std::array<double, 3> JsonObject::get(const std::string&, const std::array<double, 3>&) const;
+template std::vector<double> JsonObject::get(const std::string&, const std::vector<double>&) const;
+template std::vector<std::string> JsonObject::get(const std::string&,
+                                                  const std::vector<std::string>&) const;
+template double JsonObject::require(const std::string&) const;
+template int JsonObject::require(const std::string&) const;
+template std::int64_t JsonObject::require(const std::string&) const;
+template std::uint64_t JsonObject::require(const std::string&) const;
+template bool JsonObject::require(const std::string&) const;
+template std::string JsonObject::require(const std::string&) const;
+template std::array<double, 3> JsonObject::require(const std::string&) const;
+template std::vector<double> JsonObject::require(const std::string&) const;
+template std::vector<std::string> JsonObject::require(const std::string&) const;
+
+double JsonObject::positive(const std::string& key, double fallback) const
+{
+    const double v = get<double>(key, fallback);
+    if (!(v > 0)) failValue(key, "expected a number > 0");
+    return v;
+}
+
+double JsonObject::nonNegative(const std::string& key, double fallback) const
+{
+    const double v = get<double>(key, fallback);
+    if (!(v >= 0)) failValue(key, "expected a number >= 0");
+    return v;
+}
+
+double JsonObject::inRange(const std::string& key, double fallback, double lo, double hi) const
+{
+    const double v = get<double>(key, fallback);
+    if (!(v >= lo && v <= hi)) failValue(key, msg("expected a number in [", lo, ", ", hi, "]"));
+    return v;
+}
+
+std::string JsonObject::choice(const std::string& key, const std::string& fallback,
+                               const std::vector<std::string>& choices) const
+{
+    const std::string v = get<std::string>(key, fallback);
+    if (std::find(choices.begin(), choices.end(), v) != choices.end()) return v;
+    std::string list;
+    for (const std::string& c : choices) list += (list.empty() ? "'" : ", '") + c + "'";
+    const std::string near = closestKey(v, choices);
+    failValue(key, "expected one of " + list + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
+}
+
+JsonObject JsonObject::object(const std::string& key) const
+{
+    const Json* v = raw(key);
+    if (!v || v->is_null()) fail(key, "missing; expected an object { ... }");
+    return JsonObject(mDocument, v, pathOf(key), mSource);
+}
+
+std::optional<JsonObject> JsonObject::optionalObject(const std::string& key) const
+{
+    if (!has(key)) return std::nullopt;
+    return JsonObject(mDocument, raw(key), pathOf(key), mSource);
+}
+
+std::vector<JsonObject> JsonObject::objects(const std::string& key) const
+{
+    std::vector<JsonObject> out;
+    const Json* v = raw(key);
+    if (!v || v->is_null()) return out;
+    if (!v->is_array()) failValue(key, "expected an array [ {...}, ... ]");
+    for (std::size_t i = 0; i < v->size(); ++i) {
+        out.emplace_back(mDocument, &(*v)[i], msg(pathOf(key), "[", i, "]"), mSource);
+    }
+    return out;
+}
+
+void JsonObject::finish() const
+{
+    for (auto it = mValue->begin(); it != mValue->end(); ++it) {
+        if (mKnown.count(it.key())) continue;
+        const std::vector<std::string> known(mKnown.begin(), mKnown.end());
+        const std::string near = closestKey(it.key(), known);
+        std::string hint;
+        if (!near.empty()) {
+            hint = " (did you mean '" + near + "'?)";
+        } else if (!known.empty()) {
+            hint = " (valid keys here:";
+            for (const std::string& k : known) hint += " " + k;
+            hint += ")";
+        }
+        fail(it.key(), "unknown key" + hint);
+    }
+}
+
+void applyOverride(Json& document, const std::string& assignment)
+{
+    const std::size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0) {
+        throw SceneError(msg("-D '", assignment, "': expected path=value, e.g. settings.stiffness=5000"));
+    }
+    const std::string path = assignment.substr(0, eq);
+    const std::string text = assignment.substr(eq + 1);
+    Json value = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (value.is_discarded()) value = text;
+
+    // Walk "a.b[2].c": names separated by dots, array indices in brackets.
+    Json* node = &document;
+    std::size_t i = 0;
+    std::string walked;
+    while (i < path.size()) {
+        if (path[i] == '[') {
+            const std::size_t close = path.find(']', i);
+            if (close == std::string::npos) {
+                throw SceneError(msg("-D ", path, ": unclosed '[' in the path"));
+            }
+            const std::string digits = path.substr(i + 1, close - i - 1);
+            if (digits.empty() || !std::all_of(digits.begin(), digits.end(), ::isdigit)) {
+                throw SceneError(msg("-D ", path, ": '[", digits, "]' is not an array index"));
+            }
+            const std::size_t index = std::stoul(digits);
+            if (!node->is_array() || index >= node->size()) {
+                throw SceneError(msg("-D ", path, ": ", walked.empty() ? "the document" : walked,
+                                     " has no element [", index, "] (", node->is_array() ? node->size() : 0,
+                                     " elements)"));
+            }
+            node = &(*node)[index];
+            walked += path.substr(i, close - i + 1);
+            i = close + 1;
+            if (i < path.size() && path[i] == '.') ++i;
+            continue;
+        }
+        std::size_t end = path.find_first_of(".[", i);
+        if (end == std::string::npos) end = path.size();
+        const std::string name = path.substr(i, end - i);
+        if (name.empty()) throw SceneError(msg("-D ", path, ": empty name in the path"));
+        if (node->is_null()) *node = Json::object();
+        if (!node->is_object()) {
+            throw SceneError(msg("-D ", path, ": ", walked, " is not an object"));
+        }
+        node = &(*node)[name];
+        walked += (walked.empty() ? "" : ".") + name;
+        i = end;
+        if (i < path.size() && path[i] == '.') ++i;
+    }
+    *node = value;
+}
+
+} // namespace vdbio
+} // namespace ghostfx

@@ -1,1 +1,405 @@
-// placeholder: filled in by the pipeline work (issue 4)
+/// @file   Scene.cc
+/// @brief  Scene reading: strict JSON, role-tagged .vdb scenes, level-set loading.
+#include <ghostfx/vdbio/Scene.h>
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/vdbio/AtomicFile.h>
+
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace ghostfx {
+namespace vdbio {
+
+namespace fs = std::filesystem;
+using sph::Vec3d;
+
+// Keyed motion ---------------------------------------------------------------------------------
+
+RigidKey KeyedMotion::at(double time) const
+{
+    if (keys.empty()) return RigidKey{};
+    if (time <= keys.front().time) return keys.front();
+    if (time >= keys.back().time) return keys.back();
+    const auto upper = std::upper_bound(keys.begin(), keys.end(), time,
+                                        [](double t, const RigidKey& k) { return t < k.time; });
+    const RigidKey& b = *upper;
+    const RigidKey& a = *(upper - 1);
+    const double s = (time - a.time) / (b.time - a.time);
+    RigidKey k;
+    k.time = time;
+    k.translate = a.translate + (b.translate - a.translate) * s;
+    k.rotateDegrees = a.rotateDegrees + (b.rotateDegrees - a.rotateDegrees) * s;
+    return k;
+}
+
+openvdb::math::Mat3d KeyedMotion::rotation(const Vec3d& degrees)
+{
+    const double d2r = M_PI / 180.0;
+    const double cx = std::cos(degrees[0] * d2r), sx = std::sin(degrees[0] * d2r);
+    const double cy = std::cos(degrees[1] * d2r), sy = std::sin(degrees[1] * d2r);
+    const double cz = std::cos(degrees[2] * d2r), sz = std::sin(degrees[2] * d2r);
+    const double one = 1, zero = 0;
+    const openvdb::math::Mat3d rx(one, zero, zero, zero, cx, -sx, zero, sx, cx);
+    const openvdb::math::Mat3d ry(cy, zero, sy, zero, one, zero, -sy, zero, cy);
+    const openvdb::math::Mat3d rz(cz, -sz, zero, sz, cz, zero, zero, zero, one);
+    return rz * ry * rx;
+}
+
+// Level sets -----------------------------------------------------------------------------------
+
+sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid, const std::string& context)
+{
+    std::error_code ec;
+    if (!fs::exists(file, ec)) {
+        throw IoError(msg(context, ": file '", file, "' does not exist"));
+    }
+    openvdb::io::File vdb(file);
+    try {
+        vdb.open(/*delayLoad=*/false);
+    } catch (const openvdb::Exception& e) {
+        throw IoError(msg(context, ": file '", file, "' is not a readable .vdb file (", e.what(), ")"));
+    }
+    if (!vdb.hasGrid(grid)) {
+        std::string names;
+        for (auto it = vdb.beginName(); it != vdb.endName(); ++it) names += (names.empty() ? "'" : ", '") + *it + "'";
+        vdb.close();
+        throw GridError(msg(context, ": file '", file, "' has no grid '", grid, "' (grids: ",
+                            names.empty() ? "none" : names, ")"));
+    }
+    openvdb::GridBase::Ptr base;
+    try {
+        base = vdb.readGrid(grid);
+    } catch (const openvdb::Exception& e) {
+        vdb.close();
+        throw IoError(msg(context, ": grid '", grid, "' in '", file, "' cannot be read (", e.what(), ")"));
+    }
+    vdb.close();
+    auto floatGrid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+    if (!floatGrid) {
+        throw GridError(msg(context, ": grid '", grid, "' in '", file, "' holds ", base->valueType(),
+                            " values, expected a float level set"));
+    }
+    try {
+        return sph::makeLevelSet(floatGrid, grid);
+    } catch (const GridError& e) {
+        throw GridError(msg(context, ": '", file, "': ", e.what()));
+    }
+}
+
+namespace {
+
+Vec3d vec(const std::array<double, 3>& a) { return Vec3d(a[0], a[1], a[2]); }
+
+std::string resolve(const std::string& folder, const std::string& path)
+{
+    if (path.empty() || fs::path(path).is_absolute()) return path;
+    return (fs::path(folder) / path).lexically_normal().string();
+}
+
+/// A shape: a grid in a file, or a built-in sphere, box or container (a closed tank: solid walls
+/// of thickness `wall` around the empty box [min, max]).
+sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string& description)
+{
+    const double defaultVoxel = 0.5 * scene.spacing;
+    const bool file = g.has("file"), sphere = g.has("sphere"), box = g.has("box"),
+               container = g.has("container");
+    if (int(file) + int(sphere) + int(box) + int(container) != 1) {
+        g.fail("", "expected exactly one of 'file' (with 'grid'), 'sphere', 'box' or 'container'");
+    }
+    if (file) {
+        const std::string path = resolve(scene.folder, g.require<std::string>("file"));
+        const std::string grid = g.require<std::string>("grid");
+        g.finish();
+        description = path + ":" + grid;
+        return loadLevelSet(path, grid, msg("scene '", scene.file, "': ", g.path()));
+    }
+    const double voxel = g.positive("voxel_size", defaultVoxel);
+    openvdb::FloatGrid::Ptr grid;
+    if (sphere) {
+        const JsonObject s = g.object("sphere");
+        const Vec3d c = vec(s.require<std::array<double, 3>>("center"));
+        const double r = s.positive("radius", 0);
+        s.finish();
+        if (r < 2 * voxel) s.failValue("radius", msg("expected at least 2 voxels (", 2 * voxel, " m)"));
+        grid = sph::makeSphereLevelSet(sph::Vec3(c), sph::Real(r), sph::Real(voxel));
+        description = msg("sphere r = ", r, " m");
+    } else {
+        const JsonObject b = g.object(box ? "box" : "container");
+        const Vec3d lo = vec(b.require<std::array<double, 3>>("min"));
+        const Vec3d hi = vec(b.require<std::array<double, 3>>("max"));
+        for (int a = 0; a < 3; ++a) {
+            if (!(hi[a] - lo[a] >= 2 * voxel)) {
+                b.failValue("max", msg("expected max > min + 2 voxels on every axis (axis ", a, ")"));
+            }
+        }
+        if (box) {
+            b.finish();
+            grid = sph::makeBoxLevelSet(sph::Vec3(lo), sph::Vec3(hi), sph::Real(voxel));
+            description = "box";
+        } else {
+            const double wall = b.positive("wall", 3 * scene.spacing);
+            b.finish();
+            const Vec3d w(wall);
+            // Walls: outside the inner box and inside the outer one, max(-inner, outer).
+            grid = sph::levelSetFromSdf(
+                [lo, hi, w](const openvdb::Vec3d& x) {
+                    return std::max(-sph::boxSignedDistance(x, lo, hi),
+                                    sph::boxSignedDistance(x, lo - w, hi + w));
+                },
+                sph::Aabb{sph::Vec3(lo - w), sph::Vec3(hi + w)}, sph::Real(voxel));
+            description = msg("container, wall ", wall, " m");
+        }
+    }
+    g.finish();
+    return sph::makeLevelSet(grid, g.path());
+}
+
+void readOutputs(const JsonObject& o, SceneOutputs& out)
+{
+    out.directory = o.get<std::string>("directory", out.directory);
+    // Each section: an object, or false / null to switch that output off.
+    auto section = [&](const char* key, auto&& read, auto&& off) {
+        const Json* v = o.raw(key);
+        if (!v) return;
+        if (v->is_null() || (v->is_boolean() && !v->get<bool>())) {
+            off();
+            return;
+        }
+        if (v->is_boolean()) return; // true: defaults
+        const JsonObject s = o.object(key);
+        read(s);
+        s.finish();
+    };
+    section("points", [&](const JsonObject& s) {
+        out.pointsFile = s.get<std::string>("file", out.pointsFile);
+        out.pointChannels = s.get<std::vector<std::string>>("channels", out.pointChannels);
+        out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
+    }, [&] { out.pointsFile.clear(); });
+    section("volume", [&](const JsonObject& s) {
+        out.volumeFile = s.get<std::string>("file", out.volumeFile);
+        out.volumeGrids = s.get<std::vector<std::string>>("grids", out.volumeGrids);
+        for (const std::string& g : out.volumeGrids) {
+            if (g != "surface" && g != "density" && g != "vel" && g != "temperature") {
+                const std::string near = closestKey(g, {"surface", "density", "vel", "temperature"});
+                s.failValue("grids", msg("grid '", g, "' is not one of surface, density, vel, temperature",
+                                         near.empty() ? "" : " (did you mean '" + near + "'?)"));
+            }
+        }
+        out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
+    }, [&] { out.volumeFile.clear(); });
+    out.previewFile.clear();
+    section("preview", [&](const JsonObject& s) {
+        out.previewFile = s.get<std::string>("file", "preview.$F4.exr");
+        out.previewGrid = s.get<std::string>("grid", out.previewGrid);
+        out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
+        out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
+    }, [&] { out.previewFile.clear(); });
+    if (!out.previewFile.empty() && out.volumeFile.empty()) {
+        o.fail("preview", "a preview renders a grid of the volume output, which is off");
+    }
+    section("checkpoint", [&](const JsonObject& s) {
+        out.checkpointFile = s.get<std::string>("file", out.checkpointFile);
+        out.checkpointEvery = int(s.inRange("every", out.checkpointEvery, 0, 1e6));
+    }, [&] { out.checkpointFile.clear(); });
+    section("stats", [&](const JsonObject& s) {
+        out.statsFile = s.get<std::string>("file", out.statsFile);
+    }, [&] { out.statsFile.clear(); });
+    o.finish();
+}
+
+/// Build the JSON document of a role-tagged .vdb scene: every float level-set grid with a
+/// ROLE_METADATA string becomes a solid, liquid, emitter or gas source; settings are defaults
+/// with the particle spacing at twice the finest voxel size.
+Json documentFromRoles(const std::string& path)
+{
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw IoError(msg("scene '", path, "': file does not exist"));
+    openvdb::io::File vdb(path);
+    try {
+        vdb.open(false);
+    } catch (const openvdb::Exception& e) {
+        throw IoError(msg("scene '", path, "': not a readable .vdb file (", e.what(), ")"));
+    }
+    openvdb::GridPtrVecPtr grids = vdb.readAllGridMetadata();
+    vdb.close();
+    Json doc = {{"ghostfx_scene", SCENE_FORMAT_VERSION}, {"settings", Json::object()}};
+    const std::string name = fs::path(path).filename().string();
+    double finest = 0;
+    for (const auto& grid : *grids) {
+        const auto role = grid->getMetadata<openvdb::StringMetadata>(ROLE_METADATA);
+        if (!role) continue;
+        Json entry = {{"name", grid->getName()},
+                      {"geometry", {{"file", name}, {"grid", grid->getName()}}}};
+        const std::string r = role->value();
+        if (r == "solid") doc["solids"].push_back(entry);
+        else if (r == "liquid") doc["liquids"].push_back(entry);
+        else if (r == "emitter") doc["emitters"].push_back(entry);
+        else if (r == "source") doc["gas_sources"].push_back(entry);
+        else {
+            throw SceneError(msg("scene '", path, "': grid '", grid->getName(), "' has ", ROLE_METADATA,
+                                 " '", r, "': expected solid, liquid, emitter or source"));
+        }
+        const double dx = grid->voxelSize()[0];
+        if (dx > 0 && (finest == 0 || dx < finest)) finest = dx;
+    }
+    if (!doc.contains("liquids") && !doc.contains("emitters") && !doc.contains("gas_sources")) {
+        throw SceneError(msg("scene '", path, "': no grid has ", ROLE_METADATA,
+                             " 'liquid', 'emitter' or 'source' (a .vdb scene needs grids tagged with roles;"
+                             " 'ghostfx mesh2sdf --role' writes them)"));
+    }
+    doc["settings"]["spacing"] = 2 * finest;
+    return doc;
+}
+
+} // namespace
+
+std::string Scene::simulationFingerprint() const
+{
+    Json copy = *document;
+    copy.erase("outputs");
+    if (copy.contains("settings") && copy["settings"].is_object()) copy["settings"].erase("frame_range");
+    return copy.dump();
+}
+
+Scene readScene(const std::string& path, const std::vector<std::string>& overrides)
+{
+    Json doc;
+    const std::string ext = extensionOf(path);
+    if (ext == ".vdb") {
+        doc = documentFromRoles(path);
+    } else {
+        std::ifstream in(path);
+        if (!in) throw IoError(msg("scene '", path, "': cannot open the file"));
+        try {
+            doc = Json::parse(in, nullptr, true, /*ignore_comments=*/true);
+        } catch (const Json::parse_error& e) {
+            // nlohmann's message carries the line and column.
+            std::string what = e.what();
+            const std::size_t colon = what.find(": ");
+            throw SceneError(msg("scene '", path, "': not valid JSON (",
+                                 colon == std::string::npos ? what : what.substr(colon + 2), ")"));
+        }
+    }
+    for (const std::string& o : overrides) {
+        try {
+            applyOverride(doc, o);
+        } catch (const SceneError& e) {
+            throw SceneError(msg("scene '", path, "': ", e.what()));
+        }
+    }
+
+    Scene scene;
+    scene.file = path;
+    scene.folder = fs::path(path).parent_path().string();
+    auto shared = std::make_shared<const Json>(std::move(doc));
+    scene.document = shared;
+    const JsonObject root(shared, shared.get(), "", path);
+
+    scene.version = root.require<int>("ghostfx_scene");
+    if (scene.version != SCENE_FORMAT_VERSION) {
+        root.failValue("ghostfx_scene", msg("this ghostfx reads scene format ", SCENE_FORMAT_VERSION));
+    }
+
+    // Shared settings; the solver-specific rest is read by the caller.
+    scene.settings = root.object("settings");
+    const JsonObject& s = scene.settings;
+    scene.method = s.choice("method", "ghost", {"ghost", "basic", "gas"});
+    scene.spacing = s.positive("spacing", 0.02);
+    scene.frameRate = s.positive("frame_rate", 30);
+    const std::vector<double> range = s.get<std::vector<double>>("frame_range", {1, 24});
+    if (range.size() != 2 || range[0] < 1 || range[1] < range[0] || range[0] != std::floor(range[0]) ||
+        range[1] != std::floor(range[1])) {
+        s.failValue("frame_range", "expected [first, last] with 1 <= first <= last, whole numbers");
+    }
+    scene.firstFrame = int(range[0]);
+    scene.lastFrame = int(range[1]);
+
+    if (auto domain = root.optionalObject("domain")) {
+        if (auto kill = domain->optionalObject("kill_box")) {
+            const Vec3d lo = vec(kill->require<std::array<double, 3>>("min"));
+            const Vec3d hi = vec(kill->require<std::array<double, 3>>("max"));
+            kill->finish();
+            if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2])) {
+                domain->failValue("kill_box", "expected max > min on every axis");
+            }
+            scene.killBox = sph::Aabb{sph::Vec3(lo), sph::Vec3(hi)};
+        }
+        domain->finish();
+    }
+
+    for (const JsonObject& o : root.objects("solids")) {
+        const std::string name = o.get<std::string>("name", o.path());
+        std::string geometry;
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        SceneSolid solid{name, geometry, shape};
+        solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
+        if (auto motion = o.optionalObject("motion")) {
+            for (const JsonObject& k : motion->objects("keys")) {
+                RigidKey key;
+                key.time = k.require<double>("time");
+                key.translate = vec(k.get<std::array<double, 3>>("translate", {0, 0, 0}));
+                key.rotateDegrees = vec(k.get<std::array<double, 3>>("rotate", {0, 0, 0}));
+                k.finish();
+                if (!solid.motion.keys.empty() && !(key.time > solid.motion.keys.back().time)) {
+                    k.failValue("time", "expected key times in increasing order");
+                }
+                solid.motion.keys.push_back(key);
+            }
+            if (solid.motion.keys.empty()) motion->fail("keys", "expected at least one key");
+            motion->finish();
+            if (solid.velocity != Vec3d(0)) o.fail("velocity", "give either 'velocity' or 'motion', not both");
+        }
+        if (auto seq = o.optionalObject("sequence")) {
+            solid.sequenceFile = resolve(scene.folder, seq->require<std::string>("file"));
+            solid.sequenceGrid = seq->require<std::string>("grid");
+            seq->finish();
+            if (!hasFrameToken(solid.sequenceFile)) {
+                seq->failValue("file", "expected a frame pattern with $F (e.g. paddle.$F4.vdb)");
+            }
+        }
+        o.finish();
+        scene.solids.push_back(std::move(solid));
+    }
+    for (const JsonObject& o : root.objects("liquids")) {
+        const std::string name = o.get<std::string>("name", o.path());
+        std::string geometry;
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        SceneLiquid liquid{name, geometry, shape};
+        liquid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
+        o.finish();
+        scene.liquids.push_back(std::move(liquid));
+    }
+    for (const JsonObject& o : root.objects("emitters")) {
+        const std::string name = o.get<std::string>("name", o.path());
+        std::string geometry;
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        SceneEmitter emitter{name, geometry, shape};
+        emitter.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
+        emitter.start = o.nonNegative("start", 0);
+        emitter.end = o.get<double>("end", std::numeric_limits<double>::infinity());
+        if (!(emitter.end > emitter.start)) o.failValue("end", msg("expected end > start (", emitter.start, " s)"));
+        o.finish();
+        scene.emitters.push_back(std::move(emitter));
+    }
+    if (root.has("gas_sources")) {
+        root.fail("gas_sources", "gas sources need the gas solver ([RYY15]), which this build of "
+                                 "ghostfx does not have yet");
+    }
+    if (auto outputs = root.optionalObject("outputs")) readOutputs(*outputs, scene.outputs);
+    root.finish();
+
+    if (scene.liquids.empty() && scene.emitters.empty()) {
+        root.fail("liquids", "the scene has no liquid: expected at least one liquid body or emitter");
+    }
+    return scene;
+}
+
+} // namespace vdbio
+} // namespace ghostfx

@@ -1,0 +1,164 @@
+/// @file   Scene.h
+/// @brief  Scenes: a versioned JSON file (or a .vdb whose grids carry roles) read into
+///         level sets, motions, emitters and output requests, ready for a solver.
+/// @details The reader is strict (JsonReader.h): unknown keys, wrong types and values out of
+///          range stop the read with one line naming the file, the key path and what was
+///          expected. Level sets are read from .vdb files by file and grid name, relative to the
+///          scene's folder, and validated (class, uniform voxels, finite values); built-in shapes
+///          (sphere, box, container) need no input files.
+///
+///          vdbio knows no solver: the solver-specific part of `settings` is left to the caller,
+///          who reads it from Scene::settings and then calls Scene::settings.finish() so that a
+///          misspelt key there is reported too.
+///
+///          A minimal scene:
+///          @code{.json}
+///          { "ghostfx_scene": 1,
+///            "settings": { "method": "ghost", "spacing": 0.02, "frame_range": [1, 48] },
+///            "solids":  [ { "name": "tank", "geometry": { "container": { "min": [0,0,0], "max": [1,1,0.4] } } } ],
+///            "liquids": [ { "name": "water", "geometry": { "file": "water.vdb", "grid": "surface" } } ] }
+///          @endcode
+///          The full format is in docs/scene-format.md.
+#pragma once
+
+#include <ghostfx/sph/LevelSet.h>
+#include <ghostfx/sph/Types.h>
+#include <ghostfx/vdbio/JsonReader.h>
+
+#include <openvdb/math/Mat3.h>
+
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ghostfx {
+namespace vdbio {
+
+/// Version of the scene format this ghostfx reads.
+constexpr int SCENE_FORMAT_VERSION = 1;
+
+/// Metadata key of a grid's role in a role-tagged .vdb scene ("solid", "liquid", "emitter", "source").
+constexpr const char* ROLE_METADATA = "ghostfx_role";
+
+/// One key of a rigid motion: at `time` (s) the solid's local frame is rotated by
+/// `rotateDegrees` (about x, then y, then z) and moved by `translate` (m).
+struct RigidKey
+{
+    double time = 0;
+    sph::Vec3d translate{0};
+    sph::Vec3d rotateDegrees{0};
+};
+
+/// Piecewise-linear rigid motion through keys: translation and the three angles are
+/// interpolated linearly (exact for a rotation about one axis); held constant before the first
+/// and after the last key.
+struct KeyedMotion
+{
+    std::vector<RigidKey> keys;
+
+    /// The interpolated key at time t (s).
+    RigidKey at(double time) const;
+    /// Rotation for column vectors, world = R * local + translate: R = Rz * Ry * Rx.
+    static openvdb::math::Mat3d rotation(const sph::Vec3d& degrees);
+};
+
+struct SceneSolid
+{
+    SceneSolid(std::string name_, std::string geometry_, sph::LevelSet shape_)
+        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+
+    std::string name;
+    std::string geometry;        ///< where the shape came from, for messages and reports
+    sph::LevelSet shape;
+    sph::Vec3d velocity{0};      ///< constant velocity (m/s), if no keys
+    KeyedMotion motion;          ///< keyed rigid motion (empty: constant velocity)
+    /// Per-frame shapes (deforming solid): file pattern with $F and grid name; empty if static.
+    std::string sequenceFile, sequenceGrid;
+};
+
+struct SceneLiquid
+{
+    SceneLiquid(std::string name_, std::string geometry_, sph::LevelSet shape_)
+        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+
+    std::string name;
+    std::string geometry;
+    sph::LevelSet shape;
+    sph::Vec3d velocity{0};
+};
+
+struct SceneEmitter
+{
+    SceneEmitter(std::string name_, std::string geometry_, sph::LevelSet shape_)
+        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+
+    std::string name;
+    std::string geometry;
+    sph::LevelSet shape;
+    sph::Vec3d velocity{0};
+    double start = 0, end = std::numeric_limits<double>::infinity();
+};
+
+/// What to write per frame. Paths are frame patterns relative to `directory`; empty = off.
+struct SceneOutputs
+{
+    std::string directory = "out";
+    // Points: a PointDataGrid "particles".
+    std::string pointsFile = "liquid_points.$F4.vdb";
+    std::vector<std::string> pointChannels{"v", "id", "density", "pressure"};
+    bool pointGhosts = false;         ///< also write ghost air / ghost solid particles (with "kind")
+    // Volumes.
+    std::string volumeFile = "liquid.$F4.vdb";
+    std::vector<std::string> volumeGrids{"surface", "density", "vel"};
+    double voxelSize = 0;             ///< 0: half the particle spacing
+    // EXR preview of one grid of the volume file.
+    std::string previewFile;
+    std::string previewGrid;          ///< "" : density if written, else surface
+    int previewWidth = 640, previewHeight = 360;
+    // HDF5 checkpoint every N frames (0: only at the end and on interruption).
+    std::string checkpointFile = "checkpoint.$F4.h5";
+    int checkpointEvery = 10;
+    // Per-step statistics (HDF5, and a CSV beside it).
+    std::string statsFile = "stats.h5";
+};
+
+struct Scene
+{
+    std::string file;    ///< the scene file as given
+    std::string folder;  ///< folder input paths are relative to
+    int version = SCENE_FORMAT_VERSION;
+
+    /// The document after `-D` overrides.
+    std::shared_ptr<const Json> document;
+    /// The settings object; the caller reads its solver-specific keys, then calls finish().
+    JsonObject settings;
+
+    // Settings every solver shares.
+    std::string method;          ///< "ghost", "basic" (liquids), "gas" (gases)
+    double spacing = 0;          ///< particle spacing h (m)
+    double frameRate = 30;       ///< frames per second
+    int firstFrame = 1, lastFrame = 24; ///< frames written; frame f is the state at t = f / frameRate
+
+    sph::Aabb killBox;           ///< empty: none
+    std::vector<SceneSolid> solids;
+    std::vector<SceneLiquid> liquids;
+    std::vector<SceneEmitter> emitters;
+    SceneOutputs outputs;
+
+    /// Canonical JSON text of everything that changes the simulation (all but `outputs` and
+    /// the frame range): stored in checkpoints, compared on resume.
+    std::string simulationFingerprint() const;
+};
+
+/// Read a scene: a .json scene file, or a .vdb whose level-set grids carry a ROLE_METADATA
+/// string (a complete scene with default settings). `overrides` are `path=value` assignments
+/// applied to the document before reading (`-D` on the command line).
+Scene readScene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// Read and validate one level-set grid from a .vdb file; `context` names the scene key in
+/// messages ("solids[0].geometry").
+sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid, const std::string& context);
+
+} // namespace vdbio
+} // namespace ghostfx
