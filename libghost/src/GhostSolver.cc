@@ -76,14 +76,14 @@ GhostSolver::GhostSolver(const GhostSettings& settings)
     , mKernel((settings.validate(), settings.supportRadius()))
     , mGrid(settings.supportRadius())
 {
+    // Model only what the scene needs: v* is used by every step of both methods; the ghost air
+    // channels only by Ghost SPH (Basic SPH has no air); the solid channels come with the first
+    // solid (ensureSolidChannels).
     mParticles.addVectorChannel(VSTAR);
-    mParticles.addVectorChannel(SOLID_NORMAL);
-    mParticles.addVectorChannel(SOLID_VELOCITY);
-    mParticles.addVectorChannel(SOLID_LOCAL);
-    mParticles.addVectorChannel(SOLID_LOCAL_NORMAL);
-    mParticles.addScalarChannel(SOLID_INDEX, Real(-1));
-    mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
-    mParticles.addScalarChannel(AIR_TARGET, Real(1));
+    if (mSettings.method == Method::Ghost) {
+        mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
+        mParticles.addScalarChannel(AIR_TARGET, Real(1));
+    }
 }
 
 GhostSolver::~GhostSolver() = default;
@@ -94,12 +94,15 @@ void GhostSolver::setParticleMass(Real mass)
         throw ValueError(msg("particle mass = ", mass, " kg: expected a finite value > 0"));
     }
     mMass = mass;
-    const auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
+    const std::vector<Real>* weight =
+        mParticles.hasScalarChannel(AIR_WEIGHT) ? &mParticles.scalarChannel(AIR_WEIGHT) : nullptr;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        const bool air = mParticles.kinds()[i] == ParticleKind::GhostAir;
-        mParticles.masses()[i] = air ? weight[i] * mass : mass;
+        const bool air = weight && mParticles.kinds()[i] == ParticleKind::GhostAir;
+        mParticles.masses()[i] = air ? (*weight)[i] * mass : mass;
     }
 }
+
+void GhostSolver::setStepObserver(StepObserver observer) { mObserver = std::move(observer); }
 
 // Set-up ---------------------------------------------------------------------------------------
 
@@ -118,8 +121,20 @@ void GhostSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
 void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
 {
     if (!motion) throw ValueError(msg("solid '", solid.name(), "': no motion given"));
+    ensureSolidChannels();
     mSolids.push_back(std::make_unique<Solid>(Solid{solid, std::move(motion)}));
-    sampleSolid(mSolids.size() - 1);
+    // A solid the restored state already holds keeps its restored particles: sampling it again
+    // would duplicate them (and, with a seed that depends on the step, differ from them).
+    if (mSolids.size() > mRestoredSolids) sampleSolid(mSolids.size() - 1);
+}
+
+void GhostSolver::ensureSolidChannels()
+{
+    mParticles.addVectorChannel(SOLID_NORMAL);
+    mParticles.addVectorChannel(SOLID_VELOCITY);
+    mParticles.addVectorChannel(SOLID_LOCAL);
+    mParticles.addVectorChannel(SOLID_LOCAL_NORMAL);
+    mParticles.addScalarChannel(SOLID_INDEX, Real(-1));
 }
 
 void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
@@ -197,6 +212,11 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
 
 std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
 {
+    if (mRestored) {
+        throw ValueError(msg("liquid '", shape.name(), "': cannot add liquid after restoreState(); "
+                             "the restored particles already hold the liquid (skip liquid "
+                             "bodies when resuming)"));
+    }
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.seed = mSettings.seed + 7919ULL * (mParticles.count(ParticleKind::Liquid) + 1);
     SampleSet samples = PoissonDiskSampler(ps).sampleVolume(shape);
@@ -213,6 +233,10 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
 
 void GhostSolver::addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity)
 {
+    if (mRestored) {
+        throw ValueError("cannot add liquid particles after restoreState(); the restored particles "
+                         "already hold the liquid (skip liquid bodies when resuming)");
+    }
     for (std::size_t k = 0; k < positions.size(); ++k) {
         if (!isFinite(positions[k])) {
             throw ValueError(msg("liquid particle ", k, " has a non-finite position"));
@@ -639,6 +663,7 @@ void GhostSolver::step(Real dt)
     if (!(dt > Real(0)) || !std::isfinite(dt)) {
         throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
     }
+    checkRestoredInputs();
     const bool fresh = !mInitialized;
     initialize();
     const auto start = std::chrono::steady_clock::now();
@@ -679,6 +704,7 @@ void GhostSolver::step(Real dt)
     checkBlowUp();
     mTimings.total += secondsSince(start);
     ++mTimings.steps;
+    if (mObserver) mObserver(*this, dt);
 }
 
 void GhostSolver::stepGhost(Real dt)
@@ -727,20 +753,22 @@ void GhostSolver::stepGhost(Real dt)
     // Lines 15-18: ghost solid velocity, Eq. 3 (free slip) or the solid's velocity (no slip).
     t0 = std::chrono::steady_clock::now();
     const Real R = mSettings.supportRadius();
-    const auto& normal = mParticles.vectorChannel(SOLID_NORMAL);
-    const auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
-    const bool freeSlip = mSettings.solidSlip == SolidSlip::Free;
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::GhostSolid) return;
-        const Vec3& nrm = normal[i];
-        if (!freeSlip) {
-            vstar[i] = solidV[i];
-            return;
-        }
-        const Index j = mNearestLiquid[i];
-        const Vec3 vl = j == INVALID_INDEX ? solidV[i] : vstar[j];
-        vstar[i] = solidV[i].dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
-    });
+    if (mParticles.hasVectorChannel(SOLID_NORMAL)) { // no solid channels: no ghost solids
+        const auto& normal = mParticles.vectorChannel(SOLID_NORMAL);
+        const auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
+        const bool freeSlip = mSettings.solidSlip == SolidSlip::Free;
+        parallel::forEach(0, n, [&](std::size_t i) {
+            if (kind[i] != ParticleKind::GhostSolid) return;
+            const Vec3& nrm = normal[i];
+            if (!freeSlip) {
+                vstar[i] = solidV[i];
+                return;
+            }
+            const Index j = mNearestLiquid[i];
+            const Vec3 vl = j == INVALID_INDEX ? solidV[i] : vstar[j];
+            vstar[i] = solidV[i].dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
+        });
+    }
 
     // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid
     // neighbours only: air would bias the outermost particles ([SB12] Sec. 4.3).
@@ -854,8 +882,123 @@ Real GhostSolver::stableTimeStep() const
     return dt;
 }
 
+// Save and restore ----------------------------------------------------------------------------------
+
+SolverState GhostSolver::saveState() const
+{
+    SolverState state;
+    state.solver = methodName(mSettings.method);
+    state.particles = mParticles;
+    state.reals["time"] = mTime;
+    state.reals["particle_mass"] = double(mMass);
+    state.reals["lennard_jones"] = double(mLennardJones);
+    state.reals["max_acceleration"] = double(mMaxAcceleration);
+    state.reals["mean_neighbors"] = mMeanNeighbors;
+    state.integers["step"] = std::int64_t(mStep);
+    state.integers["frame"] = mFrame;
+    state.integers["initialized"] = mInitialized ? 1 : 0;
+    state.integers["emitted"] = std::int64_t(mEmitted);
+    state.integers["killed"] = std::int64_t(mKilled);
+    state.integers["solids"] = std::int64_t(mSolids.size());
+    state.integers["emitters"] = std::int64_t(mEmitters.size());
+    return state;
+}
+
+void GhostSolver::restoreState(const SolverState& state)
+{
+    const std::string method = methodName(mSettings.method);
+    if (state.solver != method) {
+        throw ValueError(msg("restoreState: the state was saved by the '", state.solver,
+                             "' solver, this solver runs '", method, "'; resume with the method "
+                             "the run started with"));
+    }
+    if (mRestored || mInitialized || mStep != 0 || !mParticles.empty() || !mSolids.empty() ||
+        !mEmitters.empty()) {
+        throw ValueError("restoreState: call it on a freshly constructed solver, before adding "
+                         "solids, emitters or liquid and before the first step");
+    }
+    // Read every key first, so a state missing one leaves the solver untouched.
+    const double time = state.real("time");
+    const double mass = state.real("particle_mass");
+    const double lennardJones = state.real("lennard_jones");
+    const double maxAcceleration = state.real("max_acceleration");
+    const double meanNeighbors = state.real("mean_neighbors");
+    const std::int64_t step = state.integer("step"), frame = state.integer("frame");
+    const std::int64_t initialized = state.integer("initialized");
+    const std::int64_t emitted = state.integer("emitted"), killed = state.integer("killed");
+    const std::int64_t solids = state.integer("solids"), emitters = state.integer("emitters");
+    auto requireRange = [](const char* key, std::int64_t value, std::int64_t lo, std::int64_t hi) {
+        if (value < lo || value > hi) {
+            throw ValueError(msg("restoreState: integer '", key, "' = ", value, ": expected ", lo,
+                                 " to ", hi));
+        }
+    };
+    constexpr std::int64_t BIG = std::numeric_limits<std::int64_t>::max();
+    requireRange("step", step, 0, BIG);
+    requireRange("frame", frame, 0, std::numeric_limits<int>::max());
+    requireRange("initialized", initialized, 0, 1);
+    requireRange("emitted", emitted, 0, BIG);
+    requireRange("killed", killed, 0, BIG);
+    requireRange("solids", solids, 0, BIG);
+    requireRange("emitters", emitters, 0, BIG);
+
+    // Every solid particle must name a solid the caller will add again.
+    const ParticleSet& p = state.particles;
+    const std::vector<Real>* index =
+        p.hasScalarChannel(SOLID_INDEX) ? &p.scalarChannel(SOLID_INDEX) : nullptr;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const ParticleKind k = p.kinds()[i];
+        if (k != ParticleKind::GhostSolid && k != ParticleKind::Boundary) continue;
+        if (!index || !((*index)[i] >= Real(0)) || (*index)[i] >= Real(solids)) {
+            throw ValueError(msg("restoreState: ", kindName(k), " particle id ", p.ids()[i],
+                                 " belongs to no solid of the state (", solids, " solids)"));
+        }
+    }
+    if (mSettings.method == Method::Basic && p.count(ParticleKind::GhostAir) > 0) {
+        throw ValueError("restoreState: a 'basic' state holds ghost air particles");
+    }
+
+    mParticles = p;
+    // States saved by this solver have these channels; a missing one gets what a fresh solver
+    // would have.
+    mParticles.addVectorChannel(VSTAR);
+    if (mSettings.method == Method::Ghost) {
+        mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
+        mParticles.addScalarChannel(AIR_TARGET, Real(1));
+    }
+    mTime = time;
+    mMass = Real(mass);
+    mLennardJones = Real(lennardJones);
+    mMaxAcceleration = Real(maxAcceleration);
+    mMeanNeighbors = meanNeighbors;
+    mStep = std::uint64_t(step);
+    mFrame = int(frame);
+    mInitialized = initialized != 0;
+    mEmitted = std::size_t(emitted);
+    mKilled = std::size_t(killed);
+    mRestoredSolids = std::size_t(solids);
+    mRestoredEmitters = std::size_t(emitters);
+    mRestored = true;
+}
+
+void GhostSolver::checkRestoredInputs() const
+{
+    if (mSolids.size() < mRestoredSolids) {
+        throw ValueError(msg("liquid solver: the restored state has ", mRestoredSolids,
+                             " solids but ", mSolids.size(), " were added after restoreState(); "
+                             "add the same solids, in the same order, before stepping"));
+    }
+    if (mEmitters.size() < mRestoredEmitters) {
+        throw ValueError(msg("liquid solver: the restored state has ", mRestoredEmitters,
+                             " emitters but ", mEmitters.size(), " were added after "
+                             "restoreState(); add the same emitters, in the same order, before "
+                             "stepping"));
+    }
+}
+
 void GhostSolver::advanceFrame()
 {
+    checkRestoredInputs();
     initialize();
     const double frameEnd = double(mFrame + 1) / double(mSettings.frameRate);
     if (mSettings.substeps > 0) {

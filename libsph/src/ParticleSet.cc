@@ -6,6 +6,7 @@
 #include "ghostfx/sph/Parallel.h"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace ghostfx {
 namespace sph {
@@ -210,6 +211,30 @@ const std::vector<Vec3>& ParticleSet::vectorChannel(const std::string& name) con
                              "channels: ", joinNames(vectorChannelNames())));
     }
     return it->second.data;
+}
+
+Real ParticleSet::scalarChannelDefault(const std::string& name) const
+{
+    scalarChannel(name); // throws, naming the channels that exist, if it is missing
+    return mScalars.find(name)->second.defaultValue;
+}
+
+Vec3 ParticleSet::vectorChannelDefault(const std::string& name) const
+{
+    vectorChannel(name);
+    return mVectors.find(name)->second.defaultValue;
+}
+
+std::size_t ParticleSet::memoryBytes() const
+{
+    auto bytes = [](const auto& data) {
+        return data.capacity() * sizeof(typename std::decay_t<decltype(data)>::value_type);
+    };
+    std::size_t total = bytes(mPositions) + bytes(mVelocities) + bytes(mMasses) +
+                        bytes(mDensities) + bytes(mPressures) + bytes(mKinds) + bytes(mIds);
+    for (const auto& [name, ch] : mScalars) total += bytes(ch.data);
+    for (const auto& [name, ch] : mVectors) total += bytes(ch.data);
+    return total;
 }
 
 std::vector<std::string> ParticleSet::scalarChannelNames() const

@@ -13,6 +13,17 @@
 ///          solver.addLiquid(waterLevelSet);
 ///          for (int f = 0; f < 100; ++f) solver.advanceFrame();
 ///          @endcode
+///          Resuming a run (e.g. from a vdbio checkpoint) continues it bit for bit:
+///          @code
+///          GhostSolver solver(settings);          // the same settings as the original run
+///          solver.restoreState(state);            // first, before any solid or emitter
+///          solver.addSolid(tankLevelSet);         // the same solids and emitters, same order;
+///          solver.addEmitter(nozzle, velocity);   // no liquid bodies (already in the state)
+///          while (solver.frame() < 100) solver.advanceFrame();
+///          @endcode
+///          Only the channels the scene needs exist: the solid channels (normal, solid_v,
+///          solid_x, solid_n, solid_index) appear with the first solid, the ghost air channels
+///          (air_weight, air_target) only for the Ghost method.
 ///          The solver never opens files; it reports per-phase timings for benchmarks ([SB12]
 ///          Sec. 5 breakdown) and throws NumericalError naming frame, step and the exceeded limit
 ///          when a run blows up.
@@ -23,6 +34,7 @@
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/SolverState.h>
 
 #include <openvdb/math/Mat3.h>
 
@@ -70,6 +82,11 @@ struct PhaseTimings
 class GhostSolver
 {
 public:
+    /// Called at the end of every step() with the solver and the step's dt (s), e.g. for
+    /// progress, statistics or an interrupt (an exception thrown here leaves step() after a
+    /// complete step, so the state stays consistent).
+    using StepObserver = std::function<void(const GhostSolver&, Real dt)>;
+
     explicit GhostSolver(const GhostSettings& settings);
     ~GhostSolver();
 
@@ -77,7 +94,8 @@ public:
     const sph::CubicSplineKernel& kernel() const { return mKernel; }
 
     /// Add a static solid, or one moving rigidly with constant `velocity` (m/s). Its ghost
-    /// (or boundary) particles are sampled at once, one kernel radius deep.
+    /// (or boundary) particles are sampled at once, one kernel radius deep; after
+    /// restoreState(), the solids the state already holds are not sampled again.
     void addSolid(const LevelSet& solid, const Vec3& velocity = Vec3(0));
     /// Add a solid moving rigidly: at time t its level set (given in its local frame) sits at
     /// `motion(t)`. Its ghosts move with it and carry its velocity ([SB12] Sec. 4.4).
@@ -89,7 +107,8 @@ public:
     std::size_t solidCount() const { return mSolids.size(); }
 
     /// Sample a liquid body from a level set ([SB12] Sec. 4.5 - 4.6) with initial velocity
-    /// `velocity` (m/s). Returns the number of particles added.
+    /// `velocity` (m/s). Returns the number of particles added. Throws ValueError after
+    /// restoreState(): the restored particles already hold the liquid.
     std::size_t addLiquid(const LevelSet& shape, const Vec3& velocity = Vec3(0));
 
     /// Continuous emission ([SB12] Sec. 4.5.2): from `startTime` to `endTime` (s) the emitter
@@ -100,7 +119,8 @@ public:
     void addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime = 0,
                     double endTime = std::numeric_limits<double>::infinity());
 
-    /// Add liquid particles at given positions (m), e.g. a lattice for a test.
+    /// Add liquid particles at given positions (m), e.g. a lattice for a test. Throws
+    /// ValueError after restoreState(), like addLiquid().
     void addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity = Vec3(0));
 
     /// Advance one frame: `substeps` fixed steps, or CFL-limited steps up to the frame end.
@@ -109,6 +129,26 @@ public:
     void step(Real dt);
     /// The CFL-limited time step for the current state (s).
     Real stableTimeStep() const;
+
+    /// Install (or, with an empty function, remove) the observer called after every step.
+    void setStepObserver(StepObserver observer);
+
+    /// Everything that decides how the run continues, as a SolverState with solver name
+    /// methodName(method): all particles and channels, and
+    ///  - reals: "time" (s), "particle_mass" (kg), "lennard_jones" (m^2/s^2), "max_acceleration"
+    ///    (m/s^2, used by the CFL limit), "mean_neighbors" (diagnostic);
+    ///  - integers: "step", "frame", "initialized" (0/1), "emitted", "killed", "solids" and
+    ///    "emitters" (how many the caller must add again after restoreState).
+    /// Per-step scratch (neighbour grid, nearest-liquid table) is rebuilt by every step and
+    /// timings are not simulation state, so neither is saved.
+    sph::SolverState saveState() const;
+    /// Continue from a saved state. Call it on a freshly constructed solver with the same
+    /// settings, before adding solids or emitters; then add the same solids (not sampled again:
+    /// their particles are in the state) and emitters, in the original order, and no liquid.
+    /// Throws ValueError if the state comes from another method ("ghost" / "basic"), lacks a
+    /// key, or the solver is not fresh; step() throws if fewer solids or emitters were added
+    /// again than the state had.
+    void restoreState(const sph::SolverState& state);
 
     /// Particle mass (kg), the same for every particle; set at the first step by the mass
     /// scaling of [SB12] Sec. 4.6 unless set explicitly.
@@ -137,6 +177,8 @@ private:
     struct Emitter;
 
     void initialize();
+    void ensureSolidChannels();
+    void checkRestoredInputs() const;
     void sampleSolid(std::size_t solidIndex);
     void emit();
     void applyKillBox();
@@ -167,6 +209,10 @@ private:
     int mFrame = 0;
     PhaseTimings mTimings;
     double mMeanNeighbors = 0;
+    StepObserver mObserver;
+    bool mRestored = false;            ///< restoreState() was called: no liquid may be added
+    std::size_t mRestoredSolids = 0;   ///< solids whose particles came with the restored state
+    std::size_t mRestoredEmitters = 0; ///< emitters the restored run had
 };
 
 } // namespace ghost

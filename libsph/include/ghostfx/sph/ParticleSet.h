@@ -102,6 +102,19 @@ public:
     std::vector<std::string> scalarChannelNames() const;
     std::vector<std::string> vectorChannelNames() const;
 
+    /// The value a channel gives to particles added after it was created (the `value` passed
+    /// to addScalarChannel / addVectorChannel). Throws ValueError like scalarChannel() if the
+    /// channel is missing. Checkpoints store it so a resumed set fills new particles alike.
+    Real scalarChannelDefault(const std::string& name) const;
+    Vec3 vectorChannelDefault(const std::string& name) const;
+
+    /// Bytes held by the arrays of every channel, built-in and named: the sum of each vector's
+    /// capacity() times its element size. Capacity, not size, because that is what the process
+    /// holds (vectors grow geometrically, so this can exceed size-based bytes by up to 2x after
+    /// growth); container bookkeeping (vector headers, map nodes, channel names) is left out.
+    /// Divide by size() for bytes per particle.
+    std::size_t memoryBytes() const;
+
 private:
     template <typename Fn> void forEachChannel(Fn&& fn);
     void appendDefaults(std::size_t count);

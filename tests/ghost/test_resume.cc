@@ -1,0 +1,304 @@
+/// @file   test_resume.cc
+/// @brief  Solver state save / restore (in memory; the HDF5 round trip is in
+///         tests/vdbio/test_checkpoint.cc), the restore contract, the step observer, and
+///         "model only what the scene requires": which particle channels a solver creates.
+#include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace ghostfx;
+using namespace ghostfx::sph;
+using namespace ghostfx::ghost;
+
+namespace {
+
+constexpr Real H = Real(0.01);
+
+/// A small scene that goes through every kind of solver state: a block of liquid on a floor
+/// that slides sideways (moving solid), a nozzle pouring into it (emitter), a kill box cutting
+/// the liquid's right side (killed counter) and, for Ghost SPH, air resampled every 10 steps
+/// (so a frame boundary falls in the middle of an air fade).
+struct Scene
+{
+    GhostSettings settings;
+    LevelSet floor, liquid, nozzle;
+
+    explicit Scene(Method method, int substeps)
+        : floor(makeLevelSet(makeBoxLevelSet(Vec3(-0.1f, -0.05f, -0.05f), Vec3(0.1f, 0.0f, 0.05f),
+                                             H / 2), "floor"))
+        , liquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.05f, 0.0f, -0.03f), Vec3(0.05f, 0.05f, 0.03f),
+                                              H / 2), "liquid"))
+        , nozzle(makeLevelSet(makeBoxLevelSet(Vec3(-0.02f, 0.08f, -0.02f),
+                                              Vec3(0.02f, 0.1f, 0.02f), H / 2), "nozzle"))
+    {
+        settings.method = method;
+        settings.spacing = H;
+        settings.frameRate = 60;
+        settings.substeps = substeps; // 0: CFL-adaptive, which reads the saved max acceleration
+        settings.seed = 5;
+        settings.killBox = Aabb{Vec3(-0.2f, -0.2f, -0.2f), Vec3(0.04f, 0.3f, 0.2f)};
+    }
+
+    /// Add the solids and emitters, in the same order for a fresh and a resumed solver.
+    void addInputs(GhostSolver& solver) const
+    {
+        solver.addSolid(floor, Vec3(Real(0.05), 0, 0));
+        solver.addEmitter(nozzle, Vec3(0, Real(-0.5), 0));
+    }
+};
+
+template <typename T>
+bool sameBytes(const std::vector<T>& a, const std::vector<T>& b)
+{
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(),
+                                                             a.size() * sizeof(T)) == 0);
+}
+
+/// Every channel, id and scalar of two states, compared bit for bit; "" if identical, else the
+/// first difference.
+std::string firstDifference(const SolverState& a, const SolverState& b)
+{
+    const ParticleSet& p = a.particles;
+    const ParticleSet& q = b.particles;
+    if (p.size() != q.size()) return "particle count";
+    if (!sameBytes(p.positions(), q.positions())) return "positions";
+    if (!sameBytes(p.velocities(), q.velocities())) return "velocities";
+    if (!sameBytes(p.ids(), q.ids())) return "ids";
+    if (!sameBytes(p.kinds(), q.kinds())) return "kinds";
+    if (!sameBytes(p.masses(), q.masses())) return "masses";
+    if (!sameBytes(p.densities(), q.densities())) return "densities";
+    if (!sameBytes(p.pressures(), q.pressures())) return "pressures";
+    if (p.nextId() != q.nextId()) return "next id";
+    if (p.scalarChannelNames() != q.scalarChannelNames()) return "scalar channel names";
+    if (p.vectorChannelNames() != q.vectorChannelNames()) return "vector channel names";
+    for (const auto& name : p.scalarChannelNames()) {
+        if (!sameBytes(p.scalarChannel(name), q.scalarChannel(name))) return "channel " + name;
+    }
+    for (const auto& name : p.vectorChannelNames()) {
+        if (!sameBytes(p.vectorChannel(name), q.vectorChannel(name))) return "channel " + name;
+    }
+    if (a.reals != b.reals) return "reals";
+    if (a.integers != b.integers) return "integers";
+    return "";
+}
+
+} // namespace
+
+TEST(Resume, GhostInMemoryContinuationIsBitIdentical)
+{
+    // 3 frames uninterrupted vs 1 frame, save, restore into a new solver, 2 frames. CFL-adaptive
+    // steps, so a wrong max acceleration would change every later dt.
+    const Scene scene(Method::Ghost, 0);
+    const int frames = 3, split = 1;
+    GhostSolver whole(scene.settings);
+    scene.addInputs(whole);
+    whole.addLiquid(scene.liquid);
+    for (int f = 0; f < frames; ++f) whole.advanceFrame();
+
+    GhostSolver first(scene.settings);
+    scene.addInputs(first);
+    first.addLiquid(scene.liquid);
+    for (int f = 0; f < split; ++f) first.advanceFrame();
+    const SolverState saved = first.saveState();
+
+    GhostSolver resumed(scene.settings);
+    resumed.restoreState(saved);
+    scene.addInputs(resumed);
+    // The floor's ghosts came with the state: re-adding the floor must not sample it again.
+    EXPECT_EQ(resumed.count(ParticleKind::GhostSolid), first.count(ParticleKind::GhostSolid));
+    EXPECT_EQ(resumed.particles().size(), first.particles().size());
+    while (resumed.frame() < frames) resumed.advanceFrame();
+
+    const std::string difference = firstDifference(whole.saveState(), resumed.saveState());
+    std::printf("[measured] ghost resume in memory: %zu particles (%zu liquid, %zu air, %zu solid), "
+                "%llu steps, emitted %zu, killed %zu, first difference: '%s'\n",
+                whole.particles().size(), whole.count(ParticleKind::Liquid),
+                whole.count(ParticleKind::GhostAir), whole.count(ParticleKind::GhostSolid),
+                static_cast<unsigned long long>(whole.stepCount()), whole.emittedCount(),
+                whole.killedCount(), difference.c_str());
+    // Exact: the same operations on the same bits, in the same order (STYLE.md rule 6).
+    EXPECT_EQ(difference, "");
+    EXPECT_EQ(whole.time(), resumed.time());
+    EXPECT_EQ(whole.stepCount(), resumed.stepCount());
+    // The scene must exercise what it claims to: emission, the kill box, the air layer.
+    EXPECT_GT(whole.emittedCount(), 0u);
+    EXPECT_GT(whole.killedCount(), 0u);
+    EXPECT_GT(whole.count(ParticleKind::GhostAir), 0u);
+
+    // The test has teeth: a continuation from a state with one value changed differs. The
+    // max acceleration enters only through the CFL force limit, which binds above ~1600 m/s^2
+    // here (0.4 sqrt(h / a) < 0.4 h / c), hence the large value.
+    GhostSolver right(scene.settings);
+    right.restoreState(saved);
+    scene.addInputs(right);
+    right.advanceFrame();
+    const SolverState reference = right.saveState();
+    for (const char* key : {"max_acceleration", "step"}) {
+        SolverState changed = saved;
+        if (changed.reals.count(key)) changed.reals[key] = 1e6;
+        else changed.integers[key] = 0;
+        GhostSolver wrong(scene.settings);
+        wrong.restoreState(changed);
+        scene.addInputs(wrong);
+        wrong.advanceFrame();
+        EXPECT_NE(firstDifference(reference, wrong.saveState()), "") << key;
+    }
+}
+
+TEST(Resume, RestoreContract)
+{
+    const Scene scene(Method::Ghost, 4);
+    GhostSolver original(scene.settings);
+    scene.addInputs(original);
+    original.addLiquid(scene.liquid);
+    original.step(Real(1) / 600);
+    const SolverState saved = original.saveState();
+    EXPECT_EQ(saved.solver, "ghost");
+    for (const char* key : {"time", "particle_mass", "lennard_jones", "max_acceleration"}) {
+        EXPECT_EQ(saved.reals.count(key), 1u) << key;
+    }
+    for (const char* key : {"step", "frame", "initialized", "emitted", "killed", "solids",
+                            "emitters"}) {
+        EXPECT_EQ(saved.integers.count(key), 1u) << key;
+    }
+
+    // Another method.
+    GhostSettings basicSettings = scene.settings;
+    basicSettings.method = Method::Basic;
+    GhostSolver basic(basicSettings);
+    try {
+        basic.restoreState(saved);
+        FAIL() << "restoring a ghost state into a basic solver must throw";
+    } catch (const ValueError& e) {
+        EXPECT_NE(std::string(e.what()).find("saved by the 'ghost' solver, this solver runs "
+                                             "'basic'"), std::string::npos) << e.what();
+    }
+
+    // Liquid after a restore.
+    GhostSolver resumed(scene.settings);
+    resumed.restoreState(saved);
+    try {
+        resumed.addLiquid(scene.liquid);
+        FAIL() << "addLiquid after restoreState must throw";
+    } catch (const ValueError& e) {
+        EXPECT_NE(std::string(e.what()).find("cannot add liquid after restoreState()"),
+                  std::string::npos) << e.what();
+    }
+    EXPECT_THROW(resumed.addLiquidParticles({Vec3(0)}), ValueError);
+
+    // Stepping before the solids and emitters were added again.
+    try {
+        resumed.step(Real(1) / 600);
+        FAIL() << "stepping without the restored solids must throw";
+    } catch (const ValueError& e) {
+        EXPECT_NE(std::string(e.what()).find("the restored state has 1 solids but 0 were added"),
+                  std::string::npos) << e.what();
+    }
+
+    // Restore into a solver that already has inputs, or twice.
+    GhostSolver busy(scene.settings);
+    scene.addInputs(busy);
+    EXPECT_THROW(busy.restoreState(saved), ValueError);
+    EXPECT_THROW(resumed.restoreState(saved), ValueError);
+
+    // A state missing a key names it.
+    SolverState incomplete = saved;
+    incomplete.reals.erase("max_acceleration");
+    GhostSolver fresh(scene.settings);
+    try {
+        fresh.restoreState(incomplete);
+        FAIL() << "a state without max_acceleration must be refused";
+    } catch (const ValueError& e) {
+        EXPECT_NE(std::string(e.what()).find("missing real 'max_acceleration'"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_FALSE(fresh.particles().size() > 0); // untouched by the refused restore
+}
+
+TEST(Channels, OnlyWhatTheSceneRequires)
+{
+    // Liquid-only Ghost SPH: air channels, no solid channels, no solid particles.
+    const Scene scene(Method::Ghost, 10);
+    GhostSolver liquidOnly(scene.settings);
+    liquidOnly.addLiquid(scene.liquid);
+    liquidOnly.advanceFrame();
+    const ParticleSet& p = liquidOnly.particles();
+    EXPECT_EQ(p.vectorChannelNames(), (std::vector<std::string>{"vstar"}));
+    EXPECT_EQ(p.scalarChannelNames(), (std::vector<std::string>{"air_target", "air_weight"}));
+    EXPECT_EQ(liquidOnly.count(ParticleKind::GhostSolid), 0u);
+    EXPECT_EQ(liquidOnly.count(ParticleKind::Boundary), 0u);
+    EXPECT_GT(liquidOnly.count(ParticleKind::GhostAir), 0u);
+
+    // Basic SPH with a solid: solid channels and boundary particles, no air of any kind.
+    GhostSettings basicSettings = scene.settings;
+    basicSettings.method = Method::Basic;
+    GhostSolver basic(basicSettings);
+    basic.addSolid(scene.floor);
+    basic.addLiquid(scene.liquid);
+    basic.advanceFrame();
+    const ParticleSet& q = basic.particles();
+    EXPECT_EQ(q.vectorChannelNames(),
+              (std::vector<std::string>{"normal", "solid_n", "solid_v", "solid_x", "vstar"}));
+    EXPECT_EQ(q.scalarChannelNames(), (std::vector<std::string>{"solid_index"}));
+    EXPECT_EQ(basic.count(ParticleKind::GhostAir), 0u);
+    EXPECT_EQ(basic.count(ParticleKind::GhostSolid), 0u);
+    EXPECT_GT(basic.count(ParticleKind::Boundary), 0u);
+
+    // Basic SPH, liquid only: one channel.
+    GhostSolver bare(basicSettings);
+    bare.addLiquid(scene.liquid);
+    bare.advanceFrame();
+    EXPECT_EQ(bare.particles().vectorChannelNames(), (std::vector<std::string>{"vstar"}));
+    EXPECT_TRUE(bare.particles().scalarChannelNames().empty());
+
+    // Bytes per particle: built-in channels 2 Vec3 + 3 Real + kind + id, plus the named ones.
+    const double builtIn = 2 * sizeof(Vec3) + 3 * sizeof(Real) + 1 + sizeof(ParticleId);
+    auto perParticle = [](const GhostSolver& s) {
+        return double(s.particles().memoryBytes()) / double(s.particles().size());
+    };
+    const double ghostSize = builtIn + sizeof(Vec3) + 2 * sizeof(Real);
+    const double basicSize = builtIn + 5 * sizeof(Vec3) + sizeof(Real);
+    std::printf("[measured] bytes per particle: ghost liquid-only %.1f (size-based %.0f), basic with "
+                "a solid %.1f (%.0f), basic liquid-only %.1f (%.0f)\n", perParticle(liquidOnly),
+                ghostSize, perParticle(basic), basicSize, perParticle(bare), builtIn + sizeof(Vec3));
+    // memoryBytes counts capacity: at least the size-based bytes, and at most twice that
+    // (vectors grow by doubling), plus the scratch of a sort that may be a little larger.
+    EXPECT_GE(perParticle(liquidOnly), ghostSize);
+    EXPECT_LE(perParticle(liquidOnly), 2.5 * ghostSize);
+    EXPECT_GE(perParticle(basic), basicSize);
+    EXPECT_LE(perParticle(basic), 2.5 * basicSize);
+}
+
+TEST(StepObserver, CalledAfterEveryStepWithItsDt)
+{
+    const Scene scene(Method::Ghost, 10);
+    GhostSolver solver(scene.settings);
+    solver.addLiquid(scene.liquid);
+    std::vector<Real> dts;
+    std::vector<std::uint64_t> steps;
+    solver.setStepObserver([&](const GhostSolver& s, Real dt) {
+        dts.push_back(dt);
+        steps.push_back(s.stepCount());
+    });
+    solver.advanceFrame();
+    ASSERT_EQ(dts.size(), 10u);
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+        EXPECT_EQ(steps[k], k + 1); // called after the step completed
+        EXPECT_EQ(dts[k], Real(1) / (Real(60) * Real(10)));
+    }
+
+    // An observer that throws (an interrupt) stops the run after a complete step.
+    solver.setStepObserver([](const GhostSolver&, Real) { throw std::runtime_error("interrupt"); });
+    EXPECT_THROW(solver.advanceFrame(), std::runtime_error);
+    EXPECT_EQ(solver.stepCount(), 11u);
+    solver.setStepObserver({});
+    solver.step(Real(1) / 600);
+    EXPECT_EQ(solver.stepCount(), 12u);
+}
