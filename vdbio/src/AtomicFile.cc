@@ -36,8 +36,9 @@ void writeAtomically(const std::string& path, const std::function<void(const std
     std::error_code ec;
     fs::rename(tmp, target, ec);
     if (ec) {
+        const std::string reason = ec.message();
         fs::remove(tmp, ec);
-        throw IoError(msg("'", path, "': cannot replace the file (", ec.message(), ")"));
+        throw IoError(msg("'", path, "': cannot replace the file (", reason, ")"));
     }
 }
 
