@@ -1,0 +1,1 @@
+// placeholder: filled in by the gas work (issue 5)
