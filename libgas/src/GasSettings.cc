@@ -1,1 +1,97 @@
-// placeholder: filled in by the gas work (issue 5)
+/// @file   GasSettings.cc
+/// @brief  Method names and validation of the gas solver settings ([RYY15]).
+#include "ghostfx/gas/GasSettings.h"
+
+#include <ghostfx/sph/Exceptions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace ghostfx {
+namespace gas {
+
+const char* methodName(Method method)
+{
+    switch (method) {
+    case Method::Fast: return "fast";
+    case Method::Ambient: return "ambient";
+    case Method::Uncorrected: return "uncorrected";
+    }
+    return "unknown";
+}
+
+Method methodFromName(const std::string& name)
+{
+    if (name == "fast") return Method::Fast;
+    if (name == "ambient") return Method::Ambient;
+    if (name == "uncorrected") return Method::Uncorrected;
+    throw ValueError(msg("gas method '", name, "': expected 'fast', 'ambient' or 'uncorrected'"));
+}
+
+Real GasSettings::soundSpeed() const { return std::sqrt(kappa); }
+
+Real GasSettings::speedLimit(Real dt) const
+{
+    if (maxSpeed > Real(0)) return maxSpeed;
+    // Ten spacings in one step is far beyond any CFL number a run could survive; the sound-speed
+    // bound catches blow-ups at tiny time steps.
+    const Real perStep = dt > Real(0) ? Real(10) * spacing / dt : std::numeric_limits<Real>::max();
+    return std::min(perStep, Real(100) * std::max(soundSpeed(), Real(1e-3)));
+}
+
+void GasSettings::validate() const
+{
+    auto require = [](bool ok, const char* field, double value, const char* expected) {
+        if (!ok) throw ValueError(msg("gas setting ", field, " = ", value, ": expected ", expected));
+    };
+    auto finite = [](Real v) { return std::isfinite(v); };
+    require(spacing > 0 && finite(spacing), "spacing", spacing, "a finite value > 0 (m)");
+    require(supportFactor >= Real(1.2) && supportFactor <= Real(6), "supportFactor", supportFactor,
+            "1.2 to 6 particle spacings (default 2)");
+    require(particleMass >= 0 && finite(particleMass), "particleMass", particleMass,
+            ">= 0 (kg; 0 = automatic)");
+    require(restDensity > 0 && finite(restDensity), "restDensity", restDensity,
+            "a finite value > 0 (kg/m^3; [RYY15] Sec. 6: 1/1000 of the liquid's)");
+    require(kappa > 0 && finite(kappa), "kappa", kappa, "a finite value > 0 (m^2/s^2, Eq. 11)");
+    require(delta >= Real(0.4) && delta <= Real(0.7), "delta", delta,
+            "0.4 to 0.7 ([RYY15] Sec. 3.1)");
+    require(atmosphericPressure >= 0 && finite(atmosphericPressure), "atmosphericPressure",
+            atmosphericPressure, ">= 0 (Pa, P_a of Eq. 13)");
+    require(interiorPressureScale >= 0 && interiorPressureScale <= 1, "interiorPressureScale",
+            interiorPressureScale, "0 to 1 (beta of [RYY15] Sec. 5)");
+    require(normalThreshold > 0 && normalThreshold <= Real(10), "normalThreshold", normalThreshold,
+            "0 < C_N <= 10 (|n_i| h_i, dimensionless; default 0.5)");
+    require(damping >= 0 && finite(damping), "damping", damping, ">= 0 (1/s, C_d of Eq. 14)");
+    require(viscosity >= 0 && finite(viscosity), "viscosity", viscosity, ">= 0 (Pa s)");
+    require(sph::isFinite(gravity), "gravity", gravity.length(), "finite components (m/s^2)");
+    require(finite(ambientTemperature), "ambientTemperature", ambientTemperature, "a finite value (K)");
+    require(diffusion >= 0 && finite(diffusion), "diffusion", diffusion,
+            ">= 0 (kg/(m s), D_c of Eq. 15)");
+    require(radiationTime >= 0 && finite(radiationTime), "radiationTime", radiationTime,
+            ">= 0 (s, D_r of Eq. 16; 0 = off)");
+    require(finite(buoyancy), "buoyancy", buoyancy, "a finite value (m/s^2 per K, C_b of Eq. 17)");
+    require(sph::isFinite(buoyancyDirection) && buoyancyDirection.length() > Real(1e-6),
+            "buoyancyDirection", buoyancyDirection.length(), "a finite non-zero vector");
+    require(finite(vorticityGeneration), "vorticityGeneration", vorticityGeneration,
+            "a finite value (m, beta of Eq. 25)");
+    require(vorticityStrength >= 0 && finite(vorticityStrength), "vorticityStrength",
+            vorticityStrength, ">= 0 (1/s)");
+    require(lifeStrength >= 0 && finite(lifeStrength), "lifeStrength", lifeStrength,
+            ">= 0 (s; 0 = isolated particles live forever)");
+    if (method == Method::Ambient) {
+        const Vec3 e = domain.extent();
+        require(!domain.empty() && e[0] >= 2 * supportRadius() && e[1] >= 2 * supportRadius() &&
+                    e[2] >= 2 * supportRadius(),
+                "domain extent", domain.empty() ? 0.0 : double(std::min({e[0], e[1], e[2]})),
+                "a box at least two kernel radii wide on every axis (m) for method 'ambient'");
+    }
+    require(frameRate > 0 && finite(frameRate), "frameRate", frameRate, "> 0 (frames/s)");
+    require(substeps >= 0 && substeps <= 100000, "substeps", substeps,
+            "0 (CFL-adaptive) to 100000 ([RYY15] Sec. 6: 2)");
+    require(cflNumber > 0 && cflNumber <= 2, "cflNumber", cflNumber, "0 < cfl <= 2");
+    require(maxSpeed >= 0 && finite(maxSpeed), "maxSpeed", maxSpeed, ">= 0 (m/s; 0 = automatic)");
+}
+
+} // namespace gas
+} // namespace ghostfx

@@ -1,1 +1,575 @@
-// placeholder
+/// @file   test_gas_solver.cc
+/// @brief  Fast SPH gas [RYY15]: density correction (Eq. 8), a block holding together against
+///         the uncorrected ablation (Fig. 4a vs 4c), buoyancy and heat conservation (Eqs. 15, 17),
+///         the ambient-air baseline against the fast solver (Fig. 4a vs 4b), extremes, resume and
+///         thread-count determinism. Every test prints its measurements as "[measured]" lines.
+#include <ghostfx/gas/GasSolver.h>
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/sph/NeighborGrid.h>
+#include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/Random.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace ghostfx;
+using namespace ghostfx::sph;
+using namespace ghostfx::gas;
+
+namespace {
+
+constexpr Real S = Real(0.02);     // particle spacing (m); support radius 2 S
+constexpr Real HALF = Real(0.1);   // half edge of the test blocks (m): 10 spacings across
+constexpr Real TAMB = Real(293.15);
+
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+GasSettings settingsFor(Method method)
+{
+    GasSettings s;
+    s.method = method;
+    s.spacing = S;
+    s.seed = 3;
+    // dt = 1/120 s: acoustic CFL sqrt(kappa) dt / S = 0.42 at the default kappa.
+    s.substeps = 4;
+    return s;
+}
+
+const LevelSet& blockLevelSet()
+{
+    static const LevelSet block =
+        makeLevelSet(makeBoxLevelSet(Vec3(-HALF), Vec3(HALF), S / 2), "block");
+    return block;
+}
+
+/// Distance (m) of x inside the test block's faces (the narrow band clamps phi at 3 voxels).
+Real depthInBlock(const Vec3& x)
+{
+    return HALF - std::max({std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
+}
+
+struct Spread
+{
+    double rms = 0;      ///< RMS distance of gas particles from their centroid (m)
+    double nn = 0;       ///< mean nearest-neighbour distance (m), capped at 3 S
+    Vec3d centroid{0.0};
+};
+
+Spread measureSpread(const ParticleSet& p)
+{
+    std::vector<Vec3> x;
+    Spread s;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Gas) continue;
+        x.push_back(p.positions()[i]);
+        s.centroid += Vec3d(p.positions()[i]);
+    }
+    if (x.empty()) return s;
+    s.centroid /= double(x.size());
+    NeighborGrid grid(Real(3) * S);
+    grid.build(x);
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        s.rms += (Vec3d(x[i]) - s.centroid).lengthSqr();
+        double nn = 3 * S;
+        grid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
+            if (j != i) nn = std::min(nn, double(r));
+        });
+        s.nn += nn;
+    }
+    s.rms = std::sqrt(s.rms / double(x.size()));
+    s.nn /= double(x.size());
+    return s;
+}
+
+/// Heat relative to ambient, sum_i m_i (T_i - T_ambient) over gas (J/(J/(kg K)) = kg K), in double.
+double heat(const GasSolver& solver)
+{
+    const ParticleSet& p = solver.particles();
+    const auto& T = p.scalarChannel(channel::TEMPERATURE);
+    double q = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] == ParticleKind::Gas) q += double(p.masses()[i]) * (double(T[i]) - TAMB);
+    }
+    return q;
+}
+
+template <typename T>
+bool sameBytes(const std::vector<T>& a, const std::vector<T>& b)
+{
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+/// "" if two states are identical bit for bit, else the first difference.
+std::string firstDifference(const SolverState& a, const SolverState& b)
+{
+    const ParticleSet& p = a.particles;
+    const ParticleSet& q = b.particles;
+    if (p.size() != q.size()) return "particle count";
+    if (!sameBytes(p.positions(), q.positions())) return "positions";
+    if (!sameBytes(p.velocities(), q.velocities())) return "velocities";
+    if (!sameBytes(p.ids(), q.ids())) return "ids";
+    if (!sameBytes(p.kinds(), q.kinds())) return "kinds";
+    if (!sameBytes(p.masses(), q.masses())) return "masses";
+    if (!sameBytes(p.densities(), q.densities())) return "densities";
+    if (!sameBytes(p.pressures(), q.pressures())) return "pressures";
+    if (p.nextId() != q.nextId()) return "next id";
+    if (p.scalarChannelNames() != q.scalarChannelNames()) return "scalar channel names";
+    if (p.vectorChannelNames() != q.vectorChannelNames()) return "vector channel names";
+    for (const auto& name : p.scalarChannelNames()) {
+        if (!sameBytes(p.scalarChannel(name), q.scalarChannel(name))) return "channel " + name;
+    }
+    for (const auto& name : p.vectorChannelNames()) {
+        if (!sameBytes(p.vectorChannel(name), q.vectorChannel(name))) return "channel " + name;
+    }
+    if (a.reals != b.reals) return "reals";
+    if (a.integers != b.integers) return "integers";
+    return "";
+}
+
+} // namespace
+
+// 1. Density correction, Eqs. 5, 7, 8 ---------------------------------------------------------------
+
+TEST(GasDensity, VirtualParticleCorrectionShrinksTheSurfaceShortfall)
+{
+    // One step of 1 us: the densities of the block as sampled. Outer layer: particles within a
+    // quarter spacing of a face (the surface samples); interior: deeper than one support radius.
+    double outerBar = 0, outer = 0, innerBar = 0, inner = 0, nOuter = 0, nInner = 0;
+    double outerN = 0, innerN = 0, innerAbove = 0;
+    GasSolver solver(settingsFor(Method::Fast));
+    solver.addGas(blockLevelSet(), Vec3(0), TAMB);
+    solver.step(Real(1e-6));
+    const ParticleSet& p = solver.particles();
+    const auto& rhoBar = p.scalarChannel(channel::DENSITY_UNCORRECTED);
+    const auto& normal = p.vectorChannel(channel::NORMAL);
+    const Real R = solver.settings().supportRadius();
+    const Real rho0 = solver.settings().restDensity;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const Real d = depthInBlock(p.positions()[i]);
+        const double nh = double(normal[i].length() * R);
+        if (d < Real(0.25) * S) {
+            outerBar += rhoBar[i]; outer += p.densities()[i]; outerN += nh; ++nOuter;
+        } else if (d > R) {
+            innerBar += rhoBar[i]; inner += p.densities()[i]; innerN += nh; ++nInner;
+            innerAbove += nh > solver.settings().normalThreshold;
+        }
+    }
+    const double shortBar = 1 - outerBar / nOuter / rho0, shortCorr = 1 - outer / nOuter / rho0;
+    std::printf("[measured] density correction: %zu particles, outer layer %.0f: rho_bar/rho0 = "
+                "%.3f, corrected %.3f (shortfall %.1f%% -> %.1f%%); interior %.0f: rho_bar/rho0 = "
+                "%.3f, corrected %.3f; |n|h outer %.2f, interior %.2f (%.0f%% of interior above "
+                "C_N = %.2f)\n", p.size(), nOuter, outerBar / nOuter / rho0, outer / nOuter / rho0,
+                100 * shortBar, 100 * shortCorr, nInner, innerBar / nInner / rho0,
+                inner / nInner / rho0, outerN / nOuter, innerN / nInner, 100 * innerAbove / nInner,
+                double(solver.settings().normalThreshold));
+    ASSERT_GT(nOuter, 100);
+    ASSERT_GT(nInner, 20);
+    // A surface sample misses the air half of its neighbourhood: measured 13.7 % short (float
+    // build) and 11.8 % (double build: other samples). A poly6 half space alone would give
+    // 50 %; the sampler packs the surface layer densely. Bound: 10 %.
+    EXPECT_GT(shortBar, 0.10);
+    // Eq. 8 removes most of it, overshooting a little: measured -2.6 % (float) and -5.0 %
+    // (double), i.e. 0.19 and 0.42 of the uncorrected shortfall; bound one half.
+    EXPECT_LT(std::abs(shortCorr), 0.5 * shortBar);
+    // The price: the interior, where sum_j V_j grad W_ij is only statistically zero, is raised
+    // by V_0 W_ik too. Measured +7.5 % (float), +7.3 % (double); bound 12 %.
+    EXPECT_LT(inner / innerBar, 1.12);
+    // The outer layer's normal is well above the interior noise (the basis of C_N).
+    EXPECT_GT(outerN / nOuter, 2 * innerN / nInner);
+}
+
+// 2. A block holds together; the ablation scatters ([RYY15] Fig. 4a vs 4c) -------------------------
+
+TEST(GasBlock, CompensatedBlockHoldsTogetherUncorrectedExpands)
+{
+    // The block is released at 25 % over rest density (gas just emitted under pressure). The
+    // fast solver's atmospheric pressure (Eq. 13) stops the expansion once the surface pressure
+    // balances it; without compensation nothing stops the gas expanding into the vacuum.
+    const Real overpressureMass = [] {
+        GasSolver probe(settingsFor(Method::Fast));
+        probe.addGas(blockLevelSet(), Vec3(0), TAMB);
+        probe.step(Real(1e-6));
+        return probe.particleMass() * Real(1.25);
+    }();
+    constexpr int FRAMES = 60; // 2 s
+    double growth[2][2] = {};
+    for (int pressured = 0; pressured < 2; ++pressured) {
+        for (const Method method : {Method::Fast, Method::Uncorrected}) {
+            GasSettings s = settingsFor(method);
+            if (pressured) s.particleMass = overpressureMass;
+            GasSolver solver(s);
+            solver.addGas(blockLevelSet(), Vec3(0), TAMB);
+            const Spread s0 = measureSpread(solver.particles());
+            const auto t0 = std::chrono::steady_clock::now();
+            double half = 0;
+            for (int f = 0; f < FRAMES; ++f) {
+                solver.advanceFrame();
+                if (f == FRAMES / 2 - 1) half = measureSpread(solver.particles()).rms / s0.rms;
+            }
+            const Spread s1 = measureSpread(solver.particles());
+            growth[pressured][method == Method::Uncorrected] = s1.rms / s0.rms;
+            std::printf("[measured] block %s, %s: RMS radius x%.3f after 1 s, x%.3f after 2 s; "
+                        "mean nearest neighbour %.4f -> %.4f m; %zu particles, %.2f s\n",
+                        pressured ? "at 1.25 rho0" : "at rho0", methodName(method), half,
+                        s1.rms / s0.rms, s0.nn, s1.nn, solver.count(ParticleKind::Gas), seconds(t0));
+        }
+    }
+    std::printf("[measured] block at 1.25 rho0: uncorrected / fast RMS growth = %.2f\n",
+                growth[1][1] / growth[1][0]);
+    // At rest both stay within a few per cent (measured fast 0.97, uncorrected 1.045: the
+    // clamped Eq. 11 lets the uncorrected surface relax outwards until rho <= rho0).
+    EXPECT_NEAR(growth[0][0], 1.0, 0.05);
+    EXPECT_LT(growth[0][1], 1.10);
+    // Under pressure the compensated block grows by its compression only, (1.25 / (1 + P_a /
+    // (2 kappa rho0)))^(1/3) = 1.07, measured 1.05; bound 1.12.
+    EXPECT_LT(growth[1][0], 1.12);
+    // The ablation expands well past that (measured 1.36 after 2 s, still growing); bound 1.3.
+    EXPECT_GT(growth[1][1], 1.3);
+}
+
+// 3. Buoyancy (Eq. 17) and heat conservation by diffusion (Eq. 15) ------------------------------
+
+TEST(GasTemperature, HotBlobRisesColdStaysAndDiffusionConservesHeat)
+{
+    const LevelSet blob =
+        makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.08), S / 2), "blob");
+    constexpr int FRAMES = 30; // 1 s
+    double rise[2] = {};
+    for (int hot = 0; hot < 2; ++hot) {
+        GasSettings s = settingsFor(Method::Fast);
+        if (!hot) s.buoyancy = 0;
+        GasSolver solver(s);
+        solver.addGas(blob, Vec3(0), TAMB + Real(100));
+        const Vec3d c0 = measureSpread(solver.particles()).centroid;
+        for (int f = 0; f < FRAMES; ++f) solver.advanceFrame();
+        const Vec3d c1 = measureSpread(solver.particles()).centroid;
+        rise[hot] = c1[1] - c0[1];
+        std::printf("[measured] blob %s: centroid moved (%.4f, %.4f, %.4f) m in 1 s\n",
+                    hot ? "hot, C_b = 0.0335" : "hot, C_b = 0", c1[0] - c0[0], c1[1] - c0[1],
+                    c1[2] - c0[2]);
+    }
+    // Hot: a = C_b dT = 3.35 m/s^2 at first; the boundary damping (Eq. 14, terminal speed
+    // C_b dT / C_d = 3.35 m/s on the surface) and radiation (Eq. 16) slow it. Measured 1.33 m;
+    // free fall upwards would give 1.7 m. Bound: more than 0.5 m, less than 1.7 m.
+    EXPECT_GT(rise[1], 0.5);
+    EXPECT_LT(rise[1], 1.7);
+    // Without buoyancy nothing moves it: measured below 1 mm; bound 5 mm.
+    EXPECT_LT(std::abs(rise[0]), 0.005);
+
+    // Heat: half the block hot, half at ambient; diffusion on, radiation and buoyancy off.
+    GasSettings s = settingsFor(Method::Fast);
+    s.radiationTime = 0;
+    s.buoyancy = 0;
+    // D_c = 0.005 kg/(m s): diffusivity 0.0025 m^2/s, explicit limit s^2 rho0 / (3 D_c) =
+    // 0.027 s > dt = 1/120 s. (D_c = 0.05 is past the limit: the blow-up check stops it.)
+    s.diffusion = Real(0.005);
+    GasSolver solver(s);
+    solver.addGas(blockLevelSet(), Vec3(0), TAMB);
+    auto& T = solver.particles().scalarChannel(channel::TEMPERATURE);
+    for (std::size_t i = 0; i < T.size(); ++i) {
+        if (solver.particles().positions()[i][0] > 0) T[i] = TAMB + Real(100);
+    }
+    auto spreadT = [&] {
+        double sum = 0, sum2 = 0, n = 0;
+        for (std::size_t i = 0; i < T.size(); ++i) {
+            sum += T[i]; sum2 += double(T[i]) * T[i]; ++n;
+        }
+        return std::sqrt(std::max(0.0, sum2 / n - sqr(sum / n)));
+    };
+    solver.step(Real(1e-6)); // sets the particle mass
+    const double q0 = heat(solver), sd0 = spreadT();
+    for (int f = 0; f < FRAMES; ++f) solver.advanceFrame();
+    const double q1 = heat(solver), sd1 = spreadT();
+    std::printf("[measured] diffusion only: heat %.6e -> %.6e kg K (relative change %.2e), "
+                "temperature std %.1f -> %.1f K, %zu particles\n", q0, q1, (q1 - q0) / q0, sd0, sd1,
+                solver.count(ParticleKind::Gas));
+    // Eq. 15 is antisymmetric in i, j, so heat changes only by float rounding of T += dt dT/dt
+    // (T ~ 400 K, float epsilon 6e-8, 120 steps): bound 1e-4 relative.
+    EXPECT_LT(std::abs(q1 - q0) / q0, 1e-4);
+    // And diffusion does act: the temperature spread falls (measured 50 -> 30 K; bound: by a
+    // tenth).
+    EXPECT_LT(sd1, 0.9 * sd0);
+}
+
+// 5. The ambient-air baseline and the fast solver: a plume from a source ([RYY15] Fig. 4) -----
+
+TEST(GasPlume, AmbientBaselineAndFastSolverRiseAlikeWithFarFewerParticles)
+{
+    const Real s = Real(0.025);
+    const Aabb domain{Vec3(-0.2f, 0.0f, -0.2f), Vec3(0.2f, 0.6f, 0.2f)};
+    const Vec3 sourceCentre(0, Real(0.08), 0);
+    const LevelSet nozzle =
+        makeLevelSet(makeSphereLevelSet(sourceCentre, Real(0.05), s / 2), "source");
+    constexpr int FRAMES = 24; // 0.8 s
+    double top[2] = {}, cost[2] = {}, visible[2] = {}, simulated[2] = {};
+    for (const Method method : {Method::Ambient, Method::Fast}) {
+        GasSettings gs = settingsFor(method);
+        gs.spacing = s;
+        gs.substeps = 3; // dt = 1/90 s: acoustic CFL 0.44
+        gs.domain = domain;
+        // Heat stays in the visible gas in both (no diffusion into the air, no radiation), so
+        // the two differ only in what the paper changes: air particles against compensation.
+        gs.diffusion = 0;
+        gs.radiationTime = 0;
+        // A thin gas (mu 0.002 Pa s); the fast solver stands in for the air's drag with the
+        // damping of Eq. 14, a user coefficient ([RYY15] gives no value): C_d = 7 /s matches the
+        // baseline here (measured: C_d = 5 rises 1.25x, 10 rises 0.85x the baseline's height).
+        gs.viscosity = Real(0.002);
+        gs.damping = Real(7);
+        GasSolver solver(gs);
+        GasSource src;
+        src.temperature = TAMB + Real(100);
+        solver.addSource(nozzle, src);
+        const auto t0 = std::chrono::steady_clock::now();
+        std::size_t peak = 0;
+        for (int f = 0; f < FRAMES; ++f) {
+            solver.advanceFrame();
+            peak = std::max(peak, solver.count(ParticleKind::Gas));
+        }
+        const int k = method == Method::Fast;
+        cost[k] = seconds(t0);
+        // Plume top: the 95th percentile height of the visible gas above the source centre.
+        const ParticleSet& p = solver.particles();
+        const std::vector<Real>* ambient =
+            p.hasScalarChannel(channel::AMBIENT) ? &p.scalarChannel(channel::AMBIENT) : nullptr;
+        std::vector<Real> heights;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            if (p.kinds()[i] != ParticleKind::Gas || (ambient && (*ambient)[i] != 0)) continue;
+            heights.push_back(p.positions()[i][1] - sourceCentre[1]);
+        }
+        ASSERT_FALSE(heights.empty());
+        std::sort(heights.begin(), heights.end());
+        top[k] = heights[heights.size() * 95 / 100];
+        visible[k] = double(heights.size());
+        simulated[k] = double(peak);
+        std::printf("[measured] plume %s: top %.3f m above the source after 0.8 s, %zu visible, "
+                    "%zu simulated particles (+%zu boundary), %.2f s wall\n", methodName(method),
+                    top[k], heights.size(), solver.count(ParticleKind::Gas),
+                    solver.count(ParticleKind::Boundary), cost[k]);
+    }
+    std::printf("[measured] plume: fast / ambient top = %.2f, ambient / fast simulated particles = "
+                "%.1f, wall time ambient / fast = %.1f, visible fast / ambient = %.2f\n",
+                top[1] / top[0], simulated[0] / simulated[1], cost[0] / cost[1],
+                visible[1] / visible[0]);
+    // Similar rise: within 30 % of each other (the fast solver replaces the air's drag by the
+    // boundary damping of Eq. 14, a model, not the same physics).
+    EXPECT_NEAR(top[1] / top[0], 1.0, 0.30);
+    // Far fewer particles: the whole box of air against the plume only (measured 29x, wall
+    // time 10x; the paper reports 25 - 400x fewer particles in larger scenes).
+    EXPECT_GT(simulated[0] / simulated[1], 5.0);
+}
+
+// 7. Extremes, isolated particles, resume, determinism ----------------------------------------------
+
+TEST(GasExtremes, KappaOverEightOrdersNeverGivesSilentNaN)
+{
+    int blowUps = 0;
+    for (const Real kappa : {Real(1e-4), Real(1), Real(1e4)}) {
+        for (const Method method : {Method::Fast, Method::Uncorrected}) {
+            GasSettings s = settingsFor(method);
+            s.kappa = kappa;
+            GasSolver solver(s);
+            solver.addGas(blockLevelSet(), Vec3(0), TAMB + Real(50));
+            std::string error;
+            try {
+                for (int f = 0; f < 10; ++f) solver.advanceFrame();
+            } catch (const NumericalError& e) {
+                error = e.what();
+                ++blowUps;
+            }
+            double vmax = 0;
+            bool finite = true;
+            for (std::size_t i = 0; i < solver.particles().size(); ++i) {
+                vmax = std::max(vmax, double(solver.particles().velocities()[i].length()));
+            }
+            if (error.empty()) {
+                for (std::size_t i = 0; i < solver.particles().size(); ++i) {
+                    finite = finite && isFinite(solver.particles().positions()[i]) &&
+                             isFinite(solver.particles().velocities()[i]) &&
+                             std::isfinite(solver.particles().densities()[i]);
+                }
+                EXPECT_TRUE(finite) << "silent NaN at kappa " << kappa;
+            } else {
+                EXPECT_NE(error.find("blew up at frame"), std::string::npos) << error;
+                EXPECT_NE(error.find("particle id"), std::string::npos) << error;
+                EXPECT_NE(error.find("reduce the time step"), std::string::npos) << error;
+            }
+            std::printf("[measured] kappa %g %s: %s, max speed %.3g m/s\n", double(kappa),
+                        methodName(method), error.empty() ? "ran 10 frames" : error.c_str(), vmax);
+        }
+    }
+    // kappa = 1e4 (sound speed 100 m/s) at dt = 1/120 s is CFL 420: the detector must fire.
+    EXPECT_GE(blowUps, 1);
+
+    // The CFL-adaptive stepper runs the stiff gas.
+    GasSettings s = settingsFor(Method::Fast);
+    s.kappa = Real(1e4);
+    s.substeps = 0;
+    GasSolver solver(s);
+    solver.addGas(blockLevelSet(), Vec3(0), TAMB);
+    solver.advanceFrame();
+    EXPECT_GT(solver.stepCount(), 100u);
+    std::printf("[measured] kappa 1e4 CFL-adaptive: one frame in %llu steps\n",
+                static_cast<unsigned long long>(solver.stepCount()));
+}
+
+TEST(GasExtremes, IsolatedParticlesLoseTheirLifeStrength)
+{
+    GasSettings s = settingsFor(Method::Fast);
+    s.lifeStrength = Real(0.2);
+    GasSolver solver(s);
+    solver.addGas(blockLevelSet(), Vec3(0), TAMB);
+    const std::size_t block = solver.count(ParticleKind::Gas);
+    // Three strays far from the block and from each other.
+    solver.addParticles({Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, Vec3(0), TAMB);
+    solver.advanceFrame(); // 0.033 s: all alive
+    EXPECT_EQ(solver.count(ParticleKind::Gas), block + 3);
+    for (int f = 0; f < 8; ++f) solver.advanceFrame(); // 0.3 s > 0.2 s (1 + 0.1)
+    std::printf("[measured] life strength 0.2 s: %zu isolated removed after 0.3 s, %zu left\n",
+                solver.isolatedRemovedCount(), solver.count(ParticleKind::Gas));
+    EXPECT_EQ(solver.isolatedRemovedCount(), 3u);
+    EXPECT_EQ(solver.count(ParticleKind::Gas), block);
+
+    s.lifeStrength = 0; // never removed
+    GasSolver keep(s);
+    keep.addParticles({Vec3(1, 0, 0), Vec3(0, 1, 0)}, Vec3(0), TAMB, Real(1e-5));
+    for (int f = 0; f < 10; ++f) keep.advanceFrame();
+    EXPECT_EQ(keep.count(ParticleKind::Gas), 2u);
+}
+
+namespace {
+
+/// A scene touching every piece of state: a moving solid, a rate-limited moving source,
+/// vorticity, a kill box and isolated-particle removal.
+struct ResumeScene
+{
+    GasSettings settings;
+    LevelSet floor, nozzle;
+
+    ResumeScene()
+        : floor(makeLevelSet(makeBoxLevelSet(Vec3(-0.15f, -0.06f, -0.15f), Vec3(0.15f, -0.02f, 0.15f),
+                                             S / 2), "floor"))
+        , nozzle(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.04), S / 2), "nozzle"))
+    {
+        settings = settingsFor(Method::Fast);
+        settings.vorticity = true;
+        settings.domain = Aabb{Vec3(-0.3f, -0.3f, -0.3f), Vec3(0.3f, 0.25f, 0.3f)};
+        settings.lifeStrength = Real(0.05);
+    }
+
+    void addInputs(GasSolver& solver) const
+    {
+        solver.addSolid(floor, Vec3(Real(0.05), 0, 0));
+        GasSource src;
+        src.temperature = TAMB + Real(150);
+        src.velocity = Vec3(0, Real(0.3), 0);
+        src.rate = Real(3000);
+        src.motion = [](double t) {
+            RigidTransform xf;
+            xf.translation = Vec3(Real(0.1 * t), Real(0.03), 0);
+            return xf;
+        };
+        solver.addSource(nozzle, src);
+    }
+};
+
+} // namespace
+
+TEST(GasResume, InMemoryContinuationIsBitIdentical)
+{
+    const ResumeScene scene;
+    GasSolver whole(scene.settings);
+    scene.addInputs(whole);
+    whole.addParticles({Vec3(0.2f, 0.2f, 0.2f)}, Vec3(0), TAMB); // a stray, removed later
+    for (int f = 0; f < 4; ++f) whole.advanceFrame();
+
+    GasSolver first(scene.settings);
+    scene.addInputs(first);
+    first.addParticles({Vec3(0.2f, 0.2f, 0.2f)}, Vec3(0), TAMB);
+    for (int f = 0; f < 2; ++f) first.advanceFrame();
+    const SolverState saved = first.saveState();
+
+    GasSolver resumed(scene.settings);
+    resumed.restoreState(saved);
+    scene.addInputs(resumed);
+    EXPECT_EQ(resumed.particles().size(), first.particles().size()); // floor not resampled
+    while (resumed.frame() < 4) resumed.advanceFrame();
+
+    const std::string difference = firstDifference(whole.saveState(), resumed.saveState());
+    std::printf("[measured] gas resume: %zu gas, %zu boundary, emitted %zu, killed %zu, isolated "
+                "removed %zu, %llu steps; first difference '%s'\n",
+                whole.count(ParticleKind::Gas), whole.count(ParticleKind::Boundary),
+                whole.emittedCount(), whole.killedCount(), whole.isolatedRemovedCount(),
+                static_cast<unsigned long long>(whole.stepCount()), difference.c_str());
+    EXPECT_EQ(difference, "");
+    EXPECT_GT(whole.emittedCount(), 0u);
+    EXPECT_GE(whole.isolatedRemovedCount(), 1u);
+    // Rate-limited: 3000 particles/s for 4 / 30 s is at most 400.
+    EXPECT_LE(whole.emittedCount(), 400u);
+
+    // The contract: another solver, a stale budget, gas after a restore.
+    GasSettings ambient = scene.settings;
+    ambient.method = Method::Ambient;
+    GasSolver wrong(ambient);
+    try {
+        wrong.restoreState(saved);
+        FAIL() << "restoring a fast state into an ambient solver must throw";
+    } catch (const ValueError& e) {
+        EXPECT_NE(std::string(e.what()).find("saved by gas method 'fast'"), std::string::npos)
+            << e.what();
+    }
+    GasSolver again(scene.settings);
+    again.restoreState(saved);
+    EXPECT_THROW(again.addParticles({Vec3(0)}, Vec3(0), TAMB), ValueError);
+    EXPECT_THROW(again.step(Real(0.01)), ValueError); // solids and sources not added again
+}
+
+TEST(GasDeterminism, OneAndManyThreadsGiveIdenticalRuns)
+{
+    const ResumeScene scene;
+    SolverState states[2];
+    for (int k = 0; k < 2; ++k) {
+        parallel::ThreadLimit limit(k == 0 ? 1 : 0);
+        GasSolver solver(scene.settings);
+        scene.addInputs(solver);
+        solver.addGas(blockLevelSet(), Vec3(0), TAMB + Real(30));
+        for (int f = 0; f < 3; ++f) solver.advanceFrame();
+        states[k] = solver.saveState();
+    }
+    const std::string difference = firstDifference(states[0], states[1]);
+    std::printf("[measured] 1 thread vs %d threads: %zu particles, first difference '%s'\n",
+                parallel::maxThreads(), states[0].particles.size(), difference.c_str());
+    EXPECT_EQ(difference, "");
+}
+
+TEST(GasSettingsTest, ValidationNamesTheSettingValueAndRange)
+{
+    GasSettings s;
+    s.delta = Real(0.3);
+    try {
+        s.validate();
+        FAIL() << "delta 0.3 must be refused";
+    } catch (const ValueError& e) {
+        EXPECT_NE(std::string(e.what()).find("gas setting delta = 0.3"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("0.4 to 0.7"), std::string::npos) << e.what();
+    }
+    s = GasSettings();
+    s.method = Method::Ambient; // no domain
+    EXPECT_THROW(GasSolver{s}, ValueError);
+    EXPECT_EQ(methodFromName("uncorrected"), Method::Uncorrected);
+    EXPECT_THROW(methodFromName("ghost"), ValueError);
+}
+

@@ -1,0 +1,255 @@
+/// @file   GasSolver.h
+/// @brief  Fast SPH gas without ambient air [RYY15] Secs. 3 and 5, its ambient-air baseline and
+///         the uncorrected ablation.
+/// @details The solver owns one ParticleSet: gas particles (kind Gas) and boundary particles
+///          (kind Boundary) for solids, for the walls of the ambient baseline's domain and for
+///          the external boundary a liquid coupler sets each step. In the ambient baseline the
+///          air is gas particles marked by the channel "ambient" = 1.
+///
+///          One step (Method::Fast; the baselines switch parts off, see GasSettings.h):
+///           1. emission from the sources;
+///           2. sort by cell, uncorrected density rho_bar_i = sum_j m_j W_ij (Eq. 1 without air);
+///           3. density correction: V_0 (Eq. 5) from n_bar_i = sum_j m_j / rho_bar_j grad W_ij,
+///              rho_i = rho_bar_i (1 + V_0 W_ik) (Eq. 8), p_i = kappa (rho_i - rho0) (Eq. 11);
+///           4. forces: pressure with the virtual particle (Eq. 10), atmospheric pressure
+///              P_a n_i (Eqs. 12 - 13, scaled by beta inside, Sec. 5), viscosity, gravity,
+///              damping (Eq. 14) and radiation (Eq. 16) where |n_i| h_i > C_N, temperature
+///              diffusion (Eq. 15), buoyancy (Eq. 17), optional vorticity (Eqs. 25 - 26): Eq. 24;
+///           5. symplectic Euler; solids move; collision projection; kill box; life strength of
+///              isolated particles (Sec. 5); blow-up check.
+///
+///          Variable smoothing length: every particle carries its kernel support radius in the
+///          channel "h" (the paper's h: W(r, h) vanishes for r >= h); a pair uses the symmetric
+///          support (h_i + h_j) / 2, so pair sums stay antisymmetric and heat is conserved.
+///          Kernels: Mueller et al. 2003 ([RYY15] ref. [20]): poly6 for densities, spiky gradient
+///          for pressure, normals and diffusion, the viscosity kernel's Laplacian for viscosity.
+///
+///          Use:
+///          @code
+///          GasSolver solver(settings);
+///          solver.addSolid(groundLevelSet);
+///          GasSource chimney; chimney.temperature = 373; chimney.velocity = Vec3(0, 0.5f, 0);
+///          solver.addSource(chimneyLevelSet, chimney);
+///          for (int f = 0; f < 100; ++f) solver.advanceFrame();
+///          @endcode
+///          Resuming: construct with the same settings, restoreState(state), then add the same
+///          solids and sources in the same order (solids are not sampled again) and no gas.
+#pragma once
+
+#include <ghostfx/gas/GasSettings.h>
+#include <ghostfx/sph/LevelSet.h>
+#include <ghostfx/sph/NeighborGrid.h>
+#include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/SolverState.h>
+
+#include <openvdb/math/Mat3.h>
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <vector>
+
+namespace ghostfx {
+namespace gas {
+
+using sph::Index;
+using sph::LevelSet;
+using sph::ParticleKind;
+using sph::ParticleSet;
+
+/// Names of the particle channels the gas solver keeps (exporters read them by name).
+namespace channel {
+constexpr const char* TEMPERATURE = "temperature";   ///< T (K), gas; boundaries: ambient
+constexpr const char* SUPPORT = "h";                 ///< kernel support radius h_i (m)
+constexpr const char* DENSITY_UNCORRECTED = "density_uncorrected"; ///< rho_bar (kg/m^3)
+constexpr const char* NORMAL = "normal";             ///< n_i of Eq. 12 (1/m), points inwards
+constexpr const char* LIFE = "life";                 ///< life strength l_s left (s), Sec. 5
+constexpr const char* AMBIENT = "ambient";           ///< 1 for ambient air (Method::Ambient only)
+constexpr const char* VORTICITY = "vorticity";       ///< omega of Eq. 25 (1/s), if enabled
+constexpr const char* SOLID_LOCAL = "solid_x";       ///< boundary: position in its solid's frame
+/// Boundary: index of its solid (>= 0), EXTERNAL_BOUNDARY or DOMAIN_WALL.
+constexpr const char* SOLID_INDEX = "solid_index";
+} // namespace channel
+
+/// solid_index of particles set by setExternalBoundary().
+constexpr Real EXTERNAL_BOUNDARY = Real(-1);
+/// solid_index of the ambient baseline's domain walls.
+constexpr Real DOMAIN_WALL = Real(-2);
+
+/// Placement of a rigid body: world x = rotation * local + translation.
+struct RigidTransform
+{
+    openvdb::math::Mat3<Real> rotation = openvdb::math::Mat3<Real>::identity();
+    Vec3 translation{0};
+
+    Vec3 toWorld(const Vec3& local) const { return rotation * local + translation; }
+    Vec3 toLocal(const Vec3& world) const { return rotation.transpose() * (world - translation); }
+};
+
+/// A body's placement as a function of time (s), defined for every t >= 0 and smooth enough
+/// for a central difference of 1e-4 s to give its velocity.
+using RigidMotion = std::function<RigidTransform(double time)>;
+
+/// A gas source: while active, its volume is kept full of gas (new particles grow from the gas
+/// already inside, at least 0.92 spacing from every particle), and the gas inside it is held at
+/// `temperature`. In the ambient baseline the air inside it turns into visible gas instead.
+struct GasSource
+{
+    Real temperature = Real(373.15); ///< temperature of the emitted gas (K)
+    Vec3 velocity{0};                ///< velocity of new particles (m/s)
+    /// Most particles emitted (or air particles converted) per second; 0 = as many as fit.
+    Real rate = Real(0);
+    double start = 0;                                         ///< active from (s)
+    double end = std::numeric_limits<double>::infinity();     ///< active until (s)
+    /// Placement of the source's level set at time t; empty = where the level set is.
+    RigidMotion motion;
+};
+
+/// Seconds spent in each phase of the step, accumulated since the last reset.
+struct GasTimings
+{
+    double emission = 0;    ///< sources (sampling, ambient conversion)
+    double neighbors = 0;   ///< grid rebuild and sort
+    double density = 0;     ///< Eqs. 1, 5, 7, 8, 11
+    double forces = 0;      ///< Eqs. 10, 12 - 17, 22 - 26
+    double integration = 0; ///< positions, solids, collisions, kill box, life strength, checks
+    double total = 0;
+    std::uint64_t steps = 0;
+};
+
+class GasSolver
+{
+public:
+    /// Called at the end of every step() with the solver and the step's dt (s).
+    using StepObserver = std::function<void(const GasSolver&, Real dt)>;
+
+    explicit GasSolver(const GasSettings& settings);
+    ~GasSolver();
+
+    const GasSettings& settings() const { return mSettings; }
+
+    /// Add a static solid, or one moving rigidly at constant `velocity` (m/s). Boundary particles
+    /// are Poisson-sampled in a band one kernel radius deep ([RYY15] Sec. 3.3: boundary particles
+    /// take part in every SPH sum). After restoreState() the restored solids are not resampled.
+    void addSolid(const LevelSet& solid, const Vec3& velocity = Vec3(0));
+    /// Add a solid whose level set (in its local frame) sits at `motion(t)` at time t.
+    void addMovingSolid(const LevelSet& solid, RigidMotion motion);
+    std::size_t solidCount() const { return mSolids.size(); }
+
+    /// Sample a block of gas from a level set (Poisson-disk, 0.92 spacing; samples closer than
+    /// that to existing particles or inside solids are dropped) with `velocity` (m/s) and
+    /// `temperature` (K). Returns the number added. Throws ValueError after restoreState().
+    std::size_t addGas(const LevelSet& shape, const Vec3& velocity, Real temperature);
+
+    /// Add a continuous source (see GasSource).
+    void addSource(const LevelSet& shape, const GasSource& source);
+    std::size_t sourceCount() const { return mSources.size(); }
+
+    /// Add gas particles at given positions (m), e.g. a lattice for a test. `mass` (kg) 0 means
+    /// the solver's particle mass. Throws ValueError after restoreState().
+    void addParticles(const std::vector<Vec3>& positions, const Vec3& velocity, Real temperature,
+                      Real mass = Real(0));
+
+    /// Replace the external boundary (e.g. liquid particles of a phase-transition coupler): from
+    /// the next step these particles take part in every sum like solid boundary particles,
+    /// carrying `mass` (kg) in the gas sums, until the next call replaces them.
+    void setExternalBoundary(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
+                             Real mass);
+
+    /// Advance one frame: `substeps` fixed steps, or CFL-limited steps up to the frame end.
+    void advanceFrame();
+    /// One step of length dt (s).
+    void step(Real dt);
+    /// The CFL-limited time step for the current state (s).
+    Real stableTimeStep() const;
+
+    void setStepObserver(StepObserver observer);
+
+    /// Everything that decides how the run continues, as a SolverState with solver name "gas":
+    /// all particles and channels, and
+    ///  - reals: "time" (s), "particle_mass" (kg), "max_acceleration" (m/s^2, CFL),
+    ///    "mean_neighbors", "source_budget_<k>" (particles a rate-limited source may still emit);
+    ///  - integers: "step", "frame", "initialized", "method" (as Method), "emitted", "killed",
+    ///    "isolated_removed", "solids" and "sources" (how many the caller must add again).
+    sph::SolverState saveState() const;
+    /// Continue from a saved state on a freshly constructed solver with the same settings, then
+    /// add the same solids and sources in the same order, and no gas. Throws ValueError if the
+    /// state is from another solver or method, lacks a key, or the solver is not fresh.
+    void restoreState(const sph::SolverState& state);
+
+    /// Particle mass (kg) given to new particles; automatic (settings) at the first step.
+    Real particleMass() const { return mMass; }
+
+    ParticleSet& particles() { return mParticles; }
+    const ParticleSet& particles() const { return mParticles; }
+    std::size_t count(ParticleKind kind) const { return mParticles.count(kind); }
+    /// Visible gas particles (gas that is not ambient air).
+    std::size_t visibleGasCount() const;
+    /// Ambient air particles (Method::Ambient).
+    std::size_t ambientCount() const;
+
+    double time() const { return mTime; }
+    std::uint64_t stepCount() const { return mStep; }
+    int frame() const { return mFrame; }
+
+    const GasTimings& timings() const { return mTimings; }
+    void resetTimings() { mTimings = GasTimings(); }
+    /// Mean number of neighbours per gas particle in the last density pass (self included).
+    double meanNeighbors() const { return mMeanNeighbors; }
+
+    std::size_t emittedCount() const { return mEmitted; }
+    std::size_t killedCount() const { return mKilled; }
+    /// Isolated particles removed by the life strength rule (Sec. 5).
+    std::size_t isolatedRemovedCount() const { return mIsolatedRemoved; }
+
+private:
+    struct Solid;
+    struct Source;
+
+    void initialize();
+    void ensureSolidChannels();
+    void checkRestoredInputs() const;
+    void sampleSolid(std::size_t solidIndex);
+    void buildDomainWalls();
+    void fillAmbientAir();
+    void emit(Real dt);
+    bool blockedBySolid(const Vec3& x) const;
+    Real referenceMass() const;
+    void assignMissingMasses();
+    void sortParticles();
+    void computeDensity();
+    void computeForcesAndIntegrate(Real dt);
+    void moveSolids(double t1);
+    void projectOutOfSolids();
+    void applyDomain();
+    void applyLifeStrength(Real dt);
+    void checkBlowUp(Real dt) const;
+    std::vector<Vec3> sampleShape(const LevelSet& shape, std::uint64_t seed) const;
+
+    GasSettings mSettings;
+    Vec3 mBuoyancyDir;
+    ParticleSet mParticles;
+    sph::NeighborGrid mGrid;
+    std::vector<std::unique_ptr<Solid>> mSolids;
+    std::vector<std::unique_ptr<Source>> mSources;
+    std::vector<Vec3> mNbar;               ///< n_bar_i with uncorrected densities (Eq. 5), per step
+    std::vector<std::uint8_t> mIsolated;   ///< no neighbour this step (Sec. 5)
+    Real mMass = 0;
+    Real mMaxAcceleration = 0;
+    bool mInitialized = false;
+    double mTime = 0;
+    std::uint64_t mStep = 0;
+    int mFrame = 0;
+    std::size_t mEmitted = 0, mKilled = 0, mIsolatedRemoved = 0;
+    double mMeanNeighbors = 0;
+    GasTimings mTimings;
+    StepObserver mObserver;
+    bool mRestored = false;
+    std::size_t mRestoredSolids = 0;
+    std::size_t mRestoredSources = 0;
+    std::vector<double> mRestoredBudgets;
+};
+
+} // namespace gas
+} // namespace ghostfx
