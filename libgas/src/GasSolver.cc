@@ -284,6 +284,49 @@ void GasSolver::addParticles(const std::vector<Vec3>& positions, const Vec3& vel
     }
 }
 
+Index GasSolver::addGasParticles(const std::vector<Vec3>& positions,
+                                 const std::vector<Vec3>& velocities,
+                                 const std::vector<Real>& temperatures,
+                                 const std::vector<Real>& masses,
+                                 const std::vector<Real>& supportRadii)
+{
+    const std::size_t n = positions.size();
+    if (velocities.size() != n || temperatures.size() != n || masses.size() != n ||
+        supportRadii.size() != n) {
+        throw ValueError(msg("addGasParticles: ", n, " positions but ", velocities.size(),
+                             " velocities, ", temperatures.size(), " temperatures, ",
+                             masses.size(), " masses and ", supportRadii.size(),
+                             " support radii: expected one of each per particle"));
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        if (!isFinite(positions[k]) || !isFinite(velocities[k]) ||
+            !std::isfinite(temperatures[k]) || !(masses[k] > Real(0)) ||
+            !std::isfinite(masses[k]) || !(supportRadii[k] > Real(0)) ||
+            !std::isfinite(supportRadii[k])) {
+            throw ValueError(msg("addGasParticles: particle ", k, " (mass ", masses[k],
+                                 " kg, h ", supportRadii[k], " m, temperature ", temperatures[k],
+                                 " K): expected finite values, mass > 0 and h > 0"));
+        }
+    }
+    const Index first = mParticles.addBatch(positions, Real(0), ParticleKind::Gas);
+    auto& T = mParticles.scalarChannel(channel::TEMPERATURE);
+    auto& h = mParticles.scalarChannel(channel::SUPPORT);
+    for (std::size_t k = 0; k < n; ++k) {
+        mParticles.velocities()[first + k] = velocities[k];
+        mParticles.masses()[first + k] = masses[k];
+        T[first + k] = temperatures[k];
+        h[first + k] = supportRadii[k];
+    }
+    return first;
+}
+
+Real GasSolver::referenceParticleMass() const
+{
+    if (mInitialized) return mMass;
+    if (mSettings.particleMass > Real(0)) return mSettings.particleMass;
+    return referenceMass();
+}
+
 void GasSolver::addSource(const LevelSet& shape, const GasSource& source)
 {
     if (!isFinite(source.velocity) || !std::isfinite(source.temperature)) {

@@ -1,1 +1,337 @@
-// placeholder
+/// @file   test_cli.cc
+/// @brief  `ghostfx` end to end: a small scene run through the real executable, its outputs read
+///         back, resume equality, Ctrl-C, every input error's message and exit code, and
+///         "model only what the scene requires".
+#include "LiquidScene.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/vdbio/Checkpoint.h>
+#include <ghostfx/vdbio/Scene.h>
+
+#include <gtest/gtest.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointCount.h>
+#include <openvdb/points/PointDataGrid.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <thread>
+
+namespace fs = std::filesystem;
+using namespace ghostfx;
+using vdbio::Json;
+
+extern char** environ;
+
+namespace {
+
+std::string slurp(const fs::path& p)
+{
+    std::ifstream in(p);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct Result
+{
+    int code = -1;
+    std::string err;
+};
+
+#define EXPECT_CONTAINS(text, part) \
+    EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
+
+/// Each test gets a fresh folder holding a small scene: a 0.3 m tank with a 0.1 m cube of water
+/// at 0.015 m spacing (~250 liquid particles), 10 fixed substeps per frame.
+class Cli : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        mDir = fs::temp_directory_path() /
+               ("ghostfx_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        fs::remove_all(mDir);
+        fs::create_directories(mDir);
+    }
+
+    static Json smallScene()
+    {
+        return Json::parse(R"({
+            "ghostfx_scene": 1,
+            "settings": { "method": "ghost", "spacing": 0.015, "substeps": 10, "frame_range": [1, 3],
+                          "stiffness": 2000, "seed": 7 },
+            "solids": [ { "name": "tank",
+                          "geometry": { "container": { "min": [0, 0, 0], "max": [0.3, 0.3, 0.3] } } } ],
+            "liquids": [ { "name": "water",
+                           "geometry": { "box": { "min": [0.0, 0.0, 0.0], "max": [0.12, 0.12, 0.3] } } } ],
+            "outputs": { "checkpoint": { "every": 2 } }
+        })");
+    }
+
+    std::string write(const Json& scene, const std::string& name = "scene.json") const
+    {
+        const std::string path = (mDir / name).string();
+        std::ofstream(path) << scene.dump(2);
+        return path;
+    }
+
+    /// Run the real executable with `args`; capture stderr.
+    Result run(const std::string& args) const
+    {
+        const fs::path err = mDir / "stderr.txt";
+        const std::string command = std::string(GHOSTFX_EXE) + " " + args + " > " + (mDir / "stdout.txt").string() +
+                                    " 2> " + err.string();
+        const int status = std::system(command.c_str());
+        Result r;
+        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        r.err = slurp(err);
+        return r;
+    }
+
+    /// An error run: exit code 1 and exactly one line on stderr, which is returned.
+    std::string errorLine(const std::string& args) const
+    {
+        const Result r = run(args);
+        EXPECT_EQ(r.code, 1) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "expected one line: " << r.err;
+        EXPECT_EQ(r.err.rfind("ghostfx: error: ", 0), 0u) << r.err;
+        return r.err;
+    }
+
+    fs::path mDir;
+};
+
+std::size_t pointCount(const fs::path& file)
+{
+    openvdb::io::File f(file.string());
+    f.open();
+    auto grid = openvdb::gridPtrCast<openvdb::points::PointDataGrid>(f.readGrid("particles"));
+    f.close();
+    return grid ? std::size_t(openvdb::points::pointCount(grid->tree())) : 0;
+}
+
+} // namespace
+
+TEST_F(Cli, RunsASceneToAFrameSequence)
+{
+    const Result ok = run("run " + write(smallScene()) + " --out " + (mDir / "out").string() + " --progress log");
+    ASSERT_EQ(ok.code, 0) << ok.err;
+    EXPECT_CONTAINS(ok.err, "frame 3/3");
+    const fs::path out = mDir / "out";
+    for (int f = 1; f <= 3; ++f) {
+        char name[64];
+        std::snprintf(name, sizeof(name), "liquid.%04d.vdb", f);
+        ASSERT_TRUE(fs::exists(out / name)) << name;
+        std::snprintf(name, sizeof(name), "liquid_points.%04d.vdb", f);
+        ASSERT_TRUE(fs::exists(out / name)) << name;
+    }
+    // Checkpoints every 2 frames and at the last frame; statistics in HDF5 and CSV.
+    EXPECT_TRUE(fs::exists(out / "checkpoint.0002.h5"));
+    EXPECT_TRUE(fs::exists(out / "checkpoint.0003.h5"));
+    EXPECT_TRUE(fs::exists(out / "stats.h5"));
+    const std::string csv = slurp(out / "stats.csv");
+    EXPECT_EQ(csv.rfind("frame,step,time,dt,count_liquid", 0), 0u) << csv.substr(0, 200);
+    // 3 frames x 10 substeps = 30 rows plus the header.
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 31);
+    // No temporary file is left behind by the atomic writes.
+    for (const auto& entry : fs::directory_iterator(out)) {
+        EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+    }
+
+    // The volume file: three grids with the classes Houdini and Blender expect, no point grid.
+    openvdb::io::File volume((out / "liquid.0003.vdb").string());
+    volume.open();
+    std::set<std::string> names;
+    for (auto it = volume.beginName(); it != volume.endName(); ++it) names.insert(*it);
+    EXPECT_EQ(names, (std::set<std::string>{"density", "surface", "vel"}));
+    EXPECT_EQ(volume.readGrid("surface")->getGridClass(), openvdb::GRID_LEVEL_SET);
+    EXPECT_EQ(volume.readGrid("density")->getGridClass(), openvdb::GRID_FOG_VOLUME);
+    volume.close();
+
+    // Points: liquid only (the run also holds ghost air and ghost solid particles).
+    const vdbio::CheckpointHeader header = vdbio::readCheckpointHeader((out / "checkpoint.0003.h5").string());
+    EXPECT_EQ(header.frame, 3);
+    EXPECT_GT(header.countPerKind.at("ghost_solid"), 0u);
+    EXPECT_EQ(pointCount(out / "liquid_points.0003.vdb"), header.countPerKind.at("liquid"));
+    std::printf("[measured] %zu liquid, %zu air, %zu solid ghosts after 3 frames\n",
+                header.countPerKind.at("liquid"), header.countPerKind.at("ghost_air"),
+                header.countPerKind.at("ghost_solid"));
+}
+
+TEST_F(Cli, ResumedRunMatchesAnUninterruptedOneBitForBit)
+{
+    Json scene = smallScene();
+    scene["settings"]["frame_range"] = {1, 4};
+    // An emitter and a moving solid exercise every piece of state that must survive.
+    scene["emitters"] = Json::parse(R"([{ "geometry": { "box": { "min": [0.2, 0.2, 0.1], "max": [0.26, 0.26, 0.2] } },
+                                          "velocity": [0, -0.5, 0], "start": 0, "end": 1 }])");
+    const std::string path = write(scene);
+    const fs::path a = mDir / "a", b = mDir / "b";
+    ASSERT_EQ(run("run " + path + " --out " + a.string() + " -q").code, 0);
+    ASSERT_EQ(run("run " + path + " --out " + b.string() + " -q --frames 1-2").code, 0);
+    fs::remove(b / "liquid_points.0003.vdb");
+    const Result resumed = run("run " + path + " --out " + b.string() + " -q --resume " +
+                               (b / "checkpoint.0002.h5").string());
+    ASSERT_EQ(resumed.code, 0) << resumed.err;
+
+    const std::string fingerprint = vdbio::readScene(path).simulationFingerprint();
+    const sph::SolverState sa = vdbio::readCheckpoint((a / "checkpoint.0004.h5").string(), fingerprint);
+    const sph::SolverState sb = vdbio::readCheckpoint((b / "checkpoint.0004.h5").string(), fingerprint);
+    ASSERT_EQ(sa.particles.size(), sb.particles.size());
+    const std::size_t n = sa.particles.size();
+    EXPECT_EQ(std::memcmp(sa.particles.positions().data(), sb.particles.positions().data(), n * sizeof(sph::Vec3)), 0);
+    EXPECT_EQ(std::memcmp(sa.particles.velocities().data(), sb.particles.velocities().data(), n * sizeof(sph::Vec3)), 0);
+    EXPECT_EQ(sa.particles.ids(), sb.particles.ids());
+    EXPECT_EQ(sa.reals, sb.reals);
+    EXPECT_EQ(sa.integers, sb.integers);
+    EXPECT_EQ(pointCount(a / "liquid_points.0004.vdb"), pointCount(b / "liquid_points.0004.vdb"));
+    EXPECT_TRUE(fs::exists(b / "liquid_points.0003.vdb")) << "the resumed run writes frames 3-4";
+    // The statistics continue where the checkpoint left off: 4 frames x 10 steps.
+    const std::string csv = slurp(b / "stats.csv");
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 41);
+}
+
+TEST_F(Cli, CheckpointFromOtherSettingsIsRefused)
+{
+    const std::string path = write(smallScene());
+    ASSERT_EQ(run("run " + path + " --out " + (mDir / "out").string() + " -q --frames 1-2").code, 0);
+    const std::string line = errorLine("run " + path + " -D settings.stiffness=5000 --out " + (mDir / "out").string() +
+                                       " --resume " + (mDir / "out" / "checkpoint.0002.h5").string());
+    EXPECT_CONTAINS(line, "checkpoint.0002.h5' was written with different settings");
+    EXPECT_CONTAINS(line, "stiffness");
+    EXPECT_CONTAINS(line, "2000");
+    EXPECT_CONTAINS(line, "5000");
+}
+
+TEST_F(Cli, BadInputGetsOneClearLine)
+{
+    const std::string out = " --out " + (mDir / "out").string();
+    EXPECT_CONTAINS(errorLine("run " + (mDir / "nope.json").string() + out), "nope.json': cannot open the file");
+
+    const std::string good = write(smallScene());
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.stifness=5000"),
+                    "settings.stifness: unknown key (did you mean 'stiffness'?)");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.stiffness=-1"),
+                    "settings.stiffness = -1: expected a number > 0");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.cfl=50"), "settings.cfl = 50: expected a number in [0.001, 10]");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.method=gas"), "settings.method = \"gas\": the liquid solver runs 'ghost' or 'basic'");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D 'liquids[0].geometry={\"file\":\"none.vdb\",\"grid\":\"x\"}'"),
+                    "none.vdb' does not exist");
+    // Liquid entirely inside the tank wall: no particles.
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D liquids[0].geometry.box.min=[-0.04,0.05,0.05]" +
+                              " -D liquids[0].geometry.box.max=[-0.01,0.1,0.1]"),
+                    "liquid 'water' (box) gives no particles at spacing 0.015 m");
+    // Unwritable output folder: a file where the folder should be.
+    std::ofstream(mDir / "afile") << "x";
+    EXPECT_CONTAINS(errorLine("run " + good + " --out " + (mDir / "afile").string()),
+                    "output folder '" + (mDir / "afile").string() + "': exists and is not a folder");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 5-2"), "--frames '5-2': expected 1 <= first <= last");
+    // Nothing was written by any of the failed runs.
+    EXPECT_FALSE(fs::exists(mDir / "out") && !fs::is_empty(mDir / "out"));
+}
+
+TEST_F(Cli, CtrlCFinishesTheFrameWritesACheckpointAndExitsNonZero)
+{
+    Json scene = smallScene();
+    scene["settings"]["frame_range"] = {1, 400};
+    const std::string path = write(scene);
+    const std::string out = (mDir / "out").string();
+    std::vector<std::string> args = {GHOSTFX_EXE, "run", path, "--out", out, "--progress", "none"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
+    // Wait for the first frame, then interrupt.
+    const auto start = std::chrono::steady_clock::now();
+    while (!fs::exists(fs::path(out) / "liquid.0001.vdb") &&
+           std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ::kill(pid, SIGINT);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    // The checkpoint of the last finished frame is there and names that frame.
+    int last = 0;
+    for (const auto& e : fs::directory_iterator(out)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("checkpoint.", 0) == 0) last = std::max(last, vdbio::readCheckpointHeader(e.path().string()).frame);
+    }
+    ASSERT_GE(last, 1);
+    EXPECT_LT(last, 400);
+    char name[64];
+    std::snprintf(name, sizeof(name), "liquid.%04d.vdb", last);
+    EXPECT_TRUE(fs::exists(fs::path(out) / name));
+    std::printf("[measured] interrupted after frame %d of 400\n", last);
+}
+
+TEST_F(Cli, OnlyWhatTheSceneRequiresIsModelledAndWritten)
+{
+    // A liquid-only scene (no solids): no solid ghosts and no solid channels in the solver.
+    Json scene = smallScene();
+    scene.erase("solids");
+    scene["settings"]["gravity"] = {0, 0, 0};
+    const vdbio::Scene s = vdbio::readScene(write(scene));
+    auto solver = cmd::makeLiquidSolver(s, cmd::liquidSettings(s));
+    solver->advanceFrame();
+    EXPECT_EQ(solver->count(sph::ParticleKind::GhostSolid), 0u);
+    EXPECT_EQ(solver->count(sph::ParticleKind::Boundary), 0u);
+    for (const std::string& c : solver->particles().vectorChannelNames()) {
+        EXPECT_EQ(c.find("solid"), std::string::npos) << "channel " << c << " in a scene without solids";
+    }
+    for (const std::string& c : solver->particles().scalarChannelNames()) {
+        EXPECT_EQ(c.find("solid"), std::string::npos) << "channel " << c << " in a scene without solids";
+    }
+    const double bytes = double(solver->particles().memoryBytes()) / double(solver->particles().size());
+    std::printf("[measured] %.1f bytes per particle without solids\n", bytes);
+
+    // Basic SPH: no ghost air at all.
+    // (Basic SPH's Lennard-Jones walls need the CFL-limited step: it blows up at 10 fixed substeps.)
+    const vdbio::Scene basic = vdbio::readScene(write(smallScene()), {"settings.method=basic", "settings.substeps=0"});
+    auto b = cmd::makeLiquidSolver(basic, cmd::liquidSettings(basic));
+    b->advanceFrame();
+    EXPECT_EQ(b->count(sph::ParticleKind::GhostAir), 0u);
+    for (const std::string& c : b->particles().scalarChannelNames()) {
+        EXPECT_EQ(c.find("air"), std::string::npos) << "channel " << c << " in a Basic SPH run";
+    }
+
+    // Only the grids asked for are made and written; points off means no points file.
+    const std::string path = write(smallScene());
+    ASSERT_EQ(run("run " + path + " --out " + (mDir / "out").string() +
+                  " -q --frames 1-1 -D 'outputs.volume.grids=[\"density\"]' -D outputs.points=false").code, 0);
+    openvdb::io::File volume((mDir / "out" / "liquid.0001.vdb").string());
+    volume.open();
+    std::vector<std::string> names;
+    for (auto it = volume.beginName(); it != volume.endName(); ++it) names.push_back(*it);
+    volume.close();
+    EXPECT_EQ(names, std::vector<std::string>{"density"});
+    EXPECT_FALSE(fs::exists(mDir / "out" / "liquid_points.0001.vdb"));
+}
+
+TEST_F(Cli, InfoPreviewAndSceneFromRoleTaggedVdb)
+{
+    const std::string path = write(smallScene());
+    const fs::path out = mDir / "out";
+    ASSERT_EQ(run("run " + path + " --out " + out.string() + " -q --frames 1-1 -D outputs.preview.width=160" +
+                  " -D outputs.preview.height=90").code, 0);
+    EXPECT_TRUE(fs::exists(out / "preview.0001.exr"));
+    const Result info = run("info " + (out / "liquid.0001.vdb").string());
+    EXPECT_EQ(info.code, 0) << info.err;
+    const std::string text = slurp(mDir / "stdout.txt");
+    EXPECT_CONTAINS(text, "surface");
+    EXPECT_CONTAINS(text, "density");
+    EXPECT_EQ(run("info " + (out / "checkpoint.0001.h5").string()).code, 0);
+    EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "schema_version");
+    EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o " + (mDir / "p.exr").string() +
+                  " --width 64 --height 48").code, 0);
+    EXPECT_TRUE(fs::exists(mDir / "p.exr"));
+}

@@ -1,1 +1,201 @@
-// placeholder: filled in by the pipeline work (issue 4)
+/// @file   PointsFile.cc
+/// @brief  Particles as an OpenVDB PointDataGrid ("particles"), written atomically to a file of
+///         its own.
+/// @details OpenVDB points (Bailey et al., "OpenVDB Points", DigiPro 2016 course notes; API of
+///          points/PointConversion.h): the selected positions are bucketed by a PointIndexGrid,
+///          the PointDataGrid is created from it with "P" stored as a float offset from the voxel
+///          centre (NullCodec: no quantisation), and every channel is appended and populated
+///          through the same index grid so the attribute arrays follow the point order of "P".
+///          Only this translation unit instantiates the points templates (STACK.md).
+#include "FrameGridsDetail.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/Parallel.h>
+#include <ghostfx/vdbio/AtomicFile.h>
+#include <ghostfx/vdbio/FrameFiles.h>
+
+#include <openvdb/io/File.h>
+#include <openvdb/points/PointConversion.h>
+#include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tools/PointIndexGrid.h>
+
+#include <cmath>
+#include <set>
+
+namespace ghostfx {
+namespace vdbio {
+
+namespace {
+
+using openvdb::points::PointDataGrid;
+using openvdb::points::PointDataTree;
+using openvdb::tools::PointIndexGrid;
+using openvdb::tools::PointIndexTree;
+
+/// Particle kinds known to this build, in value order (ParticleKind values are stored in files).
+constexpr sph::ParticleKind ALL_KINDS[] = {
+    sph::ParticleKind::Liquid, sph::ParticleKind::GhostAir, sph::ParticleKind::GhostSolid,
+    sph::ParticleKind::Gas, sph::ParticleKind::Boundary};
+
+const char* const BUILTIN_CHANNELS[] = {"v", "id", "density", "pressure", "mass", "kind"};
+
+/// Append attribute `name` of type T holding `data` (one value per selected particle, in the
+/// order of the position array) and route it through the index grid like "P".
+template <typename T>
+void addAttribute(PointDataTree& tree, const PointIndexTree& indexTree, const std::string& name,
+                  const std::vector<T>& data)
+{
+    openvdb::points::appendAttribute<T>(tree, name);
+    openvdb::points::populateAttribute<PointDataTree, PointIndexTree,
+                                       openvdb::points::PointAttributeVector<T>>(
+        tree, indexTree, name, openvdb::points::PointAttributeVector<T>(data));
+}
+
+/// Values of the selected particles: out[k] = T(src[selection[k]]).
+template <typename T, typename S>
+std::vector<T> gatherSelected(const std::vector<S>& src, const std::vector<sph::Index>& selection)
+{
+    std::vector<T> out(selection.size());
+    parallel::forEach(0, selection.size(), [&](std::size_t k) {
+        out[k] = T(src[selection[k]]);
+    }, 4096);
+    return out;
+}
+
+std::vector<openvdb::Vec3s> gatherSelected3(const std::vector<sph::Vec3>& src,
+                                            const std::vector<sph::Index>& selection)
+{
+    std::vector<openvdb::Vec3s> out(selection.size());
+    parallel::forEach(0, selection.size(), [&](std::size_t k) {
+        const sph::Vec3& a = src[selection[k]];
+        out[k] = openvdb::Vec3s(float(a[0]), float(a[1]), float(a[2]));
+    }, 4096);
+    return out;
+}
+
+std::string kindNamesList()
+{
+    std::string out;
+    for (sph::ParticleKind k : ALL_KINDS) {
+        out += (out.empty() ? "" : ",") + std::to_string(unsigned(k)) + "=" + sph::kindName(k);
+    }
+    return out;
+}
+
+} // namespace
+
+void PointsOptions::validate() const
+{
+    if (!(std::isfinite(voxelSize) && voxelSize >= 0.0)) {
+        throw ValueError(msg("points output: voxel size = ", voxelSize,
+                             " m: expected > 0, or 0 for automatic"));
+    }
+    std::set<std::string> seen;
+    for (const std::string& name : channels) {
+        if (name.empty() || name == "P") {
+            throw ValueError(msg("points output: channel '", name,
+                                 "': expected a channel name other than P (always written)"));
+        }
+        if (!seen.insert(name).second) {
+            throw ValueError(msg("points output: channel '", name, "' listed twice"));
+        }
+    }
+}
+
+void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
+                     const PointsOptions& options, const openvdb::MetaMap& fileMetadata)
+{
+    options.validate();
+    detail::checkOutputFolder(path, "points output");
+    // Resolve every channel before any work, so a typo costs nothing.
+    for (const std::string& name : options.channels) {
+        bool builtin = false;
+        for (const char* b : BUILTIN_CHANNELS) builtin = builtin || name == b;
+        if (builtin || particles.hasScalarChannel(name) || particles.hasVectorChannel(name)) {
+            continue;
+        }
+        std::vector<std::string> available(std::begin(BUILTIN_CHANNELS),
+                                           std::end(BUILTIN_CHANNELS));
+        for (const std::string& n : particles.scalarChannelNames()) available.push_back(n);
+        for (const std::string& n : particles.vectorChannelNames()) available.push_back(n);
+        throw ValueError(msg("points output '", path, "': channel '", name,
+                             "' not found: available: ", detail::joinNames(available)));
+    }
+
+    const std::vector<sph::Index> selection = detail::selectKinds(particles, options.kinds);
+
+    // Positions in double, so the world-to-voxel conversion adds no rounding of its own.
+    std::vector<openvdb::Vec3d> positions(selection.size());
+    parallel::forEach(0, selection.size(), [&](std::size_t k) {
+        const sph::Vec3& x = particles.positions()[selection[k]];
+        positions[k] = openvdb::Vec3d(x[0], x[1], x[2]);
+    }, 4096);
+    const openvdb::points::PointAttributeVector<openvdb::Vec3d> positionArray(positions);
+
+    double voxelSize = options.voxelSize;
+    if (voxelSize == 0.0) {
+        voxelSize = double(openvdb::points::computeVoxelSize(
+            positionArray, PointsOptions::AUTO_POINTS_PER_VOXEL));
+    }
+    const openvdb::math::Transform::Ptr xform =
+        openvdb::math::Transform::createLinearTransform(voxelSize);
+
+    const PointIndexGrid::Ptr indexGrid =
+        openvdb::tools::createPointIndexGrid<PointIndexGrid>(positionArray, *xform);
+    PointDataGrid::Ptr grid =
+        openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
+            *indexGrid, positionArray, *xform);
+    PointDataTree& tree = grid->tree();
+    const PointIndexTree& indexTree = indexGrid->tree();
+
+    for (const std::string& name : options.channels) {
+        if (name == "v") {
+            addAttribute(tree, indexTree, name, gatherSelected3(particles.velocities(), selection));
+        } else if (name == "id") {
+            addAttribute(tree, indexTree, name,
+                         gatherSelected<std::int64_t>(particles.ids(), selection));
+        } else if (name == "density") {
+            addAttribute(tree, indexTree, name, gatherSelected<float>(particles.densities(), selection));
+        } else if (name == "pressure") {
+            addAttribute(tree, indexTree, name, gatherSelected<float>(particles.pressures(), selection));
+        } else if (name == "mass") {
+            addAttribute(tree, indexTree, name, gatherSelected<float>(particles.masses(), selection));
+        } else if (name == "kind") {
+            std::vector<std::int32_t> kinds(selection.size());
+            for (std::size_t k = 0; k < selection.size(); ++k) {
+                kinds[k] = std::int32_t(particles.kinds()[selection[k]]);
+            }
+            addAttribute(tree, indexTree, name, kinds);
+        } else if (particles.hasScalarChannel(name)) {
+            addAttribute(tree, indexTree, name,
+                         gatherSelected<float>(particles.scalarChannel(name), selection));
+        } else {
+            addAttribute(tree, indexTree, name,
+                         gatherSelected3(particles.vectorChannel(name), selection));
+        }
+    }
+
+    grid->setName("particles");
+    grid->setCreator("ghostfx");
+    grid->insertMeta("kind_names", openvdb::StringMetadata(kindNamesList()));
+    grid->insertMeta("point_count", openvdb::Int64Metadata(std::int64_t(selection.size())));
+    std::string written;
+    for (sph::ParticleKind k : options.kinds) written += (written.empty() ? "" : ",") +
+                                                        std::string(sph::kindName(k));
+    grid->insertMeta("kinds_written", openvdb::StringMetadata(written));
+
+    writeAtomically(path, [&](const std::string& tmp) {
+        try {
+            openvdb::io::File file(tmp);
+            file.write(openvdb::GridCPtrVec{grid}, fileMetadata);
+            file.close();
+        } catch (const openvdb::Exception& e) {
+            throw IoError(msg("points output '", path, "': cannot write (", e.what(), ")"));
+        } catch (const std::ios_base::failure& e) {
+            throw IoError(msg("points output '", path, "': cannot write (", e.what(), ")"));
+        }
+    });
+}
+
+} // namespace vdbio
+} // namespace ghostfx

@@ -1,1 +1,221 @@
-// placeholder: filled in by the pipeline work (issue 4)
+/// @file   VolumeFile.cc
+/// @brief  Volume frame outputs: option checks, particle selection, the grid list and the
+///         atomic .vdb write. The grids themselves are built in SurfaceGrid.cc and
+///         ParticleGrids.cc.
+#include "FrameGridsDetail.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/vdbio/AtomicFile.h>
+#include <ghostfx/vdbio/FrameFiles.h>
+
+#include <openvdb/io/File.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+namespace ghostfx {
+namespace vdbio {
+
+namespace {
+
+/// Grid names the volume output uses itself: a scalar channel may not take them.
+const char* const RESERVED_GRID_NAMES[] = {"surface", "density", "vel"};
+
+bool isPositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Helpers shared by the frame-output translation units
+// ---------------------------------------------------------------------------------------------
+
+namespace detail {
+
+std::vector<sph::Index> selectKinds(const sph::ParticleSet& particles,
+                                    const std::vector<sph::ParticleKind>& kinds)
+{
+    bool wanted[256] = {};
+    for (sph::ParticleKind k : kinds) wanted[static_cast<unsigned>(k)] = true;
+    std::vector<sph::Index> selection;
+    const auto& kind = particles.kinds();
+    for (std::size_t i = 0; i < kind.size(); ++i) {
+        if (wanted[static_cast<unsigned>(kind[i])]) selection.push_back(sph::Index(i));
+    }
+    return selection;
+}
+
+std::string joinNames(const std::vector<std::string>& names)
+{
+    std::string out;
+    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out.empty() ? std::string("(none)") : out;
+}
+
+void setCommonGridMetadata(openvdb::GridBase& grid)
+{
+    grid.setCreator("ghostfx");
+    // Half floats would round rho / rho0 and distances to 3 significant digits.
+    grid.setSaveFloatAsHalf(false);
+}
+
+void checkOutputFolder(const std::string& path, const char* what)
+{
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    if (folder.empty()) return; // the working directory
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec)) {
+        throw IoError(msg(what, " '", path, "': folder '", folder.string(),
+                          "' does not exist or is not a folder"));
+    }
+}
+
+} // namespace detail
+
+// ---------------------------------------------------------------------------------------------
+// VolumeOptions
+// ---------------------------------------------------------------------------------------------
+
+void VolumeOptions::validate() const
+{
+    const char* where = "volume output: ";
+    if (!isPositiveFinite(voxelSize)) {
+        throw ValueError(msg(where, "voxel size = ", voxelSize, " m: expected > 0"));
+    }
+    const bool gathered = density || velocity || !scalarChannels.empty();
+    if (gathered) {
+        if (!isPositiveFinite(kernelSupport)) {
+            throw ValueError(msg(where, "kernel support = ", kernelSupport,
+                                 " m: expected > 0 (the SPH support radius, 3 h in [SB12])"));
+        }
+        if (!isPositiveFinite(restDensity)) {
+            throw ValueError(msg(where, "rest density = ", restDensity, " kg/m^3: expected > 0"));
+        }
+        if (!(densityCutoff >= 0.0 && densityCutoff < 1.0)) {
+            throw ValueError(msg(where, "density cutoff = ", densityCutoff,
+                                 ": expected in [0, 1) (a fraction of the rest density)"));
+        }
+    }
+    if (surface) {
+        if (!isPositiveFinite(particleSpacing)) {
+            throw ValueError(msg(where, "particle spacing = ", particleSpacing,
+                                 " m: expected > 0"));
+        }
+        if (!isPositiveFinite(surfaceRadiusSpacings)) {
+            throw ValueError(msg(where, "surface radius = ", surfaceRadiusSpacings,
+                                 " spacings: expected > 0"));
+        }
+        const double radius = surfaceRadiusSpacings * particleSpacing;
+        if (radius < voxelSize) {
+            throw ValueError(msg(where, "surface sphere radius = ", radius, " m (",
+                                 surfaceRadiusSpacings, " spacings) is below one voxel (",
+                                 voxelSize, " m): lower the voxel size (h / 2 is typical)"));
+        }
+        if (!(std::isfinite(surfaceClosingSpacings) && surfaceClosingSpacings >= 0.0)) {
+            throw ValueError(msg(where, "surface closing = ", surfaceClosingSpacings,
+                                 " spacings: expected >= 0"));
+        }
+        if (surfaceSmoothingIterations < 0) {
+            throw ValueError(msg(where, "surface smoothing iterations = ",
+                                 surfaceSmoothingIterations, ": expected >= 0"));
+        }
+        if (!std::isfinite(surfaceOffsetSpacings) ||
+            surfaceOffsetSpacings > surfaceRadiusSpacings + surfaceClosingSpacings) {
+            throw ValueError(msg(where, "surface offset = ", surfaceOffsetSpacings,
+                                 " spacings: expected finite and <= radius + closing = ",
+                                 surfaceRadiusSpacings + surfaceClosingSpacings));
+        }
+        if (surfaceHalfWidthVoxels < 3) {
+            throw ValueError(msg(where, "surface half width = ", surfaceHalfWidthVoxels,
+                                 " voxels: expected >= 3 (the level-set filters' stencils)"));
+        }
+    }
+    std::set<std::string> seen;
+    for (const std::string& name : scalarChannels) {
+        if (name.empty()) throw ValueError(msg(where, "scalar channel with an empty name"));
+        for (const char* reserved : RESERVED_GRID_NAMES) {
+            if (name == reserved) {
+                throw ValueError(msg(where, "scalar channel '", name,
+                                     "': the name is taken by a built-in grid (surface, "
+                                     "density, vel)"));
+            }
+        }
+        if (!seen.insert(name).second) {
+            throw ValueError(msg(where, "scalar channel '", name, "' listed twice"));
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// makeVolumeGrids
+// ---------------------------------------------------------------------------------------------
+
+openvdb::GridPtrVec makeVolumeGrids(const sph::ParticleSet& particles,
+                                    const VolumeOptions& options)
+{
+    options.validate();
+    for (const std::string& name : options.scalarChannels) {
+        if (name == "pressure" || particles.hasScalarChannel(name)) continue;
+        std::vector<std::string> available{"pressure"};
+        for (const std::string& n : particles.scalarChannelNames()) available.push_back(n);
+        throw ValueError(msg("volume output: scalar channel '", name,
+                             "' not found: available: ", detail::joinNames(available)));
+    }
+
+    const std::vector<sph::Index> selection = detail::selectKinds(particles, options.kinds);
+    openvdb::GridPtrVec grids;
+    if (options.surface) grids.push_back(detail::makeSurfaceGrid(particles, selection, options));
+    if (options.density || options.velocity || !options.scalarChannels.empty()) {
+        openvdb::GridPtrVec gathered = detail::makeParticleGrids(particles, selection, options);
+        grids.insert(grids.end(), gathered.begin(), gathered.end());
+    }
+    for (const openvdb::GridBase::Ptr& grid : grids) detail::setCommonGridMetadata(*grid);
+    return grids;
+}
+
+// ---------------------------------------------------------------------------------------------
+// writeVolumeFile
+// ---------------------------------------------------------------------------------------------
+
+void writeVolumeFile(const std::string& path, const openvdb::GridPtrVec& grids,
+                     const openvdb::MetaMap& fileMetadata)
+{
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < grids.size(); ++i) {
+        const openvdb::GridBase::Ptr& grid = grids[i];
+        if (!grid) throw ValueError(msg("volume output '", path, "': grid ", i, " is null"));
+        const std::string name = grid->getName();
+        if (name.empty()) {
+            throw ValueError(msg("volume output '", path, "': grid ", i, " (",
+                                 grid->type(), ") has no name"));
+        }
+        const std::string valueType = grid->valueType();
+        if (valueType == openvdb::typeNameAsString<openvdb::PointDataIndex32>() ||
+            valueType == openvdb::typeNameAsString<openvdb::PointIndex32>()) {
+            throw ValueError(msg("volume output '", path, "': grid '", name,
+                                 "' is a point grid: write it with writePointsFile (Blender "
+                                 "refuses volume files that hold point grids)"));
+        }
+        if (!names.insert(name).second) {
+            throw ValueError(msg("volume output '", path, "': two grids named '", name, "'"));
+        }
+        grid->setSaveFloatAsHalf(false);
+    }
+
+    detail::checkOutputFolder(path, "volume output");
+    writeAtomically(path, [&](const std::string& tmp) {
+        try {
+            openvdb::io::File file(tmp);
+            file.write(grids, fileMetadata);
+            file.close();
+        } catch (const openvdb::Exception& e) {
+            throw IoError(msg("volume output '", path, "': cannot write (", e.what(), ")"));
+        } catch (const std::ios_base::failure& e) {
+            throw IoError(msg("volume output '", path, "': cannot write (", e.what(), ")"));
+        }
+    });
+}
+
+} // namespace vdbio
+} // namespace ghostfx

@@ -151,6 +151,21 @@ public:
     void addParticles(const std::vector<Vec3>& positions, const Vec3& velocity, Real temperature,
                       Real mass = Real(0));
 
+    /// Add gas particles created elsewhere, e.g. vapour split off a liquid by a phase-transition
+    /// coupler ([RYY15] Sec. 4.2), one entry per particle in each vector: position (m),
+    /// velocity (m/s), temperature (K), mass (kg, finite > 0) and kernel support radius h (m,
+    /// finite > 0). Unlike addParticles this is allowed at any time, also after restoreState()
+    /// (a coupler adds vapour every step). Throws ValueError on mismatched sizes or bad values
+    /// (nothing is added then). @return index of the first new particle
+    Index addGasParticles(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
+                          const std::vector<Real>& temperatures, const std::vector<Real>& masses,
+                          const std::vector<Real>& supportRadii);
+
+    /// Mass (kg) of a gas particle at the configured spacing: particleMass() once initialised,
+    /// before that settings().particleMass or the automatic reference mass the first step will
+    /// use. Lets a coupler size particles before the first gas step.
+    Real referenceParticleMass() const;
+
     /// Replace the external boundary (e.g. liquid particles of a phase-transition coupler): from
     /// the next step these particles take part in every sum like solid boundary particles,
     /// carrying `mass` (kg) in the gas sums, until the next call replaces them.

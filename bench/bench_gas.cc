@@ -1,0 +1,214 @@
+/// @file   bench_gas.cc
+/// @brief  Boiling scene of [RYY15] Fig. 4 at the paper's scale: a Ghost SPH liquid [SB12] of about
+///         40k particles in a heated pan coupled to the gas through gas::PhaseTransition, with
+///         about 9k vapour particles; steps per second of the fast gas method (Fig. 4a) and of
+///         the ambient-air baseline (Fig. 4b) in the same run, with the per-phase breakdown.
+/// @details Scene: an open-top pan (inside 2a x 2a, walls 4 h thick), water of depth d at
+///          liquid spacing h, at the boiling point; the pan's bottom plate heats the water at
+///          `--heater` K. The vapour's rest density is 1/1000 of the water's ([RYY15] Sec. 6);
+///          its spacing is h (1000 / 12)^(1/3), so a boiling daughter (1/12 of a liquid
+///          particle) has the gas reference mass. Warm-up: coupled steps until `--vapour`
+///          vapour particles exist (or `--max-warmup` steps), not timed. Then:
+///           1. fast: `--steps` coupled steps, timed per phase (liquid, heat, transition,
+///              boundary, gas);
+///           2. baseline: the same liquid continues with a fresh ambient-air gas solver whose
+///              domain box (`--domain` m wide and deep, `--height` m high above the pan) is
+///              filled with air at the vapour spacing; the current vapour is copied into it;
+///              `--baseline-steps` coupled steps, timed the same way. The air fill happens in
+///              the first baseline step, which is not timed.
+///          dt = 1 / 1200 s (the [SB12] stiffness at 5 mm needs it; [RYY15] ran 2 steps per 1/60
+///          s frame with its own liquid). Plain main: one run takes minutes.
+///
+///          Run: build/bench/bench_gas [--spacing 0.005] [--steps 20] [--baseline-steps 3]
+#include <ghostfx/gas/GasSolver.h>
+#include <ghostfx/gas/PhaseTransition.h>
+#include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/sph/Parallel.h>
+
+#include <CLI/CLI.hpp>
+#include <openvdb/openvdb.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <memory>
+
+using namespace ghostfx;
+using namespace ghostfx::sph;
+
+namespace {
+
+class GhostLiquid : public gas::LiquidSide
+{
+public:
+    explicit GhostLiquid(ghost::GhostSolver& solver) : mSolver(solver) {}
+    ParticleSet& particles() override { return mSolver.particles(); }
+    Real restDensity() const override { return mSolver.settings().restDensity; }
+    Real supportRadius() const override { return mSolver.settings().supportRadius(); }
+    Real particleMass() const override { return mSolver.particleMass(); }
+    void step(Real dt) override { mSolver.step(dt); }
+
+private:
+    ghost::GhostSolver& mSolver;
+};
+
+double now()
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void report(const char* name, const gas::PhaseTransition& c, const gas::GasSolver& g,
+            double wall, int steps, std::size_t liquid)
+{
+    const auto& t = c.timings();
+    const double per = 1000.0 / std::max<double>(1, double(t.steps));
+    std::printf("%s: %d steps in %.2f s = %.2f steps/s (%.1f ms/step); liquid %zu, vapour %zu, "
+                "ambient air %zu, gas boundary %zu\n", name, steps, wall, steps / wall,
+                1000 * wall / steps, liquid, g.visibleGasCount(), g.ambientCount(),
+                c.boundaryCount());
+    std::printf("  per step (ms): liquid %.1f, heat %.1f, transition %.1f, boundary %.1f, gas %.1f "
+                "(gas: neighbours %.1f, density %.1f, forces %.1f, integration %.1f)\n",
+                per * t.liquid, per * t.heat, per * t.transition, per * t.boundary, per * t.gas,
+                1000 * g.timings().neighbors / std::max<double>(1, double(g.timings().steps)),
+                1000 * g.timings().density / std::max<double>(1, double(g.timings().steps)),
+                1000 * g.timings().forces / std::max<double>(1, double(g.timings().steps)),
+                1000 * g.timings().integration / std::max<double>(1, double(g.timings().steps)));
+    std::printf("  gas-only rate: %.2f steps/s; mean gas neighbours %.0f\n", double(t.steps) / t.gas,
+                g.meanNeighbors());
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"bench_gas: [RYY15] Fig. 4 boiling scene, fast gas vs ambient-air baseline"};
+    double spacing = 0.005, halfWidth = 0.1, depth = 0.17, heater = 393.15;
+    double domain = 1.6, height = 2.4;
+    int steps = 20, baselineSteps = 3, maxWarmup = 400;
+    std::size_t vapourTarget = 9000;
+    app.add_option("--spacing", spacing, "liquid spacing h (m)");
+    app.add_option("--half-width", halfWidth, "pan inside half width a (m)");
+    app.add_option("--depth", depth, "water depth (m)");
+    app.add_option("--heater", heater, "plate temperature (K)");
+    app.add_option("--vapour", vapourTarget, "vapour particles before the measurement");
+    app.add_option("--max-warmup", maxWarmup, "most warm-up steps");
+    app.add_option("--steps", steps, "measured fast steps");
+    app.add_option("--baseline-steps", baselineSteps, "measured baseline steps");
+    app.add_option("--domain", domain, "baseline air box width and depth (m)");
+    app.add_option("--height", height, "baseline air box height above the pan bottom (m)");
+    CLI11_PARSE(app, argc, argv);
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+    try {
+        openvdb::initialize();
+        const Real H = Real(spacing), a = Real(halfWidth);
+        const Real dt = Real(1) / Real(1200);
+        std::printf("bench_gas: %d threads, liquid spacing %.4f m, pan %.2f x %.2f m, depth %.3f m\n",
+                    parallel::maxThreads(), spacing, 2 * halfWidth, 2 * halfWidth, depth);
+
+        ghost::GhostSettings ls;
+        ls.spacing = H;
+        ls.seed = 5;
+        ghost::GhostSolver liquid(ls);
+        const double wall = 4 * double(H);
+        const openvdb::Vec3d lo(-a - wall, -wall, -a - wall), hi(a + wall, 2 * depth, a + wall);
+        const openvdb::Vec3d ilo(-a, 0, -a), ihi(a, 4 * depth, a);
+        auto sdf = [&](const openvdb::Vec3d& x) {
+            return std::max(boxSignedDistance(x, lo, hi), -boxSignedDistance(x, ilo, ihi));
+        };
+        const Aabb panBox{Vec3(Real(lo.x()), Real(lo.y()), Real(lo.z())),
+                          Vec3(Real(hi.x()), Real(hi.y()), Real(hi.z()))};
+        double t0 = now();
+        liquid.addSolid(makeLevelSet(levelSetFromSdf(sdf, panBox, H / 2), "pan"));
+        liquid.addLiquid(makeLevelSet(
+            makeBoxLevelSet(Vec3(-a, 0, -a), Vec3(a, Real(depth), a), H / 2), "water"));
+        std::printf("set-up (sampling): %.1f s, %zu liquid particles\n", now() - t0,
+                    liquid.count(ParticleKind::Liquid));
+        GhostLiquid side(liquid);
+
+        gas::GasSettings gs;
+        gs.spacing = H * Real(std::cbrt(1000.0 / 12.0));
+        gs.restDensity = Real(1);
+        gs.seed = 7;
+        gas::GasSolver fastGas(gs);
+
+        gas::PhaseSettings ps;
+        ps.initialTemperature = ps.boilingPoint;
+        ps.latentHeat = Real(20);
+        ps.heatingTime = Real(0.05);
+        ps.heaterBand = Real(1.5) * H;
+        ps.evaporationRate = Real(0.5);
+        const LevelSet plate = makeLevelSet(
+            makeBoxLevelSet(Vec3(-a - 4 * H, -4 * H, -a - 4 * H), Vec3(a + 4 * H, 0, a + 4 * H),
+                            H / 2, Real(8)), "plate");
+        gas::PhaseTransition fast(fastGas, side, ps);
+        fast.addHeater(plate, Real(heater));
+
+        t0 = now();
+        int warm = 0;
+        while (warm < maxWarmup && fastGas.visibleGasCount() < vapourTarget) {
+            fast.step(dt);
+            ++warm;
+        }
+        std::printf("warm-up: %d steps in %.1f s, vapour %zu, boiled %zu, evaporated %zu\n", warm,
+                    now() - t0, fastGas.visibleGasCount(), fast.boiledCount(),
+                    fast.evaporatedCount());
+
+        fast.resetTimings();
+        fastGas.resetTimings();
+        liquid.resetTimings();
+        t0 = now();
+        for (int k = 0; k < steps; ++k) fast.step(dt);
+        const double fastWall = now() - t0;
+        report("fast", fast, fastGas, fastWall, steps, liquid.count(ParticleKind::Liquid));
+        const gas::MassBudget mb = fast.massBudget();
+        std::printf("  mass budget: liquid %.6e + gas %.6e + removed %.3e kg\n", mb.liquid, mb.gas,
+                    mb.gasRemoved);
+
+        // Baseline: the same liquid, a fresh ambient-air gas solver holding a copy of the vapour.
+        gas::GasSettings bs = gs;
+        bs.method = gas::Method::Ambient;
+        const Real half = Real(0.5 * domain);
+        bs.domain = Aabb{Vec3(-half, Real(-wall), -half), Vec3(half, Real(height), half)};
+        gas::GasSolver ambientGas(bs);
+        {
+            const ParticleSet& g = fastGas.particles();
+            std::vector<Vec3> x, v;
+            std::vector<Real> T, m, h;
+            const auto& gT = g.scalarChannel(gas::channel::TEMPERATURE);
+            const auto& gh = g.scalarChannel(gas::channel::SUPPORT);
+            for (std::size_t i = 0; i < g.size(); ++i) {
+                if (g.kinds()[i] != ParticleKind::Gas) continue;
+                x.push_back(g.positions()[i]);
+                v.push_back(g.velocities()[i]);
+                T.push_back(gT[i]);
+                m.push_back(g.masses()[i]);
+                h.push_back(gh[i]);
+            }
+            ambientGas.addGasParticles(x, v, T, m, h);
+        }
+        gas::PhaseTransition baseline(ambientGas, side, ps);
+        baseline.addHeater(plate, Real(heater));
+        t0 = now();
+        baseline.step(dt); // fills the air box (not timed)
+        std::printf("baseline set-up step (air fill): %.1f s, air %zu\n", now() - t0,
+                    ambientGas.ambientCount());
+        baseline.resetTimings();
+        ambientGas.resetTimings();
+        t0 = now();
+        for (int k = 0; k < baselineSteps; ++k) baseline.step(dt);
+        const double baseWall = now() - t0;
+        report("ambient baseline", baseline, ambientGas, baseWall, baselineSteps,
+               liquid.count(ParticleKind::Liquid));
+        const double fastRate = steps / fastWall, baseRate = baselineSteps / baseWall;
+        std::printf("ratio fast / baseline: %.2fx coupled, %.2fx gas only\n", fastRate / baseRate,
+                    (double(fast.timings().steps) / fast.timings().gas) /
+                        (double(baseline.timings().steps) / baseline.timings().gas));
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_gas: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

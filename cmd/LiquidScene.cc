@@ -1,0 +1,113 @@
+/// @file   LiquidScene.cc
+#include "LiquidScene.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/vdbio/AtomicFile.h>
+
+namespace ghostfx {
+namespace cmd {
+
+using ghost::GhostSettings;
+using ghost::GhostSolver;
+using sph::Real;
+using sph::Vec3;
+
+ghost::GhostSettings liquidSettings(const vdbio::Scene& scene)
+{
+    const vdbio::JsonObject& s = scene.settings;
+    GhostSettings g;
+    if (scene.method != "ghost" && scene.method != "basic") {
+        s.failValue("method", "the liquid solver runs 'ghost' or 'basic'");
+    }
+    g.method = ghost::methodFromName(scene.method);
+    g.spacing = Real(scene.spacing);
+    g.frameRate = Real(scene.frameRate);
+    g.supportFactor = Real(s.inRange("kernel_support", g.supportFactor, 1.5, 5));
+    g.restDensity = Real(s.positive("rest_density", g.restDensity));
+    g.stiffness = Real(s.positive("stiffness", g.stiffness));
+    const auto gravity = s.get<std::array<double, 3>>("gravity", {g.gravity[0], g.gravity[1], g.gravity[2]});
+    g.gravity = Vec3(Real(gravity[0]), Real(gravity[1]), Real(gravity[2]));
+    g.xsphEpsilon = Real(s.inRange("xsph_epsilon", g.xsphEpsilon, 0, 1));
+    g.solidEpsilon = Real(s.inRange("solid_epsilon", g.solidEpsilon, 0, 1));
+    g.solidSlip = s.choice("solid_slip", "free", {"free", "no_slip"}) == "free" ? ghost::SolidSlip::Free
+                                                                               : ghost::SolidSlip::NoSlip;
+    g.airResampleSteps = int(s.inRange("air_resample_steps", g.airResampleSteps, 1, 1000));
+    g.airKeepFraction = Real(s.inRange("air_keep_fraction", g.airKeepFraction, 0, 10));
+    g.basicXsphEpsilon = Real(s.inRange("basic_xsph_epsilon", g.basicXsphEpsilon, 0, 1));
+    g.basicViscosityAlpha = Real(s.nonNegative("basic_viscosity_alpha", g.basicViscosityAlpha));
+    g.lennardJonesStrength = Real(s.nonNegative("lennard_jones_strength", g.lennardJonesStrength));
+    g.substeps = int(s.inRange("substeps", g.substeps, 0, 100000));
+    g.cflNumber = Real(s.inRange("cfl", g.cflNumber, 1e-3, 10));
+    g.maxSpeed = Real(s.nonNegative("max_speed", g.maxSpeed));
+    g.seed = s.get<std::uint64_t>("seed", g.seed);
+    g.killBox = scene.killBox;
+    s.finish();
+    g.validate();
+    return g;
+}
+
+namespace {
+
+/// The motion of a scene solid as the solver wants it.
+ghost::RigidMotion motionOf(const vdbio::SceneSolid& solid)
+{
+    if (solid.motion.keys.empty()) {
+        const Vec3 v(solid.velocity);
+        return [v](double t) {
+            ghost::RigidTransform xf;
+            xf.translation = v * Real(t);
+            return xf;
+        };
+    }
+    const vdbio::KeyedMotion keyed = solid.motion;
+    return [keyed](double t) {
+        const vdbio::RigidKey k = keyed.at(t);
+        const openvdb::math::Mat3d r = vdbio::KeyedMotion::rotation(k.rotateDegrees);
+        ghost::RigidTransform xf;
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) xf.rotation(i, j) = Real(r(i, j));
+        }
+        xf.translation = Vec3(k.translate);
+        return xf;
+    };
+}
+
+} // namespace
+
+std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene, const GhostSettings& settings,
+                                              const sph::SolverState* restored)
+{
+    auto solver = std::make_unique<GhostSolver>(settings);
+    if (restored) solver->restoreState(*restored);
+    for (const vdbio::SceneSolid& solid : scene.solids) {
+        solver->addMovingSolid(solid.shape, motionOf(solid));
+    }
+    if (!restored) {
+        for (const vdbio::SceneLiquid& liquid : scene.liquids) {
+            const std::size_t n = solver->addLiquid(liquid.shape, Vec3(liquid.velocity));
+            if (n == 0) {
+                throw SceneError(msg("scene '", scene.file, "': liquid '", liquid.name, "' (", liquid.geometry,
+                                     ") gives no particles at spacing ", scene.spacing,
+                                     " m: it is empty, thinner than the spacing, or inside a solid"));
+            }
+        }
+    }
+    for (const vdbio::SceneEmitter& e : scene.emitters) {
+        solver->addEmitter(e.shape, Vec3(e.velocity), e.start, e.end);
+    }
+    return solver;
+}
+
+void updateSolidSequences(const vdbio::Scene& scene, GhostSolver& solver, int frame)
+{
+    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+        const vdbio::SceneSolid& solid = scene.solids[i];
+        if (solid.sequenceFile.empty()) continue;
+        const std::string file = vdbio::expandFramePattern(solid.sequenceFile, frame);
+        solver.setSolidShape(i, vdbio::loadLevelSet(file, solid.sequenceGrid,
+                                                    msg("scene '", scene.file, "': solids[", i, "].sequence")));
+    }
+}
+
+} // namespace cmd
+} // namespace ghostfx

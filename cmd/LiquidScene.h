@@ -1,0 +1,31 @@
+/// @file   LiquidScene.h
+/// @brief  Wiring of a scene to the liquid solver: the liquid keys of `settings`, solids with
+///         their motions, liquid bodies and emitters.
+#pragma once
+
+#include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/sph/SolverState.h>
+#include <ghostfx/vdbio/Scene.h>
+
+#include <memory>
+
+namespace ghostfx {
+namespace cmd {
+
+/// Read the liquid solver's settings from `scene.settings` (and the shared ones already read),
+/// then check that no key of `settings` is left unread. Errors name the scene key.
+ghost::GhostSettings liquidSettings(const vdbio::Scene& scene);
+
+/// A liquid solver set up for `scene`: solids (static, moving or keyed), liquid bodies,
+/// emitters. With `restored`, the solver continues from that state: liquid bodies are not
+/// sampled again and solids take over their restored ghosts.
+std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
+                                                     const ghost::GhostSettings& settings,
+                                                     const sph::SolverState* restored = nullptr);
+
+/// Before simulating towards `frame` (the state at t = frame / fps), give every solid with a
+/// per-frame file sequence that frame's shape.
+void updateSolidSequences(const vdbio::Scene& scene, ghost::GhostSolver& solver, int frame);
+
+} // namespace cmd
+} // namespace ghostfx

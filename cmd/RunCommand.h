@@ -1,0 +1,34 @@
+/// @file   RunCommand.h
+/// @brief  `ghostfx run`: a scene to a VDB frame sequence, with checkpoints, statistics,
+///         previews, progress and clean interruption.
+#pragma once
+
+#include "Command.h"
+
+#include <string>
+#include <vector>
+
+namespace ghostfx {
+namespace cmd {
+
+struct RunOptions
+{
+    std::string scene;                 ///< scene .json (or role-tagged .vdb)
+    std::string frames;                ///< "A-B" or "B": overrides settings.frame_range
+    int threads = 0;                   ///< 0: all cores
+    std::string out;                   ///< overrides outputs.directory
+    std::vector<std::string> defines;  ///< -D path=value
+    std::string resume;                ///< checkpoint to continue from
+    bool quiet = false;
+    /// Progress display: "auto" (bar on a terminal, log lines otherwise), "bar", "log", "none".
+    std::string progress = "auto";
+};
+
+/// Exit code of a run stopped by Ctrl-C after writing its checkpoint (128 + SIGINT).
+constexpr int EXIT_INTERRUPTED = 130;
+
+/// Run a scene; returns the exit code. Throws ghostfx::Error on bad input.
+int runScene(const RunOptions& options);
+
+} // namespace cmd
+} // namespace ghostfx

@@ -1,0 +1,421 @@
+/// @file   PhaseTransition.cc
+/// @brief  Heating, boiling, evaporation and merging between a liquid and the fast gas solver
+///         ([RYY15] Sec. 4, Eqs. 15, 18 - 20).
+#include "ghostfx/gas/PhaseTransition.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/Kernels.h>
+#include <ghostfx/sph/NeighborGrid.h>
+#include <ghostfx/sph/Parallel.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <unordered_set>
+
+namespace ghostfx {
+namespace gas {
+
+namespace {
+
+template <typename... Args>
+std::string msg(Args&&... args)
+{
+    std::ostringstream s;
+    (s << ... << args);
+    return s.str();
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t0)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Deterministic value in [0, 1) from a particle id (splitmix64 finaliser).
+Real evaporationPhase(sph::ParticleId id)
+{
+    std::uint64_t z = std::uint64_t(id) + 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    return Real(double(z >> 11) * (1.0 / 9007199254740992.0)) * Real(0.999);
+}
+
+bool isSolidKind(ParticleKind k)
+{
+    return k == ParticleKind::GhostSolid || k == ParticleKind::Boundary;
+}
+
+} // namespace
+
+// Settings ----------------------------------------------------------------------------------------
+
+void PhaseSettings::validate() const
+{
+    auto positive = [](const char* name, Real v) {
+        if (!(v > Real(0)) || !std::isfinite(v)) {
+            throw ValueError(msg("phase settings: ", name, " = ", v, ": expected a finite value > 0"));
+        }
+    };
+    auto nonNegative = [](const char* name, Real v) {
+        if (!(v >= Real(0)) || !std::isfinite(v)) {
+            throw ValueError(msg("phase settings: ", name, " = ", v, ": expected a finite value >= 0"));
+        }
+    };
+    positive("boilingPoint", boilingPoint);
+    positive("initialTemperature", initialTemperature);
+    nonNegative("latentHeat", latentHeat);
+    nonNegative("heaterBand", heaterBand);
+    positive("heatingTime", heatingTime);
+    nonNegative("conductivity", conductivity);
+    positive("diffusionEpsilon", diffusionEpsilon);
+    nonNegative("evaporationRate", evaporationRate);
+    positive("evaporationOnset", evaporationOnset);
+    if (!(evaporationOnset < boilingPoint)) {
+        throw ValueError(msg("phase settings: evaporationOnset = ", evaporationOnset,
+                             " K: expected below boilingPoint = ", boilingPoint, " K"));
+    }
+    positive("surfaceThreshold", surfaceThreshold);
+    positive("liquidResplitEpsilon", liquidResplitEpsilon);
+    if (mergeEverySteps < 1) {
+        throw ValueError(msg("phase settings: mergeEverySteps = ", mergeEverySteps,
+                             ": expected >= 1"));
+    }
+    if (evaporationPattern && !evaporationPattern->hasCentre) {
+        throw ValueError(msg("phase settings: evaporationPattern '", evaporationPattern->name,
+                             "' has no centre daughter: evaporation keeps the centre as liquid "
+                             "([RYY15] Sec. 4.2)"));
+    }
+    merge.validate();
+}
+
+// Set-up ------------------------------------------------------------------------------------------
+
+PhaseTransition::PhaseTransition(GasSolver& gas, LiquidSide& liquid, const PhaseSettings& settings)
+    : mGas(gas), mLiquid(liquid), mSettings(settings)
+{
+    mSettings.validate();
+    mBoilPattern = mSettings.boilingPattern ? *mSettings.boilingPattern : icosahedronPattern();
+    mEvapPattern = mSettings.evaporationPattern ? *mSettings.evaporationPattern
+                                                : paperCubePattern();
+    mMerge = mSettings.merge;
+    if (!mMerge.resplitPattern) {
+        mMerge.resplitPattern = optimisePattern(
+            "liquid re-split", patternOffsets(PatternShape::Icosahedron),
+            double(mSettings.liquidResplitEpsilon), std::cbrt(1.0 / 12.0));
+    }
+    mMerge.candidateKind = ParticleKind::Liquid;
+    ensureChannels();
+}
+
+void PhaseTransition::ensureChannels()
+{
+    ParticleSet& p = mLiquid.particles();
+    p.addScalarChannel(TEMPERATURE, mSettings.initialTemperature);
+    addSplitChannels(p, mLiquid.supportRadius());
+    p.addScalarChannel(LATENT, Real(0));
+    p.addScalarChannel(EVAPORATION, Real(0));
+}
+
+void PhaseTransition::addHeater(const sph::LevelSet& shape, Real temperature)
+{
+    if (!(temperature > Real(0)) || !std::isfinite(temperature)) {
+        throw ValueError(msg("heater '", shape.name(), "': temperature = ", temperature,
+                             " K: expected a finite value > 0"));
+    }
+    if (!(mSettings.heaterBand < shape.bandWidth())) {
+        throw ValueError(msg("heater '", shape.name(), "': heaterBand = ", mSettings.heaterBand,
+                             " m reaches the level set's narrow band (", shape.bandWidth(),
+                             " m), beyond which phi is clamped: widen the band or reduce "
+                             "heaterBand"));
+    }
+    mHeaters.push_back(Heater{shape, temperature});
+}
+
+void PhaseTransition::setLiquidTemperature(Real temperature)
+{
+    if (!(temperature > Real(0)) || !std::isfinite(temperature)) {
+        throw ValueError(msg("liquid temperature = ", temperature, " K: expected a finite value > 0"));
+    }
+    ParticleSet& p = mLiquid.particles();
+    auto& T = p.scalarChannel(TEMPERATURE);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] == ParticleKind::Liquid) T[i] = temperature;
+    }
+}
+
+// Heat: heater relaxation and [RYY15] Eq. 15 among liquid particles ----------------------------------
+
+void PhaseTransition::heat(Real dt)
+{
+    ParticleSet& p = mLiquid.particles();
+    const std::size_t n = p.size();
+    const Real R = mLiquid.supportRadius();
+    const Real rho0 = mLiquid.restDensity();
+    const sph::CubicSplineKernel kernel(R);
+    sph::NeighborGrid grid(R);
+    grid.build(p.positions());
+
+    const auto& x = p.positions();
+    const auto& m = p.masses();
+    const auto& rho = p.densities();
+    const auto& kind = p.kinds();
+    auto& T = p.scalarChannel(TEMPERATURE);
+    auto& latent = p.scalarChannel(LATENT);
+    const Real Dc = mSettings.conductivity;
+    const Real gamma2 = mSettings.diffusionEpsilon * R * R;
+    const Real band = mSettings.heaterBand;
+    auto density = [&](std::size_t j) { return rho[j] > Real(0) ? rho[j] : rho0; };
+
+    std::vector<Real> Tnew(n);
+    mSurface.assign(n, 0);
+    parallel::forEach(0, n, [&](std::size_t i) {
+        Tnew[i] = T[i];
+        if (kind[i] != ParticleKind::Liquid) return;
+        const Real rhoI = density(i);
+        double dTdt = 0;
+        Vec3d colour(0.0); // colour-field gradient sum_j V_j gradW_ij: ~0 inside, large at a surface
+        grid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
+            const ParticleKind kj = kind[j];
+            const bool liquidJ = kj == ParticleKind::Liquid;
+            if (!liquidJ && !isSolidKind(kj)) return;
+            const Real rhoJ = density(j);
+            colour += Vec3d(kernel.gradW(xij, r) * (m[j] / rhoJ));
+            if (!liquidJ || j == i || Dc == Real(0)) return;
+            // Eq. 15: dT_i/dt = sum_j m_j / (rho_i rho_j) D_c (T_i - T_j) x_ij.gradW_ij /
+            // (r^2 + gamma^2); x_ij.gradW_ij < 0, so heat flows from hot to cold.
+            const Real xg = xij.dot(kernel.gradW(xij, r));
+            dTdt += double(m[j] / (rhoI * rhoJ) * Dc * (T[i] - T[j]) * xg / (r * r + gamma2));
+        });
+        for (const Heater& h : mHeaters) {
+            if (h.shape.phi(x[i]) < band) dTdt += double((h.temperature - T[i]) / mSettings.heatingTime);
+        }
+        Tnew[i] = Real(double(T[i]) + double(dt) * dTdt);
+        mSurface[i] = colour.length() * double(R) > double(mSettings.surfaceThreshold);
+    });
+    // Heat beyond the boiling point goes into the latent store (L / c_p, K), T stays at T_b.
+    const Real Tb = mSettings.boilingPoint;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (kind[i] != ParticleKind::Liquid) continue;
+        if (!std::isfinite(Tnew[i])) {
+            throw NumericalError(msg("phase transition: liquid particle id ", p.ids()[i],
+                                     " has a non-finite temperature after the heat step; reduce "
+                                     "dt, conductivity or raise heatingTime"));
+        }
+        if (Tnew[i] > Tb) {
+            latent[i] += Tnew[i] - Tb;
+            Tnew[i] = Tb;
+        }
+        T[i] = Tnew[i];
+    }
+}
+
+// Boiling and evaporation ([RYY15] Sec. 4.2) ----------------------------------------------------------
+
+std::size_t PhaseTransition::transfer(Real dt)
+{
+    ParticleSet& p = mLiquid.particles();
+    const std::size_t n = p.size();
+    const auto& kind = p.kinds();
+    const auto& T = p.scalarChannel(TEMPERATURE);
+    const auto& latent = p.scalarChannel(LATENT);
+    auto& pending = p.scalarChannel(EVAPORATION);
+    const Real Tb = mSettings.boilingPoint, Ton = mSettings.evaporationOnset;
+    const std::size_t cap = mSettings.maxTransitionsPerStep;
+
+    std::vector<Index> boil;
+    std::vector<sph::ParticleId> evapIds;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (kind[i] != ParticleKind::Liquid) continue;
+        if (cap && boil.size() >= cap) break;
+        if (T[i] >= Tb && latent[i] >= mSettings.latentHeat) boil.push_back(Index(i));
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        if (kind[i] != ParticleKind::Liquid || !mSurface[i] || !(T[i] > Ton)) continue;
+        if (T[i] >= Tb && latent[i] >= mSettings.latentHeat) continue; // boils instead
+        const Real f = std::min(Real(1), (T[i] - Ton) / (Tb - Ton));
+        pending[i] += mSettings.evaporationRate * f * dt;
+        // The threshold is staggered per particle by a hash of its id, so a surface that starts
+        // with equal temperatures does not evaporate in lockstep (no quantisation of the rate).
+        if (pending[i] + evaporationPhase(p.ids()[i]) >= Real(1) &&
+            (!cap || boil.size() + evapIds.size() < cap)) {
+            pending[i] -= Real(1);
+            evapIds.push_back(p.ids()[i]);
+        }
+    }
+    if (boil.empty() && evapIds.empty()) return 0;
+
+    // Boiling: every daughter becomes gas. Evaporation: the centre stays liquid.
+    SplitOptions boilOptions;
+    boilOptions.outerKind = ParticleKind::Gas;
+    boilOptions.centreKind = ParticleKind::Gas;
+    if (!boil.empty()) splitParticles(p, boil, mBoilPattern, boilOptions);
+    if (!evapIds.empty()) {
+        const std::unordered_set<sph::ParticleId> wanted(evapIds.begin(), evapIds.end());
+        std::vector<Index> evap;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            if (p.kinds()[i] == ParticleKind::Liquid && wanted.count(p.ids()[i])) {
+                evap.push_back(Index(i));
+            }
+        }
+        SplitOptions evapOptions;
+        evapOptions.outerKind = ParticleKind::Gas;
+        evapOptions.centreKind = ParticleKind::Liquid;
+        splitParticles(p, evap, mEvapPattern, evapOptions);
+    }
+    mBoiled += boil.size();
+    mEvaporated += evapIds.size();
+
+    // Hand every gas daughter to the gas solver with its exact mass; its support radius is the
+    // one a gas particle of that mass has at the gas rest density (volume expansion, Sec. 4.2).
+    const Real hGas = mGas.settings().supportRadius();
+    const double mGasRef = double(mGas.referenceParticleMass());
+    const auto& Tc = p.scalarChannel(TEMPERATURE);
+    std::vector<Vec3> xs, vs;
+    std::vector<Real> Ts, ms, hs;
+    std::vector<std::uint8_t> remove(p.size(), 0);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Gas) continue;
+        remove[i] = 1;
+        xs.push_back(p.positions()[i]);
+        vs.push_back(p.velocities()[i]);
+        Ts.push_back(Tc[i]);
+        ms.push_back(p.masses()[i]);
+        hs.push_back(Real(double(hGas) * std::cbrt(double(p.masses()[i]) / mGasRef)));
+        mVapourMass += double(p.masses()[i]);
+    }
+    p.removeIf(remove);
+    if (!xs.empty()) mGas.addGasParticles(xs, vs, Ts, ms, hs);
+    mVapourCreated += xs.size();
+    return boil.size() + evapIds.size();
+}
+
+void PhaseTransition::mergeLiquid()
+{
+    ParticleSet& p = mLiquid.particles();
+    if (mMerge.sizeRule == MergeSizeRule::VolumeSum && mMerge.referenceMass == Real(0)) {
+        // Re-split daughters get about the liquid's own support radius back: h' from the merged
+        // mass at the liquid's reference mass and support radius.
+        mMerge.sizeRule = MergeSizeRule::ReferenceDensity;
+        mMerge.referenceMass = mLiquid.particleMass();
+        mMerge.referenceRadius = mLiquid.supportRadius();
+    }
+    if (!(mMerge.referenceMass > Real(0))) return; // the liquid has no mass yet
+    sph::NeighborGrid grid(mLiquid.supportRadius() * mMerge.neighbourhoodFactor);
+    grid.build(p.positions());
+    const MergeResult r = mergeParticles(p, grid, mMerge);
+    mMerges += r.merges;
+}
+
+// The liquid as the gas's boundary ([RYY15] Sec. 3.3) ---------------------------------------------
+
+void PhaseTransition::updateBoundary()
+{
+    const ParticleSet& p = mLiquid.particles();
+    const Real cell = mGas.settings().spacing;
+    struct Bin { std::int64_t key; Vec3d x; Vec3d v; int count; };
+    std::vector<std::pair<std::int64_t, Index>> keyed;
+    keyed.reserve(p.size());
+    constexpr std::int64_t OFFSET = std::int64_t(1) << 20, BITS = 21;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Liquid) continue;
+        const Vec3& x = p.positions()[i];
+        std::int64_t key = 0;
+        for (int a = 0; a < 3; ++a) {
+            const std::int64_t c = std::int64_t(std::floor(x[a] / cell)) + OFFSET;
+            key = (key << BITS) | (std::clamp<std::int64_t>(c, 0, (std::int64_t(1) << BITS) - 1));
+        }
+        keyed.emplace_back(key, Index(i));
+    }
+    std::sort(keyed.begin(), keyed.end());
+    std::vector<Vec3> xs, vs;
+    for (std::size_t k = 0; k < keyed.size();) {
+        std::size_t e = k;
+        Vec3d x(0.0), v(0.0);
+        while (e < keyed.size() && keyed[e].first == keyed[k].first) {
+            x += Vec3d(p.positions()[keyed[e].second]);
+            v += Vec3d(p.velocities()[keyed[e].second]);
+            ++e;
+        }
+        const double c = double(e - k);
+        xs.push_back(sph::toVec3(x / c));
+        vs.push_back(sph::toVec3(v / c));
+        k = e;
+    }
+    mBoundaryCount = xs.size();
+    mGas.setExternalBoundary(xs, vs, mGas.referenceParticleMass());
+}
+
+// The coupled step ----------------------------------------------------------------------------------
+
+double PhaseTransition::gasMass() const
+{
+    const ParticleSet& g = mGas.particles();
+    const std::vector<Real>* ambient =
+        g.hasScalarChannel(channel::AMBIENT) ? &g.scalarChannel(channel::AMBIENT) : nullptr;
+    double sum = 0;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+        if (g.kinds()[i] != ParticleKind::Gas) continue;
+        if (ambient && (*ambient)[i] != Real(0)) continue;
+        sum += double(g.masses()[i]);
+    }
+    return sum;
+}
+
+MassBudget PhaseTransition::massBudget() const
+{
+    MassBudget b;
+    const ParticleSet& p = mLiquid.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] == ParticleKind::Liquid) b.liquid += double(p.masses()[i]);
+    }
+    b.gas = gasMass();
+    b.gasRemoved = mGasRemoved;
+    return b;
+}
+
+void PhaseTransition::step(Real dt)
+{
+    if (!(dt > Real(0)) || !std::isfinite(dt)) {
+        throw ValueError(msg("phase transition step: dt = ", dt, " s: expected a finite value > 0"));
+    }
+    const auto start = std::chrono::steady_clock::now();
+    auto t0 = start;
+    mLiquid.step(dt);
+    mTimings.liquid += secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    ensureChannels(); // cheap if present; a liquid solver could have rebuilt its set
+    heat(dt);
+    mTimings.heat += secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    bool changed = transfer(dt) > 0;
+    if (++mStep % std::uint64_t(mSettings.mergeEverySteps) == 0) {
+        const std::size_t before = mMerges;
+        mergeLiquid();
+        changed = changed || mMerges > before;
+    }
+    if (changed) mLiquid.particlesChanged();
+    mTimings.transition += secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    updateBoundary();
+    mTimings.boundary += secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    // The gas step only removes gas (no sources in a coupled scene, or their gas is counted as
+    // created by them): the drop of the visible gas mass across it is what it removed.
+    const double before = gasMass();
+    mGas.step(dt);
+    const double after = gasMass();
+    if (after < before) mGasRemoved += before - after;
+    mTimings.gas += secondsSince(t0);
+    mTimings.total += secondsSince(start);
+    ++mTimings.steps;
+}
+
+} // namespace gas
+} // namespace ghostfx

@@ -1,0 +1,48 @@
+/// @file   FrameGridsDetail.h
+/// @brief  Private interface between the frame-output translation units of vdbio.
+/// @details Each heavy OpenVDB instantiation lives in its own .cc (STACK.md, compile times):
+///          SurfaceGrid.cc (ParticlesToLevelSet + LevelSetFilter), ParticleGrids.cc (gathered
+///          density / velocity / channel fog grids), PointsFile.cc (PointDataGrid). VolumeFile.cc
+///          validates options, selects particles and calls these.
+#pragma once
+
+#include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/vdbio/FrameFiles.h>
+
+#include <openvdb/openvdb.h>
+
+#include <string>
+#include <vector>
+
+namespace ghostfx {
+namespace vdbio {
+namespace detail {
+
+/// Indices of the particles whose kind is in `kinds`, in increasing order.
+std::vector<sph::Index> selectKinds(const sph::ParticleSet& particles,
+                                    const std::vector<sph::ParticleKind>& kinds);
+
+/// Comma-separated list of names, for error messages.
+std::string joinNames(const std::vector<std::string>& names);
+
+/// Liquid surface level set "surface" of the selected particles (options already validated).
+openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,
+                                        const std::vector<sph::Index>& selection,
+                                        const VolumeOptions& options);
+
+/// "density", "vel" and the scalar channel grids, as asked by `options` (already validated;
+/// channel names already checked), gathered on one shared sparse topology.
+openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
+                                      const std::vector<sph::Index>& selection,
+                                      const VolumeOptions& options);
+
+/// Metadata every ghostfx grid carries: creator, full float precision on write.
+void setCommonGridMetadata(openvdb::GridBase& grid);
+
+/// Throw IoError "<what> '<path>': folder '<dir>' does not exist" (or is not a folder), so a
+/// wrong output path is reported before any grid is built and without the temporary name.
+void checkOutputFolder(const std::string& path, const char* what);
+
+} // namespace detail
+} // namespace vdbio
+} // namespace ghostfx
