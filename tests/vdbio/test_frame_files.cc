@@ -154,7 +154,9 @@ std::size_t voxelsInBall(double radius, double dx)
 double densityMass(const openvdb::FloatGrid& density, double rho0)
 {
     double sum = 0;
-    for (auto it = density.cbeginValueOn(); it; ++it) sum += double(*it) * double(it.getVoxelCount());
+    for (auto it = density.cbeginValueOn(); it; ++it) {
+        sum += double(*it) * double(it.getVoxelCount());
+    }
     return rho0 * sum * std::pow(density.voxelSize()[0], 3);
 }
 
@@ -196,7 +198,8 @@ TEST(FrameFiles, VolumeFileHasTheGridsRenderersExpect)
         // Written by the io layer: Houdini and Blender show these.
         EXPECT_TRUE((*g)[openvdb::GridBase::META_FILE_COMPRESSION]) << g->getName();
     }
-    std::printf("[measured] active voxels: surface %llu, density %llu, vel %llu, temperature %llu\n",
+    std::printf("[measured] active voxels: surface %llu, density %llu, vel %llu, "
+                "temperature %llu\n",
                 (unsigned long long)surface->activeVoxelCount(),
                 (unsigned long long)density->activeVoxelCount(),
                 (unsigned long long)vel->activeVoxelCount(),
@@ -278,7 +281,9 @@ TEST(FrameFiles, DensityGridMassAndSparsity)
 
     std::vector<Vec3> liquid;
     for (std::size_t i = 0; i < sc.particles.size(); ++i) {
-        if (sc.particles.kinds()[i] == ParticleKind::Liquid) liquid.push_back(sc.particles.positions()[i]);
+        if (sc.particles.kinds()[i] == ParticleKind::Liquid) {
+            liquid.push_back(sc.particles.positions()[i]);
+        }
     }
     NeighborGrid grid{Real(SUPPORT)};
     grid.build(liquid);
@@ -514,7 +519,8 @@ TEST(FrameFiles, PointsRoundTrip)
         EXPECT_EQ(desc.valueType(desc.find("kind")), "int32");
         openvdb::points::AttributeHandle<openvdb::Vec3f> P(leaf->constAttributeArray("P"));
         openvdb::points::AttributeHandle<openvdb::Vec3f> v(leaf->constAttributeArray("v"));
-        openvdb::points::AttributeHandle<openvdb::Vec3f> normal(leaf->constAttributeArray("normal"));
+        openvdb::points::AttributeHandle<openvdb::Vec3f> normal(
+            leaf->constAttributeArray("normal"));
         openvdb::points::AttributeHandle<std::int64_t> id(leaf->constAttributeArray("id"));
         openvdb::points::AttributeHandle<float> rho(leaf->constAttributeArray("density"));
         openvdb::points::AttributeHandle<float> p(leaf->constAttributeArray("pressure"));
@@ -531,7 +537,8 @@ TEST(FrameFiles, PointsRoundTrip)
             maxPositionError = std::max(
                 maxPositionError, (x - openvdb::Vec3d(x0[0], x0[1], x0[2])).length());
             mismatches += v.get(*idx) != openvdb::Vec3f(sc.particles.velocities()[i]);
-            mismatches += normal.get(*idx) != openvdb::Vec3f(sc.particles.vectorChannel("normal")[i]);
+            mismatches +=
+                normal.get(*idx) != openvdb::Vec3f(sc.particles.vectorChannel("normal")[i]);
             mismatches += rho.get(*idx) != float(sc.particles.densities()[i]);
             mismatches += p.get(*idx) != float(sc.particles.pressures()[i]);
             mismatches += m.get(*idx) != float(sc.particles.masses()[i]);

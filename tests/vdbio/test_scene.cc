@@ -212,8 +212,13 @@ TEST_F(SceneTest, SceneWithoutLiquidIsRefused)
     s.erase("liquids");
     EXPECT_CONTAINS(errorOf(s), "liquids: the scene has no liquid: expected at least one liquid body or emitter");
     s = baseScene();
-    s["gas_sources"] = Json::array({Json::object()});
-    EXPECT_CONTAINS(errorOf(s), "gas_sources: gas sources need the gas solver");
+    s["gas_sources"] = Json::parse(R"([{ "geometry": { "sphere": { "center": [0.5, 0.1, 0.5], "radius": 0.05 } } }])");
+    EXPECT_CONTAINS(errorOf(s), "gas_sources: gas sources need settings.method 'gas' (or heaters, for boiling)");
+    s["settings"]["method"] = "gas";
+    EXPECT_CONTAINS(errorOf(s), "liquids: a 'gas' scene simulates gas only");
+    s.erase("liquids");
+    s.erase("solids");
+    EXPECT_NO_THROW(vdbio::readScene(write(s)));
     // Not JSON at all: the parser's position is kept.
     std::ofstream(mDir / "broken.json") << "{ \"ghostfx_scene\": 1, ";
     try {

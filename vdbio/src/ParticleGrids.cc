@@ -273,16 +273,21 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
             if (!any) {
                 any = true;
                 res.density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                if (wantVel) res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                if (wantVel) {
+                    res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                }
                 res.channels.resize(nChannels);
-                for (auto& leaf : res.channels) leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                for (auto& leaf : res.channels) {
+                    leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                }
             }
             const openvdb::Index offset = openvdb::Index(voxel);
             res.density->setValueOn(offset, float(ratio));
             const double invRho = 1.0 / rho[voxel];
             if (wantVel) res.vel->setValueOn(offset, openvdb::Vec3s(mv[voxel] * invRho));
             for (std::size_t ch = 0; ch < nChannels; ++ch) {
-                res.channels[ch]->setValueOn(offset, float(ma[ch * LEAF_VOXELS + voxel] * invRho));
+                res.channels[ch]->setValueOn(offset,
+                                             float(ma[ch * LEAF_VOXELS + voxel] * invRho));
             }
         }
     }, 1);

@@ -155,11 +155,14 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
             addAttribute(tree, indexTree, name,
                          gatherSelected<std::int64_t>(particles.ids(), selection));
         } else if (name == "density") {
-            addAttribute(tree, indexTree, name, gatherSelected<float>(particles.densities(), selection));
+            addAttribute(tree, indexTree, name,
+                         gatherSelected<float>(particles.densities(), selection));
         } else if (name == "pressure") {
-            addAttribute(tree, indexTree, name, gatherSelected<float>(particles.pressures(), selection));
+            addAttribute(tree, indexTree, name,
+                         gatherSelected<float>(particles.pressures(), selection));
         } else if (name == "mass") {
-            addAttribute(tree, indexTree, name, gatherSelected<float>(particles.masses(), selection));
+            addAttribute(tree, indexTree, name,
+                         gatherSelected<float>(particles.masses(), selection));
         } else if (name == "kind") {
             std::vector<std::int32_t> kinds(selection.size());
             for (std::size_t k = 0; k < selection.size(); ++k) {

@@ -161,6 +161,26 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
     return sph::makeLevelSet(grid, g.path());
 }
 
+/// Keys of a rigid motion: { "keys": [ { "time", "translate", "rotate" }, ... ] }.
+KeyedMotion readMotion(const JsonObject& motion)
+{
+    KeyedMotion m;
+    for (const JsonObject& k : motion.objects("keys")) {
+        RigidKey key;
+        key.time = k.require<double>("time");
+        key.translate = vec(k.get<std::array<double, 3>>("translate", {0, 0, 0}));
+        key.rotateDegrees = vec(k.get<std::array<double, 3>>("rotate", {0, 0, 0}));
+        k.finish();
+        if (!m.keys.empty() && !(key.time > m.keys.back().time)) {
+            k.failValue("time", "expected key times in increasing order");
+        }
+        m.keys.push_back(key);
+    }
+    if (m.keys.empty()) motion.fail("keys", "expected at least one key");
+    motion.finish();
+    return m;
+}
+
 void readOutputs(const JsonObject& o, SceneOutputs& out)
 {
     out.directory = o.get<std::string>("directory", out.directory);
@@ -194,6 +214,22 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         }
         out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
     }, [&] { out.volumeFile.clear(); });
+    section("gas_points", [&](const JsonObject& s) {
+        out.gasPointsFile = s.get<std::string>("file", out.gasPointsFile);
+        out.gasPointChannels = s.get<std::vector<std::string>>("channels", out.gasPointChannels);
+    }, [&] { out.gasPointsFile.clear(); });
+    section("gas_volume", [&](const JsonObject& s) {
+        out.gasVolumeFile = s.get<std::string>("file", out.gasVolumeFile);
+        out.gasVolumeGrids = s.get<std::vector<std::string>>("grids", out.gasVolumeGrids);
+        for (const std::string& g : out.gasVolumeGrids) {
+            if (g != "density" && g != "vel" && g != "temperature") {
+                const std::string near = closestKey(g, {"density", "vel", "temperature"});
+                s.failValue("grids", msg("grid '", g, "' is not one of density, vel, temperature",
+                                         near.empty() ? "" : " (did you mean '" + near + "'?)"));
+            }
+        }
+        out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
+    }, [&] { out.gasVolumeFile.clear(); });
     out.previewFile.clear();
     section("preview", [&](const JsonObject& s) {
         out.previewFile = s.get<std::string>("file", "preview.$F4.exr");
@@ -201,7 +237,7 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
         out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
     }, [&] { out.previewFile.clear(); });
-    if (!out.previewFile.empty() && out.volumeFile.empty()) {
+    if (!out.previewFile.empty() && out.volumeFile.empty() && out.gasVolumeFile.empty()) {
         o.fail("preview", "a preview renders a grid of the volume output, which is off");
     }
     section("checkpoint", [&](const JsonObject& s) {
@@ -255,6 +291,10 @@ Json documentFromRoles(const std::string& path)
                              " 'ghostfx mesh2sdf --role' writes them)"));
     }
     doc["settings"]["spacing"] = 2 * finest;
+    // Sources without liquid: a gas scene.
+    if (doc.contains("gas_sources") && !doc.contains("liquids") && !doc.contains("emitters")) {
+        doc["settings"]["method"] = "gas";
+    }
     return doc;
 }
 
@@ -341,19 +381,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         SceneSolid solid{name, geometry, shape};
         solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         if (auto motion = o.optionalObject("motion")) {
-            for (const JsonObject& k : motion->objects("keys")) {
-                RigidKey key;
-                key.time = k.require<double>("time");
-                key.translate = vec(k.get<std::array<double, 3>>("translate", {0, 0, 0}));
-                key.rotateDegrees = vec(k.get<std::array<double, 3>>("rotate", {0, 0, 0}));
-                k.finish();
-                if (!solid.motion.keys.empty() && !(key.time > solid.motion.keys.back().time)) {
-                    k.failValue("time", "expected key times in increasing order");
-                }
-                solid.motion.keys.push_back(key);
-            }
-            if (solid.motion.keys.empty()) motion->fail("keys", "expected at least one key");
-            motion->finish();
+            solid.motion = readMotion(*motion);
             if (solid.velocity != Vec3d(0)) o.fail("velocity", "give either 'velocity' or 'motion', not both");
         }
         if (auto seq = o.optionalObject("sequence")) {
@@ -388,15 +416,53 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         o.finish();
         scene.emitters.push_back(std::move(emitter));
     }
-    if (root.has("gas_sources")) {
-        root.fail("gas_sources", "gas sources need the gas solver ([RYY15]), which this build of "
-                                 "ghostfx does not have yet");
+    for (const JsonObject& o : root.objects("gas_sources")) {
+        const std::string name = o.get<std::string>("name", o.path());
+        std::string geometry;
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        SceneGasSource source{name, geometry, shape};
+        source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
+        source.temperature = o.positive("temperature", source.temperature);
+        source.rate = o.nonNegative("rate", 0);
+        source.start = o.nonNegative("start", 0);
+        source.end = o.get<double>("end", std::numeric_limits<double>::infinity());
+        if (!(source.end > source.start)) o.failValue("end", msg("expected end > start (", source.start, " s)"));
+        if (auto motion = o.optionalObject("motion")) source.motion = readMotion(*motion);
+        o.finish();
+        scene.gasSources.push_back(std::move(source));
+    }
+    for (const JsonObject& o : root.objects("heaters")) {
+        const std::string name = o.get<std::string>("name", o.path());
+        std::string geometry;
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        SceneHeater heater{name, geometry, shape};
+        heater.temperature = o.positive("temperature", heater.temperature);
+        o.finish();
+        scene.heaters.push_back(std::move(heater));
+    }
+    if (auto phase = root.optionalObject("phase_transition")) {
+        if (scene.heaters.empty()) root.fail("phase_transition", "expected heaters: a phase transition needs at least one");
+        scene.phaseTransition = *phase;
     }
     if (auto outputs = root.optionalObject("outputs")) readOutputs(*outputs, scene.outputs);
     root.finish();
 
-    if (scene.liquids.empty() && scene.emitters.empty()) {
-        root.fail("liquids", "the scene has no liquid: expected at least one liquid body or emitter");
+    if (scene.method == "gas") {
+        if (!scene.liquids.empty() || !scene.emitters.empty() || !scene.heaters.empty()) {
+            root.fail(scene.liquids.empty() ? (scene.emitters.empty() ? "heaters" : "emitters") : "liquids",
+                      "a 'gas' scene simulates gas only: liquids, emitters and heaters need method 'ghost' or "
+                      "'basic' (with heaters, the liquid boils into gas)");
+        }
+        if (scene.gasSources.empty()) {
+            root.fail("gas_sources", "the scene has no gas: expected at least one gas source");
+        }
+    } else {
+        if (scene.liquids.empty() && scene.emitters.empty()) {
+            root.fail("liquids", "the scene has no liquid: expected at least one liquid body or emitter");
+        }
+        if (!scene.gasSources.empty() && scene.heaters.empty()) {
+            root.fail("gas_sources", "gas sources need settings.method 'gas' (or heaters, for boiling)");
+        }
     }
     return scene;
 }

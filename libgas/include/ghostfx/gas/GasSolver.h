@@ -40,6 +40,7 @@
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
 
 #include <openvdb/math/Mat3.h>
@@ -77,19 +78,8 @@ constexpr Real EXTERNAL_BOUNDARY = Real(-1);
 /// solid_index of the ambient baseline's domain walls.
 constexpr Real DOMAIN_WALL = Real(-2);
 
-/// Placement of a rigid body: world x = rotation * local + translation.
-struct RigidTransform
-{
-    openvdb::math::Mat3<Real> rotation = openvdb::math::Mat3<Real>::identity();
-    Vec3 translation{0};
-
-    Vec3 toWorld(const Vec3& local) const { return rotation * local + translation; }
-    Vec3 toLocal(const Vec3& world) const { return rotation.transpose() * (world - translation); }
-};
-
-/// A body's placement as a function of time (s), defined for every t >= 0 and smooth enough
-/// for a central difference of 1e-4 s to give its velocity.
-using RigidMotion = std::function<RigidTransform(double time)>;
+using sph::RigidMotion;
+using sph::RigidTransform;
 
 /// A gas source: while active, its volume is kept full of gas (new particles grow from the gas
 /// already inside, at least 0.92 spacing from every particle), and the gas inside it is held at

@@ -34,6 +34,7 @@
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
 
 #include <openvdb/math/Mat3.h>
@@ -52,20 +53,8 @@ using sph::LevelSet;
 using sph::ParticleKind;
 using sph::ParticleSet;
 
-/// Placement of a rigid solid: world x = rotation * local + translation, local being the frame
-/// its level set is defined in.
-struct RigidTransform
-{
-    openvdb::math::Mat3<Real> rotation = openvdb::math::Mat3<Real>::identity();
-    Vec3 translation{0};
-
-    Vec3 toWorld(const Vec3& local) const { return rotation * local + translation; }
-    Vec3 toLocal(const Vec3& world) const { return rotation.transpose() * (world - translation); }
-};
-
-/// A solid's placement as a function of time (s); it must be defined for every t >= 0 and be
-/// smooth enough for a central difference of 1e-4 s to give its velocity.
-using RigidMotion = std::function<RigidTransform(double time)>;
+using sph::RigidMotion;
+using sph::RigidTransform;
 
 /// Seconds spent in each phase of the step, accumulated since the last reset ([SB12] Sec. 5).
 struct PhaseTimings

@@ -100,6 +100,35 @@ struct SceneEmitter
     double start = 0, end = std::numeric_limits<double>::infinity();
 };
 
+/// A gas source ([RYY15]): keeps its volume filled with gas at `temperature` (K) moving at
+/// `velocity`, optionally limited to `rate` particles per second, between `start` and `end`.
+struct SceneGasSource
+{
+    SceneGasSource(std::string name_, std::string geometry_, sph::LevelSet shape_)
+        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+
+    std::string name;
+    std::string geometry;
+    sph::LevelSet shape;
+    sph::Vec3d velocity{0};
+    double temperature = 373.15;
+    double rate = 0;             ///< particles per second; 0: keep the volume full
+    double start = 0, end = std::numeric_limits<double>::infinity();
+    KeyedMotion motion;          ///< a moving source (the paper's steam train); empty: static
+};
+
+/// A heater for the liquid-gas phase transition: liquid near it is heated towards `temperature`.
+struct SceneHeater
+{
+    SceneHeater(std::string name_, std::string geometry_, sph::LevelSet shape_)
+        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+
+    std::string name;
+    std::string geometry;
+    sph::LevelSet shape;
+    double temperature = 400;
+};
+
 /// What to write per frame. Paths are frame patterns relative to `directory`; empty = off.
 struct SceneOutputs
 {
@@ -112,7 +141,13 @@ struct SceneOutputs
     std::string volumeFile = "liquid.$F4.vdb";
     std::vector<std::string> volumeGrids{"surface", "density", "vel"};
     double voxelSize = 0;             ///< 0: half the particle spacing
-    // EXR preview of one grid of the volume file.
+    // Gas (gas scenes and boiling): points and volumes of the gas particles.
+    std::string gasPointsFile = "gas_points.$F4.vdb";
+    std::vector<std::string> gasPointChannels{"v", "id", "temperature"};
+    std::string gasVolumeFile = "gas.$F4.vdb";
+    std::vector<std::string> gasVolumeGrids{"density", "temperature", "vel"};
+    double gasVoxelSize = 0;          ///< 0: half the gas particle spacing
+    // EXR preview of one grid of the volume file (the liquid's, else the gas's).
     std::string previewFile;
     std::string previewGrid;          ///< "" : density if written, else surface
     int previewWidth = 640, previewHeight = 360;
@@ -135,7 +170,7 @@ struct Scene
     JsonObject settings;
 
     // Settings every solver shares.
-    std::string method;          ///< "ghost", "basic" (liquids), "gas" (gases)
+    std::string method;          ///< "ghost", "basic" (liquids), "gas" (gas only: fast, ambient or uncorrected by settings.gas.variant)
     double spacing = 0;          ///< particle spacing h (m)
     double frameRate = 30;       ///< frames per second
     int firstFrame = 1, lastFrame = 24; ///< frames written; frame f is the state at t = f / frameRate
@@ -144,6 +179,11 @@ struct Scene
     std::vector<SceneSolid> solids;
     std::vector<SceneLiquid> liquids;
     std::vector<SceneEmitter> emitters;
+    std::vector<SceneGasSource> gasSources;
+    std::vector<SceneHeater> heaters;
+    /// The `phase_transition` object (boiling / evaporation settings), read by the caller when
+    /// the scene has heaters; empty otherwise.
+    JsonObject phaseTransition;
     SceneOutputs outputs;
 
     /// Canonical JSON text of everything that changes the simulation (all but `outputs` and
