@@ -2,7 +2,7 @@
 /// @brief  `ghostfx run`: scene -> solver -> frames, checkpoints, statistics and previews.
 #include "RunCommand.h"
 
-#include "LiquidScene.h"
+#include "Simulation.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/Parallel.h>
@@ -28,7 +28,6 @@ namespace ghostfx {
 namespace cmd {
 
 namespace fs = std::filesystem;
-using ghost::GhostSolver;
 using sph::ParticleKind;
 using Clock = std::chrono::steady_clock;
 
@@ -102,7 +101,7 @@ public:
 
     Progress(Mode mode, int first, int last) : mMode(mode), mFirst(first), mLast(last) {}
 
-    void step(const GhostSolver& solver, int frame, int substep)
+    void step(const Simulation& sim, int frame, int substep)
     {
         if (mMode != Mode::Bar) return;
         const auto now = Clock::now();
@@ -115,24 +114,22 @@ public:
         const double eta = done > 0 ? elapsed * (total - done) / done : 0;
         const int width = 24;
         const int filled = int(width * done / total);
-        std::fprintf(stderr, "\r\033[Kframe %d/%d [%s%s] substep %d | %zu liquid | %.1f steps/s | ETA %s",
+        std::fprintf(stderr, "\r\033[Kframe %d/%d [%s%s] substep %d | %s | %.1f steps/s | ETA %s",
                      frame, mLast, std::string(std::size_t(filled), '#').c_str(),
                      std::string(std::size_t(width - filled), '.').c_str(), substep,
-                     solver.count(ParticleKind::Liquid), rate, done > 0 ? duration(eta).c_str() : "?");
+                     sim.counts().c_str(), rate, done > 0 ? duration(eta).c_str() : "?");
         std::fflush(stderr);
     }
 
     void countStep() { ++mSteps; }
 
-    void frame(const GhostSolver& solver, int frame, int steps, double frameSeconds, bool written)
+    void frame(const Simulation& sim, int frame, int steps, double frameSeconds, bool written)
     {
         if (mMode == Mode::None) return;
         if (mMode == Mode::Bar) std::fprintf(stderr, "\r\033[K");
-        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %d steps, %zu liquid, %zu air, %zu solid ghosts, %.2f s%s\n",
-                     frame, mLast, solver.time(), steps, solver.count(ParticleKind::Liquid),
-                     solver.count(ParticleKind::GhostAir),
-                     solver.count(ParticleKind::GhostSolid) + solver.count(ParticleKind::Boundary),
-                     frameSeconds, written ? "" : " (not written: before the first frame)");
+        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %d steps, %s, %.2f s%s\n", frame, mLast, sim.time(),
+                     steps, sim.counts().c_str(), frameSeconds,
+                     written ? "" : " (not written: before the first frame)");
         std::fflush(stderr);
     }
 
@@ -150,44 +147,51 @@ private:
     Clock::time_point mStart = Clock::now(), mLastDraw{};
 };
 
-/// Per-step statistics row.
-vdbio::StatsRow statsRow(const GhostSolver& solver, int frame, double dt, const ghost::PhaseTimings& before)
+} // namespace
+
+namespace {
+
+/// Write one medium's points and volume files for `frame`; returns its grids (for previews).
+openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out, const std::string& pointsPath,
+                                const std::string& volumePath, const openvdb::MetaMap& fileMeta)
 {
-    const sph::ParticleSet& p = solver.particles();
-    const double rho0 = solver.settings().restDensity;
-    double maxSpeed = 0, errorSum = 0, errorMax = 0;
-    std::size_t liquid = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] != ParticleKind::Liquid) continue;
-        ++liquid;
-        maxSpeed = std::max(maxSpeed, double(p.velocities()[i].length()));
-        const double e = std::abs(double(p.densities()[i]) / rho0 - 1.0);
-        errorSum += e;
-        errorMax = std::max(errorMax, e);
+    const std::vector<std::string>& channels = m.liquid ? out.pointChannels : out.gasPointChannels;
+    if (!pointsPath.empty()) {
+        vdbio::PointsOptions po;
+        po.channels = channels;
+        po.kinds = m.kinds;
+        if (out.pointGhosts && !m.ghostKinds.empty()) {
+            po.kinds.insert(po.kinds.end(), m.ghostKinds.begin(), m.ghostKinds.end());
+            if (std::find(po.channels.begin(), po.channels.end(), "kind") == po.channels.end()) {
+                po.channels.push_back("kind");
+            }
+        }
+        vdbio::writePointsFile(pointsPath, *m.particles, po, fileMeta);
     }
-    const ghost::PhaseTimings& t = solver.timings();
-    vdbio::StatsRow row;
-    row.values = {
-        {"frame", frame},
-        {"step", double(solver.stepCount())},
-        {"time", solver.time()},
-        {"dt", dt},
-        {"count_liquid", double(liquid)},
-        {"count_ghost_air", double(solver.count(ParticleKind::GhostAir))},
-        {"count_ghost_solid", double(solver.count(ParticleKind::GhostSolid))},
-        {"count_boundary", double(solver.count(ParticleKind::Boundary))},
-        {"max_speed", maxSpeed},
-        {"density_error_mean", liquid ? errorSum / double(liquid) : 0.0},
-        {"density_error_max", errorMax},
-        {"t_neighbors_density", t.neighborsAndDensity - before.neighborsAndDensity},
-        {"t_pressure_force", t.pressureForce - before.pressureForce},
-        {"t_xsph_boundary", t.xsphAndBoundary - before.xsphAndBoundary},
-        {"t_air_resampling", t.airResampling - before.airResampling},
-        {"t_emission", t.emission - before.emission},
-        {"t_step", t.total - before.total},
-        {"bytes_per_particle", p.size() ? double(p.memoryBytes()) / double(p.size()) : 0.0},
-    };
-    return row;
+    openvdb::GridPtrVec grids;
+    if (volumePath.empty()) return grids;
+    const std::vector<std::string>& wanted = m.liquid ? out.volumeGrids : out.gasVolumeGrids;
+    auto wants = [&](const char* g) { return std::find(wanted.begin(), wanted.end(), g) != wanted.end(); };
+    vdbio::VolumeOptions vo;
+    const double voxel = m.liquid ? out.voxelSize : out.gasVoxelSize;
+    vo.voxelSize = voxel > 0 ? voxel : 0.5 * m.spacing;
+    vo.kernelSupport = m.support;
+    vo.restDensity = m.restDensity;
+    vo.particleSpacing = m.spacing;
+    vo.kinds = m.kinds;
+    vo.surface = m.liquid && wants("surface");
+    vo.density = wants("density");
+    vo.velocity = wants("vel");
+    if (wants("temperature")) {
+        if (!m.particles->hasScalarChannel("temperature")) {
+            throw SceneError(msg("outputs: grid 'temperature' asked for, but the ", m.name,
+                                 " particles carry no temperature in this scene"));
+        }
+        vo.scalarChannels.push_back("temperature");
+    }
+    grids = vdbio::makeVolumeGrids(*m.particles, vo);
+    vdbio::writeVolumeFile(volumePath, grids, fileMeta);
+    return grids;
 }
 
 } // namespace
@@ -199,26 +203,28 @@ int runScene(const RunOptions& o)
 
     // Scene, settings and outputs: every input error is found before any simulation.
     vdbio::Scene scene = vdbio::readScene(o.scene, o.defines);
-    const ghost::GhostSettings settings = liquidSettings(scene);
     int first = scene.firstFrame, last = scene.lastFrame;
     if (!o.frames.empty()) parseFrames(o.frames, first, last);
     const vdbio::SceneOutputs& out = scene.outputs;
     const std::string folder = o.out.empty() ? out.directory : o.out;
-    vdbio::ensureWritableDirectory(folder);
-    auto inFolder = [&](const std::string& pattern, int frame) {
-        return (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
-    };
     const std::string fingerprint = scene.simulationFingerprint();
 
-    // The solver, fresh or from a checkpoint.
-    std::unique_ptr<GhostSolver> solver;
+    // The solvers the scene needs, fresh or from a checkpoint.
+    std::unique_ptr<Simulation> sim;
     if (!o.resume.empty()) {
-        const sph::SolverState state = vdbio::readCheckpoint(o.resume, fingerprint);
-        solver = makeLiquidSolver(scene, settings, &state);
+        if (stateCount(scene) == 0) {
+            throw SceneError(msg("scene '", scene.file, "': a boiling scene (with heaters) cannot be resumed yet"));
+        }
+        const std::vector<sph::SolverState> states{vdbio::readCheckpoint(o.resume, fingerprint)};
+        sim = makeSimulation(scene, &states);
     } else {
-        solver = makeLiquidSolver(scene, settings);
+        sim = makeSimulation(scene);
     }
-    const int startFrame = solver->frame();
+    vdbio::ensureWritableDirectory(folder);
+    auto inFolder = [&](const std::string& pattern, int frame) {
+        return pattern.empty() ? std::string() : (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
+    };
+    const int startFrame = sim->frame();
 
     Progress::Mode mode = Progress::Mode::Log;
     if (o.quiet || o.progress == "none") mode = Progress::Mode::None;
@@ -228,9 +234,14 @@ int runScene(const RunOptions& o)
         progress.message(msg("nothing to do: the checkpoint is at frame ", startFrame, ", the last frame is ", last));
         return 0;
     }
-    progress.message(msg("ghostfx run '", scene.file, "': ", scene.method, " method, spacing ", scene.spacing,
-                         " m, frames ", std::max(first, startFrame + 1), "-", last, (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"),
-                         ", ", parallel::maxThreads(), " threads, output in '", folder, "'"));
+    progress.message(msg("ghostfx run '", scene.file, "': ", scene.method, scene.heaters.empty() ? "" : " + boiling",
+                         ", spacing ", scene.spacing, " m, frames ", std::max(first, startFrame + 1), "-", last,
+                         (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"), ", ", parallel::maxThreads(),
+                         " threads, output in '", folder, "'"));
+    const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0;
+    if (!out.checkpointFile.empty() && !checkpoints) {
+        progress.message("note: boiling scenes write no checkpoints yet (the phase transition's state is not saved)");
+    }
 
     // Statistics.
     std::unique_ptr<vdbio::StatsWriter> stats;
@@ -238,24 +249,22 @@ int runScene(const RunOptions& o)
         const std::string h5 = inFolder(out.statsFile, 0);
         const std::string csv = (fs::path(h5).replace_extension(".csv")).string();
         stats = std::make_unique<vdbio::StatsWriter>(h5, csv);
-        if (!o.resume.empty()) stats->resumeFrom(std::int64_t(solver->stepCount()));
+        if (!o.resume.empty()) stats->resumeFrom(std::int64_t(sim->stepCount()));
     }
 
     int frame = startFrame + 1, substep = 0;
-    ghost::PhaseTimings before = solver->timings();
-    solver->setStepObserver([&](const GhostSolver& s, sph::Real dt) {
+    sim->setStepObserver([&](double dt) {
         ++substep;
         progress.countStep();
-        progress.step(s, frame, substep);
-        if (stats) stats->append(statsRow(s, frame, double(dt), before));
-        before = s.timings();
+        progress.step(*sim, frame, substep);
+        if (stats) stats->append(sim->statsRow(frame, dt));
     });
 
     InterruptGuard interruptGuard;
     auto writeCheckpoint = [&](int f) {
-        if (out.checkpointFile.empty()) return std::string();
+        if (!checkpoints) return std::string();
         const std::string path = inFolder(out.checkpointFile, f);
-        vdbio::writeCheckpoint(path, solver->saveState(), fingerprint, f);
+        vdbio::writeCheckpoint(path, sim->saveStates().front(), fingerprint, f);
         return path;
     };
 
@@ -263,85 +272,63 @@ int runScene(const RunOptions& o)
     fileMeta.insertMeta("ghostfx_scene", openvdb::StringMetadata(scene.file));
     fileMeta.insertMeta("ghostfx_method", openvdb::StringMetadata(scene.method));
 
-    std::uint64_t stepsAtStart = solver->stepCount();
+    const std::uint64_t stepsAtStart = sim->stepCount();
     for (; frame <= last; ++frame) {
         const auto frameStart = Clock::now();
-        const std::uint64_t stepsBefore = solver->stepCount();
+        const std::uint64_t stepsBefore = sim->stepCount();
         substep = 0;
-        updateSolidSequences(scene, *solver, frame);
-        solver->advanceFrame();
+        sim->beforeFrame(frame);
+        sim->advanceFrame();
 
         const bool write = frame >= first;
         if (write) {
             fileMeta.insertMeta("frame", openvdb::Int32Metadata(frame));
-            fileMeta.insertMeta("time", openvdb::DoubleMetadata(solver->time()));
-            if (!out.pointsFile.empty()) {
-                vdbio::PointsOptions po;
-                po.channels = out.pointChannels;
-                if (out.pointGhosts) {
-                    po.kinds = {ParticleKind::Liquid, ParticleKind::GhostAir, ParticleKind::GhostSolid,
-                                ParticleKind::Boundary};
-                    if (std::find(po.channels.begin(), po.channels.end(), "kind") == po.channels.end()) {
-                        po.channels.push_back("kind");
-                    }
-                }
-                vdbio::writePointsFile(inFolder(out.pointsFile, frame), solver->particles(), po, fileMeta);
+            fileMeta.insertMeta("time", openvdb::DoubleMetadata(sim->time()));
+            openvdb::GridPtrVec previewGrids;
+            for (const OutputMedium& m : sim->media()) {
+                const bool liquid = m.liquid;
+                const openvdb::GridPtrVec grids =
+                    writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile, frame),
+                                inFolder(liquid ? out.volumeFile : out.gasVolumeFile, frame), fileMeta);
+                if (previewGrids.empty()) previewGrids = grids;
             }
-            if (!out.volumeFile.empty()) {
-                vdbio::VolumeOptions vo;
-                vo.voxelSize = out.voxelSize > 0 ? out.voxelSize : 0.5 * scene.spacing;
-                vo.kernelSupport = settings.supportRadius();
-                vo.restDensity = settings.restDensity;
-                vo.particleSpacing = scene.spacing;
-                auto wants = [&](const char* g) {
-                    return std::find(out.volumeGrids.begin(), out.volumeGrids.end(), g) != out.volumeGrids.end();
-                };
-                vo.surface = wants("surface");
-                vo.density = wants("density");
-                vo.velocity = wants("vel");
-                const openvdb::GridPtrVec grids = vdbio::makeVolumeGrids(solver->particles(), vo);
-                vdbio::writeVolumeFile(inFolder(out.volumeFile, frame), grids, fileMeta);
-                if (!out.previewFile.empty()) {
-                    vdbio::PreviewOptions pv;
-                    pv.width = out.previewWidth;
-                    pv.height = out.previewHeight;
-                    std::string name = out.previewGrid;
-                    if (name.empty()) name = vo.density ? "density" : "surface";
-                    openvdb::GridBase::Ptr grid;
-                    for (const auto& g : grids) {
-                        if (g->getName() == name) grid = g;
-                    }
-                    if (!grid) {
-                        throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '", name,
-                                             "': the volume output has no such grid"));
-                    }
-                    vdbio::renderPreview(*grid, pv, inFolder(out.previewFile, frame));
+            if (!out.previewFile.empty() && !previewGrids.empty()) {
+                vdbio::PreviewOptions pv;
+                pv.width = out.previewWidth;
+                pv.height = out.previewHeight;
+                std::string name = out.previewGrid;
+                openvdb::GridBase::Ptr grid;
+                for (const auto& g : previewGrids) {
+                    if (name.empty() ? g->getName() == "density" : g->getName() == name) grid = g;
                 }
+                if (!grid && name.empty()) grid = previewGrids.front();
+                if (!grid) {
+                    throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '", name,
+                                         "': the volume output has no such grid"));
+                }
+                vdbio::renderPreview(*grid, pv, inFolder(out.previewFile, frame));
             }
         }
         if (stats) stats->flush();
         const bool interrupted = gInterrupted.load();
-        if (interrupted || frame == last ||
-            (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
-            const std::string path = writeCheckpoint(frame);
-            if (interrupted) {
-                progress.frame(*solver, frame, int(solver->stepCount() - stepsBefore),
-                               seconds(frameStart, Clock::now()), write);
-                std::fprintf(stderr, "ghostfx: interrupted after frame %d%s\n", frame,
-                             path.empty() ? " (checkpoints are off: nothing to resume from)"
-                                          : ("; resume with: ghostfx run " + o.scene + " --resume " + path).c_str());
-                return EXIT_INTERRUPTED;
-            }
+        std::string checkpoint;
+        if (interrupted || frame == last || (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
+            checkpoint = writeCheckpoint(frame);
         }
-        progress.frame(*solver, frame, int(solver->stepCount() - stepsBefore), seconds(frameStart, Clock::now()),
-                       write);
+        progress.frame(*sim, frame, int(sim->stepCount() - stepsBefore), seconds(frameStart, Clock::now()), write);
+        if (interrupted) {
+            std::fprintf(stderr, "ghostfx: interrupted after frame %d%s\n", frame,
+                         checkpoint.empty() ? " (no checkpoint: nothing to resume from)"
+                                            : ("; resume with: ghostfx run " + o.scene + " --resume " + checkpoint).c_str());
+            return EXIT_INTERRUPTED;
+        }
     }
     const double total = seconds(runStart, Clock::now());
-    const std::uint64_t steps = solver->stepCount() - stepsAtStart;
-    const sph::ParticleSet& p = solver->particles();
+    const std::uint64_t steps = sim->stepCount() - stepsAtStart;
     progress.message(msg("done: ", steps, " steps in ", duration(total), " (", total > 0 ? double(steps) / total : 0.0,
-                         " steps/s), ", p.size(), " particles, ",
-                         p.size() ? double(p.memoryBytes()) / double(p.size()) : 0.0, " bytes per particle"));
+                         " steps/s), ", sim->particleCount(), " particles, ",
+                         sim->particleCount() ? double(sim->memoryBytes()) / double(sim->particleCount()) : 0.0,
+                         " bytes per particle"));
     return 0;
 }
 

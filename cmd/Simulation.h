@@ -1,0 +1,72 @@
+/// @file   Simulation.h
+/// @brief  What `ghostfx run` drives: one scene's solvers behind one small interface, so the
+///         frame loop, outputs, checkpoints and statistics do not care which solver runs.
+/// @details Three kinds exist: a liquid ([SB12] Ghost or Basic SPH), a gas ([RYY15] fast,
+///          ambient-air or uncorrected), and a boiling liquid (both, coupled by the [RYY15]
+///          Sec. 4 phase transition). Only the solvers a scene needs are created.
+#pragma once
+
+#include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/SolverState.h>
+#include <ghostfx/vdbio/Scene.h>
+#include <ghostfx/vdbio/Stats.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ghostfx {
+namespace cmd {
+
+/// Particles of one medium and how to turn them into output files.
+struct OutputMedium
+{
+    std::string name;                          ///< "liquid" or "gas"
+    const sph::ParticleSet* particles = nullptr;
+    std::vector<sph::ParticleKind> kinds;      ///< kinds written as this medium
+    std::vector<sph::ParticleKind> ghostKinds; ///< kinds written too with outputs.points.ghosts
+    double spacing = 0, support = 0, restDensity = 0;
+    bool liquid = true;                        ///< liquids get a surface; gases get temperature
+};
+
+class Simulation
+{
+public:
+    virtual ~Simulation() = default;
+
+    /// Advance one frame (substeps fixed or CFL-limited, as the scene says).
+    virtual void advanceFrame() = 0;
+    /// Frames advanced so far (the state is at t = frame / fps).
+    virtual int frame() const = 0;
+    virtual double time() const = 0;
+    virtual std::uint64_t stepCount() const = 0;
+
+    /// Called after every step with its dt (s).
+    virtual void setStepObserver(std::function<void(double dt)> observer) = 0;
+    /// The statistics row of the step just taken.
+    virtual vdbio::StatsRow statsRow(int frame, double dt) = 0;
+    /// Counts for log lines: "4418 liquid, 1140 air, 24467 solid ghosts".
+    virtual std::string counts() const = 0;
+    virtual std::size_t particleCount() const = 0;
+    virtual std::size_t memoryBytes() const = 0;
+
+    virtual std::vector<OutputMedium> media() const = 0;
+
+    /// Solver states for a checkpoint (one per solver), and their restoration; the order is the
+    /// simulation's own. `restore` is called on a simulation built from the same scene.
+    virtual std::vector<sph::SolverState> saveStates() const = 0;
+    /// Before simulating towards `frame`: per-frame inputs (deforming solid sequences).
+    virtual void beforeFrame(int /*frame*/) {}
+};
+
+/// Build the simulation a scene asks for, fresh or continuing from `restored` states (as saved
+/// by saveStates()). Reads and checks every solver-specific key of the scene.
+std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
+                                           const std::vector<sph::SolverState>* restored = nullptr);
+
+/// How many solver states a checkpoint of this scene holds (1, or 2 for boiling).
+std::size_t stateCount(const vdbio::Scene& scene);
+
+} // namespace cmd
+} // namespace ghostfx
