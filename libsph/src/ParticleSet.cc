@@ -72,7 +72,6 @@ void ParticleSet::appendDefaults(std::size_t count)
     mDensities.resize(n, Real(0));
     mPressures.resize(n, Real(0));
     mKinds.resize(n, ParticleKind::Liquid);
-    mIds.reserve(n);
     for (std::size_t k = 0; k < count; ++k) mIds.push_back(mNextId++);
     for (auto& [name, ch] : mScalars) ch.data.resize(n, ch.defaultValue);
     for (auto& [name, ch] : mVectors) ch.data.resize(n, ch.defaultValue);
