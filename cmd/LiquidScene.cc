@@ -4,6 +4,8 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
+#include <filesystem>
+
 namespace ghostfx {
 namespace cmd {
 
@@ -106,6 +108,22 @@ void updateSolidSequences(const vdbio::Scene& scene, GhostSolver& solver, int fr
         const std::string file = vdbio::expandFramePattern(solid.sequenceFile, frame);
         solver.setSolidShape(i, vdbio::loadLevelSet(file, solid.sequenceGrid,
                                                     msg("scene '", scene.file, "': solids[", i, "].sequence")));
+    }
+}
+
+void checkSolidSequences(const vdbio::Scene& scene, int first, int last)
+{
+    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+        const vdbio::SceneSolid& solid = scene.solids[i];
+        if (solid.sequenceFile.empty()) continue;
+        for (int f = first; f <= last; ++f) {
+            const std::string file = vdbio::expandFramePattern(solid.sequenceFile, f);
+            std::error_code ec;
+            if (!std::filesystem::exists(file, ec)) {
+                throw IoError(msg("scene '", scene.file, "': solids[", i, "].sequence: file '", file,
+                                  "' does not exist (frames ", first, "-", last, " are needed)"));
+            }
+        }
     }
 }
 

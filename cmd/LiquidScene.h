@@ -27,5 +27,9 @@ std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
 /// per-frame file sequence that frame's shape.
 void updateSolidSequences(const vdbio::Scene& scene, ghost::GhostSolver& solver, int frame);
 
+/// Check, before simulating, that every per-frame solid file from `first` to `last` exists, so a
+/// missing frame stops the run at once instead of midway.
+void checkSolidSequences(const vdbio::Scene& scene, int first, int last);
+
 } // namespace cmd
 } // namespace ghostfx

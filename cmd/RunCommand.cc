@@ -2,6 +2,7 @@
 /// @brief  `ghostfx run`: scene -> solver -> frames, checkpoints, statistics and previews.
 #include "RunCommand.h"
 
+#include "LiquidScene.h"
 #include "Simulation.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -220,6 +221,7 @@ int runScene(const RunOptions& o)
     } else {
         sim = makeSimulation(scene);
     }
+    checkSolidSequences(scene, sim->frame() + 1, last);
     vdbio::ensureWritableDirectory(folder);
     auto inFolder = [&](const std::string& pattern, int frame) {
         return pattern.empty() ? std::string() : (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
