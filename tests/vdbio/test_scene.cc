@@ -315,3 +315,34 @@ TEST(KeyedMotion, InterpolatesAndHolds)
     EXPECT_NEAR(x[0], 0, 1e-12);
     EXPECT_NEAR(x[2], -1, 1e-12);
 }
+
+TEST_F(SceneTest, GasSourceMayBeAFogVolume)
+{
+    // A fog sphere of radius 0.1 m (density 1 inside, ramping to 0 across the old band).
+    auto fog = sph::makeSphereLevelSet(sph::Vec3(0.5f), 0.1f, 0.01f);
+    openvdb::tools::sdfToFogVolume(*fog);
+    fog->setName("smoke");
+    writeGrids("smoke.vdb", {fog});
+    Json s = Json::parse(R"({ "ghostfx_scene": 1, "settings": { "method": "gas", "spacing": 0.03 },
+        "gas_sources": [ { "geometry": { "file": "smoke.vdb", "grid": "smoke", "threshold": 0.5 } } ] })");
+    const vdbio::Scene scene = vdbio::readScene(write(s));
+    ASSERT_EQ(scene.gasSources.size(), 1u);
+    const sph::LevelSet& region = scene.gasSources[0].shape;
+    // sdfToFogVolume ramps the density linearly from 1 at phi = -band (0.03 m) to 0 at the
+    // surface, so density 0.5 lies 0.015 m inside: the region's radius is 0.085 m, to a voxel
+    // (the mask's staircase and one smoothing pass).
+    const float r = 0.085f;
+    for (const sph::Vec3& d : {sph::Vec3(1, 0, 0), sph::Vec3(0, -1, 0), sph::Vec3(0, 0, 1)}) {
+        const float phi = region.phi(sph::Vec3(0.5f) + d * r);
+        std::printf("[measured] fog region phi at the expected surface: %.4f m\n", phi);
+        EXPECT_NEAR(phi, 0.0f, 0.01f);
+    }
+    EXPECT_TRUE(region.inside(sph::Vec3(0.5f)));
+    // A threshold above every density leaves nothing: a clear error.
+    s["gas_sources"][0]["geometry"]["threshold"] = 2;
+    EXPECT_CONTAINS(errorOf(s), "no voxel of the fog volume exceeds the threshold 2");
+    // Liquids and solids still need level sets.
+    s = baseScene();
+    s["liquids"][0]["geometry"] = {{"file", "smoke.vdb"}, {"grid", "smoke"}};
+    EXPECT_CONTAINS(errorOf(s), "class is 'fog volume', expected 'level set'");
+}

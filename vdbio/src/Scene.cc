@@ -2,6 +2,8 @@
 /// @brief  Scene reading: strict JSON, role-tagged .vdb scenes, level-set loading.
 #include <ghostfx/vdbio/Scene.h>
 
+#include "FogRegion.h"
+
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/vdbio/AtomicFile.h>
@@ -54,7 +56,10 @@ openvdb::math::Mat3d KeyedMotion::rotation(const Vec3d& degrees)
 
 // Level sets -----------------------------------------------------------------------------------
 
-sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid, const std::string& context)
+namespace {
+
+/// Read one float grid from a .vdb file, with errors naming the file, the grid and `context`.
+openvdb::FloatGrid::Ptr loadFloatGrid(const std::string& file, const std::string& grid, const std::string& context)
 {
     std::error_code ec;
     if (!fs::exists(file, ec)) {
@@ -86,6 +91,14 @@ sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid, con
         throw GridError(msg(context, ": grid '", grid, "' in '", file, "' holds ", base->valueType(),
                             " values, expected a float level set"));
     }
+    return floatGrid;
+}
+
+} // namespace
+
+sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid, const std::string& context)
+{
+    openvdb::FloatGrid::Ptr floatGrid = loadFloatGrid(file, grid, context);
     try {
         return sph::makeLevelSet(floatGrid, grid);
     } catch (const GridError& e) {
@@ -105,7 +118,7 @@ std::string resolve(const std::string& folder, const std::string& path)
 
 /// A shape: a grid in a file, or a built-in sphere, box or container (a closed tank: solid walls
 /// of thickness `wall` around the empty box [min, max]).
-sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string& description)
+sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string& description, bool allowFog = false)
 {
     const double defaultVoxel = 0.5 * scene.spacing;
     const bool file = g.has("file"), sphere = g.has("sphere"), box = g.has("box"),
@@ -116,9 +129,24 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
     if (file) {
         const std::string path = resolve(scene.folder, g.require<std::string>("file"));
         const std::string grid = g.require<std::string>("grid");
-        g.finish();
         description = path + ":" + grid;
-        return loadLevelSet(path, grid, msg("scene '", scene.file, "': ", g.path()));
+        const std::string context = msg("scene '", scene.file, "': ", g.path());
+        if (allowFog) {
+            // A gas source may be a fog volume: its region is where the density exceeds `threshold`.
+            const double threshold = g.nonNegative("threshold", 0.5);
+            g.finish();
+            openvdb::FloatGrid::Ptr fog = loadFloatGrid(path, grid, context);
+            if (fog->getGridClass() == openvdb::GRID_FOG_VOLUME) {
+                try {
+                    return fogRegionToLevelSet(*fog, float(threshold), grid);
+                } catch (const GridError& e) {
+                    throw GridError(msg(context, ": '", path, "': ", e.what()));
+                }
+            }
+            return loadLevelSet(path, grid, context);
+        }
+        g.finish();
+        return loadLevelSet(path, grid, context);
     }
     const double voxel = g.positive("voxel_size", defaultVoxel);
     openvdb::FloatGrid::Ptr grid;
@@ -419,7 +447,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     for (const JsonObject& o : root.objects("gas_sources")) {
         const std::string name = o.get<std::string>("name", o.path());
         std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, /*allowFog=*/true);
         SceneGasSource source{name, geometry, shape};
         source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         source.temperature = o.positive("temperature", source.temperature);
