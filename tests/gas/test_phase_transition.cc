@@ -171,7 +171,9 @@ TEST(PhaseTransition, BoilingPanMakesVapourConservesMassAndReachesBoilingPoint)
     // a daughter (SplitMerge.h), and budgets are summed in double; a few thousand float
     // roundings of 6e-8 each stay far below 1e-5 relative. Float and double builds alike.
     EXPECT_LT(relMass, 1e-5);
-    EXPECT_DOUBLE_EQ(end.gasRemoved, 0.0);
+    // Nothing leaves the domain in 0.3 s: the gas removed (kill box, life strength) is nil up to
+    // round-off (the double build measured 6.8e-16 kg, i.e. 4e-15 relative).
+    EXPECT_LT(end.gasRemoved, 1e-9 * start.total());
     // The liquid at the plate reaches T_b: heat above it is latent (T clamped at T_b exactly).
     EXPECT_NEAR(maxNearT, double(phase.boilingPoint), 1e-3);
     EXPECT_TRUE(allGasFinite(scene.vapour));
