@@ -373,6 +373,35 @@ TEST(Preview, FogSphereIsVisibleButNotBlackOnATransparentBackground)
     EXPECT_NEAR(centroid.y(), IMAGE_H / 2.0, 1.0);
 }
 
+TEST(Preview, PngMatchesTheExrThroughTheSrgbCurve)
+{
+    const fs::path dir = freshDir("preview_png");
+    openvdb::FloatGrid::Ptr fog = sphereLevelSet();
+    openvdb::tools::sdfToFogVolume(*fog);
+    fog->setName("density");
+    vdbio::PreviewOptions options;
+    options.width = IMAGE_W;
+    options.height = IMAGE_H;
+    vdbio::renderPreview(*fog, options, (dir / "fog.exr").string());
+    vdbio::renderPreview(*fog, options, (dir / "fog.png").string());
+    const vdbio::RgbaImage exr = vdbio::readExrImage((dir / "fog.exr").string());
+    const vdbio::RgbaImage png = vdbio::readExrImage((dir / "fog.png").string());
+    ASSERT_EQ(png.width, IMAGE_W);
+    ASSERT_EQ(png.height, IMAGE_H);
+    // Every PNG value is the sRGB encoding of the EXR's (half-float) value, to half an 8-bit step
+    // plus the half-float rounding of the EXR (about 1e-3 relative, so 1 step at most).
+    float worst = 0;
+    for (std::size_t i = 0; i < exr.rgba.size(); ++i) {
+        const float linear = std::clamp(exr.rgba[i], 0.0f, 1.0f);
+        const float expected = (i % 4 == 3) ? linear
+                               : linear <= 0.0031308f ? 12.92f * linear
+                                                      : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+        worst = std::max(worst, std::abs(png.rgba[i] - expected));
+    }
+    std::printf("[measured] PNG vs sRGB(EXR): worst difference %.4f (8-bit step %.4f)\n", worst, 1 / 255.0);
+    EXPECT_LE(worst, 1.5f / 255.0f);
+}
+
 TEST(Preview, LevelSetSphereIsOpaqueAndShaded)
 {
     const fs::path dir = freshDir("preview_surface");

@@ -4,6 +4,8 @@
 ///          Preview.h (STACK.md: ray tracing is one of the slower translation units to build).
 #include <ghostfx/vdbio/Preview.h>
 
+#include "PngFile.h"
+
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
@@ -197,8 +199,30 @@ std::string withoutTemporaryName(std::string text, const std::string& tmp,
     return text;
 }
 
+/// A .png path gets an 8-bit sRGB PNG (for READMEs and quick looks), anything else an EXR.
+void writePngImage(const Film& film, const std::string& path)
+{
+    const int width = int(film.width()), height = int(film.height());
+    std::vector<float> rgba(std::size_t(width) * std::size_t(height) * 4);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const Film::RGBA& p = film.pixel(std::size_t(x), std::size_t(y));
+            float* q = &rgba[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4];
+            q[0] = p.r;
+            q[1] = p.g;
+            q[2] = p.b;
+            q[3] = p.a;
+        }
+    }
+    writeAtomically(path, [&](const std::string& tmp) { writePng(tmp, width, height, rgba); });
+}
+
 void writeExr(const Film& film, const std::string& exrPath)
 {
+    if (extensionOf(exrPath) == ".png") {
+        writePngImage(film, exrPath);
+        return;
+    }
     const int width = int(film.width()), height = int(film.height());
     std::vector<Imf::Rgba> pixels(std::size_t(width) * std::size_t(height));
     for (int y = 0; y < height; ++y) {
@@ -229,7 +253,7 @@ void checkOutputFolder(const std::string& exrPath)
                           "' does not exist"));
     }
     if (fs::is_directory(exrPath, ec)) {
-        throw IoError(msg("preview image '", exrPath, "' is a folder, expected an .exr file"));
+        throw IoError(msg("preview image '", exrPath, "' is a folder, expected an .exr or .png file"));
     }
 }
 
@@ -371,6 +395,13 @@ PreviewSummary renderPreviewFromFile(const std::string& vdbPath, const PreviewOp
 
 RgbaImage readExrImage(const std::string& exrPath)
 {
+    if (extensionOf(exrPath) == ".png") {
+        RgbaImage image;
+        const std::vector<std::uint8_t> bytes = readPngRgba8(exrPath, image.width, image.height);
+        image.rgba.reserve(bytes.size());
+        for (std::uint8_t b : bytes) image.rgba.push_back(float(b) / 255.0f);
+        return image;
+    }
     try {
         Imf::RgbaInputFile file(exrPath.c_str());
         const Imath::Box2i window = file.dataWindow();

@@ -67,7 +67,8 @@ struct RgbaImage
     const float* pixel(int x, int y) const { return &rgba[4 * (std::size_t(y) * width + x)]; }
 };
 
-/// Read an RGBA OpenEXR image (any channels missing read as R = G = B = 0, A = 1).
+/// Read an RGBA OpenEXR image (any channels missing read as R = G = B = 0, A = 1), or a .png
+/// written by the preview (its stored 8-bit sRGB values / 255).
 /// Throws IoError naming the file if it cannot be read.
 RgbaImage readExrImage(const std::string& exrPath);
 
