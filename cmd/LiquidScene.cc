@@ -61,11 +61,17 @@ ghost::RigidMotion motionOf(const vdbio::SceneSolid& solid)
             return xf;
         };
     }
-    const vdbio::KeyedMotion keyed = solid.motion;
+    return keyedMotion(solid.motion);
+}
+
+} // namespace
+
+sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed)
+{
     return [keyed](double t) {
         const vdbio::RigidKey k = keyed.at(t);
         const openvdb::math::Mat3d r = vdbio::KeyedMotion::rotation(k.rotateDegrees);
-        ghost::RigidTransform xf;
+        sph::RigidTransform xf;
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) xf.rotation(i, j) = Real(r(i, j));
         }
@@ -73,8 +79,6 @@ ghost::RigidMotion motionOf(const vdbio::SceneSolid& solid)
         return xf;
     };
 }
-
-} // namespace
 
 std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene, const GhostSettings& settings,
                                               const sph::SolverState* restored)

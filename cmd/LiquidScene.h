@@ -23,6 +23,9 @@ std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
                                                      const ghost::GhostSettings& settings,
                                                      const sph::SolverState* restored = nullptr);
 
+/// The solver-side motion of keys read from a scene (rotation R = Rz Ry Rx, then translation).
+sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed);
+
 /// Before simulating towards `frame` (the state at t = frame / fps), give every solid with a
 /// per-frame file sequence that frame's shape.
 void updateSolidSequences(const vdbio::Scene& scene, ghost::GhostSolver& solver, int frame);

@@ -22,20 +22,6 @@ using sph::Vec3;
 
 namespace {
 
-sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed)
-{
-    return [keyed](double t) {
-        const vdbio::RigidKey k = keyed.at(t);
-        const openvdb::math::Mat3d r = vdbio::KeyedMotion::rotation(k.rotateDegrees);
-        sph::RigidTransform xf;
-        for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) xf.rotation(i, j) = Real(r(i, j));
-        }
-        xf.translation = Vec3(k.translate);
-        return xf;
-    };
-}
-
 /// max |v| and the mean / max of |rho / rho0 - 1| over particles of `kind` (and not ambient air).
 struct FieldStats
 {

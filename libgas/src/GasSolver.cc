@@ -90,20 +90,9 @@ inline Real lifeEpsilon(std::uint64_t seed, ParticleId id, std::uint64_t step)
 
 } // namespace
 
-/// A solid: level set in its local frame and rigid motion.
-struct GasSolver::Solid
+/// A solid: its level set (in its local frame) and its rigid motion.
+struct GasSolver::Solid : sph::MovingLevelSet
 {
-    LevelSet shape;
-    RigidMotion motion;
-
-    RigidTransform at(double time) const { return motion(time); }
-    Real phi(const Vec3& x, double time) const { return shape.phi(at(time).toLocal(x)); }
-    Vec3 velocity(const Vec3& local, double time) const
-    {
-        constexpr double DELTA = 1e-4;
-        const double t0 = std::max(0.0, time - DELTA), t1 = time + DELTA;
-        return (at(t1).toWorld(local) - at(t0).toWorld(local)) / Real(t1 - t0);
-    }
 };
 
 /// A source and its emission budget (rate-limited sources).
@@ -178,7 +167,7 @@ void GasSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
 {
     if (!motion) throw ValueError(msg("gas solid '", solid.name(), "': no motion given"));
     ensureSolidChannels();
-    mSolids.push_back(std::make_unique<Solid>(Solid{solid, std::move(motion)}));
+    mSolids.push_back(std::make_unique<Solid>(Solid{{solid, std::move(motion)}}));
     if (mSolids.size() > mRestoredSolids) sampleSolid(mSolids.size() - 1);
 }
 

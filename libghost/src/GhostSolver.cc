@@ -46,21 +46,8 @@ inline Real taitPressure(Real rho, Real rho0, Real k)
 } // namespace
 
 /// A solid: its level set (in its local frame) and its rigid motion.
-struct GhostSolver::Solid
+struct GhostSolver::Solid : sph::MovingLevelSet
 {
-    LevelSet shape;
-    RigidMotion motion;
-
-    RigidTransform at(double time) const { return motion(time); }
-    /// Level-set value at a world point x at `time`.
-    Real phi(const Vec3& x, double time) const { return shape.phi(at(time).toLocal(x)); }
-    /// Velocity (m/s) of the solid's material point `local` at `time` (central difference).
-    Vec3 velocity(const Vec3& local, double time) const
-    {
-        constexpr double DELTA = 1e-4;
-        const double t0 = std::max(0.0, time - DELTA), t1 = time + DELTA;
-        return (at(t1).toWorld(local) - at(t0).toWorld(local)) / Real(t1 - t0);
-    }
 };
 
 /// A continuous liquid source.
@@ -122,7 +109,7 @@ void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
 {
     if (!motion) throw ValueError(msg("solid '", solid.name(), "': no motion given"));
     ensureSolidChannels();
-    mSolids.push_back(std::make_unique<Solid>(Solid{solid, std::move(motion)}));
+    mSolids.push_back(std::make_unique<Solid>(Solid{{solid, std::move(motion)}}));
     // A solid the restored state already holds keeps its restored particles: sampling it again
     // would duplicate them (and, with a seed that depends on the step, differ from them).
     if (mSolids.size() > mRestoredSolids) sampleSolid(mSolids.size() - 1);

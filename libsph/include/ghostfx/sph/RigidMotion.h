@@ -3,6 +3,7 @@
 ///         liquid and gas solvers.
 #pragma once
 
+#include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/Types.h>
 
 #include <openvdb/math/Mat3.h>
@@ -26,6 +27,26 @@ struct RigidTransform
 /// A body's placement as a function of time (s). It must be defined for every t >= 0 and be
 /// smooth enough for a central difference of 1e-4 s to give its velocity.
 using RigidMotion = std::function<RigidTransform(double time)>;
+
+/// A rigid body given by a level set in its local frame and its motion: what both solvers keep
+/// per solid.
+struct MovingLevelSet
+{
+    LevelSet shape;
+    RigidMotion motion;
+
+    RigidTransform at(double time) const { return motion(time); }
+    /// Level-set value at a world point x at `time`.
+    Real phi(const Vec3& x, double time) const { return shape.phi(at(time).toLocal(x)); }
+    /// Velocity (m/s) of the body's material point `local` at `time`: a central difference of
+    /// 1e-4 s (one-sided at t = 0).
+    Vec3 velocity(const Vec3& local, double time) const
+    {
+        constexpr double DELTA = 1e-4;
+        const double t0 = time > DELTA ? time - DELTA : 0.0, t1 = time + DELTA;
+        return (at(t1).toWorld(local) - at(t0).toWorld(local)) / Real(t1 - t0);
+    }
+};
 
 } // namespace sph
 } // namespace ghostfx
