@@ -10,6 +10,8 @@
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/Random.h>
 
+#include "common/StateDiff.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -104,39 +106,8 @@ double heat(const GasSolver& solver)
     return q;
 }
 
-template <typename T>
-bool sameBytes(const std::vector<T>& a, const std::vector<T>& b)
-{
-    return a.size() == b.size() &&
-           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
-/// "" if two states are identical bit for bit, else the first difference.
-std::string firstDifference(const SolverState& a, const SolverState& b)
-{
-    const ParticleSet& p = a.particles;
-    const ParticleSet& q = b.particles;
-    if (p.size() != q.size()) return "particle count";
-    if (!sameBytes(p.positions(), q.positions())) return "positions";
-    if (!sameBytes(p.velocities(), q.velocities())) return "velocities";
-    if (!sameBytes(p.ids(), q.ids())) return "ids";
-    if (!sameBytes(p.kinds(), q.kinds())) return "kinds";
-    if (!sameBytes(p.masses(), q.masses())) return "masses";
-    if (!sameBytes(p.densities(), q.densities())) return "densities";
-    if (!sameBytes(p.pressures(), q.pressures())) return "pressures";
-    if (p.nextId() != q.nextId()) return "next id";
-    if (p.scalarChannelNames() != q.scalarChannelNames()) return "scalar channel names";
-    if (p.vectorChannelNames() != q.vectorChannelNames()) return "vector channel names";
-    for (const auto& name : p.scalarChannelNames()) {
-        if (!sameBytes(p.scalarChannel(name), q.scalarChannel(name))) return "channel " + name;
-    }
-    for (const auto& name : p.vectorChannelNames()) {
-        if (!sameBytes(p.vectorChannel(name), q.vectorChannel(name))) return "channel " + name;
-    }
-    if (a.reals != b.reals) return "reals";
-    if (a.integers != b.integers) return "integers";
-    return "";
-}
+using ghostfx::testing::firstDifference;
+using ghostfx::testing::sameBytes;
 
 } // namespace
 
