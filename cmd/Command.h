@@ -23,6 +23,7 @@ Command addRunCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
 Command addPreviewCommand(CLI::App& parent);
 Command addMesh2SdfCommand(CLI::App& parent);
+Command addStudyCommand(CLI::App& parent);
 
 } // namespace cmd
 } // namespace ghostfx

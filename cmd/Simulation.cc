@@ -119,6 +119,7 @@ public:
         m.spacing = s.settings().spacing;
         m.support = s.settings().supportRadius();
         m.restDensity = s.settings().restDensity;
+        m.gravity = s.settings().gravity;
         m.liquid = true;
         return m;
     }
@@ -219,6 +220,7 @@ OutputMedium gasMedium(const gas::GasSolver& s, const sph::ParticleSet& visible)
     m.spacing = s.settings().spacing;
     m.support = s.settings().supportRadius();
     m.restDensity = s.settings().restDensity;
+    m.gravity = s.settings().gravity;
     m.liquid = false;
     return m;
 }
@@ -334,6 +336,15 @@ gas::PhaseSettings phaseSettings(const vdbio::JsonObject& p, double spacing, dou
     return s;
 }
 
+/// Default gas spacing of a boiling scene: a boiling liquid particle splits into 12 ([RYY15]
+/// Sec. 4.2); at the density ratio rho_l / rho_g each child then has a volume of that many
+/// spacings^3.
+double vapourSpacing(const vdbio::Scene& scene, const ghost::GhostSettings& liquid)
+{
+    const gas::GasSettings probe;
+    return scene.spacing * std::cbrt(double(liquid.restDensity / probe.restDensity) / 12.0);
+}
+
 class BoilingSimulation : public Simulation
 {
 public:
@@ -343,11 +354,7 @@ public:
         const vdbio::JsonObject g = s.has("gas") ? s.object("gas") : vdbio::JsonObject();
         const ghost::GhostSettings liquid = liquidSettings(scene); // finishes settings
         mLiquid = makeLiquidSolver(scene, liquid);
-        // Default gas spacing: a boiling liquid particle splits into 12 ([RYY15] Sec. 4.2); at
-        // the density ratio rho_l / rho_g each child then has a volume of that many spacings^3.
-        gas::GasSettings probe;
-        const double ratio = liquid.restDensity / probe.restDensity;
-        mGas = makeGasSolver(scene, gasSettings(scene, g, scene.spacing * std::cbrt(ratio / 12.0), "fast"), nullptr);
+        mGas = makeGasSolver(scene, gasSettings(scene, g, vapourSpacing(scene, liquid), "fast"), nullptr);
         mSide = std::make_unique<GhostLiquidSide>(*mLiquid);
         double band = std::numeric_limits<double>::max();
         for (const vdbio::SceneHeater& h : scene.heaters) band = std::min(band, double(h.shape.bandWidth()));
@@ -451,6 +458,24 @@ private:
 };
 
 } // namespace
+
+void checkSimulationSettings(const vdbio::Scene& scene)
+{
+    const vdbio::JsonObject& s = scene.settings;
+    const vdbio::JsonObject g = s.has("gas") ? s.object("gas") : vdbio::JsonObject();
+    if (!scene.heaters.empty()) {
+        if (scene.method == "gas") s.failValue("method", "heaters boil a liquid: expected 'ghost' or 'basic'");
+        const ghost::GhostSettings liquid = liquidSettings(scene);
+        gasSettings(scene, g, vapourSpacing(scene, liquid), "fast");
+        phaseSettings(scene.phaseTransition, scene.spacing, std::numeric_limits<double>::max());
+    } else if (scene.method == "gas") {
+        gasSettings(scene, g, scene.spacing, "fast");
+        s.finish();
+    } else {
+        if (s.has("gas")) s.fail("gas", "gas settings need method 'gas' or heaters (boiling)");
+        liquidSettings(scene);
+    }
+}
 
 std::size_t stateCount(const vdbio::Scene& scene) { return scene.heaters.empty() ? 1 : 0; }
 

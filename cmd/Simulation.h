@@ -27,6 +27,7 @@ struct OutputMedium
     std::vector<sph::ParticleKind> kinds;      ///< kinds written as this medium
     std::vector<sph::ParticleKind> ghostKinds; ///< kinds written too with outputs.points.ghosts
     double spacing = 0, support = 0, restDensity = 0;
+    sph::Vec3 gravity{0};                      ///< the medium's gravity (m/s^2)
     bool liquid = true;                        ///< liquids get a surface; gases get temperature
 };
 
@@ -64,6 +65,10 @@ public:
 /// by saveStates()). Reads and checks every solver-specific key of the scene.
 std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
                                            const std::vector<sph::SolverState>* restored = nullptr);
+
+/// Read and check every solver-specific key of `scene` (as makeSimulation does) without
+/// building a solver or sampling a particle: a cheap check of a scene before a long job.
+void checkSimulationSettings(const vdbio::Scene& scene);
 
 /// How many solver states a checkpoint of this scene holds (1, or 2 for boiling).
 std::size_t stateCount(const vdbio::Scene& scene);

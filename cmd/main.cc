@@ -6,6 +6,7 @@
 ///            ghostfx preview   render a density or surface grid to an EXR image
 ///            ghostfx mesh2sdf  convert an OBJ/PLY/... triangle mesh to a level set
 ///            ghostfx sample    Poisson-disk sample a built-in shape and print statistics
+///            ghostfx study     run a scene over a sweep of settings: cost against error
 #include "Command.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -27,7 +28,7 @@ int main(int argc, char** argv)
     using namespace ghostfx::cmd;
     const std::vector<Command> commands = {addRunCommand(app), addInfoCommand(app),
                                            addPreviewCommand(app), addMesh2SdfCommand(app),
-                                           addSampleCommand(app)};
+                                           addSampleCommand(app), addStudyCommand(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -156,18 +156,20 @@ JsonObject::JsonObject()
 }
 
 JsonObject::JsonObject(std::shared_ptr<const Json> document, const Json* value, std::string path,
-                       std::string source)
-    : mDocument(std::move(document)), mValue(value), mPath(std::move(path)), mSource(std::move(source))
+                       std::string source, std::string kind)
+    : mDocument(std::move(document)), mValue(value), mPath(std::move(path)), mSource(std::move(source)),
+      mKind(std::move(kind))
 {
     if (!mValue || !mValue->is_object()) {
-        throw SceneError(msg("scene '", mSource, "': ", mPath.empty() ? "the document" : mPath,
+        throw SceneError(msg(mKind, " '", mSource, "': ", mPath.empty() ? "the document" : mPath,
                              " = ", mValue ? shortDump(*mValue) : "null", ": expected an object { ... }"));
     }
 }
 
 std::string JsonObject::pathOf(const std::string& key) const
 {
-    return mPath.empty() ? key : mPath + "." + key;
+    // An empty key names the object itself ("solids[0].geometry", not "solids[0].geometry.").
+    return mPath.empty() || key.empty() ? mPath + key : mPath + "." + key;
 }
 
 bool JsonObject::has(const std::string& key) const
@@ -185,13 +187,13 @@ const Json* JsonObject::raw(const std::string& key) const
 
 void JsonObject::fail(const std::string& key, const std::string& what) const
 {
-    throw SceneError(msg("scene '", mSource, "': ", pathOf(key), ": ", what));
+    throw SceneError(msg(mKind, " '", mSource, "': ", pathOf(key), ": ", what));
 }
 
 void JsonObject::failValue(const std::string& key, const std::string& what) const
 {
     const Json* v = raw(key);
-    throw SceneError(msg("scene '", mSource, "': ", pathOf(key), " = ", v ? shortDump(*v) : "null",
+    throw SceneError(msg(mKind, " '", mSource, "': ", pathOf(key), " = ", v ? shortDump(*v) : "null",
                          ": ", what));
 }
 
@@ -273,13 +275,13 @@ JsonObject JsonObject::object(const std::string& key) const
 {
     const Json* v = raw(key);
     if (!v || v->is_null()) fail(key, "missing; expected an object { ... }");
-    return JsonObject(mDocument, v, pathOf(key), mSource);
+    return JsonObject(mDocument, v, pathOf(key), mSource, mKind);
 }
 
 std::optional<JsonObject> JsonObject::optionalObject(const std::string& key) const
 {
     if (!has(key)) return std::nullopt;
-    return JsonObject(mDocument, raw(key), pathOf(key), mSource);
+    return JsonObject(mDocument, raw(key), pathOf(key), mSource, mKind);
 }
 
 std::vector<JsonObject> JsonObject::objects(const std::string& key) const
@@ -289,7 +291,7 @@ std::vector<JsonObject> JsonObject::objects(const std::string& key) const
     if (!v || v->is_null()) return out;
     if (!v->is_array()) failValue(key, "expected an array [ {...}, ... ]");
     for (std::size_t i = 0; i < v->size(); ++i) {
-        out.emplace_back(mDocument, &(*v)[i], msg(pathOf(key), "[", i, "]"), mSource);
+        out.emplace_back(mDocument, &(*v)[i], msg(pathOf(key), "[", i, "]"), mSource, mKind);
     }
     return out;
 }

@@ -32,8 +32,9 @@ public:
     JsonObject();
     /// @param document  keeps the whole document alive; `value` points into it
     /// @param source    the file name used in messages
+    /// @param kind      what the document is, for messages: "scene" (default) or "study"
     JsonObject(std::shared_ptr<const Json> document, const Json* value, std::string path,
-               std::string source);
+               std::string source, std::string kind = "scene");
 
     /// Path of this object ("settings", "solids[1]"; "" for the root).
     const std::string& path() const { return mPath; }
@@ -69,9 +70,9 @@ public:
     /// Throw SceneError for the first key that was never asked for.
     void finish() const;
 
-    /// SceneError "scene '<source>': <path of key>: <what>".
+    /// SceneError "<kind> '<source>': <path of key>: <what>" (kind "scene" or "study").
     [[noreturn]] void fail(const std::string& key, const std::string& what) const;
-    /// SceneError "scene '<source>': <path of key> = <value>: <what>".
+    /// SceneError "<kind> '<source>': <path of key> = <value>: <what>".
     [[noreturn]] void failValue(const std::string& key, const std::string& what) const;
 
 private:
@@ -79,6 +80,7 @@ private:
     const Json* mValue;
     std::string mPath;
     std::string mSource;
+    std::string mKind = "scene";
     mutable std::set<std::string> mKnown;
 };
 

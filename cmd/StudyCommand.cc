@@ -1,0 +1,716 @@
+/// @file   StudyCommand.cc
+/// @brief  `ghostfx study`: one scene over a sweep of settings, cost against error.
+/// @details The study file names a scene, the keys to sweep (any scene key, as for `-D`), the
+///          metrics to measure and where to write. Each case runs in a child process of its own
+///          (the same program, `ghostfx study FILE --case K`), which gives every case a clean
+///          peak-memory figure from the kernel, lets a case that blows up or runs out of time be
+///          recorded as such instead of ending the study, and lets a case run on another build
+///          (a double-precision one). The parent writes the table (CSV) after every case, and at
+///          the end the observed convergence order and a plot of error against cost with the
+///          Pareto front. Format and metric definitions: docs/study.md.
+#include "Command.h"
+#include "LiquidScene.h"
+#include "Simulation.h"
+#include "StudyMetrics.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/Parallel.h>
+#include <ghostfx/vdbio/AtomicFile.h>
+#include <ghostfx/vdbio/JsonReader.h>
+#include <ghostfx/vdbio/Plot.h>
+#include <ghostfx/vdbio/Scene.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <thread>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace ghostfx {
+namespace cmd {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+const char* const PRECISION_KEY = "precision";
+const char* const BUILD_PRECISION = sizeof(sph::Real) == sizeof(double) ? "double" : "float";
+
+// The study file ----------------------------------------------------------------------------------
+
+struct StudyCase
+{
+    std::string label;                               ///< "settings.spacing=0.02 settings.cfl=0.4"
+    std::map<std::string, Json> values;              ///< swept key -> value
+    std::vector<std::string> overrides;              ///< "-D" assignments for the scene
+    std::string precision = BUILD_PRECISION;
+    bool reference = false;
+};
+
+struct StudySpec
+{
+    std::string file, scene;
+    std::vector<std::string> axes;                   ///< swept keys, in column order
+    std::vector<StudyCase> cases;                    ///< the reference (if any) first
+    std::vector<MetricSpec> metrics;
+    std::map<std::string, std::string> executables;  ///< precision -> program
+    double maxSecondsPerRun = 0;
+    std::string directory, table, plot, plotTitle;
+    std::string plotCost = "wall_per_sim_second", plotError, plotSeries;
+    std::string convergenceKey, convergenceError;
+    bool hasReference() const { return !cases.empty() && cases.front().reference; }
+};
+
+std::string valueText(const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+
+/// key=value pairs of a JSON object, in the file's key order (nlohmann sorts; fine for columns).
+std::vector<std::pair<std::string, Json>> assignments(const vdbio::JsonObject& o, const std::string& key)
+{
+    std::vector<std::pair<std::string, Json>> out;
+    const Json* v = o.raw(key);
+    if (!v || v->is_null()) return out;
+    if (!v->is_object()) o.failValue(key, "expected an object of scene keys and values { \"settings.spacing\": 0.02 }");
+    for (auto it = v->begin(); it != v->end(); ++it) out.emplace_back(it.key(), it.value());
+    return out;
+}
+
+StudySpec readStudy(const std::string& path)
+{
+    std::ifstream in(path);
+    if (!in) throw IoError(msg("study '", path, "': cannot open the file"));
+    Json doc;
+    try {
+        doc = Json::parse(in, nullptr, true, /*ignore_comments=*/true);
+    } catch (const Json::parse_error& e) {
+        const std::string what = e.what();
+        const std::size_t colon = what.find(": ");
+        throw SceneError(msg("study '", path, "': not valid JSON (",
+                             colon == std::string::npos ? what : what.substr(colon + 2), ")"));
+    }
+    auto shared = std::make_shared<const Json>(std::move(doc));
+    const vdbio::JsonObject root(shared, shared.get(), "", path, "study");
+
+    StudySpec s;
+    s.file = path;
+    const int version = root.require<int>("ghostfx_study");
+    if (version != 1) root.failValue("ghostfx_study", "unsupported version: expected 1");
+    const fs::path folder = fs::path(path).parent_path();
+    s.scene = (folder / root.require<std::string>("scene")).lexically_normal().string();
+
+    // Cases: every combination of the sweep, times every entry of "runs".
+    std::vector<std::string> fixed;
+    for (const auto& [key, value] : assignments(root, "set")) {
+        if (key == PRECISION_KEY) root.fail("set", "precision is chosen per case in sweep or runs");
+        fixed.push_back(key + "=" + value.dump());
+    }
+    std::vector<std::map<std::string, Json>> combos(1);
+    for (const auto& [key, values] : assignments(root, "sweep")) {
+        if (!values.is_array() || values.empty()) {
+            root.fail("sweep", msg("'", key, "' = ", values.dump(), ": expected a non-empty array of values"));
+        }
+        s.axes.push_back(key);
+        std::vector<std::map<std::string, Json>> next;
+        for (const auto& combo : combos) {
+            for (const Json& v : values) {
+                next.push_back(combo);
+                next.back()[key] = v;
+            }
+        }
+        combos = std::move(next);
+    }
+    std::vector<std::map<std::string, Json>> runs;
+    for (const vdbio::JsonObject& run : root.objects("runs")) {
+        std::map<std::string, Json> values;
+        const Json* raw = shared->contains("runs") ? &(*shared)["runs"][runs.size()] : nullptr;
+        for (auto it = raw->begin(); it != raw->end(); ++it) {
+            values[it.key()] = it.value();
+            if (std::find(s.axes.begin(), s.axes.end(), it.key()) == s.axes.end()) s.axes.push_back(it.key());
+        }
+        (void)run;
+        runs.push_back(std::move(values));
+    }
+    if (runs.empty()) runs.emplace_back();
+
+    auto makeCase = [&](const std::map<std::string, Json>& values, bool reference) {
+        StudyCase c;
+        c.values = values;
+        c.reference = reference;
+        c.overrides = fixed;
+        for (const auto& [key, value] : values) {
+            c.label += (c.label.empty() ? "" : " ") + key + "=" + valueText(value);
+            if (key == PRECISION_KEY) {
+                if (value != "float" && value != "double") {
+                    root.fail(reference ? "reference" : "sweep",
+                              msg("precision = ", value.dump(), ": expected \"float\" or \"double\""));
+                }
+                c.precision = value.get<std::string>();
+            } else {
+                c.overrides.push_back(key + "=" + value.dump());
+            }
+        }
+        if (reference) c.label = "reference" + (c.label.empty() ? "" : " " + c.label);
+        return c;
+    };
+    if (root.has("reference")) {
+        std::map<std::string, Json> values;
+        for (const auto& [key, value] : assignments(root, "reference")) values[key] = value;
+        s.cases.push_back(makeCase(values, true));
+    }
+    for (const auto& combo : combos) {
+        for (const auto& run : runs) {
+            std::map<std::string, Json> values = combo;
+            for (const auto& [key, value] : run) values[key] = value;
+            s.cases.push_back(makeCase(values, false));
+        }
+    }
+
+    // Metrics: "name" or { "metric": "name", options... }.
+    const Json* metrics = root.raw("metrics");
+    if (!metrics || !metrics->is_array() || metrics->empty()) {
+        root.failValue("metrics", "expected a non-empty array of metric names (docs/study.md)");
+    }
+    for (std::size_t k = 0; k < metrics->size(); ++k) {
+        const Json& m = (*metrics)[k];
+        MetricSpec spec;
+        if (m.is_string()) {
+            spec.name = m.get<std::string>();
+        } else if (m.is_object() && m.contains("metric") && m["metric"].is_string()) {
+            spec.name = m["metric"].get<std::string>();
+            spec.options = m;
+        } else {
+            root.fail("metrics", msg("[", k, "] = ", m.dump(), ": expected a name or { \"metric\": name, ... }"));
+        }
+        makeMetric(spec, msg("study '", path, "': metrics[", k, "]")); // checks name and options
+        s.metrics.push_back(std::move(spec));
+    }
+
+    for (const auto& [precision, program] : assignments(root, "executables")) {
+        if (precision != "float" && precision != "double") {
+            root.fail("executables", msg("'", precision, "': expected \"float\" or \"double\""));
+        }
+        s.executables[precision] = valueText(program);
+    }
+    for (const StudyCase& c : s.cases) {
+        if (c.precision != BUILD_PRECISION && !s.executables.count(c.precision)) {
+            root.fail("executables", msg("case '", c.label, "' needs a ", c.precision, " build: this ghostfx is ",
+                                         BUILD_PRECISION, "; name one with \"executables\": { \"", c.precision,
+                                         "\": \"build-", c.precision, "/cmd/ghostfx\" }"));
+        }
+    }
+    s.maxSecondsPerRun = root.nonNegative("max_seconds_per_run", 0);
+
+    const vdbio::JsonObject out = root.has("output") ? root.object("output") : vdbio::JsonObject();
+    s.directory = out.get<std::string>("directory", "out/study_" + fs::path(path).stem().string());
+    s.table = out.get<std::string>("table", "study.csv");
+    s.plot = out.get<std::string>("plot", "study.png");
+    out.finish();
+
+    const vdbio::JsonObject plot = root.has("plot") ? root.object("plot") : vdbio::JsonObject();
+    s.plotCost = plot.choice("cost", s.plotCost, {"wall_per_sim_second", "wall_s", "peak_rss_mb", "particles_max",
+                                                  "particle_memory_mb", "steps"});
+    s.plotError = plot.get<std::string>("error", primaryErrorColumn(s.metrics.front().name, s.hasReference()));
+    s.plotSeries = plot.get<std::string>("series", "");
+    s.plotTitle = plot.get<std::string>("title", fs::path(path).stem().string());
+    plot.finish();
+    if (!s.plotSeries.empty() && std::find(s.axes.begin(), s.axes.end(), s.plotSeries) == s.axes.end()) {
+        root.fail("plot", msg("series = \"", s.plotSeries, "\": not a swept key (swept: ",
+                              s.axes.empty() ? std::string("none") : s.axes.front(), s.axes.size() > 1 ? ", ..." : "", ")"));
+    }
+
+    const vdbio::JsonObject conv = root.has("convergence") ? root.object("convergence") : vdbio::JsonObject();
+    const bool sweptSpacing = std::find(s.axes.begin(), s.axes.end(), "settings.spacing") != s.axes.end();
+    s.convergenceKey = conv.get<std::string>("key", sweptSpacing ? "settings.spacing" : "");
+    s.convergenceError = conv.get<std::string>("error", s.plotError);
+    conv.finish();
+    if (!s.convergenceKey.empty() && std::find(s.axes.begin(), s.axes.end(), s.convergenceKey) == s.axes.end()) {
+        root.fail("convergence", msg("key = \"", s.convergenceKey, "\": not a swept key"));
+    }
+    root.finish();
+
+    // Every column the plot or the convergence may name must be one the metrics produce.
+    std::set<std::string> columns;
+    for (const MetricSpec& m : s.metrics) {
+        auto metric = makeMetric(m, "");
+        for (const auto& [name, value] : metric->values()) columns.insert(name);
+        if (s.hasReference() && (m.name == "surge_front" || m.name == "plume_rise")) {
+            columns.insert(m.name + "_error");
+            columns.insert(m.name + "_error_m");
+        }
+    }
+    for (const std::string* column : {&s.plotError, &s.convergenceError}) {
+        if (!columns.count(*column)) {
+            std::string list;
+            for (const std::string& c : columns) list += (list.empty() ? "" : ", ") + c;
+            throw SceneError(msg("study '", path, "': ", column == &s.plotError ? "plot.error" : "convergence.error",
+                                 " = \"", *column, "\": not a column of these metrics (", list, ")"));
+        }
+    }
+    return s;
+}
+
+// One case, in the child process ------------------------------------------------------------------
+
+/// Run case `index` and return its result document. Throws like `ghostfx run`.
+Json runCase(const StudySpec& spec, std::size_t index)
+{
+    const StudyCase& c = spec.cases.at(index);
+    if (c.precision != BUILD_PRECISION) {
+        throw ValueError(msg("case '", c.label, "' asks for ", c.precision, ", this ghostfx is ", BUILD_PRECISION));
+    }
+    const auto t0 = Clock::now();
+    const vdbio::Scene scene = vdbio::readScene(spec.scene, c.overrides);
+    std::unique_ptr<Simulation> sim = makeSimulation(scene);
+    checkSolidSequences(scene, 1, scene.lastFrame);
+
+    std::vector<std::unique_ptr<Metric>> metrics;
+    for (std::size_t k = 0; k < spec.metrics.size(); ++k) {
+        metrics.push_back(makeMetric(spec.metrics[k], msg("study '", spec.file, "': metrics[", k, "]")));
+    }
+    auto sample = [&](int frame, bool first) {
+        const std::vector<OutputMedium> media = sim->media();
+        for (const auto& metric : metrics) {
+            auto it = std::find_if(media.begin(), media.end(), [&](const OutputMedium& m) { return m.name == metric->medium(); });
+            if (it == media.end()) {
+                throw SceneError(msg("metric ", metric->name(), " watches the ", metric->medium(), ", and scene '",
+                                     scene.file, "' has none"));
+            }
+            MetricSample s{&*it, sim->time(), frame, scene.lastFrame};
+            if (first) metric->start(s);
+            else metric->frame(s);
+        }
+    };
+    sample(0, true);
+    const double setup = std::chrono::duration<double>(Clock::now() - t0).count();
+
+    std::size_t particlesMax = sim->particleCount(), memoryMax = sim->memoryBytes();
+    const auto loopStart = Clock::now();
+    double sampling = 0;
+    for (int frame = 1; frame <= scene.lastFrame; ++frame) {
+        const auto frameStart = Clock::now();
+        sim->beforeFrame(frame);
+        sim->advanceFrame();
+        const auto sampleStart = Clock::now();
+        sample(frame, false);
+        sampling += std::chrono::duration<double>(Clock::now() - sampleStart).count();
+        particlesMax = std::max(particlesMax, sim->particleCount());
+        memoryMax = std::max(memoryMax, sim->memoryBytes());
+        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %llu steps, %s, %.2f s\n", frame, scene.lastFrame, sim->time(),
+                     static_cast<unsigned long long>(sim->stepCount()), sim->counts().c_str(),
+                     std::chrono::duration<double>(Clock::now() - frameStart).count());
+    }
+    // The metrics' own sampling is not the solver's cost.
+    const double wall = std::chrono::duration<double>(Clock::now() - loopStart).count() - sampling;
+
+    Json result;
+    result["status"] = "ok";
+    Json& cost = result["cost"];
+    cost["setup_s"] = setup;
+    cost["wall_s"] = wall;
+    cost["sim_s"] = sim->time();
+    cost["wall_per_sim_second"] = sim->time() > 0 ? wall / sim->time() : NAN;
+    cost["steps"] = double(sim->stepCount());
+    cost["steps_per_second"] = wall > 0 ? double(sim->stepCount()) / wall : NAN;
+    cost["particles_max"] = double(particlesMax);
+    cost["particle_memory_mb"] = double(memoryMax) / 1048576.0;
+    for (const OutputMedium& m : sim->media()) {
+        std::size_t n = 0;
+        for (sph::ParticleKind k : m.particles->kinds()) n += std::count(m.kinds.begin(), m.kinds.end(), k) > 0;
+        cost["count_" + m.name] = double(n);
+    }
+    result["counts"] = sim->counts();
+    for (const auto& metric : metrics) {
+        for (const auto& [name, value] : metric->values()) result["values"][name] = value;
+        const std::vector<double> trace = metric->trace();
+        if (!trace.empty()) result["traces"][metric->name()] = trace;
+    }
+    return result;
+}
+
+// The parent: spawn, wait, tabulate ---------------------------------------------------------------
+
+struct CaseOutcome
+{
+    std::string status = "not run"; ///< ok, failed, unstable, timeout
+    std::string note;
+    std::map<std::string, double> numbers;
+    std::map<std::string, std::vector<double>> traces;
+};
+
+std::string selfExecutable()
+{
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) throw IoError(msg("ghostfx study: cannot find its own program (/proc/self/exe: ", ec.message(), ")"));
+    return self.string();
+}
+
+/// The last non-empty line of a log file (the child's error message).
+std::string lastLine(const std::string& path)
+{
+    std::ifstream in(path);
+    std::string line, last;
+    while (std::getline(in, line)) {
+        if (!line.empty()) last = line;
+    }
+    return last;
+}
+
+CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string& program, int threads,
+                     const std::string& resultPath, const std::string& logPath)
+{
+    std::vector<std::string> args = {program, "study", spec.file, "--case", std::to_string(index),
+                                     "--result", resultPath, "--threads", std::to_string(threads)};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, logPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+    std::error_code ec;
+    fs::remove(resultPath, ec);
+    pid_t pid = 0;
+    const int err = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (err != 0) throw IoError(msg("ghostfx study: cannot start '", program, "': ", std::strerror(err)));
+
+    const auto start = Clock::now();
+    int status = 0;
+    struct rusage usage{};
+    bool timedOut = false;
+    for (;;) {
+        const pid_t done = ::wait4(pid, &status, WNOHANG, &usage);
+        if (done == pid) break;
+        if (done < 0 && errno != EINTR) throw IoError(msg("ghostfx study: waiting for case ", index, ": ", std::strerror(errno)));
+        if (spec.maxSecondsPerRun > 0 && !timedOut &&
+            std::chrono::duration<double>(Clock::now() - start).count() > spec.maxSecondsPerRun) {
+            ::kill(pid, SIGKILL);
+            timedOut = true;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+
+    CaseOutcome o;
+    o.numbers["peak_rss_mb"] = double(usage.ru_maxrss) / 1024.0; // Linux: kilobytes
+    if (timedOut) {
+        o.status = "timeout";
+        o.note = msg("stopped after max_seconds_per_run = ", spec.maxSecondsPerRun, " s");
+        return o;
+    }
+    std::ifstream in(resultPath);
+    Json result;
+    if (in) {
+        try {
+            in >> result;
+        } catch (const Json::exception&) {
+            result = Json();
+        }
+    }
+    if (!result.is_object()) {
+        o.status = "failed";
+        o.note = WIFSIGNALED(status) ? msg("killed by signal ", WTERMSIG(status)) : lastLine(logPath);
+        return o;
+    }
+    o.status = result.value("status", "failed");
+    o.note = result.value("error", result.value("counts", ""));
+    for (const char* group : {"cost", "values"}) {
+        if (!result.contains(group)) continue;
+        for (auto it = result[group].begin(); it != result[group].end(); ++it) {
+            o.numbers[it.key()] = it.value().is_number() ? it.value().get<double>() : NAN;
+        }
+    }
+    if (result.contains("traces")) {
+        for (auto it = result["traces"].begin(); it != result["traces"].end(); ++it) {
+            std::vector<double> t;
+            for (const Json& v : it.value()) t.push_back(v.is_number() ? v.get<double>() : NAN);
+            o.traces[it.key()] = std::move(t);
+        }
+    }
+    return o;
+}
+
+/// Trace errors against the reference run (which is case 0).
+void compareWithReference(const StudySpec& spec, std::vector<CaseOutcome>& outcomes)
+{
+    if (!spec.hasReference() || outcomes.front().status != "ok") return;
+    for (CaseOutcome& o : outcomes) {
+        for (const auto& [name, trace] : o.traces) {
+            auto ref = outcomes.front().traces.find(name);
+            if (ref == outcomes.front().traces.end()) continue;
+            const TraceError e = compareTraces(trace, ref->second);
+            o.numbers[name + "_error"] = e.relative;
+            o.numbers[name + "_error_m"] = e.rms;
+        }
+    }
+}
+
+const std::vector<std::string>& costColumns()
+{
+    static const std::vector<std::string> c = {"setup_s", "wall_s", "sim_s", "wall_per_sim_second", "steps",
+                                               "steps_per_second", "peak_rss_mb", "particle_memory_mb",
+                                               "particles_max"};
+    return c;
+}
+
+std::string number(double v)
+{
+    if (!std::isfinite(v)) return std::isnan(v) ? "" : (v > 0 ? "inf" : "-inf");
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%.6g", v);
+    return buffer;
+}
+
+std::string csvField(const std::string& s)
+{
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return q + "\"";
+}
+
+void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path)
+{
+    std::vector<std::string> columns = costColumns();
+    std::set<std::string> seen(columns.begin(), columns.end());
+    for (const CaseOutcome& o : outcomes) {
+        for (const auto& [name, value] : o.numbers) {
+            if (seen.insert(name).second) columns.push_back(name);
+        }
+    }
+    std::string text = "case,role,status";
+    for (const std::string& a : spec.axes) text += "," + csvField(a);
+    text += ",precision";
+    for (const std::string& c : columns) text += "," + c;
+    text += ",note\n";
+    for (std::size_t k = 0; k < outcomes.size(); ++k) {
+        const StudyCase& c = spec.cases[k];
+        const CaseOutcome& o = outcomes[k];
+        text += std::to_string(k) + "," + (c.reference ? "reference" : "sweep") + "," + o.status;
+        for (const std::string& a : spec.axes) {
+            auto it = c.values.find(a);
+            text += "," + csvField(it == c.values.end() ? "" : valueText(it->second));
+        }
+        text += "," + c.precision;
+        for (const std::string& col : columns) {
+            auto it = o.numbers.find(col);
+            text += "," + (it == o.numbers.end() ? std::string() : number(it->second));
+        }
+        text += "," + csvField(o.note) + "\n";
+    }
+    vdbio::writeAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp);
+        out << text;
+        if (!out) throw IoError(msg("study table '", path, "': write failed"));
+    });
+}
+
+double numberOr(const CaseOutcome& o, const std::string& key)
+{
+    auto it = o.numbers.find(key);
+    return it == o.numbers.end() ? NAN : it->second;
+}
+
+/// Observed order of convergence between successive values of the convergence key (halving the
+/// spacing, say), among cases that agree on every other swept key: p = ln(e1 / e2) / ln(h1 / h2).
+std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path)
+{
+    if (spec.convergenceKey.empty()) return {};
+    std::map<std::string, std::vector<std::pair<double, double>>> groups; // others -> (h, error)
+    for (std::size_t k = 0; k < outcomes.size(); ++k) {
+        const StudyCase& c = spec.cases[k];
+        if (c.reference || outcomes[k].status != "ok") continue;
+        auto key = c.values.find(spec.convergenceKey);
+        if (key == c.values.end() || !key->second.is_number()) continue;
+        std::string others;
+        for (const auto& [name, value] : c.values) {
+            if (name != spec.convergenceKey) others += (others.empty() ? "" : " ") + name + "=" + valueText(value);
+        }
+        groups[others].push_back({key->second.get<double>(), numberOr(outcomes[k], spec.convergenceError)});
+    }
+    std::string csv = "group," + spec.convergenceKey + "_coarse," + spec.convergenceKey + "_fine," +
+                      spec.convergenceError + "_coarse," + spec.convergenceError + "_fine,observed_order\n";
+    std::string report;
+    for (auto& [group, points] : groups) {
+        std::sort(points.begin(), points.end(), [](auto& a, auto& b) { return a.first > b.first; });
+        for (std::size_t k = 0; k + 1 < points.size(); ++k) {
+            const auto [h1, e1] = points[k];
+            const auto [h2, e2] = points[k + 1];
+            const double order = (e1 > 0 && e2 > 0 && h1 != h2) ? std::log(e1 / e2) / std::log(h1 / h2) : NAN;
+            csv += csvField(group) + "," + number(h1) + "," + number(h2) + "," + number(e1) + "," + number(e2) + "," +
+                   number(order) + "\n";
+            report += msg("  ", group.empty() ? "" : group + ": ", spec.convergenceKey, " ", number(h1), " -> ",
+                          number(h2), ": ", spec.convergenceError, " ", number(e1), " -> ", number(e2),
+                          ", observed order ", number(order), "\n");
+        }
+    }
+    vdbio::writeAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp);
+        out << csv;
+        if (!out) throw IoError(msg("convergence table '", path, "': write failed"));
+    });
+    return report;
+}
+
+void writeStudyPlot(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path,
+                    std::string& skipped)
+{
+    vdbio::PlotSpec plot;
+    plot.title = spec.plotTitle;
+    plot.xLabel = spec.plotCost;
+    plot.yLabel = spec.plotError;
+    for (std::size_t k = 0; k < outcomes.size(); ++k) {
+        const StudyCase& c = spec.cases[k];
+        if (c.reference) continue;
+        const double x = numberOr(outcomes[k], spec.plotCost), y = numberOr(outcomes[k], spec.plotError);
+        if (outcomes[k].status != "ok" || !(x > 0) || !(y > 0)) {
+            skipped += msg(skipped.empty() ? "" : ", ", k);
+            continue;
+        }
+        vdbio::PlotPoint p;
+        p.x = x;
+        p.y = y;
+        auto series = c.values.find(spec.plotSeries);
+        p.series = series == c.values.end() ? "runs" : spec.plotSeries + "=" + valueText(series->second);
+        for (const auto& [name, value] : c.values) {
+            if (name != spec.plotSeries) p.label += (p.label.empty() ? "" : " ") + valueText(value);
+        }
+        plot.points.push_back(p);
+    }
+    if (!plot.points.empty()) vdbio::writePlotPng(path, plot);
+}
+
+struct StudyOptions
+{
+    std::string study;
+    std::string out;
+    int threads = 0;
+    bool quiet = false;
+    int caseIndex = -1;
+    std::string result;
+};
+
+int runStudyCase(const StudyOptions& o, const StudySpec& spec)
+{
+    if (o.caseIndex < 0 || std::size_t(o.caseIndex) >= spec.cases.size()) {
+        throw ValueError(msg("--case ", o.caseIndex, ": the study has cases 0-", spec.cases.size() - 1));
+    }
+    parallel::ThreadLimit threadLimit(o.threads);
+    Json result;
+    int code = 0;
+    try {
+        result = runCase(spec, std::size_t(o.caseIndex));
+    } catch (const NumericalError& e) {
+        result = {{"status", "unstable"}, {"error", e.what()}};
+        code = 1;
+    } catch (const Error& e) {
+        result = {{"status", "failed"}, {"error", e.what()}};
+        code = 1;
+    }
+    if (!o.result.empty()) {
+        vdbio::writeAtomically(o.result, [&](const std::string& tmp) {
+            std::ofstream out(tmp);
+            out << result.dump(1);
+            if (!out) throw IoError(msg("study result '", o.result, "': write failed"));
+        });
+    }
+    if (code != 0) std::fprintf(stderr, "ghostfx study: case %d %s: %s\n", o.caseIndex,
+                                result["status"].get<std::string>().c_str(), result["error"].get<std::string>().c_str());
+    return code;
+}
+
+int runStudy(const StudyOptions& o)
+{
+    const StudySpec spec = readStudy(o.study);
+    if (o.caseIndex >= 0) return runStudyCase(o, spec);
+
+    // Every case's scene and settings are checked before anything runs.
+    for (const StudyCase& c : spec.cases) {
+        try {
+            const vdbio::Scene scene = vdbio::readScene(spec.scene, c.overrides);
+            if (c.precision == BUILD_PRECISION) checkSimulationSettings(scene);
+        } catch (const Error& e) {
+            throw SceneError(msg("study '", spec.file, "': case '", c.label, "': ", e.what()));
+        }
+    }
+    const std::string folder = o.out.empty() ? spec.directory : o.out;
+    vdbio::ensureWritableDirectory(folder);
+    vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
+    const std::string self = selfExecutable();
+    const std::string table = (fs::path(folder) / spec.table).string();
+    auto say = [&](const std::string& line) {
+        if (!o.quiet) std::fprintf(stderr, "%s\n", line.c_str());
+    };
+    say(msg("ghostfx study '", spec.file, "': scene '", spec.scene, "', ", spec.cases.size(), " runs, ",
+            spec.metrics.size(), " metrics, output in '", folder, "'"));
+
+    std::vector<CaseOutcome> outcomes(spec.cases.size());
+    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
+        const StudyCase& c = spec.cases[k];
+        const std::string program = c.precision == BUILD_PRECISION ? self : spec.executables.at(c.precision);
+        const std::string stem = (fs::path(folder) / "runs" / msg("case_", k < 10 ? "0" : "", k)).string();
+        const auto start = Clock::now();
+        outcomes[k] = runChild(spec, k, program, o.threads, stem + ".json", stem + ".log");
+        compareWithReference(spec, outcomes);
+        writeTable(spec, outcomes, table);
+        const CaseOutcome& r = outcomes[k];
+        std::string line = msg("[", k + 1, "/", spec.cases.size(), "] ", c.label.empty() ? "base scene" : c.label, ": ",
+                               r.status);
+        if (r.status == "ok") {
+            line += msg(", ", number(numberOr(r, "wall_s")), " s (", number(numberOr(r, "wall_per_sim_second")),
+                        " s per simulated s), ", number(numberOr(r, "peak_rss_mb")), " MB, ",
+                        number(numberOr(r, "particles_max")), " particles; ", spec.plotError, " = ",
+                        number(numberOr(r, spec.plotError)));
+        } else {
+            line += msg(" after ", number(std::chrono::duration<double>(Clock::now() - start).count()), " s: ", r.note,
+                        " (log: ", stem, ".log)");
+        }
+        say(line);
+    }
+
+    const std::string order = convergenceReport(spec, outcomes, (fs::path(folder) / "convergence.csv").string());
+    if (!order.empty()) say("convergence (convergence.csv):\n" + order.substr(0, order.size() - 1));
+    std::string skipped;
+    const std::string plot = (fs::path(folder) / spec.plot).string();
+    writeStudyPlot(spec, outcomes, plot, skipped);
+    say(msg("table: ", table, "; plot: ", plot,
+            skipped.empty() ? "" : " (not plotted, failed or without a positive value: cases " + skipped + ")"));
+    return 0;
+}
+
+} // namespace
+
+Command addStudyCommand(CLI::App& parent)
+{
+    auto o = std::make_shared<StudyOptions>();
+    CLI::App* c = parent.add_subcommand("study", "Run a scene over a sweep of settings: cost against error (CSV + PNG plot)");
+    c->add_option("study", o->study, "study file (.json; docs/study.md)")->required();
+    c->add_option("--out", o->out, "output folder (default: output.directory of the study)");
+    c->add_option("--threads", o->threads, "worker threads per run (0: all cores)")->check(CLI::NonNegativeNumber);
+    c->add_flag("-q,--quiet", o->quiet, "print errors only");
+    // Internal: how the study runs one case in a child process.
+    c->add_option("--case", o->caseIndex)->group("");
+    c->add_option("--result", o->result)->group("");
+    return {c, [o] { return runStudy(*o); }};
+}
+
+} // namespace cmd
+} // namespace ghostfx

@@ -1,0 +1,272 @@
+/// @file   test_study.cc
+/// @brief  `ghostfx study` end to end: the table, the plot, reference traces, failed cases and
+///         bad study files, on a free-falling drop small enough to run many times.
+#include <ghostfx/sph/Types.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+std::string slurp(const fs::path& p)
+{
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+/// A CSV table as rows of column -> text.
+std::vector<std::map<std::string, std::string>> readCsv(const fs::path& p)
+{
+    std::ifstream in(p);
+    std::string line;
+    std::vector<std::string> header;
+    std::vector<std::map<std::string, std::string>> rows;
+    auto split = [](const std::string& l) {
+        std::vector<std::string> f;
+        std::string cur;
+        bool quoted = false;
+        for (char c : l) {
+            if (c == '"') quoted = !quoted;
+            else if (c == ',' && !quoted) { f.push_back(cur); cur.clear(); }
+            else cur += c;
+        }
+        f.push_back(cur);
+        return f;
+    };
+    if (std::getline(in, line)) header = split(line);
+    while (std::getline(in, line)) {
+        const std::vector<std::string> f = split(line);
+        std::map<std::string, std::string> row;
+        for (std::size_t k = 0; k < header.size() && k < f.size(); ++k) row[header[k]] = f[k];
+        rows.push_back(row);
+    }
+    return rows;
+}
+
+double num(const std::map<std::string, std::string>& row, const std::string& key)
+{
+    auto it = row.find(key);
+    return it == row.end() || it->second.empty() ? NAN : std::stod(it->second);
+}
+
+class Study : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        mDir = fs::temp_directory_path() /
+               ("ghostfx_study_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        fs::remove_all(mDir);
+        fs::create_directories(mDir);
+        // A drop of water in free fall, no solid anywhere: its centre of mass must follow
+        // x0 + v0 t + g t^2 / 2 whatever the internal forces do (they cancel in pairs).
+        std::ofstream(mDir / "drop.json") << R"({
+            "ghostfx_scene": 1,
+            "settings": { "method": "ghost", "spacing": 0.02, "substeps": 10, "frame_range": [1, 4],
+                          "stiffness": 2000, "seed": 3 },
+            "liquids": [ { "name": "drop", "geometry": { "sphere": { "center": [0, 1, 0], "radius": 0.06 } },
+                           "velocity": [0.5, 0, 0] } ]
+        })";
+    }
+
+    fs::path writeStudy(const Json& study, const std::string& name = "study.json") const
+    {
+        std::ofstream(mDir / name) << study.dump(2);
+        return mDir / name;
+    }
+
+    Json baseStudy() const
+    {
+        Json s = Json::parse(R"({ "ghostfx_study": 1, "scene": "drop.json",
+                                  "metrics": ["free_fall", "density_error", "volume_drift"] })");
+        s["output"]["directory"] = (mDir / "out").string();
+        return s;
+    }
+
+    struct Result
+    {
+        int code = -1;
+        std::string err;
+    };
+
+    Result run(const std::string& args) const
+    {
+        const fs::path err = mDir / "stderr.txt";
+        const std::string command = std::string(GHOSTFX_EXE) + " " + args + " 2> " + err.string();
+        const int status = std::system(command.c_str());
+        return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+    }
+
+    /// A bad study: exit code 1, one line on stderr (returned), nothing written.
+    std::string errorLine(const Json& study) const
+    {
+        const Result r = run("study " + writeStudy(study).string() + " --threads 1");
+        EXPECT_EQ(r.code, 1) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_FALSE(fs::exists(mDir / "out")) << "a refused study wrote output";
+        return r.err;
+    }
+
+    fs::path mDir;
+};
+
+} // namespace
+
+TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
+{
+    Json s = baseStudy();
+    s["sweep"]["settings.substeps"] = {5, 20};
+    s["sweep"]["settings.method"] = {"ghost", "basic"};
+    s["plot"]["series"] = "settings.method";
+    const Result r = run("study " + writeStudy(s).string() + " --threads 1");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("[4/4]"), std::string::npos) << r.err;
+
+    const auto rows = readCsv(mDir / "out" / "study.csv");
+    ASSERT_EQ(rows.size(), 4u);
+    for (const auto& row : rows) {
+        ASSERT_EQ(row.at("status"), "ok") << row.at("note");
+        EXPECT_EQ(row.at("precision"), sizeof(ghostfx::sph::Real) == 8 ? "double" : "float");
+        // Cost: 4 frames at 30 fps; wall time per simulated second = wall / (4/30).
+        EXPECT_NEAR(num(row, "sim_s"), 4.0 / 30.0, 1e-6);
+        EXPECT_NEAR(num(row, "wall_per_sim_second"), num(row, "wall_s") / num(row, "sim_s"), 1e-3 * num(row, "wall_per_sim_second"));
+        EXPECT_EQ(num(row, "steps"), 4 * std::stod(row.at("settings.substeps")));
+        EXPECT_GT(num(row, "peak_rss_mb"), 1.0);
+        EXPECT_GT(num(row, "count_liquid"), 50);
+        // Free fall: pairwise forces cancel, so the centre of mass moves as the integrator moves
+        // one particle. Symplectic Euler (v += dt g, then x += dt v) over n steps of dt lands at
+        // x0 + v0 T + g T^2 / 2 + g T dt / 2: an O(dt) error of exactly |g| T dt / 2, which the
+        // metric must find. Basic SPH's forces are symmetric: to 1 %. Ghost SPH's are not quite
+        // (ghost air pushes the liquid but is not pushed back; XSPH weights m_j / rho_j differ):
+        // measured within 0.03 spacings of the integrator's error; allowed 0.06.
+        const double T = 4.0 / 30.0, dt = T / num(row, "steps");
+        const double expected = 9.81 * T * dt / 2 / 0.02;
+        const double tolerance = row.at("settings.method") == "basic" ? 0.01 * expected : 0.06;
+        EXPECT_NEAR(num(row, "free_fall_com_error_spacings"), expected, tolerance) << row.at("settings.method");
+        // No particle is added or removed.
+        EXPECT_EQ(num(row, "mass_drift"), 0.0);
+        EXPECT_GE(num(row, "density_error_max"), num(row, "density_error_mean"));
+    }
+    // Ghost air fills the drop's missing neighbours: its density error is smaller than Basic's
+    // (Basic's surface particles see a truncated sum, [SB12] Fig. 3).
+    EXPECT_LT(num(rows[0], "density_error_mean") + num(rows[1], "density_error_mean"),
+              num(rows[2], "density_error_mean") + num(rows[3], "density_error_mean"));
+    // The plot is a PNG with its signature.
+    const std::string png = slurp(mDir / "out" / "study.png");
+    ASSERT_GT(png.size(), 8u);
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+}
+
+TEST_F(Study, TracesAreComparedWithTheReferenceAndOrderIsReported)
+{
+    Json s = baseStudy();
+    // The drop's lowest point, tracked downwards, against a reference with finer steps.
+    s["metrics"] = Json::array({Json{{"metric", "surge_front"}, {"direction", {0, -1, 0}}, {"percentile", 100}}});
+    s["sweep"]["settings.spacing"] = {0.03, 0.02};
+    s["reference"]["settings.spacing"] = 0.015;
+    const Result r = run("study " + writeStudy(s).string() + " --threads 1");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(mDir / "out" / "study.csv");
+    ASSERT_EQ(rows.size(), 3u);
+    EXPECT_EQ(rows[0].at("role"), "reference");
+    EXPECT_EQ(num(rows[0], "surge_front_error_m"), 0.0);
+    for (std::size_t k = 1; k < 3; ++k) {
+        // Every drop falls 8.7 cm in 4 frames; they differ only in where their lowest particle
+        // sits (within a spacing of the sphere's surface): error finite, under 2 spacings.
+        const double e = num(rows[k], "surge_front_error_m");
+        EXPECT_TRUE(std::isfinite(e));
+        EXPECT_LT(e, 2 * 0.03);
+        EXPECT_NEAR(num(rows[k], "surge_front_error"), e / (0.5 * 9.81 * std::pow(4.0 / 30.0, 2)), 0.2 * num(rows[k], "surge_front_error") + 1e-9);
+    }
+    const auto order = readCsv(mDir / "out" / "convergence.csv");
+    ASSERT_EQ(order.size(), 1u);
+    EXPECT_EQ(num(order[0], "settings.spacing_coarse"), 0.03);
+    EXPECT_EQ(num(order[0], "settings.spacing_fine"), 0.02);
+    EXPECT_NEAR(num(order[0], "observed_order"),
+                std::log(num(rows[1], "surge_front_error") / num(rows[2], "surge_front_error")) / std::log(1.5), 1e-3);
+}
+
+TEST_F(Study, BlownUpCaseIsRecordedAndTheStudyGoesOn)
+{
+    Json s = baseStudy();
+    // One fixed step per frame at a stiffness of 1e7 Pa (sound speed 84 m/s, dt = 1/30 s):
+    // the acoustic CFL number is 140, far beyond stability.
+    s["runs"] = Json::array({Json{{"settings.stiffness", 1e7}, {"settings.substeps", 1}},
+                             Json{{"settings.stiffness", 2000}, {"settings.substeps", 10}}});
+    const Result r = run("study " + writeStudy(s).string() + " --threads 1");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("unstable"), std::string::npos) << r.err;
+    const auto rows = readCsv(mDir / "out" / "study.csv");
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0].at("status"), "unstable");
+    EXPECT_NE(rows[0].at("note").find("blew up"), std::string::npos) << rows[0].at("note");
+    EXPECT_EQ(rows[1].at("status"), "ok");
+    EXPECT_TRUE(fs::exists(mDir / "out" / "runs" / "case_00.log"));
+}
+
+TEST_F(Study, BadStudyFilesGetOneClearLine)
+{
+    const std::string file = (mDir / "study.json").string();
+    {
+        Json s = baseStudy();
+        s["metrics"] = {"free_fal"};
+        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file + "': metrics[0] = \"free_fal\": unknown metric "
+                                "(expected one of density_error, volume_drift, hydrostatic_pressure, free_fall, "
+                                "cube_shape, surge_front, plume_rise)\n");
+    }
+    {
+        Json s = baseStudy();
+        s["sweep"]["settings.spacng"] = {0.02};
+        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file + "': case 'settings.spacng=0.02': scene '" +
+                                    (mDir / "drop.json").string() +
+                                    "': settings.spacng: unknown key (did you mean 'spacing'?)\n");
+    }
+    {
+        Json s = baseStudy();
+        s["sweep"]["settings.spacing"] = Json::array();
+        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file +
+                                    "': sweep: 'settings.spacing' = []: expected a non-empty array of values\n");
+    }
+    {
+        Json s = baseStudy();
+        s["sweep"]["precision"] = {sizeof(ghostfx::sph::Real) == 8 ? "float" : "double"};
+        const std::string e = errorLine(s);
+        EXPECT_NE(e.find("executables: case 'precision="), std::string::npos) << e;
+    }
+    {
+        Json s = baseStudy();
+        s["plot"]["error"] = "hydrostatic_pressure_error";
+        const std::string e = errorLine(s);
+        EXPECT_NE(e.find("plot.error = \"hydrostatic_pressure_error\": not a column of these metrics"), std::string::npos) << e;
+    }
+    {
+        Json s = baseStudy();
+        s["metrics"] = Json::array({Json{{"metric", "surge_front"}, {"percentil", 90}}});
+        const std::string e = errorLine(s);
+        EXPECT_NE(e.find("metrics[0].percentil: unknown option of this metric"), std::string::npos) << e;
+    }
+    {
+        Json s = baseStudy();
+        s["scene"] = "missing.json";
+        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file + "': case '': scene '" +
+                                    (mDir / "missing.json").string() + "': cannot open the file\n");
+    }
+    EXPECT_EQ(errorLine(Json::parse(R"({"ghostfx_study": 1, "scene": "drop.json"})")),
+              "ghostfx: error: study '" + file + "': metrics = null: expected a non-empty array of metric names "
+              "(docs/study.md)\n");
+}
