@@ -224,7 +224,7 @@ StudySpec readStudy(const std::string& path)
     out.finish();
 
     const vdbio::JsonObject plot = root.has("plot") ? root.object("plot") : vdbio::JsonObject();
-    s.plotCost = plot.choice("cost", s.plotCost, {"wall_per_sim_second", "wall_s", "peak_rss_mb", "particles_max",
+    s.plotCost = plot.choice("cost", s.plotCost, {"wall_per_sim_second", "cpu_per_sim_second", "wall_s", "cpu_s", "peak_rss_mb", "particles_max",
                                                   "particle_memory_mb", "steps"});
     s.plotError = plot.get<std::string>("error", primaryErrorColumn(s.metrics.front().name, s.hasReference()));
     s.plotSeries = plot.get<std::string>("series", "");
@@ -268,6 +268,16 @@ StudySpec readStudy(const std::string& path)
 
 // One case, in the child process ------------------------------------------------------------------
 
+/// CPU time of this process, all threads, user + system (s). Unlike wall time it does not grow
+/// when other work shares the machine (with one thread per run it is the run's cost on an idle
+/// core); the metrics' sampling, single-threaded, is subtracted from both.
+double cpuSeconds()
+{
+    struct rusage u{};
+    ::getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 /// Run case `index` and return its result document. Throws like `ghostfx run`.
 Json runCase(const StudySpec& spec, std::size_t index)
 {
@@ -301,6 +311,7 @@ Json runCase(const StudySpec& spec, std::size_t index)
     const double setup = std::chrono::duration<double>(Clock::now() - t0).count();
 
     std::size_t particlesMax = sim->particleCount(), memoryMax = sim->memoryBytes();
+    const double cpuStart = cpuSeconds();
     const auto loopStart = Clock::now();
     double sampling = 0;
     for (int frame = 1; frame <= scene.lastFrame; ++frame) {
@@ -318,6 +329,7 @@ Json runCase(const StudySpec& spec, std::size_t index)
     }
     // The metrics' own sampling is not the solver's cost.
     const double wall = std::chrono::duration<double>(Clock::now() - loopStart).count() - sampling;
+    const double cpu = cpuSeconds() - cpuStart - sampling;
 
     Json result;
     result["status"] = "ok";
@@ -326,6 +338,8 @@ Json runCase(const StudySpec& spec, std::size_t index)
     cost["wall_s"] = wall;
     cost["sim_s"] = sim->time();
     cost["wall_per_sim_second"] = sim->time() > 0 ? wall / sim->time() : NAN;
+    cost["cpu_s"] = cpu;
+    cost["cpu_per_sim_second"] = sim->time() > 0 ? cpu / sim->time() : NAN;
     cost["steps"] = double(sim->stepCount());
     cost["steps_per_second"] = wall > 0 ? double(sim->stepCount()) / wall : NAN;
     cost["particles_max"] = double(particlesMax);
@@ -354,12 +368,14 @@ struct CaseOutcome
     std::map<std::string, std::vector<double>> traces;
 };
 
+/// This program, for the child runs. /proc/self/exe names the running image itself, so a study
+/// keeps working while its program file is rebuilt or replaced under it.
 std::string selfExecutable()
 {
-    std::error_code ec;
-    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    if (ec) throw IoError(msg("ghostfx study: cannot find its own program (/proc/self/exe: ", ec.message(), ")"));
-    return self.string();
+    if (::access("/proc/self/exe", X_OK) != 0) {
+        throw IoError(msg("ghostfx study: cannot run its own program again (/proc/self/exe: ", std::strerror(errno), ")"));
+    }
+    return "/proc/self/exe";
 }
 
 /// The last non-empty line of a log file (the child's error message).
@@ -465,7 +481,8 @@ void compareWithReference(const StudySpec& spec, std::vector<CaseOutcome>& outco
 
 const std::vector<std::string>& costColumns()
 {
-    static const std::vector<std::string> c = {"setup_s", "wall_s", "sim_s", "wall_per_sim_second", "steps",
+    static const std::vector<std::string> c = {"setup_s", "wall_s", "sim_s", "wall_per_sim_second", "cpu_s",
+                                               "cpu_per_sim_second", "steps",
                                                "steps_per_second", "peak_rss_mb", "particle_memory_mb",
                                                "particles_max"};
     return c;
@@ -675,8 +692,8 @@ int runStudy(const StudyOptions& o)
         std::string line = msg("[", k + 1, "/", spec.cases.size(), "] ", c.label.empty() ? "base scene" : c.label, ": ",
                                r.status);
         if (r.status == "ok") {
-            line += msg(", ", number(numberOr(r, "wall_s")), " s (", number(numberOr(r, "wall_per_sim_second")),
-                        " s per simulated s), ", number(numberOr(r, "peak_rss_mb")), " MB, ",
+            line += msg(", ", number(numberOr(r, "wall_s")), " s wall, ", number(numberOr(r, "cpu_s")), " s CPU (",
+                        number(numberOr(r, "wall_per_sim_second")), " s per simulated s), ", number(numberOr(r, "peak_rss_mb")), " MB, ",
                         number(numberOr(r, "particles_max")), " particles; ", spec.plotError, " = ",
                         number(numberOr(r, spec.plotError)));
         } else {
