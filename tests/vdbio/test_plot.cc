@@ -7,6 +7,8 @@
 // Private to vdbio, included only to read the image back.
 #include "../../vdbio/src/PngFile.h"
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -38,32 +40,10 @@ std::size_t fileCount(const fs::path& dir)
     return std::size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 
-std::string slurp(const fs::path& p)
-{
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using ghostfx::testing::slurp;
 
-/// Run `f`, expect it to throw E and return the message ("" and a test failure otherwise).
-template <typename E, typename F>
-std::string errorOf(F&& f)
-{
-    try {
-        f();
-    } catch (const E& e) {
-        return e.what();
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "unexpected exception type: " << e.what();
-        return "";
-    }
-    ADD_FAILURE() << "no exception thrown";
-    return "";
-}
-
-bool contains(const std::string& text, const std::string& part)
-{
-    return text.find(part) != std::string::npos;
-}
+using ghostfx::testing::contains;
+using ghostfx::testing::errorOf;
 
 /// A PNG read back as 8-bit RGBA.
 struct Image

@@ -12,6 +12,8 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/LevelSetUtil.h>
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 
 // The HDF5 part needs the test executable to see HDF5's headers and libraries (HDF5::HDF5 in
@@ -46,26 +48,8 @@ fs::path freshDir(const std::string& name)
 
 void writeText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
-/// Run `f`, expect it to throw E and return the message ("" and a test failure otherwise).
-template <typename E, typename F>
-std::string errorOf(F&& f)
-{
-    try {
-        f();
-    } catch (const E& e) {
-        return e.what();
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "unexpected exception type: " << e.what();
-        return "";
-    }
-    ADD_FAILURE() << "no exception";
-    return "";
-}
-
-bool contains(const std::string& text, const std::string& part)
-{
-    return text.find(part) != std::string::npos;
-}
+using ghostfx::testing::contains;
+using ghostfx::testing::errorOf;
 
 /// Axis-aligned box [lo, hi] as an OBJ with one normal per face (so Assimp keeps 24 vertices
 /// and the converter must weld them), faces as quads (so Assimp must triangulate).

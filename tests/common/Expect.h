@@ -1,0 +1,46 @@
+/// @file   Expect.h
+/// @brief  Test helpers shared by the test files: the message of an expected exception, a
+///         substring check and reading a whole file.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace ghostfx {
+namespace testing {
+
+/// Run `f`, expect it to throw E and return the message ("" and a test failure otherwise).
+template <typename E, typename F>
+std::string errorOf(F&& f)
+{
+    try {
+        f();
+    } catch (const E& e) {
+        return e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "unexpected exception type: " << e.what();
+        return "";
+    }
+    ADD_FAILURE() << "no exception thrown";
+    return "";
+}
+
+inline bool contains(const std::string& text, const std::string& part)
+{
+    return text.find(part) != std::string::npos;
+}
+
+/// The whole file as bytes ("" if it cannot be read).
+inline std::string slurp(const std::filesystem::path& p)
+{
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+} // namespace testing
+} // namespace ghostfx
