@@ -197,6 +197,9 @@ private:
 // divided by the bottom pressure rho0 |g| H: the systematic error of the pressure profile. The
 // surface is the top particle's height plus half a spacing (a particle stands for the cube
 // around it), H the depth from there to half a spacing below the lowest particle.
+// The balance error compares instead with |g| times the integral of the measured density from
+// the surface down: the exact equilibrium of the liquid as compressed as it is, so it isolates
+// the force balance from the compressibility that a finite stiffness allows.
 // Also reported: the particles' own rms deviation on the same scale (the profile error plus the
 // pressure noise of a weakly compressible liquid, which grows with the stiffness), and the
 // least-squares slope of p against d, relative to rho0 |g| (0 is exact).
@@ -232,6 +235,8 @@ public:
         top += 0.5 * m.spacing;
         const double depth = top - bottom + 0.5 * m.spacing;
         mScale = m.restDensity * g;
+        mRestDensity = m.restDensity;
+        mSpacing = m.spacing;
         mDepthSum += depth;
         double sq = 0, sdd = 0, sdp = 0, sd = 0, sp = 0;
         for (std::size_t i : liquid) {
@@ -242,6 +247,7 @@ public:
             Layer& layer = mLayers[int(std::floor(d / m.spacing))];
             layer.depth += d;
             layer.pressure += pi;
+            layer.density += p.densities()[i];
             ++layer.count;
         }
         const double n = double(liquid.size());
@@ -253,14 +259,26 @@ public:
 
     std::vector<std::pair<std::string, double>> values() const override
     {
-        double sq = 0, count = 0;
+        // The balance reference integrates the measured layer densities from the surface down:
+        // p_bal(d) = |g| (sum of rho_j h over the layers above + rho_k (d - k h)).
+        const double g = mScale / mRestDensity;
+        double sq = 0, sqBalance = 0, count = 0, above = 0;
+        int next = 0;
         for (const auto& [index, layer] : mLayers) {
             const double d = layer.depth / layer.count, pl = layer.pressure / layer.count;
+            const double rho = layer.density / layer.count;
+            for (; next < index; ++next) above += rho * mSpacing; // layers with no particle: this density
+            const double balance = g * (above + rho * (d - index * mSpacing));
+            above += rho * mSpacing;
+            next = index + 1;
             sq += layer.count * (pl - mScale * d) * (pl - mScale * d);
+            sqBalance += layer.count * (pl - balance) * (pl - balance);
             count += layer.count;
         }
         const double depth = mFrames ? mDepthSum / mFrames : NAN;
-        return {{"hydrostatic_pressure_error", count > 0 ? std::sqrt(sq / count) / (mScale * depth) : NAN},
+        const double bottom = mScale * depth;
+        return {{"hydrostatic_pressure_error", count > 0 ? std::sqrt(sq / count) / bottom : NAN},
+                {"hydrostatic_balance_error", count > 0 ? std::sqrt(sqBalance / count) / bottom : NAN},
                 {"hydrostatic_pressure_noise", mFrames ? mNoiseSum / mFrames : NAN},
                 {"hydrostatic_slope_error", mFrames ? mSlopeSum / mFrames : NAN}};
     }
@@ -268,11 +286,11 @@ public:
 private:
     struct Layer
     {
-        double depth = 0, pressure = 0, count = 0;
+        double depth = 0, pressure = 0, density = 0, count = 0;
     };
     double mFrom;
     std::map<int, Layer> mLayers;
-    double mScale = 1, mDepthSum = 0, mNoiseSum = 0, mSlopeSum = 0;
+    double mScale = 1, mRestDensity = 1, mSpacing = 1, mDepthSum = 0, mNoiseSum = 0, mSlopeSum = 0;
     int mFrames = 0;
 };
 

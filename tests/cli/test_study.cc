@@ -270,3 +270,35 @@ TEST_F(Study, BadStudyFilesGetOneClearLine)
               "ghostfx: error: study '" + file + "': metrics = null: expected a non-empty array of metric names "
               "(docs/study.md)\n");
 }
+
+TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
+{
+    std::ofstream(mDir / "tank.json") << R"({
+        "ghostfx_scene": 1,
+        "settings": { "method": "ghost", "spacing": 0.025, "substeps": 0, "cfl": 0.4, "stiffness": 20000,
+                      "frame_range": [1, 15], "seed": 1 },
+        "solids": [ { "name": "tank",
+                      "geometry": { "container": { "min": [0, 0, 0], "max": [0.2, 0.3, 0.2], "wall": 0.08 } } } ],
+        "liquids": [ { "name": "water", "geometry": { "box": { "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] } } } ]
+    })";
+    Json s = baseStudy();
+    s["scene"] = "tank.json";
+    s["metrics"] = {"hydrostatic_pressure", "density_error"};
+    const Result r = run("study " + writeStudy(s).string() + " --threads 2");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(mDir / "out" / "study.csv");
+    ASSERT_EQ(rows.size(), 1u);
+    ASSERT_EQ(rows[0].at("status"), "ok") << rows[0].at("note");
+    // The free surface is known to half a spacing either way (a particle stands for the cube
+    // around it), which alone shifts the profile by h / (2 H) = 0.0625 of the bottom pressure;
+    // measured 0.085 here (8 layers). Allowed: h / H.
+    EXPECT_LT(num(rows[0], "hydrostatic_pressure_error"), 0.025 / 0.2);
+    EXPECT_LT(num(rows[0], "hydrostatic_balance_error"), 0.025 / 0.2);
+    // The slope of p against depth does not depend on where the surface is: rho0 |g| to within
+    // the compression a stiffness of 20 kPa allows (measured 3 %; allowed 10 %).
+    EXPECT_LT(std::abs(num(rows[0], "hydrostatic_slope_error")), 0.1);
+    // The same stiffness keeps the mean density within 2 % of rho0 (measured 0.9 % in the study).
+    EXPECT_LT(num(rows[0], "density_error_mean"), 0.02);
+    // Single particles scatter more than the layer means: the noise bounds the profile error.
+    EXPECT_GE(num(rows[0], "hydrostatic_pressure_noise"), num(rows[0], "hydrostatic_pressure_error"));
+}
