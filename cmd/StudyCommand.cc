@@ -623,7 +623,53 @@ struct StudyOptions
     bool quiet = false;
     int caseIndex = -1;
     std::string result;
+    bool replot = false;
 };
+
+/// Read a study table back (for --replot): numbers by column, status and note, row by row.
+std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& path)
+{
+    std::ifstream in(path);
+    if (!in) throw IoError(msg("study table '", path, "': cannot open the file (run the study first)"));
+    auto split = [](const std::string& line) {
+        std::vector<std::string> fields(1);
+        bool quoted = false;
+        for (std::size_t k = 0; k < line.size(); ++k) {
+            const char ch = line[k];
+            if (ch == '"') {
+                if (quoted && k + 1 < line.size() && line[k + 1] == '"') fields.back() += line[++k];
+                else quoted = !quoted;
+            } else if (ch == ',' && !quoted) {
+                fields.emplace_back();
+            } else {
+                fields.back() += ch;
+            }
+        }
+        return fields;
+    };
+    std::string line;
+    std::getline(in, line);
+    const std::vector<std::string> header = split(line);
+    std::vector<CaseOutcome> outcomes(spec.cases.size());
+    std::size_t row = 0;
+    while (std::getline(in, line)) {
+        const std::vector<std::string> f = split(line);
+        if (row >= outcomes.size() || f.size() != header.size()) {
+            throw SceneError(msg("study table '", path, "': row ", row + 1, " does not fit study '", spec.file,
+                                 "' (", spec.cases.size(), " cases, ", header.size(), " columns)"));
+        }
+        CaseOutcome& o = outcomes[row++];
+        for (std::size_t k = 0; k < header.size(); ++k) {
+            if (header[k] == "status") o.status = f[k];
+            else if (header[k] == "note") o.note = f[k];
+            else if (std::find(costColumns().begin(), costColumns().end(), header[k]) != costColumns().end() ||
+                     header[k].rfind("count_", 0) == 0 || k > 3 + spec.axes.size()) {
+                o.numbers[header[k]] = f[k].empty() ? NAN : std::strtod(f[k].c_str(), nullptr);
+            }
+        }
+    }
+    return outcomes;
+}
 
 int runStudyCase(const StudyOptions& o, const StudySpec& spec)
 {
@@ -654,10 +700,32 @@ int runStudyCase(const StudyOptions& o, const StudySpec& spec)
     return code;
 }
 
+/// The convergence table and the plot, from the outcomes of every case.
+int finishStudy(const StudyOptions& o, const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
+                const std::string& folder)
+{
+    auto say = [&](const std::string& line) {
+        if (!o.quiet) std::fprintf(stderr, "%s\n", line.c_str());
+    };
+    const std::string order = convergenceReport(spec, outcomes, (fs::path(folder) / "convergence.csv").string());
+    if (!order.empty()) say("convergence (convergence.csv):\n" + order.substr(0, order.size() - 1));
+    std::string skipped;
+    const std::string plot = (fs::path(folder) / spec.plot).string();
+    writeStudyPlot(spec, outcomes, plot, skipped);
+    say(msg("table: ", (fs::path(folder) / spec.table).string(), "; plot: ", plot,
+            skipped.empty() ? "" : " (not plotted, failed or without a positive value: cases " + skipped + ")"));
+    return 0;
+}
+
 int runStudy(const StudyOptions& o)
 {
     const StudySpec spec = readStudy(o.study);
     if (o.caseIndex >= 0) return runStudyCase(o, spec);
+    if (o.replot) {
+        const std::string folder = o.out.empty() ? spec.directory : o.out;
+        const std::vector<CaseOutcome> outcomes = readTable(spec, (fs::path(folder) / spec.table).string());
+        return finishStudy(o, spec, outcomes, folder);
+    }
 
     // Every case's scene and settings are checked before anything runs.
     for (const StudyCase& c : spec.cases) {
@@ -703,14 +771,7 @@ int runStudy(const StudyOptions& o)
         say(line);
     }
 
-    const std::string order = convergenceReport(spec, outcomes, (fs::path(folder) / "convergence.csv").string());
-    if (!order.empty()) say("convergence (convergence.csv):\n" + order.substr(0, order.size() - 1));
-    std::string skipped;
-    const std::string plot = (fs::path(folder) / spec.plot).string();
-    writeStudyPlot(spec, outcomes, plot, skipped);
-    say(msg("table: ", table, "; plot: ", plot,
-            skipped.empty() ? "" : " (not plotted, failed or without a positive value: cases " + skipped + ")"));
-    return 0;
+    return finishStudy(o, spec, outcomes, folder);
 }
 
 } // namespace
@@ -723,6 +784,8 @@ Command addStudyCommand(CLI::App& parent)
     c->add_option("--out", o->out, "output folder (default: output.directory of the study)");
     c->add_option("--threads", o->threads, "worker threads per run (0: all cores)")->check(CLI::NonNegativeNumber);
     c->add_flag("-q,--quiet", o->quiet, "print errors only");
+    c->add_flag("--replot", o->replot, "only redraw the plot and convergence table from the study's existing table "
+                                      "(after changing \"plot\" or \"convergence\")");
     // Internal: how the study runs one case in a child process.
     c->add_option("--case", o->caseIndex)->group("");
     c->add_option("--result", o->result)->group("");

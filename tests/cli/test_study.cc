@@ -170,6 +170,14 @@ TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
     const std::string png = slurp(mDir / "out" / "study.png");
     ASSERT_GT(png.size(), 8u);
     EXPECT_EQ(png.substr(1, 3), "PNG");
+
+    // --replot redraws from the table alone (no run: the table is left as it was).
+    const std::string table = slurp(mDir / "out" / "study.csv");
+    fs::remove(mDir / "out" / "study.png");
+    const Result again = run("study " + (mDir / "study.json").string() + " --replot");
+    ASSERT_EQ(again.code, 0) << again.err;
+    EXPECT_TRUE(fs::exists(mDir / "out" / "study.png"));
+    EXPECT_EQ(slurp(mDir / "out" / "study.csv"), table);
 }
 
 TEST_F(Study, TracesAreComparedWithTheReferenceAndOrderIsReported)
