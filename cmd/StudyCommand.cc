@@ -76,6 +76,7 @@ struct StudySpec
     std::string directory, table, plot, plotTitle;
     std::string plotCost = "wall_per_sim_second", plotError, plotSeries;
     std::string convergenceKey, convergenceError;
+    bool convergenceInverse = false;                 ///< the step size is 1 / key (substeps)
     bool hasReference() const { return !cases.empty() && cases.front().reference; }
 };
 
@@ -239,6 +240,7 @@ StudySpec readStudy(const std::string& path)
     const bool sweptSpacing = std::find(s.axes.begin(), s.axes.end(), "settings.spacing") != s.axes.end();
     s.convergenceKey = conv.get<std::string>("key", sweptSpacing ? "settings.spacing" : "");
     s.convergenceError = conv.get<std::string>("error", s.plotError);
+    s.convergenceInverse = conv.get<bool>("inverse", false);
     conv.finish();
     if (!s.convergenceKey.empty() && std::find(s.axes.begin(), s.axes.end(), s.convergenceKey) == s.axes.end()) {
         root.fail("convergence", msg("key = \"", s.convergenceKey, "\": not a swept key"));
@@ -561,9 +563,11 @@ std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutco
         for (const auto& [name, value] : c.values) {
             if (name != spec.convergenceKey) others += (others.empty() ? "" : " ") + name + "=" + valueText(value);
         }
-        groups[others].push_back({key->second.get<double>(), numberOr(outcomes[k], spec.convergenceError)});
+        const double value = key->second.get<double>();
+        groups[others].push_back({spec.convergenceInverse ? 1.0 / value : value, numberOr(outcomes[k], spec.convergenceError)});
     }
-    std::string csv = "group," + spec.convergenceKey + "_coarse," + spec.convergenceKey + "_fine," +
+    const std::string h = spec.convergenceInverse ? "1/" + spec.convergenceKey : spec.convergenceKey;
+    std::string csv = "group," + h + "_coarse," + h + "_fine," +
                       spec.convergenceError + "_coarse," + spec.convergenceError + "_fine,observed_order\n";
     std::string report;
     for (auto& [group, points] : groups) {
@@ -574,7 +578,7 @@ std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutco
             const double order = (e1 > 0 && e2 > 0 && h1 != h2) ? std::log(e1 / e2) / std::log(h1 / h2) : NAN;
             csv += csvField(group) + "," + number(h1) + "," + number(h2) + "," + number(e1) + "," + number(e2) + "," +
                    number(order) + "\n";
-            report += msg("  ", group.empty() ? "" : group + ": ", spec.convergenceKey, " ", number(h1), " -> ",
+            report += msg("  ", group.empty() ? "" : group + ": ", h, " ", number(h1), " -> ",
                           number(h2), ": ", spec.convergenceError, " ", number(e1), " -> ", number(e2),
                           ", observed order ", number(order), "\n");
         }
