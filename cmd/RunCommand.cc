@@ -237,6 +237,8 @@ int runScene(const RunOptions& o)
         return 0;
     }
     progress.message(msg("ghostfx run '", scene.file, "': ", scene.method, scene.heaters.empty() ? "" : " + boiling",
+                         scene.forceFields.empty() ? "" : msg(" + ", scene.forceFields.size(),
+                                                              scene.forceFields.size() == 1 ? " attractor" : " attractors"),
                          ", spacing ", scene.spacing, " m, frames ", std::max(first, startFrame + 1), "-", last,
                          (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"), ", ", parallel::maxThreads(),
                          " threads, output in '", folder, "'"));

@@ -168,6 +168,15 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
     s.seed = g.get<std::uint64_t>("seed", s.seed);
     s.frameRate = Real(scene.frameRate);
     s.domain = scene.killBox;
+    // force_fields ([RYY15] Fig. 7): point attractors act on the gas.
+    for (const vdbio::SceneForceField& field : scene.forceFields) {
+        gas::Attractor a;
+        a.position = Vec3(field.attractor.position);
+        a.strength = Real(field.attractor.strength);
+        a.radius = Real(field.attractor.radius);
+        a.falloff = gas::falloffFromName(field.attractor.falloff);
+        s.attractors.push_back(a);
+    }
     g.finish();
     if (s.method == gas::Method::Ambient && s.domain.empty()) {
         g.failValue("variant", "the ambient-air baseline fills a box with air: expected domain.kill_box");

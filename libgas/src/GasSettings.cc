@@ -29,6 +29,31 @@ Method methodFromName(const std::string& name)
     throw ValueError(msg("gas method '", name, "': expected 'fast', 'ambient' or 'uncorrected'"));
 }
 
+const char* falloffName(Falloff falloff)
+{
+    switch (falloff) {
+    case Falloff::InverseSquare: return "inverse_square";
+    case Falloff::Constant: return "constant";
+    }
+    return "unknown";
+}
+
+Falloff falloffFromName(const std::string& name)
+{
+    if (name == "inverse_square") return Falloff::InverseSquare;
+    if (name == "constant") return Falloff::Constant;
+    throw ValueError(msg("attractor falloff '", name, "': expected 'inverse_square' or 'constant'"));
+}
+
+Vec3 Attractor::acceleration(const Vec3& x) const
+{
+    const Vec3 d = position - x;   // towards c
+    const Real r = d.length();
+    if (r < radius) return d * (strength / radius);   // linear core, zero at c
+    const Real s = falloff == Falloff::InverseSquare ? strength * sph::sqr(radius / r) : strength;
+    return d * (s / r);
+}
+
 Real GasSettings::soundSpeed() const { return std::sqrt(kappa); }
 
 Real GasSettings::speedLimit(Real dt) const
@@ -79,6 +104,16 @@ void GasSettings::validate() const
             vorticityStrength, ">= 0 (1/s)");
     require(lifeStrength >= 0 && finite(lifeStrength), "lifeStrength", lifeStrength,
             ">= 0 (s; 0 = isolated particles live forever)");
+    for (std::size_t k = 0; k < attractors.size(); ++k) {
+        const Attractor& a = attractors[k];
+        const std::string name = "attractors[" + std::to_string(k) + "].";
+        require(sph::isFinite(a.position), (name + "position").c_str(), a.position.length(),
+                "finite coordinates (m)");
+        require(finite(a.strength), (name + "strength").c_str(), a.strength,
+                "a finite value (m/s^2; < 0 repels)");
+        require(a.radius > 0 && finite(a.radius), (name + "radius").c_str(), a.radius,
+                "a finite value > 0 (m)");
+    }
     if (method == Method::Ambient) {
         const Vec3 e = domain.extent();
         require(!domain.empty() && e[0] >= 2 * supportRadius() && e[1] >= 2 * supportRadius() &&

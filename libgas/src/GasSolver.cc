@@ -202,9 +202,14 @@ void GasSolver::sampleSolid(std::size_t solidIndex)
 bool GasSolver::blockedBySolid(const Vec3& x) const
 {
     // New gas keeps half a spacing from solid surfaces, where the solid's surface samples sit.
+    // phi is clamped at the band width beyond the narrow band: a solid whose band is narrower
+    // than the clearance (a liquid scene's solid, voxels of half the liquid spacing, seen by
+    // the coarser vapour of a boiling scene) reads "clamped" everywhere outside it, which is
+    // at least a band width away, so the clearance is capped just below the band width.
     const Real clearance = Real(0.5) * mSettings.spacing;
     for (const auto& solid : mSolids) {
-        if (solid->phi(x, mTime) < clearance) return true;
+        const Real band = solid->shape.bandWidth();
+        if (solid->phi(x, mTime) < std::min(clearance, Real(0.99) * band)) return true;
     }
     return false;
 }
@@ -703,6 +708,12 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
     // g of Eq. 25: gravity, or standard gravity against the buoyancy direction when the gas has
     // no weight (the default), so the boundary still generates vorticity.
     const Vec3 gVort = g.lengthSqr() > Real(0) ? g : Real(-9.81) * mBuoyancyDir;
+    // Attractors pull the visible gas only, not the ambient baseline's air (GasSettings.h).
+    const std::vector<Attractor>& attractors = mSettings.attractors;
+    const std::vector<Real>* ambient = mParticles.hasScalarChannel(channel::AMBIENT)
+                                           ? &mParticles.scalarChannel(channel::AMBIENT)
+                                           : nullptr;
+    const auto& x = mParticles.positions();
 
     std::vector<Vec3> accel(n, Vec3(0));
     std::vector<Real> dTdt(n, Real(0));
@@ -774,6 +785,9 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
         // Eq. 24.
         Vec3 a = F / rho[i] + g + mSettings.buoyancy * (T[i] - Tamb) * mBuoyancyDir; // Eq. 17
         if (fast && surface) a -= mSettings.damping * vi;                             // Eq. 14
+        if (!attractors.empty() && !(ambient && (*ambient)[i] != Real(0))) {
+            for (const Attractor& field : attractors) a += field.acceleration(x[i]); // Fig. 7
+        }
         if (omega) {
             a += mSettings.vorticityStrength * toReal(vortex);
             dOmega[i] = toReal(stretch) +

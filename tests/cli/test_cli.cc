@@ -402,6 +402,30 @@ TEST_F(Cli, GasPlumeRunsToDensityAndTemperatureVolumes)
                     "settings.gas.variant = \"ambient\": the ambient-air baseline fills a box with air: expected domain.kill_box");
 }
 
+TEST_F(Cli, AttractorRunsAndACheckpointWithoutItIsRefused)
+{
+    // [RYY15] Fig. 7: the plume's source with an attractor above it. A checkpoint written
+    // without the attractor must not resume the scene with it (force_fields are part of the
+    // simulation fingerprint), and the message names the difference.
+    const std::string path = write(plumeScene(), "plume.json");
+    const fs::path out = mDir / "out";
+    ASSERT_EQ(run("run " + path + " --out " + out.string() + " -q --frames 1-2").code, 0);
+    const std::string field =
+        " -D 'force_fields=[{\"name\":\"magic\",\"attractor\":{\"position\":[0.3,0.6,0],\"strength\":2}}]'";
+    const std::string line = errorLine("run " + path + field + " --out " + (mDir / "b").string() +
+                                       " --resume " + (out / "checkpoint.0002.h5").string());
+    EXPECT_CONTAINS(line, "checkpoint.0002.h5' was written with different settings: /force_fields is missing "
+                          "there, [{\"attractor\":{\"position\":[0.3,0.6,0],\"strength\":2},\"name\":\"magic\"}] "
+                          "in this scene");
+    // The scene with the attractor runs, and says so.
+    const Result r = run("run " + path + field + " --out " + (mDir / "c").string() + " --progress log --frames 1-2");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_CONTAINS(r.err, "gas + 1 attractor, spacing 0.04 m");
+    // And a liquid scene refuses it.
+    EXPECT_CONTAINS(errorLine("run " + write(smallScene()) + field + " --out " + (mDir / "d").string()),
+                    "force_fields: attractors act on gas; this scene has no gas");
+}
+
 TEST_F(Cli, BoilingPanRunsLiquidAndVapour)
 {
     const Json scene = Json::parse(R"({

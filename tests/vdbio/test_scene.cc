@@ -346,3 +346,70 @@ TEST_F(SceneTest, GasSourceMayBeAFogVolume)
     s["liquids"][0]["geometry"] = {{"file", "smoke.vdb"}, {"grid", "smoke"}};
     EXPECT_CONTAINS(errorOf(s), "class is 'fog volume', expected 'level set'");
 }
+
+TEST_F(SceneTest, ForceFieldsReadStrictlyAndBelongToTheFingerprint)
+{
+    // A gas scene with the [RYY15] Fig. 7 attractor.
+    Json s = baseScene();
+    s.erase("liquids");
+    s["settings"]["method"] = "gas";
+    s["gas_sources"] = Json::parse(R"([{ "geometry": { "sphere": { "center": [0.5, 0.1, 0.5], "radius": 0.05 } } }])");
+    s["force_fields"] = Json::parse(R"([
+        { "name": "magic", "attractor": { "position": [0.5, 0.8, 0.5], "strength": 3, "radius": 0.2 } },
+        { "attractor": { "position": [0, 1, 0], "strength": -1.5, "falloff": "constant" } } ])");
+    const vdbio::Scene scene = vdbio::readScene(write(s));
+    ASSERT_EQ(scene.forceFields.size(), 2u);
+    EXPECT_EQ(scene.forceFields[0].name, "magic");
+    EXPECT_EQ(scene.forceFields[0].attractor.position, sph::Vec3d(0.5, 0.8, 0.5));
+    EXPECT_DOUBLE_EQ(scene.forceFields[0].attractor.strength, 3.0);
+    EXPECT_DOUBLE_EQ(scene.forceFields[0].attractor.radius, 0.2);
+    EXPECT_EQ(scene.forceFields[0].attractor.falloff, "inverse_square");
+    EXPECT_EQ(scene.forceFields[1].name, "force_fields[1]");            // default name: the path
+    EXPECT_DOUBLE_EQ(scene.forceFields[1].attractor.radius, 0.1);       // default radius (m)
+    EXPECT_DOUBLE_EQ(scene.forceFields[1].attractor.strength, -1.5);    // negative: repels
+    EXPECT_EQ(scene.forceFields[1].attractor.falloff, "constant");
+
+    // Bad input: one line naming the key path, the value and what was expected.
+    auto bad = [&](const std::string& override) { return errorOf(s, {override}); };
+    EXPECT_CONTAINS(bad("force_fields[0].attractor.radius=-0.1"),
+                    "scene.json': force_fields[0].attractor.radius = -0.1: expected a number > 0");
+    EXPECT_CONTAINS(bad("force_fields[0].attractor.strength=\"big\""),
+                    "scene.json': force_fields[0].attractor.strength = \"big\": expected a number");
+    EXPECT_CONTAINS(bad("force_fields[0].attractor.position=[1,2]"),
+                    "scene.json': force_fields[0].attractor.position = [1,2]: expected an array of 3 numbers");
+    EXPECT_CONTAINS(bad("force_fields[0].attractor.falloff=cubic"),
+                    "scene.json': force_fields[0].attractor.falloff = \"cubic\": expected one of "
+                    "'inverse_square', 'constant'");
+    EXPECT_CONTAINS(bad("force_fields[0].attractor.strenght=2"),
+                    "scene.json': force_fields[0].attractor.strenght: unknown key (did you mean 'strength'?)");
+    Json t = s;
+    t["force_fields"][0]["attractor"].erase("strength");
+    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields[0].attractor.strength: missing; expected a number");
+    t = s;
+    t["force_fields"][0]["atractor"] = t["force_fields"][0]["attractor"];
+    t["force_fields"][0].erase("attractor");
+    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields[0].atractor: unknown key (did you mean 'attractor'?)");
+    t = s;
+    t["force_fields"][0].erase("attractor");
+    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields[0].attractor: missing; expected a field kind: "
+                                "'attractor'");
+    t = s;
+    t["force_field"] = t["force_fields"];
+    t.erase("force_fields");
+    EXPECT_CONTAINS(errorOf(t), "scene.json': force_field: unknown key (did you mean 'force_fields'?)");
+    // A liquid-only scene has nothing for an attractor to act on.
+    t = baseScene();
+    t["force_fields"] = s["force_fields"];
+    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields: attractors act on gas; this scene has no gas");
+
+    // Part of the simulation fingerprint: a checkpoint of the scene without the field (or with
+    // another strength) is refused for the scene with it.
+    const std::string path = write(s, "gas.json");
+    Json plain = s;
+    plain.erase("force_fields");
+    const std::string without = vdbio::readScene(write(plain, "plain.json")).simulationFingerprint();
+    const std::string with = vdbio::readScene(path).simulationFingerprint();
+    EXPECT_NE(without, with);
+    EXPECT_NE(with, vdbio::readScene(path, {"force_fields[0].attractor.strength=4"}).simulationFingerprint());
+    EXPECT_EQ(with, vdbio::readScene(path, {"outputs.directory=elsewhere"}).simulationFingerprint());
+}

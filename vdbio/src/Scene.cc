@@ -468,6 +468,26 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         o.finish();
         scene.heaters.push_back(std::move(heater));
     }
+    for (const JsonObject& o : root.objects("force_fields")) {
+        SceneForceField field;
+        field.name = o.get<std::string>("name", o.path());
+        if (!o.has("attractor")) {
+            o.finish(); // a misspelt kind is reported as an unknown key with the closest one
+            o.fail("attractor", "missing; expected a field kind: 'attractor' { \"position\": [x, y, z], "
+                                "\"strength\": S, \"radius\": R }");
+        }
+        const JsonObject a = o.object("attractor");
+        SceneAttractor& at = field.attractor;
+        at.position = vec(a.require<std::array<double, 3>>("position"));
+        const double strength = a.require<double>("strength");
+        if (!std::isfinite(strength)) a.failValue("strength", "expected a finite number (m/s^2; < 0 repels)");
+        at.strength = strength;
+        at.radius = a.positive("radius", at.radius);
+        at.falloff = a.choice("falloff", at.falloff, {"inverse_square", "constant"});
+        a.finish();
+        o.finish();
+        scene.forceFields.push_back(std::move(field));
+    }
     if (auto phase = root.optionalObject("phase_transition")) {
         if (scene.heaters.empty()) root.fail("phase_transition", "expected heaters: a phase transition needs at least one");
         scene.phaseTransition = *phase;
@@ -490,6 +510,10 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         }
         if (!scene.gasSources.empty() && scene.heaters.empty()) {
             root.fail("gas_sources", "gas sources need settings.method 'gas' (or heaters, for boiling)");
+        }
+        if (!scene.forceFields.empty() && scene.heaters.empty()) {
+            root.fail("force_fields", "attractors act on gas; this scene has no gas (expected settings.method "
+                                      "'gas', or heaters that boil the liquid into vapour)");
         }
     }
     return scene;

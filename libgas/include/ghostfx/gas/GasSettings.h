@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace ghostfx {
 namespace gas {
@@ -42,6 +43,41 @@ enum class Method {
 const char* methodName(Method method);
 /// Parse a method name; throws ValueError listing the valid names.
 Method methodFromName(const std::string& name);
+
+/// How an attractor's pull falls off outside its core radius R (Attractor).
+enum class Falloff {
+    /// |a| = S (R / r)^2 for r >= R: the gravity of a uniform ball of radius R (the default).
+    InverseSquare,
+    /// |a| = S for r >= R: the same pull at any distance.
+    Constant,
+};
+
+/// "inverse_square" or "constant".
+const char* falloffName(Falloff falloff);
+/// Parse a falloff name; throws ValueError listing the valid names.
+Falloff falloffFromName(const std::string& name);
+
+/// A point attractor: a body force pulling gas towards `position`, the "magic attractor" that
+/// draws the plumes of [RYY15] Fig. 7. The paper shows the effect but gives no formula; this
+/// one is the gravity of a uniform ball of radius R whose surface pull is S: with r = |c - x|,
+///
+///     a(x) = S (c - x) / R                       for r < R   (linear core: zero and finite at c)
+///     a(x) = S (c - x) / r * (R / r)^2           for r >= R  (Falloff::InverseSquare)
+///     a(x) = S (c - x) / r                       for r >= R  (Falloff::Constant)
+///
+/// continuous at r = R, where |a| = S is largest. A negative S repels. It acts on the visible
+/// gas only (not on the ambient air of Method::Ambient: a conservative force on a uniform
+/// fluid only builds up a pressure gradient, which would leave the air still and hide it).
+struct Attractor
+{
+    Vec3 position{0};              ///< c (m)
+    Real strength = Real(1);       ///< S (m/s^2): the pull at r = R; < 0 repels
+    Real radius = Real(0.1);       ///< R (m): core radius, > 0
+    Falloff falloff = Falloff::InverseSquare;
+
+    /// a(x) (m/s^2) at position x (m).
+    Vec3 acceleration(const Vec3& x) const;
+};
 
 struct GasSettings
 {
@@ -115,6 +151,11 @@ struct GasSettings
     /// Scale (1/s) turning the vortex velocity of Eq. 26, sum_j V_j (omega_j x r_ij) W_ij (m/s),
     /// into an acceleration. [RYY15] calls Eq. 26 a force without giving its units.
     Real vorticityStrength = Real(5);
+
+    // Force fields ------------------------------------------------------------------------------
+    /// Point attractors acting on the visible gas in the force stage, added to Eq. 24 (the
+    /// magic attractor of [RYY15] Fig. 7; see Attractor for the formula). Empty by default.
+    std::vector<Attractor> attractors;
 
     // Isolated particles (Sec. 5) -----------------------------------------------------------------
     /// l_s (s): a particle with no neighbour loses dt (1 + epsilon), epsilon in [0, 0.1), per

@@ -15,6 +15,7 @@
 ///              P_a n_i (Eqs. 12 - 13, scaled by beta inside, Sec. 5), viscosity, gravity,
 ///              damping (Eq. 14) and radiation (Eq. 16) where |n_i| h_i > C_N, temperature
 ///              diffusion (Eq. 15), buoyancy (Eq. 17), optional vorticity (Eqs. 25 - 26): Eq. 24;
+///              plus the point attractors of GasSettings::attractors (Fig. 7) on visible gas;
 ///           5. symplectic Euler; solids move; collision projection; kill box; life strength of
 ///              isolated particles (Sec. 5); blow-up check.
 ///

@@ -129,6 +129,26 @@ struct SceneHeater
     double temperature = 400;
 };
 
+/// A point attractor of `force_fields` ([RYY15] Fig. 7, the "magic attractor"): pulls gas
+/// towards `position` (m) with `strength` (m/s^2) at the core radius `radius` (m), linearly
+/// inside the core and with `falloff` ("inverse_square" or "constant") outside. The formula is
+/// gas::Attractor's (libgas/include/ghostfx/gas/GasSettings.h); docs/scene-format.md.
+struct SceneAttractor
+{
+    sph::Vec3d position{0};
+    double strength = 0;
+    double radius = 0.1;
+    std::string falloff = "inverse_square";
+};
+
+/// One entry of the scene's `force_fields`: a name and exactly one kind of field (so far:
+/// `attractor`). Fields act on gas: gas scenes and the vapour of boiling scenes.
+struct SceneForceField
+{
+    std::string name;
+    SceneAttractor attractor;
+};
+
 /// What to write per frame. Paths are frame patterns relative to `directory`; empty = off.
 struct SceneOutputs
 {
@@ -181,6 +201,7 @@ struct Scene
     std::vector<SceneEmitter> emitters;
     std::vector<SceneGasSource> gasSources;
     std::vector<SceneHeater> heaters;
+    std::vector<SceneForceField> forceFields;
     /// The `phase_transition` object (boiling / evaporation settings), read by the caller when
     /// the scene has heaters; empty otherwise.
     JsonObject phaseTransition;
