@@ -506,6 +506,12 @@ std::string csvField(const std::string& s)
     return q + "\"";
 }
 
+double numberOr(const CaseOutcome& o, const std::string& key)
+{
+    auto it = o.numbers.find(key);
+    return it == o.numbers.end() ? NAN : it->second;
+}
+
 void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path)
 {
     std::vector<std::string> columns = costColumns();
@@ -542,10 +548,55 @@ void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
     });
 }
 
-double numberOr(const CaseOutcome& o, const std::string& key)
+
+
+/// The same table in Markdown, with the columns a reader compares (cost, then every metric),
+/// numbers to 3 significant digits: for documentation and review.
+void writeMarkdown(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path)
 {
-    auto it = o.numbers.find(key);
-    return it == o.numbers.end() ? NAN : it->second;
+    const std::vector<std::string> cost = {"cpu_per_sim_second", "wall_per_sim_second", "steps", "peak_rss_mb",
+                                           "particles_max"};
+    std::vector<std::string> metrics;
+    std::set<std::string> skip(costColumns().begin(), costColumns().end());
+    for (const CaseOutcome& o : outcomes) {
+        for (const auto& [name, value] : o.numbers) {
+            if (!skip.count(name) && name.rfind("count_", 0) != 0 &&
+                std::find(metrics.begin(), metrics.end(), name) == metrics.end()) {
+                metrics.push_back(name);
+            }
+        }
+    }
+    auto cell = [](double v) {
+        if (!std::isfinite(v)) return std::string(std::isnan(v) ? "" : "inf");
+        char buffer[32];
+        std::snprintf(buffer, sizeof(buffer), std::abs(v) >= 1000 ? "%.0f" : "%.3g", v);
+        return std::string(buffer);
+    };
+    std::string text = "| run |";
+    std::string rule = "|---|";
+    for (const std::string& a : spec.axes) { text += " " + a + " |"; rule += "---|"; }
+    text += " status |";
+    rule += "---|";
+    for (const std::string& c : cost) { text += " " + c + " |"; rule += "---:|"; }
+    for (const std::string& m : metrics) { text += " " + m + " |"; rule += "---:|"; }
+    text += "\n" + rule + "\n";
+    for (std::size_t k = 0; k < outcomes.size(); ++k) {
+        const StudyCase& c = spec.cases[k];
+        text += "| " + std::to_string(k) + (c.reference ? " (ref)" : "") + " |";
+        for (const std::string& a : spec.axes) {
+            auto it = c.values.find(a);
+            text += " " + (it == c.values.end() ? std::string() : valueText(it->second)) + " |";
+        }
+        text += " " + outcomes[k].status + " |";
+        for (const std::string& col : cost) text += " " + cell(numberOr(outcomes[k], col)) + " |";
+        for (const std::string& col : metrics) text += " " + cell(numberOr(outcomes[k], col)) + " |";
+        text += "\n";
+    }
+    vdbio::writeAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp);
+        out << text;
+        if (!out) throw IoError(msg("study table '", path, "': write failed"));
+    });
 }
 
 /// Observed order of convergence between successive values of the convergence key (halving the
@@ -716,6 +767,7 @@ int finishStudy(const StudyOptions& o, const StudySpec& spec, const std::vector<
     std::string skipped;
     const std::string plot = (fs::path(folder) / spec.plot).string();
     writeStudyPlot(spec, outcomes, plot, skipped);
+    writeMarkdown(spec, outcomes, (fs::path(fs::path(folder) / spec.table).replace_extension(".md")).string());
     say(msg("table: ", (fs::path(folder) / spec.table).string(), "; plot: ", plot,
             skipped.empty() ? "" : " (not plotted, failed or without a positive value: cases " + skipped + ")"));
     return 0;
