@@ -661,7 +661,9 @@ void writeStudyPlot(const StudySpec& spec, const std::vector<CaseOutcome>& outco
         p.x = x;
         p.y = y;
         auto series = c.values.find(spec.plotSeries);
-        p.series = series == c.values.end() ? "runs" : spec.plotSeries + "=" + valueText(series->second);
+        // The key's last part names the series ("variant=fast"): legends have little room.
+        const std::string key = spec.plotSeries.substr(spec.plotSeries.find_last_of('.') + 1);
+        p.series = series == c.values.end() ? "runs" : key + "=" + valueText(series->second);
         for (const auto& [name, value] : c.values) {
             if (name != spec.plotSeries) p.label += (p.label.empty() ? "" : " ") + valueText(value);
         }
