@@ -382,9 +382,12 @@ public:
             const Real dt = Real(1) / (mFrameRate * Real(mSubsteps));
             for (int s = 0; s < mSubsteps; ++s) stepOnce(dt);
         } else {
-            while (mLiquid->time() < frameEnd - 1e-9) {
-                const Real dt = std::min({mLiquid->stableTimeStep(), mGas->stableTimeStep(),
-                                          Real(frameEnd - mLiquid->time())});
+            // As GhostSolver::advanceFrame: no extra step for a rounding leftover.
+            const double tolerance = 1e-6 / double(mFrameRate);
+            while (frameEnd - mLiquid->time() > tolerance) {
+                const double remaining = frameEnd - mLiquid->time();
+                Real dt = std::min(mLiquid->stableTimeStep(), mGas->stableTimeStep());
+                if (double(dt) > remaining - tolerance) dt = Real(remaining);
                 stepOnce(dt);
             }
         }

@@ -1033,8 +1033,15 @@ void GasSolver::advanceFrame()
         const Real dt = Real(1) / (mSettings.frameRate * Real(mSettings.substeps));
         for (int s = 0; s < mSettings.substeps; ++s) step(dt);
     } else {
-        while (mTime < frameEnd - 1e-12) {
-            const Real dt = std::min(stableTimeStep(), Real(frameEnd - mTime));
+        // Steps are Real and the clock is double: float rounding leaves a remainder of ~1e-11 s
+        // at the frame's end that once cost a whole extra step. Leftovers below a millionth of
+        // the frame are dropped (the clock is set to the frame's end below), and a step that
+        // nearly reaches the end is stretched to land on it.
+        const double tolerance = 1e-6 / double(mSettings.frameRate);
+        while (frameEnd - mTime > tolerance) {
+            const double remaining = frameEnd - mTime;
+            Real dt = stableTimeStep();
+            if (double(dt) > remaining - tolerance) dt = Real(remaining);
             step(dt);
         }
     }
