@@ -30,6 +30,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -77,6 +78,7 @@ struct StudySpec
     std::string plotCost = "wall_per_sim_second", plotError, plotSeries;
     std::string convergenceKey, convergenceError;
     bool convergenceInverse = false;                 ///< the step size is 1 / key (substeps)
+    std::optional<std::vector<std::string>> convergenceGroupBy; ///< keys that form groups (default: all others)
     bool hasReference() const { return !cases.empty() && cases.front().reference; }
 };
 
@@ -241,6 +243,14 @@ StudySpec readStudy(const std::string& path)
     s.convergenceKey = conv.get<std::string>("key", sweptSpacing ? "settings.spacing" : "");
     s.convergenceError = conv.get<std::string>("error", s.plotError);
     s.convergenceInverse = conv.get<bool>("inverse", false);
+    if (conv.has("group_by")) {
+        s.convergenceGroupBy = conv.get<std::vector<std::string>>("group_by", {});
+        for (const std::string& key : *s.convergenceGroupBy) {
+            if (std::find(s.axes.begin(), s.axes.end(), key) == s.axes.end()) {
+                conv.failValue("group_by", msg("'", key, "' is not a swept key"));
+            }
+        }
+    }
     conv.finish();
     if (!s.convergenceKey.empty() && std::find(s.axes.begin(), s.axes.end(), s.convergenceKey) == s.axes.end()) {
         root.fail("convergence", msg("key = \"", s.convergenceKey, "\": not a swept key"));
@@ -612,7 +622,10 @@ std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutco
         if (key == c.values.end() || !key->second.is_number()) continue;
         std::string others;
         for (const auto& [name, value] : c.values) {
-            if (name != spec.convergenceKey) others += (others.empty() ? "" : " ") + name + "=" + valueText(value);
+            const bool grouping = spec.convergenceGroupBy
+                                      ? std::count(spec.convergenceGroupBy->begin(), spec.convergenceGroupBy->end(), name) > 0
+                                      : name != spec.convergenceKey;
+            if (grouping) others += (others.empty() ? "" : " ") + name + "=" + valueText(value);
         }
         const double value = key->second.get<double>();
         groups[others].push_back({spec.convergenceInverse ? 1.0 / value : value, numberOr(outcomes[k], spec.convergenceError)});
