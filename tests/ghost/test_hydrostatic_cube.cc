@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 using namespace ghostfx;
@@ -124,4 +126,74 @@ TEST(HydrostaticCube, GhostKeepsShapeVolumeAndUniformDensityWhereBasicShrinksInt
     // under 0.8 of Ghost SPH's.
     EXPECT_LT(basic.end.volume / basic.start.volume, 0.95);
     EXPECT_LT(outerPacking(basic), 0.8 * outerPacking(ghost));
+}
+
+// [SB12] Fig. 4 over 2 s -------------------------------------------------------------------------
+// The 300 steps above are too short to see kept ghost air accumulate: with airKeepFraction 0.8
+// (the former default) the cube holds for 0.3 s and blows apart within 2 s. A coarser cube
+// (8 across, 572 liquid particles) keeps this under 20 s on one core.
+
+namespace {
+
+constexpr Real ZG_H = Real(0.025);          // particle spacing (m): 8 across, 572 liquid particles
+constexpr Real ZG_EDGE = Real(0.2);         // cube edge (m)
+constexpr Real ZG_DT = Real(1) / Real(750); // acoustic CFL c dt / h = 0.2 at k = 2000
+constexpr int ZG_STEPS = 1500;              // 2 s
+
+struct Shape
+{
+    double gyration; ///< radius of gyration of the liquid about its centre of mass (m)
+    double maxSpeed; ///< largest liquid speed (m/s)
+};
+
+Shape measureShape(const ParticleSet& p)
+{
+    Vec3d com(0);
+    std::size_t n = 0;
+    double vmax = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Liquid) continue;
+        com += Vec3d(p.positions()[i]);
+        vmax = std::max(vmax, double(p.velocities()[i].length()));
+        ++n;
+    }
+    com /= double(n);
+    double rg = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] == ParticleKind::Liquid) rg += (Vec3d(p.positions()[i]) - com).lengthSqr();
+    }
+    return {std::sqrt(rg / double(n)), vmax};
+}
+
+} // namespace
+
+// KNOWN OPEN DEFECT, disabled: fails with the default airKeepFraction 0.8 (gyration +10..30 %,
+// 1.3 - 5 m/s by 2 s). Replace-all (airKeepFraction 10) passes here (+1.3 %, 0.38 m/s) but fails
+// HydrostaticTank and the 300-step HydrostaticCube shell bound and still spreads at h = 0.0125.
+TEST(ZeroGravityCube, DISABLED_DefaultGhostAirKeepsTheCubeTogetherForTwoSeconds)
+{
+    GhostSettings settings; // default air handling: the subject of this test
+    settings.spacing = ZG_H;
+    settings.gravity = Vec3(0);
+    settings.seed = 1;
+    GhostSolver solver(settings);
+    solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(0), Vec3(ZG_EDGE), ZG_H / 2), "cube"));
+    solver.step(ZG_DT);
+    const Shape start = measureShape(solver.particles());
+    double lateSpeed = 0; // largest liquid speed over the second second (m/s)
+    for (int s = 1; s < ZG_STEPS; ++s) {
+        solver.step(ZG_DT);
+        if (s >= ZG_STEPS / 2) lateSpeed = std::max(lateSpeed, measureShape(solver.particles()).maxSpeed);
+    }
+    const Shape end = measureShape(solver.particles());
+    std::printf("[measured] zero-g cube, 2 s: gyration %+.2f %%, max speed over 1-2 s %.3f m/s, "
+                "%zu air\n", 100.0 * (end.gyration / start.gyration - 1.0), lateSpeed,
+                solver.count(ParticleKind::GhostAir));
+
+    // Measured (seed 1, h = 0.025, CFL-adaptive CLI run of the same scene and this fixed step):
+    // replacing the whole layer, gyration radius -1 % to +1.5 % and max speed 0.17 - 0.25 m/s
+    // (the resampling noise) throughout; keeping air (airKeepFraction 0.8, the former default),
+    // +10 % to +30 % and 1.3 - 5 m/s by 2 s, growing. Bounds: gyration 4 %, speed 0.6 m/s.
+    EXPECT_NEAR(end.gyration / start.gyration, 1.0, 0.04);
+    EXPECT_LT(lateSpeed, 0.6);
 }
