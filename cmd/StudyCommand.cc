@@ -211,13 +211,6 @@ StudySpec readStudy(const std::string& path)
         }
         s.executables[precision] = valueText(program);
     }
-    for (const StudyCase& c : s.cases) {
-        if (c.precision != BUILD_PRECISION && !s.executables.count(c.precision)) {
-            root.fail("executables", msg("case '", c.label, "' needs a ", c.precision, " build: this ghostfx is ",
-                                         BUILD_PRECISION, "; name one with \"executables\": { \"", c.precision,
-                                         "\": \"build-", c.precision, "/cmd/ghostfx\" }"));
-        }
-    }
     s.maxSecondsPerRun = root.nonNegative("max_seconds_per_run", 0);
 
     const vdbio::JsonObject out = root.has("output") ? root.object("output") : vdbio::JsonObject();
@@ -798,6 +791,15 @@ int runStudy(const StudyOptions& o)
         return finishStudy(o, spec, outcomes, folder);
     }
 
+    // Cases of the other precision run on the program named for it (checked by the parent only:
+    // a child of the other build sees this build's cases as "other").
+    for (const StudyCase& c : spec.cases) {
+        if (c.precision != BUILD_PRECISION && !spec.executables.count(c.precision)) {
+            throw SceneError(msg("study '", spec.file, "': executables: case '", c.label, "' needs a ", c.precision,
+                                 " build: this ghostfx is ", BUILD_PRECISION, "; name one with \"executables\": { \"",
+                                 c.precision, "\": \"build-", c.precision, "/cmd/ghostfx\" }"));
+        }
+    }
     // Every case's scene and settings are checked before anything runs.
     for (const StudyCase& c : spec.cases) {
         try {
