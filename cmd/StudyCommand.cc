@@ -525,8 +525,10 @@ void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
         }
     }
     std::string text = "case,role,status";
+    // The precision is a column of its own unless it is swept (then it is one of the axes).
+    const bool precisionColumn = std::find(spec.axes.begin(), spec.axes.end(), PRECISION_KEY) == spec.axes.end();
     for (const std::string& a : spec.axes) text += "," + csvField(a);
-    text += ",precision";
+    if (precisionColumn) text += ",precision";
     for (const std::string& c : columns) text += "," + c;
     text += ",note\n";
     for (std::size_t k = 0; k < outcomes.size(); ++k) {
@@ -537,7 +539,7 @@ void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
             auto it = c.values.find(a);
             text += "," + csvField(it == c.values.end() ? "" : valueText(it->second));
         }
-        text += "," + c.precision;
+        if (precisionColumn) text += "," + c.precision;
         for (const std::string& col : columns) {
             auto it = o.numbers.find(col);
             text += "," + (it == o.numbers.end() ? std::string() : number(it->second));
@@ -713,6 +715,9 @@ std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& pat
     std::string line;
     std::getline(in, line);
     const std::vector<std::string> header = split(line);
+    // case, role, status, the axes, the precision (unless swept), then numbers (writeTable).
+    const bool precisionSwept = std::find(spec.axes.begin(), spec.axes.end(), PRECISION_KEY) != spec.axes.end();
+    const std::size_t firstNumber = 3 + spec.axes.size() + (precisionSwept ? 0 : 1);
     std::vector<CaseOutcome> outcomes(spec.cases.size());
     std::size_t row = 0;
     while (std::getline(in, line)) {
@@ -726,7 +731,7 @@ std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& pat
             if (header[k] == "status") o.status = f[k];
             else if (header[k] == "note") o.note = f[k];
             else if (std::find(costColumns().begin(), costColumns().end(), header[k]) != costColumns().end() ||
-                     header[k].rfind("count_", 0) == 0 || k > 3 + spec.axes.size()) {
+                     header[k].rfind("count_", 0) == 0 || k >= firstNumber) {
                 o.numbers[header[k]] = f[k].empty() ? NAN : std::strtod(f[k].c_str(), nullptr);
             }
         }
