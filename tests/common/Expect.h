@@ -1,6 +1,6 @@
 /// @file   Expect.h
 /// @brief  Test helpers shared by the test files: the message of an expected exception, a
-///         substring check and reading a whole file.
+///         substring check, a fresh temporary folder and reading a whole file.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -33,6 +33,15 @@ std::string errorOf(F&& f)
 inline bool contains(const std::string& text, const std::string& part)
 {
     return text.find(part) != std::string::npos;
+}
+
+/// An empty folder of the system's temporary directory for one test ("ghostfx_test_<name>").
+inline std::filesystem::path freshDir(const std::string& name)
+{
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("ghostfx_test_" + name);
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
 }
 
 /// The whole file as bytes ("" if it cannot be read).

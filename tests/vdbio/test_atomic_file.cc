@@ -3,6 +3,8 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -21,13 +23,7 @@ std::string slurp(const fs::path& p)
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-fs::path freshDir(const std::string& name)
-{
-    const fs::path dir = fs::temp_directory_path() / ("ghostfx_test_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+using ghostfx::testing::freshDir;
 
 } // namespace
 

@@ -27,13 +27,7 @@ using vdbio::PlotSpec;
 
 namespace {
 
-fs::path freshDir(const std::string& name)
-{
-    const fs::path dir = fs::temp_directory_path() / ("ghostfx_test_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+using ghostfx::testing::freshDir;
 
 std::size_t fileCount(const fs::path& dir)
 {

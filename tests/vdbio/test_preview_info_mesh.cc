@@ -38,13 +38,7 @@ using openvdb::Vec3d;
 
 namespace {
 
-fs::path freshDir(const std::string& name)
-{
-    const fs::path dir = fs::temp_directory_path() / ("ghostfx_test_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+using ghostfx::testing::freshDir;
 
 void writeText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
