@@ -7,6 +7,10 @@
 # Run from the repository root:  examples/bunny/make_bunny.sh [path/to/ghostfx]
 set -euo pipefail
 ghostfx=${1:-build/cmd/ghostfx}
+for tool in node npm; do
+    command -v "$tool" >/dev/null || { echo "make_bunny.sh: '$tool' not found: sudo apt-get install -y nodejs npm" >&2; exit 1; }
+done
+[ -x "$ghostfx" ] || { echo "make_bunny.sh: '$ghostfx' is not an executable ghostfx (build it with make build, or pass its path)" >&2; exit 1; }
 here=$(cd "$(dirname "$0")" && pwd)
 scratch=out/bunny/npm
 mkdir -p "$scratch"
