@@ -7,6 +7,7 @@
 #include <ghostfx/gas/GasSolver.h>
 #include <ghostfx/gas/PhaseTransition.h>
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/FrameSteps.h>
 
 #include <algorithm>
 #include <cmath>
@@ -372,25 +373,14 @@ public:
         for (const vdbio::SceneHeater& h : scene.heaters) mPhase->addHeater(h.shape, Real(h.temperature));
         mFrameRate = liquid.frameRate;
         mSubsteps = liquid.substeps;
-        mCfl = liquid.substeps == 0;
     }
 
     void advanceFrame() override
     {
         const double frameEnd = double(mFrame + 1) / double(mFrameRate);
-        if (!mCfl) {
-            const Real dt = Real(1) / (mFrameRate * Real(mSubsteps));
-            for (int s = 0; s < mSubsteps; ++s) stepOnce(dt);
-        } else {
-            // As GhostSolver::advanceFrame: no extra step for a rounding leftover.
-            const double tolerance = 1e-6 / double(mFrameRate);
-            while (frameEnd - mLiquid->time() > tolerance) {
-                const double remaining = frameEnd - mLiquid->time();
-                Real dt = std::min(mLiquid->stableTimeStep(), mGas->stableTimeStep());
-                if (double(dt) > remaining - tolerance) dt = Real(remaining);
-                stepOnce(dt);
-            }
-        }
+        sph::stepFrame(frameEnd, mFrameRate, mSubsteps, [this] { return mLiquid->time(); },
+                       [this] { return std::min(mLiquid->stableTimeStep(), mGas->stableTimeStep()); },
+                       [this](Real dt) { stepOnce(dt); });
         ++mFrame;
     }
     int frame() const override { return mFrame; }
@@ -462,7 +452,6 @@ private:
     std::function<void(double)> mObserver;
     Real mFrameRate = 30;
     int mSubsteps = 20;
-    bool mCfl = false;
     int mFrame = 0;
     gas::GasTimings mGasBefore;
     gas::PhaseTransitionTimings mPhaseBefore;

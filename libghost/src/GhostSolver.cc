@@ -4,6 +4,7 @@
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/FrameSteps.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/SphDensity.h>
@@ -988,22 +989,8 @@ void GhostSolver::advanceFrame()
     checkRestoredInputs();
     initialize();
     const double frameEnd = double(mFrame + 1) / double(mSettings.frameRate);
-    if (mSettings.substeps > 0) {
-        const Real dt = Real(1) / (mSettings.frameRate * Real(mSettings.substeps));
-        for (int s = 0; s < mSettings.substeps; ++s) step(dt);
-    } else {
-        // Steps are Real and the clock is double: float rounding leaves a remainder of ~1e-11 s
-        // at the frame's end that once cost a whole extra step. Leftovers below a millionth of
-        // the frame are dropped (the clock is set to the frame's end below), and a step that
-        // nearly reaches the end is stretched to land on it.
-        const double tolerance = 1e-6 / double(mSettings.frameRate);
-        while (frameEnd - mTime > tolerance) {
-            const double remaining = frameEnd - mTime;
-            Real dt = stableTimeStep();
-            if (double(dt) > remaining - tolerance) dt = Real(remaining);
-            step(dt);
-        }
-    }
+    sph::stepFrame(frameEnd, mSettings.frameRate, mSettings.substeps, [this] { return mTime; },
+                   [this] { return stableTimeStep(); }, [this](Real dt) { step(dt); });
     mTime = frameEnd; // no drift from summing substeps
     ++mFrame;
 }
