@@ -20,6 +20,8 @@
 ///          s frame with its own liquid). Plain main: one run takes minutes.
 ///
 ///          Run: build/bench/bench_gas [--spacing 0.005] [--steps 20] [--baseline-steps 3]
+#include "GhostLiquidSide.h"
+
 #include <ghostfx/gas/GasSolver.h>
 #include <ghostfx/gas/PhaseTransition.h>
 #include <ghostfx/ghost/GhostSolver.h>
@@ -41,19 +43,6 @@ using namespace ghostfx::sph;
 
 namespace {
 
-class GhostLiquid : public gas::LiquidSide
-{
-public:
-    explicit GhostLiquid(ghost::GhostSolver& solver) : mSolver(solver) {}
-    ParticleSet& particles() override { return mSolver.particles(); }
-    Real restDensity() const override { return mSolver.settings().restDensity; }
-    Real supportRadius() const override { return mSolver.settings().supportRadius(); }
-    Real particleMass() const override { return mSolver.particleMass(); }
-    void step(Real dt) override { mSolver.step(dt); }
-
-private:
-    ghost::GhostSolver& mSolver;
-};
 
 double now()
 {
@@ -126,7 +115,7 @@ int main(int argc, char** argv)
             makeBoxLevelSet(Vec3(-a, 0, -a), Vec3(a, Real(depth), a), H / 2), "water"));
         std::printf("set-up (sampling): %.1f s, %zu liquid particles\n", now() - t0,
                     liquid.count(ParticleKind::Liquid));
-        GhostLiquid side(liquid);
+        coupling::GhostLiquidSide side(liquid);
 
         gas::GasSettings gs;
         gs.spacing = H * Real(std::cbrt(1000.0 / 12.0));

@@ -2,6 +2,7 @@
 /// @brief  The liquid, gas and boiling simulations behind `ghostfx run`.
 #include "Simulation.h"
 
+#include "GhostLiquidSide.h"
 #include "LiquidScene.h"
 
 #include <ghostfx/gas/GasSolver.h>
@@ -312,21 +313,6 @@ private:
 
 // Boiling -----------------------------------------------------------------------------------------
 
-/// The Ghost SPH liquid as the phase transition sees it (libgas knows no libghost type).
-class GhostLiquidSide : public gas::LiquidSide
-{
-public:
-    explicit GhostLiquidSide(GhostSolver& solver) : mSolver(solver) {}
-    sph::ParticleSet& particles() override { return mSolver.particles(); }
-    Real restDensity() const override { return mSolver.settings().restDensity; }
-    Real supportRadius() const override { return mSolver.settings().supportRadius(); }
-    Real particleMass() const override { return mSolver.particleMass(); }
-    void step(Real dt) override { mSolver.step(dt); }
-
-private:
-    GhostSolver& mSolver;
-};
-
 gas::PhaseSettings phaseSettings(const vdbio::JsonObject& p, double spacing, double heaterBandLimit)
 {
     gas::PhaseSettings s;
@@ -365,7 +351,7 @@ public:
         const ghost::GhostSettings liquid = liquidSettings(scene); // finishes settings
         mLiquid = makeLiquidSolver(scene, liquid);
         mGas = makeGasSolver(scene, gasSettings(scene, g, vapourSpacing(scene, liquid), "fast"), nullptr);
-        mSide = std::make_unique<GhostLiquidSide>(*mLiquid);
+        mSide = std::make_unique<coupling::GhostLiquidSide>(*mLiquid);
         double band = std::numeric_limits<double>::max();
         for (const vdbio::SceneHeater& h : scene.heaters) band = std::min(band, double(h.shape.bandWidth()));
         mPhase = std::make_unique<gas::PhaseTransition>(*mGas, *mSide,
@@ -447,7 +433,7 @@ private:
     const vdbio::Scene& mScene;
     std::unique_ptr<GhostSolver> mLiquid;
     std::unique_ptr<gas::GasSolver> mGas;
-    std::unique_ptr<GhostLiquidSide> mSide;
+    std::unique_ptr<coupling::GhostLiquidSide> mSide;
     std::unique_ptr<gas::PhaseTransition> mPhase;
     std::function<void(double)> mObserver;
     Real mFrameRate = 30;

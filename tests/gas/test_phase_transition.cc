@@ -7,6 +7,8 @@
 /// @details Scenes are small (a few hundred liquid particles, liquid spacing 1 cm) so the file
 ///          runs in well under a minute on one core. The liquid-gas density ratio is the paper's
 ///          1000:1 (water 1000 kg/m^3, vapour 1 kg/m^3, Sec. 6) in every test.
+#include "GhostLiquidSide.h"
+
 #include <ghostfx/gas/PhaseTransition.h>
 #include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/Exceptions.h>
@@ -28,20 +30,6 @@ constexpr Real DT = Real(1) / Real(1200); ///< [SB12] k = 2000 Pa needs about 1/
 constexpr Real A = Real(0.04);            ///< pan half width (m)
 constexpr Real DEPTH = Real(0.04);        ///< water depth (m)
 
-/// Ghost SPH liquid solver seen through the coupler's narrow interface.
-class GhostLiquid : public gas::LiquidSide
-{
-public:
-    explicit GhostLiquid(ghost::GhostSolver& solver) : mSolver(solver) {}
-    ParticleSet& particles() override { return mSolver.particles(); }
-    Real restDensity() const override { return mSolver.settings().restDensity; }
-    Real supportRadius() const override { return mSolver.settings().supportRadius(); }
-    Real particleMass() const override { return mSolver.particleMass(); }
-    void step(Real dt) override { mSolver.step(dt); }
-
-private:
-    ghost::GhostSolver& mSolver;
-};
 
 /// Open-top pan: walls 4 h thick around the inside [-a, a] x [0, top] x [-a, a].
 LevelSet panLevelSet(Real a, Real top)
@@ -81,7 +69,7 @@ gas::GasSettings vapourSettings()
 struct Scene
 {
     ghost::GhostSolver liquid;
-    GhostLiquid side;
+    coupling::GhostLiquidSide side;
     gas::GasSolver vapour;
     std::unique_ptr<gas::PhaseTransition> coupler;
 
