@@ -262,6 +262,10 @@ void printRun(const RunResult& r)
     for (const auto& row : rows) {
         std::printf("    %-46s %8.1f ms %6.1f %%\n", row.name, 1e3 * row.s / n,
                     percent(row.s, t.total));
+        if (row.s == t.neighborsAndDensity) {
+            std::printf("      %-44s %8.1f ms %6.1f %%\n", "of which sort + neighbour search",
+                        1e3 * t.sortAndSearch / n, percent(t.sortAndSearch, t.total));
+        }
     }
     const double pairs = double(r.liquid) * r.meanNeighbors;
     std::printf("  mean neighbours %.1f; %.2f ns per particle-neighbour pair; %.1f wall s per "

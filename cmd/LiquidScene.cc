@@ -86,7 +86,10 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene, const G
     auto solver = std::make_unique<GhostSolver>(settings);
     if (restored) solver->restoreState(*restored);
     for (const vdbio::SceneSolid& solid : scene.solids) {
-        solver->addMovingSolid(solid.shape, motionOf(solid));
+        // A solid without motion keys moves at its constant velocity, or stands still: then its
+        // particles are sorted once and never re-placed.
+        if (solid.motion.keys.empty()) solver->addSolid(solid.shape, Vec3(solid.velocity));
+        else solver->addMovingSolid(solid.shape, motionOf(solid));
     }
     if (!restored) {
         for (const vdbio::SceneLiquid& liquid : scene.liquids) {

@@ -167,7 +167,11 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
                 po.channels.push_back("kind");
             }
         }
-        vdbio::writePointsFile(pointsPath, *m.particles, po, fileMeta);
+        if (out.pointGhosts && m.withGhosts) {
+            vdbio::writePointsFile(pointsPath, m.withGhosts(), po, fileMeta);
+        } else {
+            vdbio::writePointsFile(pointsPath, *m.particles, po, fileMeta);
+        }
     }
     openvdb::GridPtrVec grids;
     if (volumePath.empty()) return grids;

@@ -92,7 +92,7 @@ public:
             {"t_air_resampling", t.airResampling - mBefore.airResampling},
             {"t_emission", t.emission - mBefore.emission},
             {"t_step", t.total - mBefore.total},
-            {"bytes_per_particle", s.particles().size() ? double(memoryBytes()) / double(s.particles().size()) : 0.0},
+            {"bytes_per_particle", particleCount() ? double(memoryBytes()) / double(particleCount()) : 0.0},
         };
         mBefore = t;
         return row;
@@ -104,10 +104,16 @@ public:
                    " air, ", mSolver->count(ParticleKind::GhostSolid) + mSolver->count(ParticleKind::Boundary),
                    " solid ghosts");
     }
-    std::size_t particleCount() const override { return mSolver->particles().size(); }
-    std::size_t memoryBytes() const override { return mSolver->particles().memoryBytes(); }
+    std::size_t particleCount() const override { return liquidParticleCount(*mSolver); }
+    std::size_t memoryBytes() const override { return mSolver->memoryBytes(); }
 
     std::vector<OutputMedium> media() const override { return {liquidMedium(*mSolver)}; }
+
+    /// Liquid, air and solid particles.
+    static std::size_t liquidParticleCount(const GhostSolver& s)
+    {
+        return s.particles().size() + s.count(ParticleKind::GhostSolid) + s.count(ParticleKind::Boundary);
+    }
 
     std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
 
@@ -118,6 +124,7 @@ public:
         m.particles = &s.particles();
         m.kinds = {ParticleKind::Liquid};
         m.ghostKinds = {ParticleKind::GhostAir, ParticleKind::GhostSolid, ParticleKind::Boundary};
+        m.withGhosts = [&s] { return s.allParticles(); };
         m.spacing = s.settings().spacing;
         m.support = s.settings().supportRadius();
         m.restDensity = s.settings().restDensity;
@@ -404,10 +411,13 @@ public:
         return msg(mLiquid->count(ParticleKind::Liquid), " liquid, ", mGas->visibleGasCount(), " vapour, ",
                    mPhase->boiledCount(), " boiled");
     }
-    std::size_t particleCount() const override { return mLiquid->particles().size() + mGas->particles().size(); }
+    std::size_t particleCount() const override
+    {
+        return LiquidSimulation::liquidParticleCount(*mLiquid) + mGas->particles().size();
+    }
     std::size_t memoryBytes() const override
     {
-        return mLiquid->particles().memoryBytes() + mGas->particles().memoryBytes();
+        return mLiquid->memoryBytes() + mGas->particles().memoryBytes();
     }
 
     std::vector<OutputMedium> media() const override

@@ -26,6 +26,9 @@ struct OutputMedium
     const sph::ParticleSet* particles = nullptr;
     std::vector<sph::ParticleKind> kinds;      ///< kinds written as this medium
     std::vector<sph::ParticleKind> ghostKinds; ///< kinds written too with outputs.points.ghosts
+    /// Every particle of the medium, ghosts included, when they live apart from `particles`
+    /// (the liquid solver keeps its solid particles in blocks); empty: `particles` has them.
+    std::function<sph::ParticleSet()> withGhosts;
     double spacing = 0, support = 0, restDensity = 0;
     sph::Vec3 gravity{0};                      ///< the medium's gravity (m/s^2)
     bool liquid = true;                        ///< liquids get a surface; gases get temperature

@@ -3,32 +3,40 @@
 ///         density summed over liquid only, Tait pressure, Becker and Teschner 2007 artificial
 ///         viscosity (alpha = 0.0005), Lennard-Jones repulsion from solid particles (Monaghan
 ///         1994) and XSPH on the position update (Monaghan 1989, epsilon = 0.5).
+/// @details Uses the step's neighbour lists like Ghost SPH (GhostStep.cc): the boundary
+///          particles act only through the Lennard-Jones force, from the solid blocks' lists.
 #include "ghostfx/ghost/GhostSolver.h"
+
+#include "GhostInternal.h"
 
 #include <ghostfx/sph/Parallel.h>
 
-#include <chrono>
+#include <algorithm>
 
 namespace ghostfx {
 namespace ghost {
 
 using namespace sph;
+using namespace detail;
 
 void GhostSolver::stepBasic(Real dt)
 {
+    prepareSolidBlocks();
     auto t0 = std::chrono::steady_clock::now();
-    sortAndComputeDensity();
-    mTimings.neighborsAndDensity +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    searchNeighbors();
+    mTimings.sortAndSearch += secondsSince(t0);
+    computeDensity();
+    mTimings.neighborsAndDensity += secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
     const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
     const auto& m = mParticles.masses();
     const auto& rho = mParticles.densities();
     const auto& p = mParticles.pressures();
     const auto& kind = mParticles.kinds();
     auto& v = mParticles.velocities();
-    auto& vnew = mParticles.vectorChannel("vstar");
+    auto& vnew = mParticles.vectorChannel(VSTAR);
     const Vec3 g = mSettings.gravity;
     const Real c = mSettings.soundSpeed();
     // Becker and Teschner 2007, Eq. 11: Pi_ij = -nu min(v_ij . x_ij, 0) / (|x_ij|^2 + 0.01 s^2),
@@ -49,51 +57,56 @@ void GhostSolver::stepBasic(Real dt)
         }
         const Real pi = p[i] / sqr(rho[i]);
         Vec3 a = g;
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
-            if (j == i) return;
-            if (kind[j] == ParticleKind::Liquid) {
-                Real term = pi + p[j] / sqr(rho[j]);
-                const Real vx = (v[i] - v[j]).dot(xij);
-                if (vx < Real(0)) {
-                    const Real nu = Real(2) * alpha * s * c / (rho[i] + rho[j]);
-                    term += -nu * vx / (r * r + Real(0.01) * s * s);
-                }
-                a -= m[j] * term * mKernel.gradW(xij, r);
-            } else if (kind[j] == ParticleKind::Boundary && r < r0 && r > Real(0)) {
+        for (Index j : mFluidLists[i]) {
+            if (j == i) continue;
+            const Vec3 xij = x[i] - x[j];
+            const Real r = xij.length();
+            Real term = pi + p[j] / sqr(rho[j]);
+            const Real vx = (v[i] - v[j]).dot(xij);
+            if (vx < Real(0)) {
+                const Real nu = Real(2) * alpha * s * c / (rho[i] + rho[j]);
+                term += -nu * vx / (r * r + Real(0.01) * s * s);
+            }
+            a -= m[j] * term * mKernel.gradW(xij, r);
+        }
+        for (const SolidBlock* b : {&mStatic, &mMoving}) {
+            const Vec3* y = b->block.particles().positions().data();
+            for (Index k : b->lists[i]) {
+                const Vec3 xik = x[i] - y[k];
+                const Real r = xik.length();
+                if (!(r < r0) || !(r > Real(0))) continue;
                 const Real q = r0 / r;
                 const Real q2 = q * q, q4 = q2 * q2;
-                a += (D * (q4 * q4 * q4 - q4) / (r * r)) * xij;
+                a += (D * (q4 * q4 * q4 - q4) / (r * r)) * xik;
             }
-        });
+        }
         vnew[i] = v[i] + dt * a;
         accel[i] = a.length();
-    });
-    mMaxAcceleration = 0;
-    for (std::size_t i = 0; i < n; ++i) mMaxAcceleration = std::max(mMaxAcceleration, accel[i]);
-    mTimings.pressureForce +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }, 512);
+    mMaxAcceleration = n ? *std::max_element(accel.begin(), accel.end()) : Real(0);
+    mTimings.pressureForce += secondsSince(t0);
 
     // XSPH on positions: x += dt (v + eps sum_j 2 m_j / (rho_i + rho_j) (v_j - v_i) W_ij).
     t0 = std::chrono::steady_clock::now();
     const Real eps = mSettings.basicXsphEpsilon;
-    auto& x = mParticles.positions();
+    auto& xw = mParticles.positions();
     std::vector<Vec3> xnew(n);
     parallel::forEach(0, n, [&](std::size_t i) {
         xnew[i] = x[i];
         if (kind[i] != ParticleKind::Liquid) return;
         Vec3 dv(0);
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
-            if (j == i || kind[j] != ParticleKind::Liquid) return;
+        for (Index j : mFluidLists[i]) {
+            if (j == i || kind[j] != ParticleKind::Liquid) continue;
+            const Real r = (x[i] - x[j]).length();
             dv += (Real(2) * m[j] / (rho[i] + rho[j]) * mKernel.W(r)) * (vnew[j] - vnew[i]);
-        });
+        }
         xnew[i] = x[i] + dt * (vnew[i] + eps * dv);
-    });
+    }, 512);
     parallel::forEach(0, n, [&](std::size_t i) {
-        x[i] = xnew[i];
+        xw[i] = xnew[i];
         if (kind[i] == ParticleKind::Liquid) v[i] = vnew[i];
-    });
-    mTimings.xsphAndBoundary +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }, 4096);
+    mTimings.xsphAndBoundary += secondsSince(t0);
 }
 
 } // namespace ghost

@@ -1,7 +1,10 @@
 /// @file   GhostSolver.cc
-/// @brief  Ghost SPH [SB12] Algorithm 3: set-up, ghost air and solid layers, the step, collision
-///         projection, time stepping and blow-up detection. Basic SPH is in BasicSph.cc.
+/// @brief  [SB12] set-up: solids and their particle blocks, liquid bodies, emitters, the kill
+///         box, the mass scaling, time stepping, and saving and restoring a run. The step is in
+///         GhostStep.cc, the air layer in GhostAir.cc, Basic SPH in BasicSph.cc.
 #include "ghostfx/ghost/GhostSolver.h"
+
+#include "GhostInternal.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
@@ -10,46 +13,13 @@
 #include <ghostfx/sph/SphDensity.h>
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 
 namespace ghostfx {
 namespace ghost {
 
 using namespace sph;
-
-namespace {
-
-/// Names of the solver's particle channels.
-constexpr const char* VSTAR = "vstar";             ///< v* = v + dt a, Algorithm 3 line 14
-constexpr const char* SOLID_NORMAL = "normal";     ///< ghost solid: outward normal, world frame
-constexpr const char* SOLID_VELOCITY = "solid_v";  ///< ghost solid: velocity of its solid (m/s)
-constexpr const char* SOLID_LOCAL = "solid_x";     ///< ghost solid: position in its solid's frame
-constexpr const char* SOLID_LOCAL_NORMAL = "solid_n"; ///< ghost solid: normal in its solid's frame
-constexpr const char* SOLID_INDEX = "solid_index"; ///< ghost solid: which solid (index)
-constexpr const char* AIR_WEIGHT = "air_weight";   ///< ghost air: fade weight, mass = weight m
-constexpr const char* AIR_TARGET = "air_target";   ///< ghost air: 1 fading in / kept, 0 fading out
-
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-/// Tait equation of state ([SB12] Sec. 3, Monaghan 1994): p = k ((rho / rho0)^7 - 1).
-inline Real taitPressure(Real rho, Real rho0, Real k)
-{
-    const Real q = rho / rho0;
-    const Real q2 = q * q;
-    return k * (q2 * q2 * q2 * q - Real(1));
-}
-
-} // namespace
-
-/// A solid: its level set (in its local frame) and its rigid motion.
-struct GhostSolver::Solid : sph::MovingLevelSet
-{
-};
+using namespace detail;
 
 /// A continuous liquid source.
 struct GhostSolver::Emitter
@@ -63,10 +33,12 @@ GhostSolver::GhostSolver(const GhostSettings& settings)
     : mSettings(settings)
     , mKernel((settings.validate(), settings.supportRadius()))
     , mGrid(settings.supportRadius())
+    , mStatic(settings.supportRadius())
+    , mMoving(settings.supportRadius())
 {
-    // Model only what the scene needs: v* is used by every step of both methods; the ghost air
-    // channels only by Ghost SPH (Basic SPH has no air); the solid channels come with the first
-    // solid (ensureSolidChannels).
+    // Model only what the scene needs: v* is used by every step of both methods, the ghost air
+    // channels only by Ghost SPH (Basic SPH has no air). Solid channels live on the solid
+    // particles only, in their blocks.
     mParticles.addVectorChannel(VSTAR);
     if (mSettings.method == Method::Ghost) {
         mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
@@ -88,41 +60,55 @@ void GhostSolver::setParticleMass(Real mass)
         const bool air = weight && mParticles.kinds()[i] == ParticleKind::GhostAir;
         mParticles.masses()[i] = air ? (*weight)[i] * mass : mass;
     }
+    for (SolidBlock* b : {&mStatic, &mMoving}) {
+        auto& m = b->block.particles().masses();
+        std::fill(m.begin(), m.end(), mass);
+    }
 }
 
 void GhostSolver::setStepObserver(StepObserver observer) { mObserver = std::move(observer); }
 
-// Set-up ---------------------------------------------------------------------------------------
+// Solids ------------------------------------------------------------------------------------------
 
 void GhostSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
 {
     if (!isFinite(velocity)) {
         throw ValueError(msg("solid '", solid.name(), "': velocity is not finite"));
     }
-    addMovingSolid(solid, [velocity](double t) {
+    addSolidBody(solid, [velocity](double t) {
         RigidTransform xf;
         xf.translation = velocity * Real(t);
         return xf;
-    });
+    }, velocity != Vec3(0));
 }
 
 void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
 {
     if (!motion) throw ValueError(msg("solid '", solid.name(), "': no motion given"));
-    ensureSolidChannels();
-    mSolids.push_back(std::make_unique<Solid>(Solid{{solid, std::move(motion)}}));
-    // A solid the restored state already holds keeps its restored particles: sampling it again
-    // would duplicate them (and, with a seed that depends on the step, differ from them).
-    if (mSolids.size() > mRestoredSolids) sampleSolid(mSolids.size() - 1);
+    addSolidBody(solid, std::move(motion), true);
 }
 
-void GhostSolver::ensureSolidChannels()
+void GhostSolver::addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving)
 {
-    mParticles.addVectorChannel(SOLID_NORMAL);
-    mParticles.addVectorChannel(SOLID_VELOCITY);
-    mParticles.addVectorChannel(SOLID_LOCAL);
-    mParticles.addVectorChannel(SOLID_LOCAL_NORMAL);
-    mParticles.addScalarChannel(SOLID_INDEX, Real(-1));
+    mSolids.push_back(std::make_unique<Solid>(Solid{{solid, std::move(motion)}, moving}));
+    // A solid the restored state already holds keeps its restored particles: sampling it again
+    // would duplicate them (and, with a seed that depends on the step, differ from them).
+    const std::size_t index = mSolids.size() - 1;
+    if (index < mRestoredSolids) claimRestoredSolid(index);
+    else sampleSolid(index);
+}
+
+GhostSolver::SolidBlock& GhostSolver::blockOf(std::size_t solidIndex)
+{
+    return mSolids[solidIndex]->moving ? mMoving : mStatic;
+}
+
+void GhostSolver::clearSolidScratch(SolidBlock& b)
+{
+    b.touched.clear();
+    b.nearest.assign(b.block.size(), NO_LIQUID);
+    b.block.touch();
+    mProjectAll = true;
 }
 
 void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
@@ -131,15 +117,12 @@ void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
         throw ValueError(msg("setSolidShape: solid ", solidIndex, " does not exist (",
                              mSolids.size(), " solids)"));
     }
-    // Drop the old ghosts of this solid, then sample the new shape.
-    const auto& index = mParticles.scalarChannel(SOLID_INDEX);
-    std::vector<std::uint8_t> remove(mParticles.size(), 0);
-    for (std::size_t i = 0; i < remove.size(); ++i) {
-        const ParticleKind k = mParticles.kinds()[i];
-        remove[i] = (k == ParticleKind::GhostSolid || k == ParticleKind::Boundary) &&
-                    std::size_t(index[i]) == solidIndex;
-    }
-    mParticles.removeIf(remove);
+    // Drop the old particles of this solid, then sample the new shape.
+    ParticleSet& set = blockOf(solidIndex).block.particles();
+    const auto& index = set.scalarChannel(SOLID_INDEX);
+    std::vector<std::uint8_t> remove(set.size(), 0);
+    for (std::size_t i = 0; i < remove.size(); ++i) remove[i] = std::size_t(index[i]) == solidIndex;
+    set.removeIf(remove);
     mSolids[solidIndex]->shape = shape;
     sampleSolid(solidIndex);
 }
@@ -162,8 +145,8 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mStep;
     const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(solid);
 
-    // Outward normal of each ghost from its nearest surface sample: phi is clamped beyond the
-    // narrow band, which is often thinner than a kernel radius.
+    // Outward normal of each particle from its nearest surface sample: phi is clamped beyond
+    // the narrow band, which is often thinner than a kernel radius.
     std::vector<Vec3> surface;
     std::vector<Vec3> surfaceNormal;
     for (std::size_t i = 0; i < samples.size(); ++i) {
@@ -175,28 +158,120 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     NeighborGrid surfaceGrid(mSettings.supportRadius());
     surfaceGrid.build(surface);
 
-    const Index first = Index(mParticles.size());
+    SolidBlock& target = blockOf(solidIndex);
+    ParticleSet& set = target.block.particles();
+    auto& normals = set.addVectorChannel(SOLID_NORMAL);
+    auto& index = set.addScalarChannel(SOLID_INDEX, Real(-1));
+    std::vector<Vec3>* localNormals = nullptr;
+    std::vector<Vec3>* locals = nullptr;
+    std::vector<Vec3>* solidV = nullptr;
+    if (body.moving) {
+        localNormals = &set.addVectorChannel(SOLID_LOCAL_NORMAL);
+        locals = &set.addVectorChannel(SOLID_LOCAL);
+        solidV = &set.addVectorChannel(SOLID_VELOCITY);
+    }
+    // Solid particles take their ids from the same counter as the liquid, so ids stay unique
+    // across the sets.
+    set.setNextId(std::max(set.nextId(), mParticles.nextId()));
     std::vector<Vec3> positions(samples.positions);
     for (Vec3& x : positions) x = xf.toWorld(x);
     const ParticleKind kind =
         mSettings.method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary;
-    mParticles.addBatch(positions, mMass, kind);
-    auto& normals = mParticles.vectorChannel(SOLID_NORMAL);
-    auto& localNormals = mParticles.vectorChannel(SOLID_LOCAL_NORMAL);
-    auto& locals = mParticles.vectorChannel(SOLID_LOCAL);
-    auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
-    auto& index = mParticles.scalarChannel(SOLID_INDEX);
+    const Index first = set.addBatch(positions, mMass, kind);
+    mParticles.setNextId(set.nextId());
+    const Real R = mSettings.supportRadius();
     for (std::size_t k = 0; k < samples.size(); ++k) {
-        const Index s = surfaceGrid.nearest(samples.positions[k], Real(2) * mSettings.supportRadius(),
-                                            [](Index) { return true; });
-        localNormals[first + k] = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
-        normals[first + k] = xf.rotation * localNormals[first + k];
-        locals[first + k] = samples.positions[k];
+        const Index s = surfaceGrid.nearest(samples.positions[k], Real(2) * R, [](Index) { return true; });
+        const Vec3 localNormal = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
+        normals[first + k] = xf.rotation * localNormal;
         index[first + k] = Real(solidIndex);
-        solidV[first + k] = body.velocity(samples.positions[k], mTime);
-        mParticles.velocities()[first + k] = solidV[first + k];
+        set.densities()[first + k] = mSettings.restDensity;
+        if (body.moving) {
+            (*localNormals)[first + k] = localNormal;
+            (*locals)[first + k] = samples.positions[k];
+            (*solidV)[first + k] = body.velocity(samples.positions[k], mTime);
+            set.velocities()[first + k] = (*solidV)[first + k];
+        }
+    }
+    clearSolidScratch(target);
+}
+
+void GhostSolver::claimRestoredSolid(std::size_t solidIndex)
+{
+    // The restored solid particles of this solid move from the pending set into the block
+    // their solid belongs to, with the values of a particle no liquid reaches.
+    const auto& index = mPendingSolids.scalarChannel(SOLID_INDEX);
+    std::vector<std::uint8_t> mine(mPendingSolids.size(), 0);
+    for (std::size_t i = 0; i < mine.size(); ++i) mine[i] = std::size_t(index[i]) == solidIndex;
+    ParticleSet claimed = mPendingSolids.select(mine);
+    mPendingSolids.removeIf(mine);
+    const bool moving = mSolids[solidIndex]->moving;
+    if (!moving) {
+        for (const char* c : {SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) claimed.removeChannel(c);
+    } else {
+        for (const char* c : {SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) {
+            if (!claimed.hasVectorChannel(c)) {
+                throw ValueError(msg("restoreState: moving solid ", solidIndex, " has no '", c,
+                                     "' channel in the state (was it saved as a static solid?)"));
+            }
+        }
+    }
+    for (std::size_t i = 0; i < claimed.size(); ++i) {
+        claimed.densities()[i] = mSettings.restDensity;
+        claimed.pressures()[i] = 0;
+        claimed.velocities()[i] = moving ? claimed.vectorChannel(SOLID_VELOCITY)[i] : Vec3(0);
+    }
+    SolidBlock& target = blockOf(solidIndex);
+    target.block.particles().append(claimed);
+    clearSolidScratch(target);
+}
+
+void GhostSolver::moveSolids(double time)
+{
+    // Solids move rigidly: every particle of a moving solid goes to its material point's new
+    // place and velocity. Static solids are never touched.
+    mMaxSolidSpeed = 0;
+    ParticleSet& set = mMoving.block.particles();
+    if (set.empty()) return;
+    std::vector<RigidTransform> placement;
+    for (const auto& solid : mSolids) placement.push_back(solid->at(time));
+    auto& x = set.positions();
+    auto& v = set.velocities();
+    const auto& local = set.vectorChannel(SOLID_LOCAL);
+    const auto& localNormal = set.vectorChannel(SOLID_LOCAL_NORMAL);
+    const auto& index = set.scalarChannel(SOLID_INDEX);
+    auto& normal = set.vectorChannel(SOLID_NORMAL);
+    auto& solidV = set.vectorChannel(SOLID_VELOCITY);
+    std::vector<Real> speed(set.size());
+    parallel::forEach(0, set.size(), [&](std::size_t i) {
+        const std::size_t b = std::size_t(index[i]);
+        x[i] = placement[b].toWorld(local[i]);
+        normal[i] = placement[b].rotation * localNormal[i];
+        solidV[i] = mSolids[b]->velocity(local[i], time);
+        v[i] = solidV[i];
+        speed[i] = solidV[i].length();
+    });
+    mMaxSolidSpeed = *std::max_element(speed.begin(), speed.end());
+    // Re-sorted at the start of the next step (after its scratch is reset).
+    mMoving.block.touch();
+}
+
+void GhostSolver::appendSolidPositionsInBox(const Aabb& box, std::vector<Vec3>& out) const
+{
+    for (const SolidBlock* b : {&mStatic, &mMoving}) {
+        if (b->block.empty()) continue;
+        if (b->block.stale()) {
+            // Not yet sorted (added since the last step): test every particle.
+            for (const Vec3& x : b->block.particles().positions()) {
+                if (box.contains(x)) out.push_back(x);
+            }
+        } else {
+            b->block.grid().forEachInBox(box, [&](Index, const Vec3& x) { out.push_back(x); });
+        }
     }
 }
+
+// Liquid and emitters ----------------------------------------------------------------------------
 
 std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
 {
@@ -288,6 +363,7 @@ void GhostSolver::emit()
                 obstacles.push_back(x);
             }
         }
+        appendSolidPositionsInBox(near, obstacles);
         std::vector<Vec3> fresh;
         if (seeds.empty()) {
             // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
@@ -325,16 +401,16 @@ void GhostSolver::applyKillBox()
     std::size_t killed = 0;
     bool any = false;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        const ParticleKind k = mParticles.kinds()[i];
-        if ((k == ParticleKind::Liquid || k == ParticleKind::GhostAir) &&
-            !box.contains(mParticles.positions()[i])) {
+        if (!box.contains(mParticles.positions()[i])) {
             remove[i] = any = true;
-            killed += k == ParticleKind::Liquid;
+            killed += mParticles.kinds()[i] == ParticleKind::Liquid;
         }
     }
     if (any) mParticles.removeIf(remove);
     mKilled += killed;
 }
+
+// Initialisation: the first air layer and the mass scaling ---------------------------------------
 
 void GhostSolver::initialize()
 {
@@ -351,36 +427,34 @@ void GhostSolver::initialize()
         // ghost air layer in place so every liquid particle has a complete neighbourhood. Basic
         // SPH gets the same mass (its air layer is sampled for the measurement only), so the
         // two methods start from the same state and differ only in how they treat the surface.
-        std::vector<Vec3> positions = mParticles.positions();
-        std::vector<std::uint8_t> liquid(positions.size());
-        for (std::size_t i = 0; i < liquid.size(); ++i) {
-            liquid[i] = mParticles.kinds()[i] == ParticleKind::Liquid;
-        }
+        const GhostSolver* measured = this;
+        std::unique_ptr<GhostSolver> probe;
         if (mSettings.method == Method::Basic) {
             GhostSettings probeSettings = mSettings;
             probeSettings.method = Method::Ghost;
-            GhostSolver probe(probeSettings);
+            probe = std::make_unique<GhostSolver>(probeSettings);
             // The probe shares the solids and takes this solver's boundary particles as its
             // ghost solids: sampling them again would cost as much as the first time.
-            for (const auto& solid : mSolids) probe.mSolids.push_back(std::make_unique<Solid>(*solid));
-            std::vector<Vec3> boundary;
-            for (std::size_t i = 0; i < positions.size(); ++i) {
-                if (mParticles.kinds()[i] == ParticleKind::Boundary) boundary.push_back(positions[i]);
+            for (const auto& solid : mSolids) probe->mSolids.push_back(std::make_unique<Solid>(*solid));
+            for (const SolidBlock* b : {&mStatic, &mMoving}) {
+                SolidBlock& to = b == &mStatic ? probe->mStatic : probe->mMoving;
+                to.block.particles() = b->block.particles();
+                auto& kinds = to.block.particles().kinds();
+                std::fill(kinds.begin(), kinds.end(), ParticleKind::GhostSolid);
+                to.block.touch();
             }
-            probe.mParticles.addBatch(boundary, Real(0), ParticleKind::GhostSolid);
             std::vector<Vec3> liquidOnly;
-            for (std::size_t i = 0; i < liquid.size(); ++i) {
-                if (liquid[i]) liquidOnly.push_back(positions[i]);
+            for (std::size_t i = 0; i < mParticles.size(); ++i) {
+                if (mParticles.kinds()[i] == ParticleKind::Liquid) liquidOnly.push_back(mParticles.positions()[i]);
             }
-            probe.addLiquidParticles(liquidOnly);
-            probe.resampleAir();
-            positions = probe.mParticles.positions();
-            liquid.assign(positions.size(), 0);
-            for (std::size_t i = 0; i < liquid.size(); ++i) {
-                liquid[i] = probe.mParticles.kinds()[i] == ParticleKind::Liquid;
-            }
+            probe->addLiquidParticles(liquidOnly);
+            probe->resampleAir();
+            measured = probe.get();
         }
-        setParticleMass(massForRestDensity(positions, mKernel, mSettings.restDensity, liquid));
+        const ParticleSet all = measured->allParticles();
+        std::vector<std::uint8_t> liquid(all.size());
+        for (std::size_t i = 0; i < liquid.size(); ++i) liquid[i] = all.kinds()[i] == ParticleKind::Liquid;
+        setParticleMass(massForRestDensity(all.positions(), mKernel, mSettings.restDensity, liquid));
     } else {
         setParticleMass(mMass);
     }
@@ -405,469 +479,48 @@ void GhostSolver::initialize()
     mInitialized = true;
 }
 
-// [SB12] Sec. 4.3: ghost air ------------------------------------------------------------------
+// Counts and views ------------------------------------------------------------------------------
 
-void GhostSolver::resampleAir()
+std::size_t GhostSolver::count(ParticleKind kind) const
 {
-    const auto start = std::chrono::steady_clock::now();
-    const Real R = mSettings.supportRadius();
-    const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
-    const double time = mTime;
-
-    std::vector<Vec3> liquid, liquidV;
-    for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
-        liquid.push_back(mParticles.positions()[i]);
-        liquidV.push_back(mParticles.velocities()[i]);
-    }
-    if (liquid.empty()) return;
-    NeighborGrid liquidGrid(R);
-    liquidGrid.build(liquid);
-
-    // The liquid body: particles with at least one liquid neighbour. Isolated particles move
-    // ballistically and get no air ([SB12] Sec. 4.5); like the solids they are obstacles the
-    // new air keeps r away from. Air lives within a kernel radius of the body only, so escaped
-    // spray neither attracts air nor stretches the sampling region.
-    std::vector<Vec3> body, bodyV, obstacles;
-    Aabb bounds;
-    for (std::size_t i = 0; i < liquid.size(); ++i) {
-        int n = 0;
-        liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real) { ++n; });
-        if (n > 1) {
-            body.push_back(liquid[i]);
-            bodyV.push_back(liquidV[i]);
-            bounds.expand(liquid[i]);
-        } else {
-            obstacles.push_back(liquid[i]);
-        }
-    }
-    NeighborGrid bodyGrid(R);
-    bodyGrid.build(body);
-    auto nearBody = [&](const Vec3& x, Real* distance = nullptr) {
-        return bodyGrid.nearest(x, R, [](Index) { return true; }, distance);
-    };
-
-    auto insideSolid = [&](const Vec3& x) {
-        for (const auto& solid : mSolids) {
-            if (solid->phi(x, time) < Real(0)) return true;
-        }
-        return false;
-    };
-    // Inside the liquid: its smoothed indicator sum_j W(x - x_j) / n0, with n0 = rho0 / m the
-    // interior value, exceeds one half there (the free surface is its half level). The
-    // Poisson test alone is not enough: a relaxed liquid has holes a little wider than r
-    // (tests/sph/test_sampler.cc measures 1.05 - 1.1 r), and air seeded into them would sit
-    // inside the liquid with p = 0, adding mass where there is no free surface.
-    // Interior value n0 of sum_j W: rho0 / m once the mass is known; before (the first layer)
-    // the 75th percentile of the liquid particles' own sums, which lies in the interior.
-    Real n0 = 0;
-    if (mMass > Real(0)) {
-        n0 = mSettings.restDensity / mMass;
-    } else {
-        std::vector<Real> sums(liquid.size());
-        parallel::forEach(0, liquid.size(), [&](std::size_t i) {
-            Real sum = 0;
-            liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real rij) {
-                sum += mKernel.W(rij);
-            });
-            sums[i] = sum;
-        });
-        std::nth_element(sums.begin(), sums.begin() + sums.size() * 3 / 4, sums.end());
-        n0 = sums[sums.size() * 3 / 4];
-    }
-    // The indicator counts ghost solids too: the thin gap between liquid and a wall is not
-    // free surface, and air there would hold the liquid off the wall.
-    std::vector<Vec3> dense = liquid;
-    for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        if (mParticles.kinds()[i] == ParticleKind::GhostSolid) dense.push_back(mParticles.positions()[i]);
-    }
-    NeighborGrid denseGrid(R);
-    denseGrid.build(dense);
-    auto insideLiquid = [&](const Vec3& x) {
-        Real sum = 0;
-        denseGrid.forEachInRadius(x, R, [&](Index, const Vec3&, Real rij) { sum += mKernel.W(rij); });
-        return sum > Real(0.5) * n0;
-    };
-
-    // Keep the air that is still where the layer should be: within a kernel radius of the
-    // liquid body, no closer to it than a fraction of r, outside solids and the liquid, and not
-    // crowded (air advected with converging liquid bunches up: of two air particles closer than
-    // that fraction of r, the later one goes). The rest fades out, and new air fades in, over the
-    // steps until the next resampling: replacing the whole layer at once (as [SB12] Sec. 4.3
-    // describes) makes the surface density jump by a few percent at every resampling, which with
-    // the paper's soft stiffness pumps energy into the liquid; fading is the remedy [SB12]
-    // Sec. 4.7 suggests.
-    const Real keepDistance = mSettings.airKeepFraction * r;
-    auto& target = mParticles.scalarChannel(AIR_TARGET);
-    const std::size_t n = mParticles.size();
-    std::vector<std::uint8_t> keep(n, 0);
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
-        const Vec3& x = mParticles.positions()[i];
-        Real d = -1;
-        keep[i] = nearBody(x, &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x) &&
-                  !insideLiquid(x);
-    });
-    if (keepDistance > Real(0)) {
-        std::vector<Vec3> airX;
-        std::vector<std::size_t> airIndex;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (keep[i]) { airX.push_back(mParticles.positions()[i]); airIndex.push_back(i); }
-        }
-        NeighborGrid airGrid(keepDistance);
-        airGrid.build(airX);
-        for (std::size_t a = 0; a < airX.size(); ++a) {
-            airGrid.forEachNeighbor(Index(a), [&](Index b, const Vec3&, Real) {
-                if (b < a && keep[airIndex[b]]) keep[airIndex[a]] = 0;
-            });
-        }
-    }
-    std::vector<Vec3> seeds = body;
-    for (std::size_t i = 0; i < n; ++i) {
-        const ParticleKind k = mParticles.kinds()[i];
-        if (k == ParticleKind::GhostAir) {
-            if (keep[i]) {
-                seeds.push_back(mParticles.positions()[i]);
-            } else {
-                // Fading air is no obstacle: the new layer cross-fades with it.
-                target[i] = Real(0);
-            }
-        } else if (k != ParticleKind::Liquid) {
-            obstacles.push_back(mParticles.positions()[i]);
-        }
-    }
-    if (body.empty()) {
-        mTimings.airResampling += secondsSince(start);
-        return;
-    }
-
-    auto accept = [&](const Vec3& x) {
-        return nearBody(x) != INVALID_INDEX && !insideSolid(x) && !insideLiquid(x);
-    };
-    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-    ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
-    ps.seed = mSettings.seed ^ (0x9e3779b97f4a7c15ULL * (mStep + 1));
-    const std::vector<Vec3> air =
-        PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, bounds.padded(R));
-
-    const Index first = mParticles.addBatch(air, mMass, ParticleKind::GhostAir);
-    // The very first layer is there from the start; later ones fade in.
-    const bool fade = mInitialized;
-    auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
-    // Ghost air velocity: the nearest liquid particle's ([SB12] Sec. 4.3).
-    parallel::forEach(first, mParticles.size(), [&](std::size_t i) {
-        weight[i] = fade ? Real(0) : Real(1);
-        mParticles.masses()[i] = weight[i] * mMass;
-        const Index j = nearBody(mParticles.positions()[i]);
-        mParticles.velocities()[i] = j == INVALID_INDEX ? Vec3(0) : bodyV[j];
-        mParticles.densities()[i] = mSettings.restDensity;
-    });
-    mTimings.airResampling += secondsSince(start);
+    return mParticles.count(kind) + mStatic.block.particles().count(kind) +
+           mMoving.block.particles().count(kind) + mPendingSolids.count(kind);
 }
 
-void GhostSolver::fadeAir()
+ParticleSet GhostSolver::solidParticles() const
 {
-    auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
-    const auto& target = mParticles.scalarChannel(AIR_TARGET);
-    const Real rate = Real(1) / Real(mSettings.airResampleSteps);
-    std::vector<std::uint8_t> remove(mParticles.size(), 0);
-    bool anyRemoved = false;
-    for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        if (mParticles.kinds()[i] != ParticleKind::GhostAir) continue;
-        weight[i] = target[i] > weight[i] ? std::min(target[i], weight[i] + rate)
-                                          : std::max(target[i], weight[i] - rate);
-        mParticles.masses()[i] = weight[i] * mMass;
-        if (weight[i] == Real(0) && target[i] == Real(0)) remove[i] = anyRemoved = true;
-    }
-    if (anyRemoved) mParticles.removeIf(remove);
-}
-
-// Density -----------------------------------------------------------------------------------------
-
-Index GhostSolver::nearestLiquid(const Vec3& x, Real maxRadius) const
-{
-    return mGrid.nearestOfKind(x, mParticles.kinds(), ParticleKind::Liquid, maxRadius);
-}
-
-void GhostSolver::sortAndComputeDensity()
-{
-    mGrid.sortParticles(mParticles);
-    const auto& x = mParticles.positions();
-    const auto& m = mParticles.masses();
-    const auto& kind = mParticles.kinds();
-    auto& rho = mParticles.densities();
-    const Real rho0 = mSettings.restDensity;
-    const bool ghost = mSettings.method == Method::Ghost;
-    const std::size_t n = mParticles.size();
-
-    // Eq. 1 for liquid particles: Ghost SPH sums over every kind, Basic SPH over liquid only.
-    std::vector<std::uint32_t> neighbours(n, 0);
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Liquid) {
-            rho[i] = rho0;
-            return;
+    ParticleSet out;
+    for (const SolidBlock* b : {&mStatic, &mMoving}) {
+        ParticleSet set = b->block.particles();
+        // The last step's extrapolation where liquid reached ([SB12] Algorithm 3).
+        for (Index k : b->touched) {
+            set.densities()[k] = b->rho[k];
+            set.pressures()[k] = b->p[k];
+            set.velocities()[k] = b->vstar[k];
         }
-        Real sum = 0;
-        std::uint32_t count = 0;
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
-            if (ghost || kind[j] == ParticleKind::Liquid) {
-                sum += m[j] * mKernel.W(r);
-                ++count;
-            }
-        });
-        rho[i] = sum;
-        neighbours[i] = count;
-    });
-    const double liquidCount = parallel::sum(0, n, [&](std::size_t i) {
-        return kind[i] == ParticleKind::Liquid ? 1.0 : 0.0;
-    });
-    mMeanNeighbors = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); }) /
-                     std::max(1.0, liquidCount);
-
-    // Algorithm 3 lines 5-7: ghost solid density = density of the nearest liquid particle.
-    // The nearest liquid particle is kept for the velocity extrapolation of lines 16-18.
-    if (ghost) {
-        const Real R = mSettings.supportRadius();
-        mNearestLiquid.assign(n, INVALID_INDEX);
-        parallel::forEach(0, n, [&](std::size_t i) {
-            if (kind[i] != ParticleKind::GhostSolid) return;
-            const Index j = nearestLiquid(x[i], R);
-            mNearestLiquid[i] = j;
-            rho[i] = j == INVALID_INDEX ? rho0 : rho[j];
-        });
+        out.append(set);
     }
-
-    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0).
-    auto& p = mParticles.pressures();
-    parallel::forEach(0, n, [&](std::size_t i) {
-        p[i] = taitPressure(rho[i], rho0, mSettings.stiffness);
-    });
+    out.append(mPendingSolids);
+    return out;
 }
 
-// The step ---------------------------------------------------------------------------------------
-
-void GhostSolver::step(Real dt)
+ParticleSet GhostSolver::allParticles() const
 {
-    if (!(dt > Real(0)) || !std::isfinite(dt)) {
-        throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
-    }
-    checkRestoredInputs();
-    const bool fresh = !mInitialized;
-    initialize();
-    const auto start = std::chrono::steady_clock::now();
-    // Algorithm 3 line 1: new liquid from the emitters (the first step's was added by
-    // initialize(), before the mass scaling).
-    if (!fresh && !mEmitters.empty()) {
-        const auto t0 = std::chrono::steady_clock::now();
-        emit();
-        mTimings.emission += secondsSince(t0);
-    }
-    if (mSettings.method == Method::Ghost) stepGhost(dt);
-    else stepBasic(dt);
-
-    // Solids move rigidly: every ghost goes to its material point's new place and velocity.
-    if (!mSolids.empty()) {
-        const double t1 = mTime + double(dt);
-        std::vector<RigidTransform> placement;
-        for (const auto& solid : mSolids) placement.push_back(solid->at(t1));
-        auto& x = mParticles.positions();
-        const auto& kind = mParticles.kinds();
-        const auto& local = mParticles.vectorChannel(SOLID_LOCAL);
-        const auto& localNormal = mParticles.vectorChannel(SOLID_LOCAL_NORMAL);
-        const auto& index = mParticles.scalarChannel(SOLID_INDEX);
-        auto& normal = mParticles.vectorChannel(SOLID_NORMAL);
-        auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
-        parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
-            if (kind[i] != ParticleKind::GhostSolid && kind[i] != ParticleKind::Boundary) return;
-            const std::size_t b = std::size_t(index[i]);
-            x[i] = placement[b].toWorld(local[i]);
-            normal[i] = placement[b].rotation * localNormal[i];
-            solidV[i] = mSolids[b]->velocity(local[i], t1);
-        });
-    }
-    mTime += double(dt);
-    ++mStep;
-    projectOutOfSolids();
-    applyKillBox();
-    checkBlowUp();
-    mTimings.total += secondsSince(start);
-    ++mTimings.steps;
-    if (mObserver) mObserver(*this, dt);
+    ParticleSet out = mParticles;
+    out.append(solidParticles());
+    return out;
 }
 
-void GhostSolver::stepGhost(Real dt)
+std::size_t GhostSolver::memoryBytes() const
 {
-    // Line 1: resample the air every airResampleSteps steps (the first step always has air),
-    // then move every fading air particle's weight one step towards its target.
-    if (mStep > 0 && mStep % std::uint64_t(mSettings.airResampleSteps) == 0) resampleAir();
-    fadeAir();
-
-    auto t0 = std::chrono::steady_clock::now();
-    sortAndComputeDensity();
-    mTimings.neighborsAndDensity += secondsSince(t0);
-
-    const std::size_t n = mParticles.size();
-    const auto& x = mParticles.positions();
-    const auto& m = mParticles.masses();
-    const auto& rho = mParticles.densities();
-    const auto& p = mParticles.pressures();
-    const auto& kind = mParticles.kinds();
-    auto& v = mParticles.velocities();
-    auto& vstar = mParticles.vectorChannel(VSTAR);
-    const Vec3 g = mSettings.gravity;
-
-    // Lines 11-14: liquid acceleration from gravity and Monaghan's symmetric pressure gradient
-    // over every neighbour, v* = v + dt a.
-    t0 = std::chrono::steady_clock::now();
-    std::vector<Real> accel(n, Real(0));
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Liquid) {
-            vstar[i] = v[i];
-            return;
-        }
-        const Real pi = p[i] / sqr(rho[i]);
-        Vec3 a = g;
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
-            if (j == i) return;
-            a -= m[j] * (pi + p[j] / sqr(rho[j])) * mKernel.gradW(xij, r);
-        });
-        vstar[i] = v[i] + dt * a;
-        accel[i] = a.length();
-    });
-    mMaxAcceleration = 0;
-    for (std::size_t i = 0; i < n; ++i) mMaxAcceleration = std::max(mMaxAcceleration, accel[i]);
-    mTimings.pressureForce += secondsSince(t0);
-
-    // Lines 15-18: ghost solid velocity, Eq. 3 (free slip) or the solid's velocity (no slip).
-    t0 = std::chrono::steady_clock::now();
-    const Real R = mSettings.supportRadius();
-    if (mParticles.hasVectorChannel(SOLID_NORMAL)) { // no solid channels: no ghost solids
-        const auto& normal = mParticles.vectorChannel(SOLID_NORMAL);
-        const auto& solidV = mParticles.vectorChannel(SOLID_VELOCITY);
-        const bool freeSlip = mSettings.solidSlip == SolidSlip::Free;
-        parallel::forEach(0, n, [&](std::size_t i) {
-            if (kind[i] != ParticleKind::GhostSolid) return;
-            const Vec3& nrm = normal[i];
-            if (!freeSlip) {
-                vstar[i] = solidV[i];
-                return;
-            }
-            const Index j = mNearestLiquid[i];
-            const Vec3 vl = j == INVALID_INDEX ? solidV[i] : vstar[j];
-            vstar[i] = solidV[i].dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
-        });
+    std::size_t bytes = mParticles.memoryBytes() + mGrid.memoryBytes() + mFluidLists.memoryBytes() +
+                        mPendingSolids.memoryBytes() + mQueryMask.capacity() + mScratch.capacity() * sizeof(Real);
+    for (const SolidBlock* b : {&mStatic, &mMoving}) {
+        bytes += b->block.memoryBytes() + b->lists.memoryBytes() +
+                 b->nearest.capacity() * sizeof(std::uint64_t) + b->touched.capacity() * sizeof(Index) +
+                 (b->rho.capacity() + b->p.capacity() + b->pOverRho2.capacity()) * sizeof(Real) + b->vstar.capacity() * sizeof(Vec3);
     }
-
-    // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid
-    // neighbours only: air would bias the outermost particles ([SB12] Sec. 4.3).
-    const Real eps = mSettings.xsphEpsilon, epsSolid = mSettings.solidEpsilon;
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Liquid) return;
-        Vec3 dv(0);
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
-            const ParticleKind kj = kind[j];
-            if (kj == ParticleKind::GhostAir || j == i) return;
-            const Real e = kj == ParticleKind::GhostSolid ? epsSolid : eps;
-            dv += (e * m[j] / rho[j] * mKernel.W(r)) * (vstar[j] - vstar[i]);
-        });
-        v[i] = vstar[i] + dv;
-    });
-
-    // Lines 22-25: air takes the new velocity of its nearest liquid particle (searched up to two
-    // kernel radii: air advects between resamplings and may drift a little).
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::GhostAir) return;
-        const Index j = nearestLiquid(x[i], Real(2) * R);
-        if (j != INVALID_INDEX) v[i] = v[j];
-    });
-    // Ghost solids keep their extrapolated velocity for output; their motion is the solid's.
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] == ParticleKind::GhostSolid) v[i] = vstar[i];
-    });
-
-    // Lines 26-28: positions of liquid and air.
-    auto& xw = mParticles.positions();
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] == ParticleKind::Liquid || kind[i] == ParticleKind::GhostAir) xw[i] += dt * v[i];
-    });
-    mTimings.xsphAndBoundary += secondsSince(t0);
-}
-
-// Collisions, time stepping, blow-up ---------------------------------------------------------------
-
-void GhostSolver::projectOutOfSolids()
-{
-    if (mSolids.empty()) return;
-    const auto start = std::chrono::steady_clock::now();
-    auto& x = mParticles.positions();
-    auto& v = mParticles.velocities();
-    const auto& kind = mParticles.kinds();
-    const double time = mTime;
-    std::vector<RigidTransform> placement;
-    for (const auto& solid : mSolids) placement.push_back(solid->at(time));
-    // [SB12] Sec. 3 "Solid Collisions": a liquid particle inside a solid goes back to its
-    // surface (level-set closest point) and loses the velocity that points into the solid.
-    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Liquid) return;
-        for (std::size_t b = 0; b < mSolids.size(); ++b) {
-            const Solid& solid = *mSolids[b];
-            const RigidTransform& xf = placement[b];
-            const Vec3 local = xf.toLocal(x[i]);
-            if (!(solid.shape.phi(local) < Real(0))) continue;
-            const SurfaceProjection proj = solid.shape.projectToSurface(local);
-            if (!proj.converged) continue; // deeper than the band: left for the blow-up check
-            const Vec3 nrm = xf.rotation * solid.shape.normal(proj.point);
-            x[i] = xf.toWorld(proj.point);
-            const Real vn = (v[i] - solid.velocity(proj.point, time)).dot(nrm);
-            if (vn < Real(0)) v[i] -= vn * nrm;
-        }
-    });
-    mTimings.xsphAndBoundary += secondsSince(start);
-}
-
-void GhostSolver::checkBlowUp() const
-{
-    const Real limit = mSettings.speedLimit();
-    const Real limit2 = limit * limit;
-    const auto& x = mParticles.positions();
-    const auto& v = mParticles.velocities();
-    const std::size_t n = mParticles.size();
-    std::atomic<std::size_t> bad{n};
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (isFinite(x[i]) && isFinite(v[i]) && v[i].lengthSqr() <= limit2) return;
-        std::size_t expected = bad.load();
-        while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
-    }, 4096);
-    const std::size_t i = bad.load();
-    if (i == n) return;
-    const char* kind = kindName(mParticles.kinds()[i]);
-    if (!isFinite(x[i]) || !isFinite(v[i])) {
-        throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep,
-                                 " (t = ", mTime, " s): ", kind, " particle id ", mParticles.ids()[i],
-                                 " has a non-finite position or velocity; reduce the time step "
-                                 "(substeps / cflNumber) or the stiffness"));
-    }
-    throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep, " (t = ",
-                             mTime, " s): ", kind, " particle id ", mParticles.ids()[i], " moves at ",
-                             v[i].length(), " m/s, beyond maxSpeed = ", limit,
-                             " m/s; reduce the time step (substeps / cflNumber) or the stiffness"));
-}
-
-Real GhostSolver::stableTimeStep() const
-{
-    // Acoustic CFL: dt <= cfl h / (c + |v|max); body force: dt <= cfl sqrt(h / |g|).
-    const auto& v = mParticles.velocities();
-    Real vmax = 0;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-        if (mParticles.kinds()[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
-    }
-    const Real h = mSettings.spacing;
-    Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
-    // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration
-    // of the last step (gravity before the first), which covers stiff Lennard-Jones walls.
-    const Real a = std::max(mMaxAcceleration, mSettings.gravity.length());
-    if (a > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / a));
-    return dt;
+    return bytes;
 }
 
 // Save and restore ----------------------------------------------------------------------------------
@@ -876,7 +529,10 @@ SolverState GhostSolver::saveState() const
 {
     SolverState state;
     state.solver = methodName(mSettings.method);
+    // The solid particles as the blocks hold them (the step's extrapolation is scratch).
     state.particles = mParticles;
+    for (const SolidBlock* b : {&mStatic, &mMoving}) state.particles.append(b->block.particles());
+    state.particles.append(mPendingSolids);
     state.reals["time"] = mTime;
     state.reals["particle_mass"] = double(mMass);
     state.reals["lennard_jones"] = double(mLennardJones);
@@ -934,6 +590,7 @@ void GhostSolver::restoreState(const SolverState& state)
     const ParticleSet& p = state.particles;
     const std::vector<Real>* index =
         p.hasScalarChannel(SOLID_INDEX) ? &p.scalarChannel(SOLID_INDEX) : nullptr;
+    std::vector<std::uint8_t> solid(p.size(), 0);
     for (std::size_t i = 0; i < p.size(); ++i) {
         const ParticleKind k = p.kinds()[i];
         if (k != ParticleKind::GhostSolid && k != ParticleKind::Boundary) continue;
@@ -941,12 +598,22 @@ void GhostSolver::restoreState(const SolverState& state)
             throw ValueError(msg("restoreState: ", kindName(k), " particle id ", p.ids()[i],
                                  " belongs to no solid of the state (", solids, " solids)"));
         }
+        solid[i] = 1;
     }
     if (mSettings.method == Method::Basic && p.count(ParticleKind::GhostAir) > 0) {
         throw ValueError("restoreState: a 'basic' state holds ghost air particles");
     }
 
-    mParticles = p;
+    // Liquid and air go to the particle set; the solid particles wait for their solid to be
+    // added again, which tells whether it is static or moving.
+    std::vector<std::uint8_t> moving(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) moving[i] = !solid[i];
+    mParticles = p.select(moving);
+    mPendingSolids = p.select(solid);
+    for (const char* c : {SOLID_NORMAL, SOLID_INDEX, SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) {
+        mParticles.removeChannel(c);
+    }
+    for (const char* c : {VSTAR, AIR_WEIGHT, AIR_TARGET}) mPendingSolids.removeChannel(c);
     // States saved by this solver have these channels; a missing one gets what a fresh solver
     // would have.
     mParticles.addVectorChannel(VSTAR);
@@ -982,6 +649,25 @@ void GhostSolver::checkRestoredInputs() const
                              "restoreState(); add the same emitters, in the same order, before "
                              "stepping"));
     }
+}
+
+// Time stepping ----------------------------------------------------------------------------------
+
+Real GhostSolver::stableTimeStep() const
+{
+    // Acoustic CFL: dt <= cfl h / (c + |v|max); body force: dt <= cfl sqrt(h / |g|).
+    const auto& v = mParticles.velocities();
+    Real vmax = 0;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        if (mParticles.kinds()[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
+    }
+    const Real h = mSettings.spacing;
+    Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
+    // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration
+    // of the last step (gravity before the first), which covers stiff Lennard-Jones walls.
+    const Real a = std::max(mMaxAcceleration, mSettings.gravity.length());
+    if (a > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / a));
+    return dt;
 }
 
 void GhostSolver::advanceFrame()

@@ -1,5 +1,5 @@
 /// @file   NeighborGrid.cc
-/// @brief  Parallel counting sort behind NeighborGrid::build.
+/// @brief  Parallel counting sort and cell table behind NeighborGrid::build.
 #include "ghostfx/sph/NeighborGrid.h"
 
 #include "ghostfx/sph/Exceptions.h"
@@ -26,8 +26,10 @@ NeighborGrid::NeighborGrid(Real cellSize)
 
 std::size_t NeighborGrid::memoryBytes() const
 {
-    return mBucketStart.capacity() * sizeof(std::uint32_t) +
-           mKey.capacity() * sizeof(std::uint64_t) + mPos.capacity() * sizeof(Vec3) +
+    return mBucketCell.capacity() * sizeof(std::uint32_t) +
+           mCellKey.capacity() * sizeof(std::uint64_t) +
+           mCellStart.capacity() * sizeof(std::uint32_t) +
+           (mX.capacity() + mY.capacity() + mZ.capacity()) * sizeof(Real) +
            mIndex.capacity() * sizeof(Index) + mSlotOf.capacity() * sizeof(std::uint32_t);
 }
 
@@ -36,6 +38,7 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     if (count >= std::size_t(INVALID_INDEX)) {
         throw ValueError(msg("neighbour grid: ", count, " particles exceed the 32-bit index range"));
     }
+    mIdentity = false;
     // Table size: the smallest power of two >= 2 N (at least 64), so buckets average <= 0.5
     // particle-cells and a compact block of cells never wraps onto itself.
     std::size_t tableSize = 64;
@@ -81,15 +84,15 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     }, 4096);
 
     // 3. Exclusive scan into bucket starts; the counts become scatter cursors.
-    mBucketStart.resize(tableSize + 1);
+    std::vector<std::uint32_t> bucketStart(tableSize + 1);
     std::uint32_t running = 0;
     for (std::size_t b = 0; b < tableSize; ++b) {
-        mBucketStart[b] = running;
+        bucketStart[b] = running;
         const std::uint32_t c = counts[b].load(std::memory_order_relaxed);
         counts[b].store(running, std::memory_order_relaxed);
         running += c;
     }
-    mBucketStart[tableSize] = running;
+    bucketStart[tableSize] = running;
 
     // 4. Scatter particle indices to their bucket's slots.
     mIndex.resize(count);
@@ -97,22 +100,57 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         mIndex[counts[bucket[i]].fetch_add(1, std::memory_order_relaxed)] = Index(i);
     }, 4096);
 
-    // 5. The scatter order inside a bucket depends on thread timing: sort each bucket by index
-    //    (buckets hold a few cells' worth of particles) so the result is deterministic.
+    // 5. The scatter order inside a bucket depends on thread timing: sort each bucket by cell,
+    //    then index, so the result is deterministic and every cell is one run of slots. Count
+    //    the cells of each bucket on the way.
+    std::vector<std::uint32_t> bucketCells(tableSize + 1, 0);
     parallel::forEach(0, tableSize, [&](std::size_t b) {
-        const std::uint32_t lo = mBucketStart[b], hi = mBucketStart[b + 1];
-        if (hi - lo > 1) std::sort(mIndex.begin() + lo, mIndex.begin() + hi);
+        const std::uint32_t lo = bucketStart[b], hi = bucketStart[b + 1];
+        if (hi - lo > 1) {
+            std::sort(mIndex.begin() + lo, mIndex.begin() + hi, [&key](Index a, Index c) {
+                return key[a] != key[c] ? key[a] < key[c] : a < c;
+            });
+        }
+        std::uint32_t cells = 0;
+        for (std::uint32_t s = lo; s < hi; ++s) cells += s == lo || key[mIndex[s]] != key[mIndex[s - 1]];
+        bucketCells[b] = cells;
     }, 4096);
 
-    // 6. Gather keys and positions in sorted order; inverse map for forEachNeighbor(i).
-    mKey.resize(count);
-    mPos.resize(count);
+    // 6. Cell table: buckets to cells (exclusive scan), cells to slots and keys.
+    mBucketCell.resize(tableSize + 1);
+    std::uint32_t cellCount = 0;
+    for (std::size_t b = 0; b < tableSize; ++b) {
+        mBucketCell[b] = cellCount;
+        cellCount += bucketCells[b];
+    }
+    mBucketCell[tableSize] = cellCount;
+    mCellKey.resize(cellCount);
+    mCellStart.resize(std::size_t(cellCount) + 1);
+    mCellStart[cellCount] = std::uint32_t(count);
+    parallel::forEach(0, tableSize, [&](std::size_t b) {
+        std::uint32_t cell = mBucketCell[b];
+        for (std::uint32_t s = bucketStart[b], hi = bucketStart[b + 1]; s < hi; ++s) {
+            const std::uint64_t k = key[mIndex[s]];
+            if (s == bucketStart[b] || k != key[mIndex[s - 1]]) {
+                mCellKey[cell] = k;
+                mCellStart[cell] = s;
+                ++cell;
+            }
+        }
+    }, 4096);
+
+    // 7. Gather coordinates in sorted order; inverse map for forEachNeighbor(i). The coordinate
+    //    arrays carry PADDING more entries, so vectorised distance loops may read past a range.
+    mX.assign(count + PADDING, Real(0));
+    mY.assign(count + PADDING, Real(0));
+    mZ.assign(count + PADDING, Real(0));
     mSlotOf.resize(count);
-    parallel::forEach(0, count, [&](std::size_t k) {
-        const Index i = mIndex[k];
-        mKey[k] = key[i];
-        mPos[k] = positions[i];
-        mSlotOf[i] = std::uint32_t(k);
+    parallel::forEach(0, count, [&](std::size_t s) {
+        const Index i = mIndex[s];
+        mX[s] = positions[i][0];
+        mY[s] = positions[i][1];
+        mZ[s] = positions[i][2];
+        mSlotOf[i] = std::uint32_t(s);
     }, 4096);
 }
 
@@ -125,6 +163,7 @@ void NeighborGrid::sortParticles(ParticleSet& particles)
         mIndex[k] = Index(k);
         mSlotOf[k] = std::uint32_t(k);
     }, 8192);
+    mIdentity = true;
 }
 
 } // namespace sph

@@ -140,6 +140,45 @@ void ParticleSet::reorder(const std::vector<Index>& order)
     for (auto& [name, ch] : mVectors) permute(ch.data, order, vecScratch);
 }
 
+void ParticleSet::append(const ParticleSet& other)
+{
+    const std::size_t n = size(), m = other.size();
+    for (const auto& [name, ch] : other.mScalars) addScalarChannel(name, ch.defaultValue);
+    for (const auto& [name, ch] : other.mVectors) addVectorChannel(name, ch.defaultValue);
+    auto cat = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+    cat(mPositions, other.mPositions);
+    cat(mVelocities, other.mVelocities);
+    cat(mMasses, other.mMasses);
+    cat(mDensities, other.mDensities);
+    cat(mPressures, other.mPressures);
+    cat(mKinds, other.mKinds);
+    cat(mIds, other.mIds);
+    for (auto& [name, ch] : mScalars) {
+        auto it = other.mScalars.find(name);
+        if (it != other.mScalars.end()) cat(ch.data, it->second.data);
+        else ch.data.resize(n + m, ch.defaultValue);
+    }
+    for (auto& [name, ch] : mVectors) {
+        auto it = other.mVectors.find(name);
+        if (it != other.mVectors.end()) cat(ch.data, it->second.data);
+        else ch.data.resize(n + m, ch.defaultValue);
+    }
+    mNextId = std::max(mNextId, other.mNextId);
+}
+
+ParticleSet ParticleSet::select(const std::vector<std::uint8_t>& keep) const
+{
+    if (keep.size() != size()) {
+        throw ValueError(msg("ParticleSet::select: mask has ", keep.size(),
+                             " entries, expected one per particle (", size(), ")"));
+    }
+    ParticleSet out = *this;
+    std::vector<std::uint8_t> remove(keep.size());
+    for (std::size_t i = 0; i < keep.size(); ++i) remove[i] = !keep[i];
+    out.removeIf(remove);
+    return out;
+}
+
 void ParticleSet::reserve(std::size_t n)
 {
     forEachChannel([n](auto& data) { data.reserve(n); });
@@ -177,6 +216,12 @@ std::vector<Vec3>& ParticleSet::addVectorChannel(const std::string& name, const 
     auto [it, inserted] = mVectors.try_emplace(name, VectorChannel{{}, value});
     if (inserted) it->second.data.assign(size(), value);
     return it->second.data;
+}
+
+void ParticleSet::removeChannel(const std::string& name)
+{
+    mScalars.erase(name);
+    mVectors.erase(name);
 }
 
 bool ParticleSet::hasScalarChannel(const std::string& name) const { return mScalars.count(name); }

@@ -41,7 +41,7 @@ TEST(MovingSolid, PaddlePushesLiquidAndLeavesNoneInside)
 
     const Real dt = Real(1) / 1200;
     for (int k = 0; k < 120; ++k) solver.step(dt); // 0.1 s: the paddle advances 5 cm
-    const ParticleSet& p = solver.particles();
+    const ParticleSet p = solver.allParticles();
     const RigidTransform now = motion(solver.time());
     double worstGhost = 0, worstVelocity = 0, deepest = 0, momentumX = 0;
     const auto& local = p.vectorChannel("solid_x");
@@ -92,11 +92,12 @@ TEST(MovingSolid, PerFrameShapeReplacesTheGhosts)
     solver.setSolidShape(0, raised);
     solver.advanceFrame();
     double deepest = 0, highestGhost = -1;
-    for (std::size_t i = 0; i < solver.particles().size(); ++i) {
-        const Vec3& x = solver.particles().positions()[i];
-        if (solver.particles().kinds()[i] == ParticleKind::Liquid) {
+    const ParticleSet all = solver.allParticles();
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        const Vec3& x = all.positions()[i];
+        if (all.kinds()[i] == ParticleKind::Liquid) {
             deepest = std::min(deepest, double(raised.phi(x)));
-        } else if (solver.particles().kinds()[i] == ParticleKind::GhostSolid) {
+        } else if (all.kinds()[i] == ParticleKind::GhostSolid) {
             highestGhost = std::max(highestGhost, double(x[1]));
         }
     }

@@ -206,7 +206,8 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     EXPECT_EQ(liquidOnly.count(ParticleKind::Boundary), 0u);
     EXPECT_GT(liquidOnly.count(ParticleKind::GhostAir), 0u);
 
-    // Basic SPH with a solid: solid channels and boundary particles, no air of any kind.
+    // Basic SPH with a static solid: boundary particles, in their own set with only the static
+    // solid channels (the liquid carries none); no air of any kind.
     GhostSettings basicSettings = scene.settings;
     basicSettings.method = Method::Basic;
     GhostSolver basic(basicSettings);
@@ -214,12 +215,23 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     basic.addLiquid(scene.liquid);
     basic.advanceFrame();
     const ParticleSet& q = basic.particles();
-    EXPECT_EQ(q.vectorChannelNames(),
-              (std::vector<std::string>{"normal", "solid_n", "solid_v", "solid_x", "vstar"}));
-    EXPECT_EQ(q.scalarChannelNames(), (std::vector<std::string>{"solid_index"}));
+    EXPECT_EQ(q.vectorChannelNames(), (std::vector<std::string>{"vstar"}));
+    EXPECT_TRUE(q.scalarChannelNames().empty());
+    const ParticleSet solids = basic.solidParticles();
+    EXPECT_EQ(solids.vectorChannelNames(), (std::vector<std::string>{"normal"}));
+    EXPECT_EQ(solids.scalarChannelNames(), (std::vector<std::string>{"solid_index"}));
+    EXPECT_EQ(solids.size(), basic.count(ParticleKind::Boundary));
     EXPECT_EQ(basic.count(ParticleKind::GhostAir), 0u);
     EXPECT_EQ(basic.count(ParticleKind::GhostSolid), 0u);
     EXPECT_GT(basic.count(ParticleKind::Boundary), 0u);
+
+    // A moving solid's particles also carry their place, normal and velocity in the solid's frame.
+    GhostSolver paddle(scene.settings);
+    paddle.addSolid(scene.floor, Vec3(Real(0.1), 0, 0));
+    paddle.addLiquid(scene.liquid);
+    paddle.advanceFrame();
+    EXPECT_EQ(paddle.solidParticles().vectorChannelNames(),
+              (std::vector<std::string>{"normal", "solid_n", "solid_v", "solid_x"}));
 
     // Basic SPH, liquid only: one channel.
     GhostSolver bare(basicSettings);
@@ -228,22 +240,22 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     EXPECT_EQ(bare.particles().vectorChannelNames(), (std::vector<std::string>{"vstar"}));
     EXPECT_TRUE(bare.particles().scalarChannelNames().empty());
 
-    // Bytes per particle: built-in channels 2 Vec3 + 3 Real + kind + id, plus the named ones.
+    // Bytes per particle of the particle storage: built-in channels 2 Vec3 + 3 Real + kind + id,
+    // plus the named ones.
     const double builtIn = 2 * sizeof(Vec3) + 3 * sizeof(Real) + 1 + sizeof(ParticleId);
-    auto perParticle = [](const GhostSolver& s) {
-        return double(s.particles().memoryBytes()) / double(s.particles().size());
-    };
+    auto perParticle = [](const ParticleSet& s) { return double(s.memoryBytes()) / double(s.size()); };
     const double ghostSize = builtIn + sizeof(Vec3) + 2 * sizeof(Real);
-    const double basicSize = builtIn + 5 * sizeof(Vec3) + sizeof(Real);
-    std::printf("[measured] bytes per particle: ghost liquid-only %.1f (size-based %.0f), basic with "
-                "a solid %.1f (%.0f), basic liquid-only %.1f (%.0f)\n", perParticle(liquidOnly),
-                ghostSize, perParticle(basic), basicSize, perParticle(bare), builtIn + sizeof(Vec3));
+    const double staticSolidSize = builtIn + sizeof(Vec3) + sizeof(Real);
+    std::printf("[measured] bytes per particle: ghost liquid-only %.1f (size-based %.0f), static "
+                "solid particles %.1f (%.0f), basic liquid-only %.1f (%.0f)\n",
+                perParticle(liquidOnly.particles()), ghostSize, perParticle(solids), staticSolidSize,
+                perParticle(bare.particles()), builtIn + sizeof(Vec3));
     // memoryBytes counts capacity: at least the size-based bytes, and at most twice that
     // (vectors grow by doubling), plus the scratch of a sort that may be a little larger.
-    EXPECT_GE(perParticle(liquidOnly), ghostSize);
-    EXPECT_LE(perParticle(liquidOnly), 2.5 * ghostSize);
-    EXPECT_GE(perParticle(basic), basicSize);
-    EXPECT_LE(perParticle(basic), 2.5 * basicSize);
+    EXPECT_GE(perParticle(liquidOnly.particles()), ghostSize);
+    EXPECT_LE(perParticle(liquidOnly.particles()), 2.5 * ghostSize);
+    EXPECT_GE(perParticle(solids), staticSolidSize);
+    EXPECT_LE(perParticle(solids), 2.5 * staticSolidSize);
 }
 
 TEST(StepObserver, CalledAfterEveryStepWithItsDt)

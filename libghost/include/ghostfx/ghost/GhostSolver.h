@@ -21,18 +21,26 @@
 ///          solver.addEmitter(nozzle, velocity);   // no liquid bodies (already in the state)
 ///          while (solver.frame() < 100) solver.advanceFrame();
 ///          @endcode
-///          Only the channels the scene needs exist: the solid channels (normal, solid_v,
-///          solid_x, solid_n, solid_index) appear with the first solid, the ghost air channels
-///          (air_weight, air_target) only for the Ghost method.
+///          Solid particles live apart from the liquid and air, in two boundary blocks
+///          (sph::BoundaryBlock): one for static solids, sorted once and never touched again, and
+///          one for moving solids, re-placed every step. A step searches neighbours once
+///          (sph::NeighborLists, from the liquid particles into the liquid-and-air grid and each
+///          block's grid) and every pass reuses the lists, so a solid particle no liquid reaches
+///          costs nothing: the cost of a step follows the liquid, not the tank.
+///          Only the channels the scene needs exist: the ghost air channels (air_weight,
+///          air_target) only for the Ghost method; the solid channels (normal, solid_index, and
+///          for moving solids solid_v, solid_x, solid_n) only on the solid particles.
 ///          The solver never opens files; it reports per-phase timings for benchmarks ([SB12]
 ///          Sec. 5 breakdown) and throws NumericalError naming frame, step and the exceeded limit
 ///          when a run blows up.
 #pragma once
 
 #include <ghostfx/ghost/GhostSettings.h>
+#include <ghostfx/sph/BoundaryBlock.h>
 #include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborGrid.h>
+#include <ghostfx/sph/NeighborLists.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
@@ -59,7 +67,8 @@ using sph::RigidTransform;
 /// Seconds spent in each phase of the step, accumulated since the last reset ([SB12] Sec. 5).
 struct PhaseTimings
 {
-    double neighborsAndDensity = 0; ///< grid rebuild + sort + density (+ solid density extrapolation)
+    double neighborsAndDensity = 0; ///< sort + neighbour search + density (+ solid density extrapolation)
+    double sortAndSearch = 0;       ///< of which: the sort and the neighbour search
     double pressureForce = 0;       ///< equation of state + pressure (and Basic viscosity/LJ) forces
     double xsphAndBoundary = 0;     ///< ghost velocities, XSPH, positions, collisions
     double airResampling = 0;       ///< ghost air sampling
@@ -84,7 +93,8 @@ public:
 
     /// Add a static solid, or one moving rigidly with constant `velocity` (m/s). Its ghost
     /// (or boundary) particles are sampled at once, one kernel radius deep; after
-    /// restoreState(), the solids the state already holds are not sampled again.
+    /// restoreState(), the solids the state already holds are not sampled again. A solid with
+    /// zero velocity is static: its particles join the static block (sorted once).
     void addSolid(const LevelSet& solid, const Vec3& velocity = Vec3(0));
     /// Add a solid moving rigidly: at time t its level set (given in its local frame) sits at
     /// `motion(t)`. Its ghosts move with it and carry its velocity ([SB12] Sec. 4.4).
@@ -144,9 +154,20 @@ public:
     Real particleMass() const { return mMass; }
     void setParticleMass(Real mass);
 
+    /// The moving particles: liquid and ghost air.
     ParticleSet& particles() { return mParticles; }
     const ParticleSet& particles() const { return mParticles; }
-    std::size_t count(ParticleKind kind) const { return mParticles.count(kind); }
+    /// The solid particles (ghost solids for Ghost SPH, boundary particles for Basic SPH) of the
+    /// static solids and of the moving ones. Their density, pressure and velocity are those
+    /// of the last step's extrapolation where liquid reached them ([SB12] Algorithm 3 lines
+    /// 5-7 and 15-18), otherwise rho0, 0 and the solid's velocity.
+    ParticleSet solidParticles() const;
+    /// Every particle, liquid, air and solid, in one set: what saveState() stores.
+    ParticleSet allParticles() const;
+    /// Particles of one kind, in every set.
+    std::size_t count(ParticleKind kind) const;
+    /// Bytes held by the solver: particles, boundary blocks, neighbour grid and lists, scratch.
+    std::size_t memoryBytes() const;
 
     double time() const { return mTime; }
     std::uint64_t stepCount() const { return mStep; }
@@ -156,6 +177,8 @@ public:
     void resetTimings() { mTimings = PhaseTimings(); }
     /// Mean number of neighbours per liquid particle in the last density pass (self included).
     double meanNeighbors() const { return mMeanNeighbors; }
+    /// Liquid-neighbour pairs in the last neighbour search, solid neighbours included.
+    std::size_t lastPairCount() const { return mPairCount; }
 
     /// Liquid particles emitted and removed by the kill box since the start.
     std::size_t emittedCount() const { return mEmitted; }
@@ -164,40 +187,68 @@ public:
 private:
     struct Solid;
     struct Emitter;
+    /// Solid particles of one kind of solid (static or moving) and the step's scratch.
+    struct SolidBlock
+    {
+        explicit SolidBlock(Real cellSize) : block(cellSize) {}
+        sph::BoundaryBlock block;
+        sph::NeighborLists lists;           ///< this step: liquid particle -> block particles
+        std::vector<std::uint64_t> nearest; ///< per particle: packed (r^2, nearest liquid) or EMPTY
+        std::vector<Index> touched;         ///< particles some liquid reached this step
+        /// Per particle, valid where touched: density and pressure ([SB12] Algorithm 3 lines
+        /// 5-10), p / rho^2, and the Eq. 3 velocity.
+        std::vector<Real> rho, p, pOverRho2;
+        std::vector<Vec3> vstar;
+    };
 
     void initialize();
-    void ensureSolidChannels();
     void checkRestoredInputs() const;
+    void addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving);
+    SolidBlock& blockOf(std::size_t solidIndex);
+    void clearSolidScratch(SolidBlock& block);
+    void prepareSolidBlocks();
     void sampleSolid(std::size_t solidIndex);
+    void claimRestoredSolid(std::size_t solidIndex);
     void emit();
     void applyKillBox();
     bool blockedBySolid(const Vec3& x) const;
+    void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;
     void resampleAir();
     void fadeAir();
-    void sortAndComputeDensity();
+    void searchNeighbors();
+    void computeDensity();
+    void extrapolateSolidVelocity();
     void stepGhost(Real dt);
     void stepBasic(Real dt);
-    void projectOutOfSolids();
+    void moveSolids(double time);
+    void projectOutOfSolids(Real dt);
     void checkBlowUp() const;
     Index nearestLiquid(const Vec3& x, Real maxRadius) const;
 
     GhostSettings mSettings;
     sph::CubicSplineKernel mKernel;
-    ParticleSet mParticles;
-    sph::NeighborGrid mGrid;
+    ParticleSet mParticles;              ///< liquid and ghost air
+    sph::NeighborGrid mGrid;             ///< over mParticles, rebuilt (and mParticles sorted) each step
+    sph::NeighborLists mFluidLists;      ///< this step: liquid particle -> mParticles
+    std::vector<std::uint8_t> mQueryMask;///< this step: 1 for the liquid particles
+    std::vector<Real> mScratch;          ///< per particle scratch of a pass
+    SolidBlock mStatic, mMoving;         ///< solid particles of static and of moving solids
+    ParticleSet mPendingSolids;          ///< restored solid particles until their solid is added
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Emitter>> mEmitters;
     std::size_t mEmitted = 0, mKilled = 0;
     Real mMass = 0;
     Real mLennardJones = 0;
     Real mMaxAcceleration = 0; ///< largest liquid acceleration of the last step (m/s^2)
-    std::vector<Index> mNearestLiquid; ///< per ghost solid, its nearest liquid particle this step
+    Real mMaxSolidSpeed = 0;   ///< fastest moving-solid particle (m/s), for the collision test
+    bool mProjectAll = true;   ///< a solid changed shape: test every liquid particle for collision
     bool mInitialized = false;
     double mTime = 0;
     std::uint64_t mStep = 0;
     int mFrame = 0;
     PhaseTimings mTimings;
     double mMeanNeighbors = 0;
+    std::size_t mPairCount = 0;
     StepObserver mObserver;
     bool mRestored = false;            ///< restoreState() was called: no liquid may be added
     std::size_t mRestoredSolids = 0;   ///< solids whose particles came with the restored state

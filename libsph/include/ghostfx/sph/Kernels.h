@@ -14,6 +14,8 @@
 ///            [RYY15] for density (poly6), pressure gradient (spiky) and viscosity (Laplacian).
 #pragma once
 
+#include <algorithm>
+
 #include "ghostfx/sph/Exceptions.h"
 #include "ghostfx/sph/Types.h"
 
@@ -21,6 +23,11 @@ namespace ghostfx {
 namespace sph {
 
 namespace detail {
+/// min and max by value: std::min / std::max return references, which keeps GCC from turning
+/// them into vector min / max instructions inside neighbour loops.
+inline Real lesser(Real a, Real b) { return b < a ? b : a; }
+inline Real greater(Real a, Real b) { return a < b ? b : a; }
+
 inline Real checkedSupport(Real supportRadius, const char* kernelName)
 {
     if (!(supportRadius > Real(0)) || !std::isfinite(supportRadius)) {
@@ -36,6 +43,9 @@ inline Real checkedSupport(Real supportRadius, const char* kernelName)
 ///   W = 1/(pi s^3) * 1/4 (2 - q)^3            for 1 <= q < 2, and 0 beyond.
 class CubicSplineKernel
 {
+    static Real lesser(Real a, Real b) { return detail::lesser(a, b); }
+    static Real greater(Real a, Real b) { return detail::greater(a, b); }
+
 public:
     /// Support factor of [SB12] Sec. 3: support radius = 3 x particle spacing.
     static constexpr Real SB12_SUPPORT_FACTOR = Real(3);
@@ -45,6 +55,7 @@ public:
         : mSupport(detail::checkedSupport(supportRadius, "cubic spline kernel"))
         , mInvS(Real(2) / supportRadius)
         , mSigma(Real(1) / (PI * cube(supportRadius / Real(2))))
+        , mCut(Real(1e20) / supportRadius)
     {}
 
     /// Kernel for particle spacing h (m) with support radius `supportFactor` * h.
@@ -55,36 +66,62 @@ public:
 
     Real supportRadius() const { return mSupport; }
 
+    // Branch-free forms, so neighbour loops vectorise and never mispredict (q < 1 holds for a
+    // third of the pairs at random): with u = min(q, 1), v = max(q, 1) and t = max(2 - v, 0),
+    // each piece is evaluated at its clamped argument, where the other piece is constant, and
+    // the two are added:
+    //   W     = sigma (0.75 (1 - 2 u^2 + u^3) + 0.25 t^3)
+    //   dW/dr = sigma / s (u (2.25 u - 3) + 0.75 - 0.75 t^2)
+    //   (dW/dr) / r = sigma / s^2 (2.25 (u - 1) - 0.75 t^2 / v)
+    // which reduce to the two polynomials above on their intervals, to exactly 0 for q >= 2,
+    // and keep each polynomial's accuracy near q = 0 and q = 1. t is also cut to 0 for r >= R
+    // (the test is on r itself: r * (2 / R) can round below 2 at r = R, and W(R) must be 0)
+    // through min(2 - v, (R - r) * big), which is negative exactly when r >= R.
+
     Real W(Real r) const
     {
         const Real q = r * mInvS;
-        // r * (2 / R) can round below 2 at r = R: test r itself so W(R) is exactly 0.
-        if (r >= mSupport || q >= Real(2)) return Real(0);
-        if (q < Real(1)) return mSigma * (Real(1) - Real(1.5) * q * q + Real(0.75) * q * q * q);
-        return mSigma * Real(0.25) * cube(Real(2) - q);
+        const Real u = lesser(q, Real(1));
+        const Real t = cutoff(q, r);
+        return mSigma * (Real(0.75) * (Real(1) - Real(2) * u * u + u * u * u) + Real(0.25) * t * t * t);
     }
 
     Real dWdr(Real r) const
     {
         const Real q = r * mInvS;
-        if (r >= mSupport || q >= Real(2)) return Real(0);
-        if (q < Real(1)) return mSigma * mInvS * (Real(-3) * q + Real(2.25) * q * q);
-        return -mSigma * mInvS * Real(0.75) * sqr(Real(2) - q);
+        const Real u = lesser(q, Real(1));
+        const Real t = cutoff(q, r);
+        return mSigma * mInvS * (u * (Real(2.25) * u - Real(3)) + Real(0.75) - Real(0.75) * t * t);
     }
 
-    Vec3 gradW(const Vec3& xij, Real r) const
+    /// (dW/dr) / r (1/m^5): grad W = xij * gradFactor(r). Finite at r = 0 (where xij = 0) and
+    /// zero for r >= R.
+    Real gradFactor(Real r) const
     {
-        if (r <= Real(0) || r >= mSupport) return Vec3(0);
-        return xij * (dWdr(r) / r);
+        const Real q = r * mInvS;
+        const Real u = lesser(q, Real(1));
+        const Real v = greater(q, Real(1));
+        const Real t = cutoff(q, r);
+        return mSigma * mInvS * mInvS * (Real(2.25) * (u - Real(1)) - Real(0.75) * t * t / v);
     }
+
+    /// grad W = dW/dr x_ij / r; zero at r = 0 and for r >= R.
+    Vec3 gradW(const Vec3& xij, Real r) const { return xij * gradFactor(r); }
 
     Real W(const Vec3& xij) const { return W(xij.length()); }
     Vec3 gradW(const Vec3& xij) const { return gradW(xij, xij.length()); }
 
 private:
+    /// t = max(2 - max(q, 1), 0), and 0 for r >= R.
+    Real cutoff(Real q, Real r) const
+    {
+        return std::max(std::min(Real(2) - greater(q, Real(1)), (mSupport - r) * mCut), Real(0));
+    }
+
     Real mSupport; ///< R (m)
     Real mInvS;    ///< 1 / s = 2 / R (1/m)
     Real mSigma;   ///< 1 / (pi s^3) (1/m^3)
+    Real mCut;     ///< 1e20 / R (1/m): (R - r) * mCut exceeds 2 for any r below R
 };
 
 /// Mueller et al. 2003 poly6: W = 315 / (64 pi R^9) (R^2 - r^2)^3. Smooth at r = 0; used for

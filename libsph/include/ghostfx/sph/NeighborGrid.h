@@ -1,6 +1,6 @@
 /// @file   NeighborGrid.h
 /// @brief  Hashed uniform grid for fixed-radius neighbour queries, rebuilt by a parallel
-///         counting sort.
+///         counting sort, with a compact table of occupied cells.
 /// @details Cells are cubes of side `cellSize` (normally the kernel support radius), so the
 ///          neighbours of a particle lie in the 27 cells around it. Cells are not stored densely:
 ///          a cell (i, j, k) goes to bucket morton(i, j, k) mod T, where the table size T is a
@@ -8,17 +8,21 @@
 ///          apart the particles are (a lone particle 1 km away costs one bucket, not a dense
 ///          box), and for any compact region narrower than T^(1/3) cells per axis no two cells
 ///          share a bucket and the bucket order is the Z-order of the cells, so sorting by bucket
-///          keeps nearby cells nearby in memory. Buckets that do hold several cells are told
-///          apart by each slot's packed cell key.
+///          keeps nearby cells nearby in memory.
 ///
 ///          `build()` sorts particles by bucket (parallel count, exclusive scan, parallel scatter,
-///          then a per-bucket sort by index so the order never depends on thread timing) and
-///          keeps a sorted copy of the positions, so the inner loops stream through memory.
-///          Reorder the particle set itself with `order()` (see `sortParticles`) to make every
-///          other channel stream too.
+///          then a per-bucket sort by cell and index so the order never depends on thread
+///          timing). The particles of one cell are then one contiguous run of sorted slots: the
+///          grid keeps a table of the occupied cells (first slot and packed cell key), reached
+///          from the bucket, so a cell lookup is two array reads and a key compare and the
+///          candidates of a query are a few dense slot ranges. Sorted coordinates are stored as
+///          three arrays (x, y, z), so the distance filter over a range vectorises. Reorder
+///          the particle set itself with `order()` (see `sortParticles`) to make every other
+///          channel stream too.
 ///
 ///          Neighbour callbacks receive `(j, xij, rij)`: the particle index, x_i - x_j (m) and
 ///          |x_i - x_j| (m). A particle is its own neighbour (j == i, rij == 0), as SPH sums need.
+///          NeighborLists.h builds compact per-particle lists from this grid, once per step.
 #pragma once
 
 #include "ghostfx/sph/Types.h"
@@ -38,6 +42,20 @@ public:
     /// (with 3 cm cells, 31 km). Farther particles are rejected with a ValueError.
     static constexpr std::int32_t MAX_CELL_COORD = (1 << 20) - 1;
 
+    /// Integer coordinates of a cell.
+    struct Cell
+    {
+        std::int32_t i, j, k;
+        bool operator==(const Cell& o) const { return i == o.i && j == o.j && k == o.k; }
+        bool operator!=(const Cell& o) const { return !(*this == o); }
+    };
+    /// Sorted slots [begin, end) of the particles of one cell.
+    struct SlotRange
+    {
+        std::uint32_t begin = 0, end = 0;
+        bool empty() const { return begin == end; }
+    };
+
     /// @param cellSize  cell side (m), normally the kernel support radius; queries with a
     ///                  radius up to `cellSize` visit 27 cells, larger radii more
     explicit NeighborGrid(Real cellSize);
@@ -56,23 +74,75 @@ public:
     /// Sorted slot k holds particle `order()[k]`: pass it to ParticleSet::reorder.
     const std::vector<Index>& order() const { return mIndex; }
 
-    std::size_t size() const { return mPos.size(); }
+    std::size_t size() const { return mIndex.size(); }
     /// Buckets in the hash table (a power of two).
-    std::size_t bucketCount() const { return mBucketStart.empty() ? 0 : mBucketStart.size() - 1; }
+    std::size_t bucketCount() const { return mBucketCell.empty() ? 0 : mBucketCell.size() - 1; }
+    /// Occupied cells.
+    std::size_t cellCount() const { return mCellKey.size(); }
     /// Bytes held by the grid's arrays.
     std::size_t memoryBytes() const;
+
+    // Cell-level access (NeighborLists, boundary activity) ------------------------------------
+
+    /// Cell of a finite point. Coordinates are clamped just beyond the representable range,
+    /// so a query point far outside cannot overflow; no particle lives out there anyway.
+    Cell cellOf(const Vec3& x) const
+    {
+        auto axis = [this](Real v) {
+            const Real limit = Real(MAX_CELL_COORD + 2);
+            return std::int32_t(clamp(std::floor(v * mInvCellSize), -limit, limit));
+        };
+        return {axis(x[0]), axis(x[1]), axis(x[2])};
+    }
+    /// The sorted slots of cell c (empty if no particle lies in it).
+    SlotRange cellSlots(const Cell& c) const
+    {
+        const std::uint32_t b = bucketOf(c);
+        const std::uint64_t key = packKey(c);
+        for (std::uint32_t k = mBucketCell[b], end = mBucketCell[b + 1]; k < end; ++k) {
+            if (mCellKey[k] == key) return {mCellStart[k], mCellStart[k + 1]};
+        }
+        return {};
+    }
+    /// Whether any particle lies in cell c.
+    bool occupied(const Cell& c) const { return !cellSlots(c).empty(); }
+    /// Occupied cell k (in sorted order): its coordinates and slots.
+    Cell cellAt(std::size_t k) const { return unpackKey(mCellKey[k]); }
+    SlotRange cellSlotsAt(std::size_t k) const { return {mCellStart[k], mCellStart[k + 1]}; }
+    /// Entries past the last slot in each sorted coordinate array (zeros), so a vectorised
+    /// distance loop may read a few slots past the end.
+    static constexpr std::size_t PADDING = 4;
+    /// Sorted coordinates (m), one array per axis, indexed by slot.
+    const Real* sortedX() const { return mX.data(); }
+    const Real* sortedY() const { return mY.data(); }
+    const Real* sortedZ() const { return mZ.data(); }
+    /// Position (m) of sorted slot s.
+    Vec3 sortedPosition(std::uint32_t s) const { return Vec3(mX[s], mY[s], mZ[s]); }
+    /// The particle index held by sorted slot s.
+    Index particleAt(std::uint32_t s) const { return mIndex[s]; }
+    /// The sorted slot of particle i.
+    std::uint32_t slotOf(Index i) const { return mSlotOf[i]; }
+    /// Whether slot s holds particle s for every s (after sortParticles).
+    bool identityOrder() const { return mIdentity; }
+
+    // Queries ----------------------------------------------------------------------------------
 
     /// Call fn(j, xij, rij) for every particle j with |x_i - x_j| < cellSize, including i.
     template <typename Fn>
     void forEachNeighbor(Index i, Fn&& fn) const
     {
-        const std::uint32_t slot = mSlotOf[i];
-        forEachInRadius(mPos[slot], mCellSize, fn);
+        forEachInRadius(sortedPosition(mSlotOf[i]), mCellSize, fn);
     }
 
     /// Call fn(j, x - x_j, r) for every particle j with |x - x_j| < radius (m).
     template <typename Fn>
     void forEachInRadius(const Vec3& x, Real radius, Fn&& fn) const;
+
+    /// Call fn(j, x_j) for every particle j inside the box (bounds included), in slot order
+    /// within each cell: visits the cells the box overlaps, or sweeps every particle when that
+    /// is cheaper.
+    template <typename Fn>
+    void forEachInBox(const Aabb& box, Fn&& fn) const;
 
     /// Index of the particle closest to x among those with pred(j) true and distance below
     /// maxRadius (m), or INVALID_INDEX. Searches rings of cells outward and stops as soon as no
@@ -89,30 +159,24 @@ public:
     }
 
 private:
-    struct Cell { std::int32_t i, j, k; };
-
-    /// Cell of a finite point. Coordinates are clamped just beyond the representable range,
-    /// so a query point far outside cannot overflow; no particle lives out there anyway.
-    Cell cellOf(const Vec3& x) const
-    {
-        auto axis = [this](Real v) {
-            const Real limit = Real(MAX_CELL_COORD + 2);
-            return std::int32_t(clamp(std::floor(v * mInvCellSize), -limit, limit));
-        };
-        return {axis(x[0]), axis(x[1]), axis(x[2])};
-    }
-
     /// Whether a search `reach` cells wide would visit more cells than there are particles:
     /// then a plain sweep over the particles is cheaper.
     bool sweepIsCheaper(Real reach) const
     {
-        return cube(Real(2) * reach + Real(1)) > Real(mPos.size());
+        return cube(Real(2) * reach + Real(1)) > Real(size());
     }
+    static constexpr std::int64_t KEY_OFFSET = std::int64_t(1) << 20;
     static std::uint64_t packKey(const Cell& c)
     {
-        constexpr std::int64_t OFFSET = std::int64_t(1) << 20;
-        return (std::uint64_t(c.i + OFFSET) << 42) | (std::uint64_t(c.j + OFFSET) << 21) |
-               std::uint64_t(c.k + OFFSET);
+        return (std::uint64_t(c.i + KEY_OFFSET) << 42) | (std::uint64_t(c.j + KEY_OFFSET) << 21) |
+               std::uint64_t(c.k + KEY_OFFSET);
+    }
+    static Cell unpackKey(std::uint64_t key)
+    {
+        constexpr std::uint64_t MASK = (std::uint64_t(1) << 21) - 1;
+        return {std::int32_t(std::int64_t(key >> 42 & MASK) - KEY_OFFSET),
+                std::int32_t(std::int64_t(key >> 21 & MASK) - KEY_OFFSET),
+                std::int32_t(std::int64_t(key & MASK) - KEY_OFFSET)};
     }
     static std::uint64_t spreadBits(std::uint64_t v)
     {
@@ -136,11 +200,13 @@ private:
 
     Real mCellSize, mInvCellSize;
     std::uint64_t mTableMask = 0;
-    std::vector<std::uint32_t> mBucketStart; ///< bucket b holds slots [start[b], start[b+1])
-    std::vector<std::uint64_t> mKey;         ///< packed cell key of each sorted slot
-    std::vector<Vec3> mPos;                  ///< positions in sorted order (m)
+    std::vector<std::uint32_t> mBucketCell;  ///< bucket b holds cells [cell[b], cell[b+1])
+    std::vector<std::uint64_t> mCellKey;     ///< packed key of each occupied cell, sorted order
+    std::vector<std::uint32_t> mCellStart;   ///< cell k holds slots [start[k], start[k+1])
+    std::vector<Real> mX, mY, mZ;            ///< positions in sorted order (m)
     std::vector<Index> mIndex;               ///< particle index of each sorted slot
     std::vector<std::uint32_t> mSlotOf;      ///< sorted slot of each particle index
+    bool mIdentity = false;                  ///< mIndex[s] == s for every slot
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -148,31 +214,27 @@ private:
 template <typename Fn>
 inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, Fn& fn) const
 {
-    const std::uint32_t b = bucketOf(c);
-    const std::uint32_t end = mBucketStart[b + 1];
-    std::uint32_t k = mBucketStart[b];
-    if (k == end) return;
-    const std::uint64_t key = packKey(c);
-    // Two passes per batch of slots: a branch-free filter that appends every slot of this cell
-    // within the radius to `hit`, then the callbacks, in slot order with the same xij and rij as
-    // a plain loop. Inside a cell the particle order is arbitrary in a running simulation, so a
-    // branch on `r2 < radius2` is mispredicted very often; the filter takes about a third off a
-    // density pass over sorted particles (bench/RESULTS.md, "Neighbour search").
+    const SlotRange range = cellSlots(c);
+    // Two passes per batch of slots: a branch-free filter that appends every slot within the
+    // radius to `hit`, then the callbacks, in slot order with the same xij and rij as a plain
+    // loop. Inside a cell the particle order is arbitrary in a running simulation, so a branch
+    // on `r2 < radius2` is mispredicted very often (bench/RESULTS.md, "Neighbour search").
     constexpr std::uint32_t BATCH = 64;
     std::uint32_t hit[BATCH];
     Real hitR2[BATCH];
-    while (k < end) {
-        const std::uint32_t stop = end - k > BATCH ? k + BATCH : end;
+    for (std::uint32_t k = range.begin; k < range.end;) {
+        const std::uint32_t stop = range.end - k > BATCH ? k + BATCH : range.end;
         std::uint32_t n = 0;
         for (std::uint32_t s = k; s < stop; ++s) {
-            const Real r2 = (x - mPos[s]).lengthSqr();
+            const Real dx = x[0] - mX[s], dy = x[1] - mY[s], dz = x[2] - mZ[s];
+            const Real r2 = dx * dx + dy * dy + dz * dz;
             hit[n] = s;
             hitR2[n] = r2;
-            n += std::uint32_t(r2 < radius2) & std::uint32_t(mKey[s] == key);
+            n += std::uint32_t(r2 < radius2);
         }
         for (std::uint32_t h = 0; h < n; ++h) {
             const std::uint32_t s = hit[h];
-            fn(mIndex[s], x - mPos[s], std::sqrt(hitR2[h]));
+            fn(mIndex[s], x - sortedPosition(s), std::sqrt(hitR2[h]));
         }
         k = stop;
     }
@@ -181,12 +243,12 @@ inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, 
 template <typename Fn>
 inline void NeighborGrid::forEachInRadius(const Vec3& x, Real radius, Fn&& fn) const
 {
-    if (mPos.empty() || !isFinite(x) || !(radius > Real(0))) return;
+    if (mIndex.empty() || !isFinite(x) || !(radius > Real(0))) return;
     const Real radius2 = radius * radius;
     const Real reachCells = std::ceil(radius * mInvCellSize);
     if (sweepIsCheaper(reachCells)) {
-        for (std::size_t s = 0; s < mPos.size(); ++s) {
-            const Vec3 xij = x - mPos[s];
+        for (std::uint32_t s = 0; s < mIndex.size(); ++s) {
+            const Vec3 xij = x - sortedPosition(s);
             const Real r2 = xij.lengthSqr();
             if (r2 < radius2) fn(mIndex[s], xij, std::sqrt(r2));
         }
@@ -203,6 +265,32 @@ inline void NeighborGrid::forEachInRadius(const Vec3& x, Real radius, Fn&& fn) c
     }
 }
 
+template <typename Fn>
+inline void NeighborGrid::forEachInBox(const Aabb& box, Fn&& fn) const
+{
+    if (mIndex.empty() || box.empty() || !isFinite(box.min) || !isFinite(box.max)) return;
+    const Cell lo = cellOf(box.min), hi = cellOf(box.max);
+    const double cells = double(hi.i - lo.i + 1) * double(hi.j - lo.j + 1) * double(hi.k - lo.k + 1);
+    if (cells > double(cellCount())) {
+        for (std::uint32_t s = 0; s < mIndex.size(); ++s) {
+            const Vec3 x = sortedPosition(s);
+            if (box.contains(x)) fn(mIndex[s], x);
+        }
+        return;
+    }
+    for (std::int32_t i = lo.i; i <= hi.i; ++i) {
+        for (std::int32_t j = lo.j; j <= hi.j; ++j) {
+            for (std::int32_t k = lo.k; k <= hi.k; ++k) {
+                const SlotRange r = cellSlots(Cell{i, j, k});
+                for (std::uint32_t s = r.begin; s < r.end; ++s) {
+                    const Vec3 x = sortedPosition(s);
+                    if (box.contains(x)) fn(mIndex[s], x);
+                }
+            }
+        }
+    }
+}
+
 template <typename Pred>
 inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, Real* distance) const
 {
@@ -214,13 +302,12 @@ inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, R
         const bool closer = r2 < best2 || (r2 == best2 && best != INVALID_INDEX && j < best);
         if (closer && pred(j)) { best2 = r2; best = j; }
     };
-    if (!mPos.empty() && isFinite(x) && maxRadius > Real(0)) {
+    if (!mIndex.empty() && isFinite(x) && maxRadius > Real(0)) {
         const Real maxRingCells = std::ceil(maxRadius * mInvCellSize);
         if (sweepIsCheaper(maxRingCells)) {
             // A search this wide would visit more cells than there are particles.
-            for (std::size_t s = 0; s < mPos.size(); ++s) {
-                const Vec3 xij = x - mPos[s];
-                consider(mIndex[s], xij, Real(0));
+            for (std::uint32_t s = 0; s < mIndex.size(); ++s) {
+                consider(mIndex[s], x - sortedPosition(s), Real(0));
             }
         } else {
             const Cell c = cellOf(x);

@@ -60,6 +60,13 @@ public:
     void reserve(std::size_t n);
     void clear();
 
+    /// Append every particle of `other`, ids included (the caller keeps ids unique). Channels
+    /// of either set that the other lacks are filled with their default value. The id counter
+    /// becomes the larger of the two.
+    void append(const ParticleSet& other);
+    /// The particles i with `keep[i] != 0`, in order, with every channel and the id counter.
+    ParticleSet select(const std::vector<std::uint8_t>& keep) const;
+
     /// Number of particles of one kind.
     std::size_t count(ParticleKind kind) const;
 
@@ -89,6 +96,9 @@ public:
     std::vector<Real>& addScalarChannel(const std::string& name, Real value = Real(0));
     /// Add (or fetch, if it exists) a vector channel filled with `value`.
     std::vector<Vec3>& addVectorChannel(const std::string& name, const Vec3& value = Vec3(0));
+
+    /// Drop a named channel (scalar or vector); nothing happens if it does not exist.
+    void removeChannel(const std::string& name);
 
     bool hasScalarChannel(const std::string& name) const;
     bool hasVectorChannel(const std::string& name) const;

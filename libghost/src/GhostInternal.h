@@ -1,0 +1,69 @@
+/// @file   GhostInternal.h
+/// @brief  What the files of GhostSolver share and nobody else needs: the solid record, channel
+///         names, the Tait equation, the packed nearest-liquid key and a timer.
+#pragma once
+
+#include "ghostfx/ghost/GhostSolver.h"
+
+#include <ghostfx/sph/RigidMotion.h>
+#include <ghostfx/sph/Types.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+
+namespace ghostfx {
+namespace ghost {
+
+/// A solid: its level set (in its local frame), its rigid motion, and whether it moves (a
+/// static solid's particles live in the static block and are never re-placed).
+struct GhostSolver::Solid : sph::MovingLevelSet
+{
+    bool moving;
+};
+
+namespace detail {
+
+using sph::Index;
+using sph::Real;
+
+/// Names of the solver's particle channels (stored in checkpoints: do not rename).
+constexpr const char* VSTAR = "vstar";             ///< v* = v + dt a, Algorithm 3 line 14
+constexpr const char* SOLID_NORMAL = "normal";     ///< solid particle: outward normal, world frame
+constexpr const char* SOLID_INDEX = "solid_index"; ///< solid particle: which solid (index)
+constexpr const char* SOLID_VELOCITY = "solid_v";  ///< moving solid particle: velocity (m/s)
+constexpr const char* SOLID_LOCAL = "solid_x";     ///< moving solid particle: position, solid frame
+constexpr const char* SOLID_LOCAL_NORMAL = "solid_n"; ///< moving solid particle: normal, solid frame
+constexpr const char* AIR_WEIGHT = "air_weight";   ///< ghost air: fade weight, mass = weight m
+constexpr const char* AIR_TARGET = "air_target";   ///< ghost air: 1 fading in / kept, 0 fading out
+
+/// Tait equation of state ([SB12] Sec. 3, Monaghan 1994): p = k ((rho / rho0)^7 - 1).
+inline Real taitPressure(Real rho, Real rho0, Real k)
+{
+    const Real q = rho / rho0;
+    const Real q2 = q * q;
+    return k * (q2 * q2 * q2 * q - Real(1));
+}
+
+/// Nearest-liquid key of a solid particle: the distance in the high 32 bits (as float bits,
+/// which order like the values for r >= 0) and the liquid index in the low ones, so the
+/// smallest key is the nearest liquid particle and, at equal distance, the lowest index. Taking
+/// the minimum is order-independent: any thread count gives the same answer.
+constexpr std::uint64_t NO_LIQUID = ~std::uint64_t(0);
+inline std::uint64_t nearestKey(Real r, Index liquid)
+{
+    const float f = float(r);
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    return std::uint64_t(bits) << 32 | liquid;
+}
+inline Index nearestIndex(std::uint64_t key) { return Index(key & 0xffffffffu); }
+
+inline double secondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+} // namespace detail
+} // namespace ghost
+} // namespace ghostfx

@@ -1,0 +1,420 @@
+/// @file   GhostStep.cc
+/// @brief  [SB12] Algorithm 3, one step: one neighbour search, then density (Eq. 1) with the
+///         ghost solids' density (lines 5-7), pressure (lines 8-10), pressure force (lines
+///         11-14), ghost solid velocity (Eq. 3, lines 15-18), XSPH (Eq. 2, lines 19-21), air
+///         velocity (lines 22-25) and positions (lines 26-28); then collisions and the blow-up
+///         check.
+/// @details Every pass reads the neighbour lists of the step (searchNeighbors): liquid to liquid
+///          and air, and liquid to the particles of each solid block. The nearest liquid particle
+///          of a solid particle, which lines 5-7 and 15-18 need, is found in the density pass
+///          from the same lists, as the minimum of a packed (distance, index) key: the solid
+///          particles no liquid reaches are never visited.
+#include "ghostfx/ghost/GhostSolver.h"
+
+#include "GhostInternal.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/PairBatch.h>
+#include <ghostfx/sph/Parallel.h>
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+
+namespace ghostfx {
+namespace ghost {
+
+using namespace sph;
+using namespace detail;
+
+namespace {
+
+/// *target = min(*target, key); true for the one caller that replaced NO_LIQUID.
+inline bool atomicMin(std::uint64_t* target, std::uint64_t key)
+{
+    std::uint64_t old = __atomic_load_n(target, __ATOMIC_RELAXED);
+    while (key < old) {
+        if (__atomic_compare_exchange_n(target, &old, key, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+            return old == NO_LIQUID;
+        }
+    }
+    return false;
+}
+
+} // namespace
+
+void GhostSolver::prepareSolidBlocks()
+{
+    // Forget the last step's extrapolation (only where it was made), then re-sort the blocks
+    // whose particles changed or moved.
+    for (SolidBlock* b : {&mStatic, &mMoving}) {
+        for (Index k : b->touched) b->nearest[k] = NO_LIQUID;
+        b->touched.clear();
+        if (b->block.stale()) b->block.rebuild();
+        const std::size_t n = b->block.size();
+        if (b->nearest.size() != n) b->nearest.assign(n, NO_LIQUID);
+        if (b->rho.size() != n) {
+            b->rho.resize(n);
+            b->p.resize(n);
+            b->pOverRho2.resize(n);
+            b->vstar.resize(n);
+        }
+    }
+}
+
+void GhostSolver::searchNeighbors()
+{
+    // Sort liquid and air by cell so every pass streams through memory, then search once:
+    // each liquid particle's neighbours among liquid and air, and in each solid block.
+    mGrid.sortParticles(mParticles);
+    const std::size_t n = mParticles.size();
+    const auto& kind = mParticles.kinds();
+    mQueryMask.resize(n);
+    parallel::forEach(0, n, [&](std::size_t i) {
+        mQueryMask[i] = kind[i] == ParticleKind::Liquid;
+    }, 4096);
+    const Real R = mSettings.supportRadius();
+    const Vec3* x = mParticles.positions().data();
+    mFluidLists.build(mGrid, x, n, R, mQueryMask.data());
+    for (SolidBlock* b : {&mStatic, &mMoving}) b->lists.build(b->block.grid(), x, n, R, mQueryMask.data());
+}
+
+void GhostSolver::computeDensity()
+{
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& kind = mParticles.kinds();
+    auto& rho = mParticles.densities();
+    const Real rho0 = mSettings.restDensity;
+    const bool ghost = mSettings.method == Method::Ghost;
+    SolidBlock* blocks[2] = {&mStatic, &mMoving};
+
+    // Eq. 1 for liquid particles: Ghost SPH sums over every kind, Basic SPH over liquid only
+    // (it has no air, and its boundary particles act through Lennard-Jones forces instead).
+    // Ghost SPH also finds each solid particle's nearest liquid particle (lines 5-7).
+    std::vector<std::uint32_t> neighbours(n, 0);
+    std::mutex touchedMutex;
+    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        std::vector<Index> firstTouch[2];
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) {
+                rho[i] = rho0;
+                continue;
+            }
+            const Vec3 xi = x[i];
+            const NeighborLists::List fluid = mFluidLists[i];
+            Real sum = 0;
+            batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
+                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                sum += b.sum(b.f);
+            });
+            std::size_t count = fluid.size();
+            for (int k = 0; ghost && k < 2; ++k) {
+                SolidBlock& block = *blocks[k];
+                const NeighborLists::List solid = block.lists[i];
+                Real w = 0;
+                batch.forEachBatch(xi, block.block.particles().positions().data(), solid, [&](PairBatch& b) {
+                    for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
+                    w += b.sum(b.f);
+                    for (int c = 0; c < b.n; ++c) {
+                        if (atomicMin(&block.nearest[b.j[c]], nearestKey(b.r[c], Index(i)))) {
+                            firstTouch[k].push_back(b.j[c]);
+                        }
+                    }
+                });
+                sum += mMass * w;
+                count += solid.size();
+            }
+            rho[i] = sum;
+            neighbours[i] = std::uint32_t(count);
+        }
+        if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
+            std::lock_guard<std::mutex> lock(touchedMutex);
+            for (int k = 0; k < 2; ++k) {
+                blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(), firstTouch[k].end());
+            }
+        }
+    }, 512);
+    const double liquidCount = parallel::sum(0, n, [&](std::size_t i) {
+        return kind[i] == ParticleKind::Liquid ? 1.0 : 0.0;
+    });
+    const double pairs = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); });
+    mMeanNeighbors = pairs / std::max(1.0, liquidCount);
+    mPairCount = std::size_t(pairs);
+
+    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0).
+    auto& p = mParticles.pressures();
+    parallel::forEach(0, n, [&](std::size_t i) {
+        p[i] = taitPressure(rho[i], rho0, mSettings.stiffness);
+    }, 2048);
+
+    // Lines 5-7: a ghost solid takes the density (and so the pressure) of its nearest liquid
+    // particle. The order of `touched` depends on the threads; nothing below depends on it.
+    for (SolidBlock* b : blocks) {
+        parallel::forEach(0, b->touched.size(), [&](std::size_t t) {
+            const Index s = b->touched[t];
+            const Index j = nearestIndex(b->nearest[s]);
+            b->rho[s] = rho[j];
+            b->p[s] = p[j];
+            b->pOverRho2[s] = p[j] / sqr(rho[j]);
+        }, 1024);
+    }
+}
+
+void GhostSolver::extrapolateSolidVelocity()
+{
+    // Lines 15-18: ghost solid velocity, Eq. 3: the solid's normal velocity and the nearest
+    // liquid particle's tangential one (free slip), or the solid's velocity (no slip).
+    const auto& vstar = mParticles.vectorChannel(VSTAR);
+    const bool freeSlip = mSettings.solidSlip == SolidSlip::Free;
+    for (SolidBlock* b : {&mStatic, &mMoving}) {
+        const ParticleSet& set = b->block.particles();
+        if (b->touched.empty()) continue;
+        const auto& normal = set.vectorChannel(SOLID_NORMAL);
+        const std::vector<Vec3>* solidV =
+            set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
+        parallel::forEach(0, b->touched.size(), [&](std::size_t t) {
+            const Index s = b->touched[t];
+            const Vec3 vs = solidV ? (*solidV)[s] : Vec3(0);
+            if (!freeSlip) {
+                b->vstar[s] = vs;
+                return;
+            }
+            const Vec3& nrm = normal[s];
+            const Vec3& vl = vstar[nearestIndex(b->nearest[s])];
+            b->vstar[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
+        }, 1024);
+    }
+}
+
+void GhostSolver::stepGhost(Real dt)
+{
+    // Line 1: resample the air every airResampleSteps steps (the first step always has air),
+    // then move every fading air particle's weight one step towards its target.
+    prepareSolidBlocks();
+    if (mStep > 0 && mStep % std::uint64_t(mSettings.airResampleSteps) == 0) resampleAir();
+    fadeAir();
+
+    auto t0 = std::chrono::steady_clock::now();
+    searchNeighbors();
+    mTimings.sortAndSearch += secondsSince(t0);
+    computeDensity();
+    mTimings.neighborsAndDensity += secondsSince(t0);
+
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& rho = mParticles.densities();
+    const auto& p = mParticles.pressures();
+    const auto& kind = mParticles.kinds();
+    auto& v = mParticles.velocities();
+    auto& vstar = mParticles.vectorChannel(VSTAR);
+    const Vec3 g = mSettings.gravity;
+    const Real M = mMass;
+
+    // Lines 11-14: liquid acceleration from gravity and Monaghan's symmetric pressure gradient
+    // over every neighbour, v* = v + dt a.
+    t0 = std::chrono::steady_clock::now();
+    mScratch.resize(n);
+    parallel::forEach(0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);
+    std::vector<Real> accel(n, Real(0));
+    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) {
+                vstar[i] = v[i];
+                continue;
+            }
+            const Vec3 xi = x[i];
+            const Real pi = mScratch[i];
+            // The particle itself is in its list: r = 0 gives grad W = 0.
+            Vec3 a = g;
+            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + mScratch[b.j[k]]);
+                for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
+                a += b.sumScaledOffsets(b.f);
+            });
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                const Real* ratio = block->pOverRho2.data();
+                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
+                                   [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = M * (pi + ratio[b.j[k]]);
+                    for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
+                    a += b.sumScaledOffsets(b.f);
+                });
+            }
+            vstar[i] = v[i] + dt * a;
+            accel[i] = a.length();
+        }
+    }, 512);
+    mMaxAcceleration = *std::max_element(accel.begin(), accel.end());
+    mTimings.pressureForce += secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    extrapolateSolidVelocity();
+
+    // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid
+    // neighbours only: air would bias the outermost particles ([SB12] Sec. 4.3). The weight
+    // eps m_j / rho_j of each neighbour is computed once (zero for air).
+    const Real eps = mSettings.xsphEpsilon, epsSolid = mSettings.solidEpsilon;
+    parallel::forEach(0, n, [&](std::size_t j) {
+        mScratch[j] = kind[j] == ParticleKind::GhostAir ? Real(0) : eps * m[j] / rho[j];
+    }, 2048);
+    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) continue;
+            const Vec3 xi = x[i], vi = vstar[i];
+            // The particle itself adds w W(0) (v_i - v_i) = 0.
+            Vec3 dv(0);
+            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = mScratch[b.j[k]];
+                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                dv += b.sumScaledDifferences(b.f, vstar.data(), vi);
+            });
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                const Real* rhoSolid = block->rho.data();
+                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
+                                   [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = epsSolid * M / rhoSolid[b.j[k]];
+                    for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                    dv += b.sumScaledDifferences(b.f, block->vstar.data(), vi);
+                });
+            }
+            v[i] = vi + dv;
+        }
+    }, 512);
+
+    // Lines 22-25: air takes the new velocity of its nearest liquid particle (searched up to two
+    // kernel radii: air advects between resamplings and may drift a little).
+    const Real R = mSettings.supportRadius();
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] != ParticleKind::GhostAir) return;
+        const Index j = nearestLiquid(x[i], Real(2) * R);
+        if (j != INVALID_INDEX) v[i] = v[j];
+    });
+
+    // Lines 26-28: positions of liquid and air.
+    auto& xw = mParticles.positions();
+    parallel::forEach(0, n, [&](std::size_t i) { xw[i] += dt * v[i]; }, 4096);
+    mTimings.xsphAndBoundary += secondsSince(t0);
+}
+
+// The step ----------------------------------------------------------------------------------------
+
+void GhostSolver::step(Real dt)
+{
+    if (!(dt > Real(0)) || !std::isfinite(dt)) {
+        throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
+    }
+    checkRestoredInputs();
+    const bool fresh = !mInitialized;
+    initialize();
+    const auto start = std::chrono::steady_clock::now();
+    // Algorithm 3 line 1: new liquid from the emitters (the first step's was added by
+    // initialize(), before the mass scaling).
+    if (!fresh && !mEmitters.empty()) {
+        const auto t0 = std::chrono::steady_clock::now();
+        emit();
+        mTimings.emission += secondsSince(t0);
+    }
+    if (mSettings.method == Method::Ghost) stepGhost(dt);
+    else stepBasic(dt);
+
+    const double t1 = mTime + double(dt);
+    moveSolids(t1);
+    mTime = t1;
+    ++mStep;
+    projectOutOfSolids(dt);
+    applyKillBox();
+    checkBlowUp();
+    mTimings.total += secondsSince(start);
+    ++mTimings.steps;
+    if (mObserver) mObserver(*this, dt);
+}
+
+// Collisions and blow-up -------------------------------------------------------------------------
+
+Index GhostSolver::nearestLiquid(const Vec3& x, Real maxRadius) const
+{
+    return mGrid.nearestOfKind(x, mParticles.kinds(), ParticleKind::Liquid, maxRadius);
+}
+
+void GhostSolver::projectOutOfSolids(Real dt)
+{
+    if (mSolids.empty()) return;
+    const auto start = std::chrono::steady_clock::now();
+    auto& x = mParticles.positions();
+    auto& v = mParticles.velocities();
+    const auto& kind = mParticles.kinds();
+    const double time = mTime;
+    std::vector<RigidTransform> placement;
+    for (const auto& solid : mSolids) placement.push_back(solid->at(time));
+    // Only particles near a solid can have entered it. A liquid particle with no solid particle
+    // within R at the start of the step is at least R - 2h from every solid surface (surface
+    // samples lie about h apart); it cannot have crossed that this step unless it, or a moving
+    // solid, went farther. After a solid changed shape every particle is tested.
+    const Real h = mSettings.spacing;
+    const Real margin = std::max(Real(0), mSettings.supportRadius() - Real(2) * h);
+    const bool all = mProjectAll || mFluidLists.size() != mParticles.size();
+    const Real solidSpeed = mMaxSolidSpeed;
+    // [SB12] Sec. 3 "Solid Collisions": a liquid particle inside a solid goes back to its
+    // surface (level-set closest point) and loses the velocity that points into the solid.
+    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Liquid) return;
+        const bool near = all || !mStatic.lists[i].empty() || !mMoving.lists[i].empty() ||
+                          dt * (v[i].length() + solidSpeed) >= margin;
+        if (!near) return;
+        for (std::size_t b = 0; b < mSolids.size(); ++b) {
+            const Solid& solid = *mSolids[b];
+            const RigidTransform& xf = placement[b];
+            const Vec3 local = xf.toLocal(x[i]);
+            if (!(solid.shape.phi(local) < Real(0))) continue;
+            const SurfaceProjection proj = solid.shape.projectToSurface(local);
+            if (!proj.converged) continue; // deeper than the band: left for the blow-up check
+            const Vec3 nrm = xf.rotation * solid.shape.normal(proj.point);
+            x[i] = xf.toWorld(proj.point);
+            const Real vn = (v[i] - solid.velocity(proj.point, time)).dot(nrm);
+            if (vn < Real(0)) v[i] -= vn * nrm;
+        }
+    });
+    mProjectAll = false;
+    mTimings.xsphAndBoundary += secondsSince(start);
+}
+
+void GhostSolver::checkBlowUp() const
+{
+    const Real limit = mSettings.speedLimit();
+    const Real limit2 = limit * limit;
+    const auto& x = mParticles.positions();
+    const auto& v = mParticles.velocities();
+    const std::size_t n = mParticles.size();
+    std::atomic<std::size_t> bad{n};
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (isFinite(x[i]) && isFinite(v[i]) && v[i].lengthSqr() <= limit2) return;
+        std::size_t expected = bad.load();
+        while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
+    }, 4096);
+    const std::size_t i = bad.load();
+    if (i == n) return;
+    const char* kind = kindName(mParticles.kinds()[i]);
+    if (!isFinite(x[i]) || !isFinite(v[i])) {
+        throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep,
+                                 " (t = ", mTime, " s): ", kind, " particle id ", mParticles.ids()[i],
+                                 " has a non-finite position or velocity; reduce the time step "
+                                 "(substeps / cflNumber) or the stiffness"));
+    }
+    throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep, " (t = ",
+                             mTime, " s): ", kind, " particle id ", mParticles.ids()[i], " moves at ",
+                             v[i].length(), " m/s, beyond maxSpeed = ", limit,
+                             " m/s; reduce the time step (substeps / cflNumber) or the stiffness"));
+}
+
+} // namespace ghost
+} // namespace ghostfx

@@ -1,0 +1,223 @@
+/// @file   NeighborLists.cc
+/// @brief  The search behind NeighborLists::build: cached stencils, per-query cell culling and a
+///         branch-free distance filter.
+#include "ghostfx/sph/NeighborLists.h"
+
+#include "ghostfx/sph/Exceptions.h"
+#include "ghostfx/sph/Parallel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace ghostfx {
+namespace sph {
+
+namespace {
+
+/// Candidates per distance batch (the width of a hit mask).
+constexpr std::uint32_t BATCH = 64;
+
+/// Left-packing table for four lanes: for a 4-bit hit mask, the lane numbers of its set bits
+/// in increasing order (unused entries 0), and how many there are.
+struct PackTable
+{
+    alignas(16) std::int32_t lanes[16][4];
+    std::uint8_t count[16];
+    constexpr PackTable() : lanes(), count()
+    {
+        for (int m = 0; m < 16; ++m) {
+            int c = 0;
+            for (int b = 0; b < 4; ++b) {
+                if (m & (1 << b)) lanes[m][c++] = b;
+            }
+            count[m] = std::uint8_t(c);
+        }
+    }
+};
+constexpr PackTable PACK;
+
+/// Append `first + k` to dst (from index `used`) for every k < len with r2[k] < radius2, in
+/// increasing k; returns the new count. Branch-free: with SSE2 and float, four lanes are
+/// compared at a time and their hits left-packed through a 16-entry table (an unconditional
+/// 4-wide store, advanced by the hit count); otherwise a scalar compaction. dst must have room
+/// for len + 3 more entries, and r2 for a multiple of four (the caller pads with zeros; lanes
+/// at or beyond len are masked off).
+inline std::size_t appendHits(const Real* r2, std::size_t len, Real radius2, std::uint32_t first,
+                              Index* dst, std::size_t used)
+{
+#if defined(__SSE2__) && !defined(GHOSTFX_DOUBLE)
+    const __m128 limit = _mm_set1_ps(radius2);
+    for (std::size_t k = 0; k < len; k += 4) {
+        int mask = _mm_movemask_ps(_mm_cmplt_ps(_mm_load_ps(r2 + k), limit));
+        if (len - k < 4) mask &= (1 << (len - k)) - 1;
+        const __m128i lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(PACK.lanes[mask]));
+        const __m128i index = _mm_add_epi32(lanes, _mm_set1_epi32(std::int32_t(first + k)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + used), index);
+        used += PACK.count[mask];
+    }
+#else
+    for (std::size_t k = 0; k < len; ++k) {
+        dst[used] = first + Index(k);
+        used += std::size_t(r2[k] < radius2);
+    }
+#endif
+    return used;
+}
+
+/// The occupied cells of the 3 x 3 x 3 block around one cell: their slot ranges and their
+/// offset (di, dj, dk) + 1 from the centre.
+struct Stencil
+{
+    NeighborGrid::Cell centre{std::numeric_limits<std::int32_t>::min(), 0, 0};
+    int count = 0;
+    NeighborGrid::SlotRange range[27];
+    std::uint8_t offset[27][3];
+
+    void lookUp(const NeighborGrid& grid, const NeighborGrid::Cell& c)
+    {
+        centre = c;
+        count = 0;
+        for (int di = 0; di < 3; ++di) {
+            for (int dj = 0; dj < 3; ++dj) {
+                for (int dk = 0; dk < 3; ++dk) {
+                    const NeighborGrid::SlotRange r =
+                        grid.cellSlots({c.i + di - 1, c.j + dj - 1, c.k + dk - 1});
+                    if (r.empty()) continue;
+                    range[count] = r;
+                    offset[count][0] = std::uint8_t(di);
+                    offset[count][1] = std::uint8_t(dj);
+                    offset[count][2] = std::uint8_t(dk);
+                    ++count;
+                }
+            }
+        }
+    }
+};
+
+} // namespace
+
+void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
+                          Real radius, const std::uint8_t* wanted)
+{
+    if (!(radius > Real(0)) || radius > targets.cellSize()) {
+        throw ValueError(msg("neighbour lists: radius ", radius, " m: expected > 0 and at most the "
+                             "grid's cell size ", targets.cellSize(), " m"));
+    }
+    const std::size_t chunks = (count + CHUNK - 1) / CHUNK;
+    mEnd.resize(count);
+    if (mChunks.size() < chunks) mChunks.resize(chunks);
+    const Real radius2 = radius * radius;
+    const Real cellSize = targets.cellSize();
+    const Real* X = targets.sortedX();
+    const Real* Y = targets.sortedY();
+    const Real* Z = targets.sortedZ();
+    const bool empty = targets.size() == 0;
+
+    parallel::forEach(0, chunks, [&](std::size_t chunk) {
+        Chunk& out = mChunks[chunk];
+        std::size_t used = 0;
+        Stencil stencil;
+        alignas(16) Real r2[BATCH] = {};
+        const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
+        for (std::size_t q = chunk * CHUNK; q < qEnd; ++q) {
+            if (empty || (wanted && !wanted[q]) || !isFinite(queries[q])) {
+                mEnd[q] = std::uint32_t(used);
+                continue;
+            }
+            const Vec3& x = queries[q];
+            const NeighborGrid::Cell c = targets.cellOf(x);
+            if (c != stencil.centre) stencil.lookUp(targets, c);
+            // Squared distance from x to the slab of each neighbouring cell, per axis: 0 for its
+            // own cell, the distance to the lower / upper face for the others. A cell is
+            // reachable when the sum over the axes is below R^2. The faces are moved out by a
+            // small slack, so float rounding in the cell assignment never drops a neighbour.
+            Real axis2[3][3];
+            const Real cell[3] = {Real(c.i), Real(c.j), Real(c.k)};
+            for (int a = 0; a < 3; ++a) {
+                const Real slack = Real(1e-3) * cellSize + Real(1e-5) * std::abs(x[a]);
+                const Real lo = x[a] - cell[a] * cellSize;
+                const Real below = std::max(Real(0), lo - slack);
+                const Real above = std::max(Real(0), cellSize - lo - slack);
+                axis2[a][0] = below * below;
+                axis2[a][1] = 0;
+                axis2[a][2] = above * above;
+            }
+            const Real qx = x[0], qy = x[1], qz = x[2];
+            // Reachable cells whose slots follow each other (neighbours along z usually do: z
+            // is the lowest Morton bit) are searched as one range.
+            auto search = [&](NeighborGrid::SlotRange range) {
+                out.reserve(used + (range.end - range.begin) + 4, used);
+                Index* dst = out.data.get();
+                for (std::uint32_t s0 = range.begin; s0 < range.end; s0 += BATCH) {
+                    const std::size_t len = std::min<std::size_t>(BATCH, range.end - s0);
+                    const std::size_t padded = (len + 3) & ~std::size_t(3);
+                    const Real* xs = X + s0;
+                    const Real* ys = Y + s0;
+                    const Real* zs = Z + s0;
+                    // Distances first (vectorises; the grid pads its arrays, so reading up to
+                    // three slots past the range is safe), then the hits.
+                    for (std::size_t k = 0; k < padded; ++k) {
+                        const Real dx = qx - xs[k], dy = qy - ys[k], dz = qz - zs[k];
+                        r2[k] = dx * dx + dy * dy + dz * dz;
+                    }
+                    used = appendHits(r2, len, radius2, s0, dst, used);
+                }
+            };
+            NeighborGrid::SlotRange run;
+            for (int n = 0; n < stencil.count; ++n) {
+                const std::uint8_t* o = stencil.offset[n];
+                if (axis2[0][o[0]] + axis2[1][o[1]] + axis2[2][o[2]] >= radius2) continue;
+                const NeighborGrid::SlotRange range = stencil.range[n];
+                if (!run.empty() && range.begin == run.end) {
+                    run.end = range.end;
+                    continue;
+                }
+                if (!run.empty()) search(run);
+                run = range;
+            }
+            if (!run.empty()) search(run);
+            if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
+                throw ValueError("neighbour lists: more than 2^32 pairs in one chunk");
+            }
+            mEnd[q] = std::uint32_t(used);
+        }
+        // Slots to particle indices (nothing to do for a grid over a sorted set).
+        if (!targets.identityOrder()) {
+            Index* dst = out.data.get();
+            for (std::size_t k = 0; k < used; ++k) dst[k] = targets.particleAt(dst[k]);
+        }
+    }, 1);
+}
+
+void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)
+{
+    if (size <= capacity) return;
+    const std::size_t grown = std::max(size, capacity + capacity / 2 + 1024);
+    std::unique_ptr<Index[]> bigger(new Index[grown]);
+    if (used > 0) std::copy(data.get(), data.get() + used, bigger.get());
+    data = std::move(bigger);
+    capacity = grown;
+}
+
+std::size_t NeighborLists::pairCount() const
+{
+    std::size_t total = 0;
+    for (std::size_t q = CHUNK - 1; q < mEnd.size(); q += CHUNK) total += mEnd[q];
+    if (mEnd.size() % CHUNK != 0) total += mEnd.back();
+    return total;
+}
+
+std::size_t NeighborLists::memoryBytes() const
+{
+    std::size_t bytes = mEnd.capacity() * sizeof(std::uint32_t);
+    for (const auto& c : mChunks) bytes += c.capacity * sizeof(Index);
+    return bytes;
+}
+
+} // namespace sph
+} // namespace ghostfx
