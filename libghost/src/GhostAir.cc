@@ -1,10 +1,19 @@
 /// @file   GhostAir.cc
 /// @brief  The ghost air layer of [SB12] Sec. 4.3: sampled around the liquid body, kept where it
 ///         still belongs, faded in and out between resamplings.
+/// @details Resampling runs right after the step's neighbour search and reuses it: the grid of
+///          liquid and air answers the nearest-body and inside-the-liquid questions, and the
+///          liquid particles' lists give each one's liquid-and-solid indicator. New air grows
+///          only from the particles near the free surface (and the kept air): growth from a
+///          particle deeper than 2r lands inside the liquid and is refused anyway, so seeding
+///          from the whole body (as before) spent most of the resampling on rejected candidates.
+///          New air starts at weight 0 and is appended after the lists were built; it takes part
+///          in the sums from the next step on.
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "GhostInternal.h"
 
+#include <ghostfx/sph/PairBatch.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/PoissonSampler.h>
 
@@ -16,111 +25,134 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-// [SB12] Sec. 4.3: ghost air ------------------------------------------------------------------
+namespace {
+
+/// A liquid particle seeds new air when its liquid-and-solid indicator is below this fraction
+/// of the interior value: at the free surface the indicator is about one half, and it reaches
+/// 0.97 about 1.5 h deep (cubic spline, support 3 h), below the 2r = 1.84 h that Bridson's
+/// annulus reaches out of the liquid.
+constexpr Real SURFACE_SEED_FRACTION = Real(0.97);
+
+} // namespace
 
 void GhostSolver::resampleAir()
 {
+    // Needs the grid and lists of searchNeighbors() for the current positions.
     const auto start = std::chrono::steady_clock::now();
-    prepareSolidBlocks();
     const Real R = mSettings.supportRadius();
     const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
     const double time = mTime;
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& kind = mParticles.kinds();
 
-    std::vector<Vec3> liquid, liquidV;
-    for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
-        liquid.push_back(mParticles.positions()[i]);
-        liquidV.push_back(mParticles.velocities()[i]);
-    }
-    if (liquid.empty()) return;
-    NeighborGrid liquidGrid(R);
-    liquidGrid.build(liquid);
-
-    // The liquid body: particles with at least one liquid neighbour. Isolated particles move
-    // ballistically and get no air ([SB12] Sec. 4.5); like the solids they are obstacles the
-    // new air keeps r away from. Air lives within a kernel radius of the body only, so escaped
-    // spray neither attracts air nor stretches the sampling region.
-    std::vector<Vec3> body, bodyV, obstacles;
-    Aabb bounds;
-    for (std::size_t i = 0; i < liquid.size(); ++i) {
-        int n = 0;
-        liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real) { ++n; });
-        if (n > 1) {
-            body.push_back(liquid[i]);
-            bodyV.push_back(liquidV[i]);
-            bounds.expand(liquid[i]);
-        } else {
-            obstacles.push_back(liquid[i]);
+    // 1. Per liquid particle: its liquid-and-solid indicator sum_j W_ij (ghost solids count:
+    //    the thin gap between liquid and a wall is not free surface, and air there would hold
+    //    the liquid off the wall) and whether it has a liquid neighbour. Particles without one
+    //    move ballistically and get no air ([SB12] Sec. 4.5): like the solids they are
+    //    obstacles the new air keeps r away from. Air lives within a kernel radius of the body
+    //    only, so escaped spray neither attracts air nor stretches the sampling region.
+    std::vector<Real> indicator(n, Real(0));
+    std::vector<std::uint8_t> body(n, 0);
+    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) continue;
+            Real sum = 0;
+            int liquidNeighbours = 0;
+            batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = Real(kind[b.j[k]] == ParticleKind::Liquid);
+                for (int k = 0; k < b.n; ++k) liquidNeighbours += int(b.f[k]);
+                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                sum += b.sum(b.f);
+            });
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                batch.forEachBatch(x[i], block->block.particles().positions().data(), block->lists[i],
+                                   [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
+                    sum += b.sum(b.f);
+                });
+            }
+            indicator[i] = sum;
+            body[i] = liquidNeighbours > 1;
         }
+    }, 512);
+    Aabb bounds;
+    std::size_t bodyCount = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!body[i]) continue;
+        bounds.expand(x[i]);
+        ++bodyCount;
     }
-    NeighborGrid bodyGrid(R);
-    bodyGrid.build(body);
-    auto nearBody = [&](const Vec3& x, Real* distance = nullptr) {
-        return bodyGrid.nearest(x, R, [](Index) { return true; }, distance);
+    if (bodyCount == 0) {
+        mTimings.airResampling += secondsSince(start);
+        return;
+    }
+    auto nearBody = [&](const Vec3& q, Real* distance = nullptr) {
+        return mGrid.nearest(q, R, [&](Index j) { return body[j] != 0; }, distance);
     };
-
-    auto insideSolid = [&](const Vec3& x) {
+    auto insideSolid = [&](const Vec3& q) {
         for (const auto& solid : mSolids) {
-            if (solid->phi(x, time) < Real(0)) return true;
+            if (solid->phi(q, time) < Real(0)) return true;
         }
         return false;
     };
-    // Inside the liquid: its smoothed indicator sum_j W(x - x_j) / n0, with n0 = rho0 / m the
-    // interior value, exceeds one half there (the free surface is its half level). The
-    // Poisson test alone is not enough: a relaxed liquid has holes a little wider than r
-    // (tests/sph/test_sampler.cc measures 1.05 - 1.1 r), and air seeded into them would sit
-    // inside the liquid with p = 0, adding mass where there is no free surface.
-    // Interior value n0 of sum_j W: rho0 / m once the mass is known; before (the first layer)
-    // the 75th percentile of the liquid particles' own sums, which lies in the interior.
+
+    // 2. Inside the liquid: its smoothed indicator sum_j W(x - x_j) / n0, with n0 = rho0 / m the
+    //    interior value, exceeds one half there (the free surface is its half level). The
+    //    Poisson test alone is not enough: a relaxed liquid has holes a little wider than r
+    //    (tests/sph/test_sampler.cc measures 1.05 - 1.1 r), and air seeded into them would sit
+    //    inside the liquid with p = 0, adding mass where there is no free surface. Before the
+    //    mass is known (the first layer), n0 is the 75th percentile of the liquid particles'
+    //    own sums, which lies in the interior.
     Real n0 = 0;
     if (mMass > Real(0)) {
         n0 = mSettings.restDensity / mMass;
     } else {
-        std::vector<Real> sums(liquid.size());
-        parallel::forEach(0, liquid.size(), [&](std::size_t i) {
-            Real sum = 0;
-            liquidGrid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real rij) {
-                sum += mKernel.W(rij);
-            });
-            sums[i] = sum;
-        });
+        std::vector<Real> sums;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (kind[i] == ParticleKind::Liquid) sums.push_back(indicator[i]);
+        }
         std::nth_element(sums.begin(), sums.begin() + sums.size() * 3 / 4, sums.end());
         n0 = sums[sums.size() * 3 / 4];
     }
-    // The indicator counts ghost solids too (through their blocks' grids): the thin gap between
-    // liquid and a wall is not free surface, and air there would hold the liquid off the wall.
-    auto insideLiquid = [&](const Vec3& x) {
+    auto insideLiquid = [&](const Vec3& q) {
         Real sum = 0;
-        auto add = [&](Index, const Vec3&, Real rij) { sum += mKernel.W(rij); };
-        liquidGrid.forEachInRadius(x, R, add);
-        for (const SolidBlock* b : {&mStatic, &mMoving}) b->block.grid().forEachInRadius(x, R, add);
+        mGrid.forEachInRadius(q, R, [&](Index j, const Vec3&, Real rij) {
+            if (kind[j] == ParticleKind::Liquid) sum += mKernel.W(rij);
+        });
+        for (const SolidBlock* b : {&mStatic, &mMoving}) {
+            b->block.grid().forEachInRadius(q, R, [&](Index, const Vec3&, Real rij) { sum += mKernel.W(rij); });
+        }
         return sum > Real(0.5) * n0;
     };
 
-    // Keep the air that is still where the layer should be: within a kernel radius of the
-    // liquid body, no closer to it than a fraction of r, outside solids and the liquid, and not
-    // crowded (air advected with converging liquid bunches up: of two air particles closer than
-    // that fraction of r, the later one goes). The rest fades out, and new air fades in, over the
-    // steps until the next resampling: replacing the whole layer at once (as [SB12] Sec. 4.3
-    // describes) makes the surface density jump by a few percent at every resampling, which with
-    // the paper's soft stiffness pumps energy into the liquid; fading is the remedy [SB12]
-    // Sec. 4.7 suggests.
+    // 3. Keep the air that is still where the layer should be: within a kernel radius of the
+    //    liquid body, no closer to it than a fraction of r, outside solids and the liquid, and
+    //    not crowded (air advected with converging liquid bunches up: of two air particles
+    //    closer than that fraction of r, the later one goes). The rest fades out, and new air
+    //    fades in, over the steps until the next resampling: replacing the whole layer at once
+    //    (as [SB12] Sec. 4.3 describes) makes the surface density jump by a few percent at
+    //    every resampling, which with the paper's soft stiffness pumps energy into the liquid;
+    //    fading is the remedy [SB12] Sec. 4.7 suggests.
     const Real keepDistance = mSettings.airKeepFraction * r;
     auto& target = mParticles.scalarChannel(AIR_TARGET);
-    const std::size_t n = mParticles.size();
     std::vector<std::uint8_t> keep(n, 0);
     parallel::forEach(0, n, [&](std::size_t i) {
-        if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
-        const Vec3& x = mParticles.positions()[i];
+        if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
         Real d = -1;
-        keep[i] = nearBody(x, &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x) &&
-                  !insideLiquid(x);
+        keep[i] = nearBody(x[i], &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x[i]) &&
+                  !insideLiquid(x[i]);
     });
     if (keepDistance > Real(0)) {
         std::vector<Vec3> airX;
         std::vector<std::size_t> airIndex;
         for (std::size_t i = 0; i < n; ++i) {
-            if (keep[i]) { airX.push_back(mParticles.positions()[i]); airIndex.push_back(i); }
+            if (keep[i]) {
+                airX.push_back(x[i]);
+                airIndex.push_back(i);
+            }
         }
         NeighborGrid airGrid(keepDistance);
         airGrid.build(airX);
@@ -130,25 +162,25 @@ void GhostSolver::resampleAir()
             });
         }
     }
-    std::vector<Vec3> seeds = body;
+
+    // 4. Seeds: the body's particles near the free surface and the kept air; obstacles: the
+    //    rest of the liquid and the solid particles near the layer. Fading air is no obstacle:
+    //    the new layer cross-fades with it.
+    std::vector<Vec3> seeds, obstacles;
     for (std::size_t i = 0; i < n; ++i) {
-        if (mParticles.kinds()[i] != ParticleKind::GhostAir) continue;
-        if (keep[i]) {
-            seeds.push_back(mParticles.positions()[i]);
+        if (kind[i] == ParticleKind::GhostAir) {
+            if (keep[i]) seeds.push_back(x[i]);
+            else target[i] = Real(0);
+        } else if (body[i] && indicator[i] < SURFACE_SEED_FRACTION * n0) {
+            seeds.push_back(x[i]);
         } else {
-            // Fading air is no obstacle: the new layer cross-fades with it.
-            target[i] = Real(0);
+            obstacles.push_back(x[i]);
         }
     }
-    // Solid particles near the layer are obstacles: the air keeps r from them.
     appendSolidPositionsInBox(bounds.padded(R + Real(2) * r), obstacles);
-    if (body.empty()) {
-        mTimings.airResampling += secondsSince(start);
-        return;
-    }
 
-    auto accept = [&](const Vec3& x) {
-        return nearBody(x) != INVALID_INDEX && !insideSolid(x) && !insideLiquid(x);
+    auto accept = [&](const Vec3& q) {
+        return nearBody(q) != INVALID_INDEX && !insideSolid(q) && !insideLiquid(q);
     };
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
@@ -156,16 +188,17 @@ void GhostSolver::resampleAir()
     const std::vector<Vec3> air =
         PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, bounds.padded(R));
 
+    // 5. The new air: faded in from weight 0 (the very first layer is there from the start),
+    //    with the velocity of the nearest body particle ([SB12] Sec. 4.3).
     const Index first = mParticles.addBatch(air, mMass, ParticleKind::GhostAir);
-    // The very first layer is there from the start; later ones fade in.
     const bool fade = mInitialized;
     auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
-    // Ghost air velocity: the nearest liquid particle's ([SB12] Sec. 4.3).
+    auto& v = mParticles.velocities();
     parallel::forEach(first, mParticles.size(), [&](std::size_t i) {
         weight[i] = fade ? Real(0) : Real(1);
         mParticles.masses()[i] = weight[i] * mMass;
         const Index j = nearBody(mParticles.positions()[i]);
-        mParticles.velocities()[i] = j == INVALID_INDEX ? Vec3(0) : bodyV[j];
+        v[i] = j == INVALID_INDEX ? Vec3(0) : v[j];
         mParticles.densities()[i] = mSettings.restDensity;
     });
     mTimings.airResampling += secondsSince(start);

@@ -420,7 +420,11 @@ void GhostSolver::initialize()
         throw ValueError("liquid solver: no liquid particles (add a liquid body, particles, or an "
                          "emitter active at the start)");
     }
-    if (mSettings.method == Method::Ghost) resampleAir();
+    if (mSettings.method == Method::Ghost) {
+        prepareSolidBlocks();
+        searchNeighbors();
+        resampleAir();
+    }
 
     if (mMass == Real(0)) {
         // [SB12] Sec. 4.6: scale the mass so the liquid's mean density is rho0, measured with a
@@ -448,6 +452,8 @@ void GhostSolver::initialize()
                 if (mParticles.kinds()[i] == ParticleKind::Liquid) liquidOnly.push_back(mParticles.positions()[i]);
             }
             probe->addLiquidParticles(liquidOnly);
+            probe->prepareSolidBlocks();
+            probe->searchNeighbors();
             probe->resampleAir();
             measured = probe.get();
         }

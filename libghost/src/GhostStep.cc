@@ -195,15 +195,19 @@ void GhostSolver::stepGhost(Real dt)
 {
     // Line 1: resample the air every airResampleSteps steps (the first step always has air),
     // then move every fading air particle's weight one step towards its target.
+    // Fading runs first: it removes the air that has faded out, before the sort. New air is
+    // sampled after the search (reusing it) with weight 0, so it has no part in this step's sums.
     prepareSolidBlocks();
-    if (mStep > 0 && mStep % std::uint64_t(mSettings.airResampleSteps) == 0) resampleAir();
     fadeAir();
 
     auto t0 = std::chrono::steady_clock::now();
     searchNeighbors();
-    mTimings.sortAndSearch += secondsSince(t0);
+    const double search = secondsSince(t0);
+    mTimings.sortAndSearch += search;
+    if (mStep > 0 && mStep % std::uint64_t(mSettings.airResampleSteps) == 0) resampleAir();
+    t0 = std::chrono::steady_clock::now();
     computeDensity();
-    mTimings.neighborsAndDensity += secondsSince(t0);
+    mTimings.neighborsAndDensity += search + secondsSince(t0);
 
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
@@ -362,13 +366,14 @@ void GhostSolver::projectOutOfSolids(Real dt)
     // solid, went farther. After a solid changed shape every particle is tested.
     const Real h = mSettings.spacing;
     const Real margin = std::max(Real(0), mSettings.supportRadius() - Real(2) * h);
-    const bool all = mProjectAll || mFluidLists.size() != mParticles.size();
+    const bool all = mProjectAll;
+    const std::size_t listed = mFluidLists.size(); // particles added after the search are air
     const Real solidSpeed = mMaxSolidSpeed;
     // [SB12] Sec. 3 "Solid Collisions": a liquid particle inside a solid goes back to its
     // surface (level-set closest point) and loses the velocity that points into the solid.
     parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
         if (kind[i] != ParticleKind::Liquid) return;
-        const bool near = all || !mStatic.lists[i].empty() || !mMoving.lists[i].empty() ||
+        const bool near = all || i >= listed || !mStatic.lists[i].empty() || !mMoving.lists[i].empty() ||
                           dt * (v[i].length() + solidSpeed) >= margin;
         if (!near) return;
         for (std::size_t b = 0; b < mSolids.size(); ++b) {
@@ -376,8 +381,12 @@ void GhostSolver::projectOutOfSolids(Real dt)
             const RigidTransform& xf = placement[b];
             const Vec3 local = xf.toLocal(x[i]);
             if (!(solid.shape.phi(local) < Real(0))) continue;
-            const SurfaceProjection proj = solid.shape.projectToSurface(local);
-            if (!proj.converged) continue; // deeper than the band: left for the blow-up check
+            SurfaceProjection proj = solid.shape.projectToSurface(local);
+            // At edges and corners the projection can oscillate between cells: step out along
+            // the smooth normal instead. Deeper than the band no direction is known; that
+            // particle is left for the blow-up check.
+            if (!proj.converged) proj = solid.shape.pushOutside(local);
+            if (!proj.converged) continue;
             const Vec3 nrm = xf.rotation * solid.shape.normal(proj.point);
             x[i] = xf.toWorld(proj.point);
             const Real vn = (v[i] - solid.velocity(proj.point, time)).dot(nrm);

@@ -147,6 +147,31 @@ SurfaceProjection LevelSet::projectToSurface(const Vec3& x, Real tolerance, int 
     return result;
 }
 
+SurfaceProjection LevelSet::pushOutside(const Vec3& x, int maxSteps) const
+{
+    const Real clampLimit = mImpl->bandWidth * Real(0.999);
+    const Real slack = Real(1e-3) * mImpl->voxelSize;
+    SurfaceProjection result;
+    result.point = x;
+    for (int it = 0; it <= maxSteps; ++it) {
+        const Real p = phi(result.point);
+        result.residual = std::abs(p);
+        result.iterations = it;
+        if (p >= Real(0)) {
+            result.converged = true;
+            return result;
+        }
+        if (-p >= clampLimit || it == maxSteps) break;
+        // Newton along the smooth gradient: near an edge the interpolated distance rounds off
+        // and its gradient is shorter than one, so a plain step of -phi would creep outward.
+        const Vec3 g = gradient(result.point);
+        const Real g2 = g.lengthSqr();
+        if (!(g2 > Real(1e-12))) break;
+        result.point += g * ((slack - p) / std::max(g2, Real(0.25)));
+    }
+    return result;
+}
+
 std::vector<std::array<std::int32_t, 3>> LevelSet::surfaceCells() const
 {
     std::vector<std::array<std::int32_t, 3>> cells;

@@ -373,7 +373,12 @@ TEST(Resume, BasicFromCheckpointIsBitIdentical)
     // Lennard-Jones strength chosen at the first step must come back. Basic SPH's stiff
     // Lennard-Jones walls need the acceleration limit of the adaptive step (with fixed steps
     // of 1/600 s this scene blows up in frame 3, as tests/ghost/test_extremes.cc describes).
-    checkResume(ResumeScene(Method::Basic, 0, Vec3(Real(0.05), 0, 0)), 4, 2, "basic");
+    // Seed 12: with seed 11 (the Ghost scenes' seed) the emitted jet skims the moving floor and
+    // takes a Lennard-Jones kick at its edge in frame 3 (1 of 12 seeds tried, Basic SPH's known
+    // fragility); this test is about resuming, not about Basic SPH's stability.
+    ResumeScene scene(Method::Basic, 0, Vec3(Real(0.05), 0, 0));
+    scene.settings.seed = 12;
+    checkResume(scene, 4, 2, "basic");
 }
 
 // Statistics --------------------------------------------------------------------------------------

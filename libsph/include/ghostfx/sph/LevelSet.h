@@ -77,6 +77,11 @@ public:
     /// false) when x or an iterate is beyond the band, where no direction to the surface is known.
     SurfaceProjection projectToSurface(const Vec3& x, Real tolerance = Real(-1),
                                        int maxIterations = 20) const;
+    /// Move a point inside (phi < 0) to just outside the surface: Newton steps along the
+    /// smooth (central-difference) gradient until phi >= 0. Where projectToSurface() oscillates
+    /// (at edges and corners the trilinear gradient jumps between cells) this still ends
+    /// outside. Fails (converged = false) beyond the band, where no direction is known.
+    SurfaceProjection pushOutside(const Vec3& x, int maxSteps = 64) const;
 
     /// Index-space coordinates (i, j, k) of every grid cell [i, i+1] x [j, j+1] x [k, k+1] whose
     /// 8 corner samples do not all share a sign: the cells the surface passes through. Sorted.
