@@ -423,7 +423,7 @@ void GhostSolver::initialize()
     if (mSettings.method == Method::Ghost) {
         prepareSolidBlocks();
         searchNeighbors();
-        resampleAir();
+        resampleAir(-1);
     }
 
     if (mMass == Real(0)) {
@@ -454,7 +454,7 @@ void GhostSolver::initialize()
             probe->addLiquidParticles(liquidOnly);
             probe->prepareSolidBlocks();
             probe->searchNeighbors();
-            probe->resampleAir();
+            probe->resampleAir(-1);
             measured = probe.get();
         }
         const ParticleSet all = measured->allParticles();
@@ -520,7 +520,7 @@ ParticleSet GhostSolver::allParticles() const
 std::size_t GhostSolver::memoryBytes() const
 {
     std::size_t bytes = mParticles.memoryBytes() + mGrid.memoryBytes() + mFluidLists.memoryBytes() +
-                        mPendingSolids.memoryBytes() + mQueryMask.capacity() + mScratch.capacity() * sizeof(Real);
+                        mPendingSolids.memoryBytes() + mQueryMask.capacity() + mLiquidMask.capacity() + mScratch.capacity() * sizeof(Real);
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
         bytes += b->block.memoryBytes() + b->lists.memoryBytes() +
                  b->nearest.capacity() * sizeof(std::uint64_t) + b->touched.capacity() * sizeof(Index) +

@@ -68,15 +68,19 @@ void GhostSolver::searchNeighbors()
     // each liquid particle's neighbours among liquid and air, and in each solid block.
     mGrid.sortParticles(mParticles);
     const std::size_t n = mParticles.size();
+    // Air is searched too (liquid and air neighbours only): its nearest liquid particle, whose
+    // velocity it takes (lines 22-25), is then the nearest liquid entry of its list.
     const auto& kind = mParticles.kinds();
     mQueryMask.resize(n);
+    mLiquidMask.resize(n);
     parallel::forEach(0, n, [&](std::size_t i) {
-        mQueryMask[i] = kind[i] == ParticleKind::Liquid;
+        mLiquidMask[i] = kind[i] == ParticleKind::Liquid;
+        mQueryMask[i] = mLiquidMask[i] || kind[i] == ParticleKind::GhostAir;
     }, 4096);
     const Real R = mSettings.supportRadius();
     const Vec3* x = mParticles.positions().data();
     mFluidLists.build(mGrid, x, n, R, mQueryMask.data());
-    for (SolidBlock* b : {&mStatic, &mMoving}) b->lists.build(b->block.grid(), x, n, R, mQueryMask.data());
+    for (SolidBlock* b : {&mStatic, &mMoving}) b->lists.build(b->block.grid(), x, n, R, mLiquidMask.data());
 }
 
 void GhostSolver::computeDensity()
@@ -204,7 +208,7 @@ void GhostSolver::stepGhost(Real dt)
     searchNeighbors();
     const double search = secondsSince(t0);
     mTimings.sortAndSearch += search;
-    if (mStep > 0 && mStep % std::uint64_t(mSettings.airResampleSteps) == 0) resampleAir();
+    if (mStep > 0) resampleAir(int(mStep % std::uint64_t(mSettings.airResampleSteps)));
     t0 = std::chrono::steady_clock::now();
     computeDensity();
     mTimings.neighborsAndDensity += search + secondsSince(t0);
@@ -297,12 +301,25 @@ void GhostSolver::stepGhost(Real dt)
 
     // Lines 22-25: air takes the new velocity of its nearest liquid particle (searched up to two
     // kernel radii: air advects between resamplings and may drift a little).
+    // The nearest liquid entry of the air particle's list (within R), else a search to 2R.
+    // Air added after the search (this step's resampling) already has its velocity.
     const Real R = mSettings.supportRadius();
-    parallel::forEach(0, n, [&](std::size_t i) {
+    const std::size_t listed = mFluidLists.size();
+    parallel::forEach(0, std::min(n, listed), [&](std::size_t i) {
         if (kind[i] != ParticleKind::GhostAir) return;
-        const Index j = nearestLiquid(x[i], Real(2) * R);
+        Index j = INVALID_INDEX;
+        Real best2 = R * R;
+        for (Index k : mFluidLists[i]) {
+            if (kind[k] != ParticleKind::Liquid) continue;
+            const Real r2 = (x[i] - x[k]).lengthSqr();
+            if (r2 < best2 || (r2 == best2 && k < j)) {
+                best2 = r2;
+                j = k;
+            }
+        }
+        if (j == INVALID_INDEX) j = nearestLiquid(x[i], Real(2) * R);
         if (j != INVALID_INDEX) v[i] = v[j];
-    });
+    }, 256);
 
     // Lines 26-28: positions of liquid and air.
     auto& xw = mParticles.positions();

@@ -8,7 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
+
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
 
 namespace ghostfx {
 namespace sph {
@@ -97,6 +102,18 @@ public:
         return found;
     }
 
+    /// Call fn(position) for the entries other than `ignore` closer than `radius` (<= 2
+    /// cellSize) to x.
+    template <typename Fn>
+    void forEachWithin(const Vec3& x, Real radius, int ignore, Fn&& fn) const
+    {
+        const Real r2 = radius * radius;
+        visit(x, radius, [&](int id) {
+            if (id != ignore && (mPos[id] - x).lengthSqr() < r2) fn(mPos[id]);
+            return true;
+        });
+    }
+
     /// Append the entries other than `ignore` closer than `radius` (<= 2 cellSize) to x.
     void gather(const Vec3& x, Real radius, int ignore, std::vector<Vec3>& out) const
     {
@@ -149,6 +166,68 @@ private:
     std::vector<int> mNext;
     std::vector<std::int64_t> mCell;
     std::vector<Vec3> mPos;
+};
+
+/// B(p) of Algorithm 2, the samples within 2r of p, as coordinate arrays padded to a multiple
+/// of four with far-away points, so the nearest-distance test of every candidate runs four
+/// samples at a time. The minimum is exact, so the result does not depend on the lane order.
+class Ball
+{
+public:
+    void gather(const PointGrid& grid, const Vec3& p, Real radius, int ignore)
+    {
+        mX.clear();
+        mY.clear();
+        mZ.clear();
+        grid.forEachWithin(p, radius, ignore, [&](const Vec3& q) {
+            mX.push_back(q[0]);
+            mY.push_back(q[1]);
+            mZ.push_back(q[2]);
+        });
+        mCount = mX.size();
+        while (mX.size() % 4 != 0) {
+            mX.push_back(FAR);
+            mY.push_back(FAR);
+            mZ.push_back(FAR);
+        }
+    }
+
+    bool empty() const { return mCount == 0; }
+
+    /// min over the ball of |x - q|^2.
+    Real minDistance2(const Vec3& x) const
+    {
+        const std::size_t n = mX.size();
+#if defined(__SSE2__) && !defined(GHOSTFX_DOUBLE)
+        const __m128 cx = _mm_set1_ps(x[0]), cy = _mm_set1_ps(x[1]), cz = _mm_set1_ps(x[2]);
+        __m128 best = _mm_set1_ps(std::numeric_limits<float>::max());
+        for (std::size_t k = 0; k < n; k += 4) {
+            const __m128 dx = _mm_sub_ps(cx, _mm_loadu_ps(mX.data() + k));
+            const __m128 dy = _mm_sub_ps(cy, _mm_loadu_ps(mY.data() + k));
+            const __m128 dz = _mm_sub_ps(cz, _mm_loadu_ps(mZ.data() + k));
+            const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)),
+                                         _mm_mul_ps(dz, dz));
+            best = _mm_min_ps(best, d2);
+        }
+        alignas(16) float lanes[4];
+        _mm_store_ps(lanes, best);
+        return std::min(std::min(lanes[0], lanes[1]), std::min(lanes[2], lanes[3]));
+#else
+        Real best = std::numeric_limits<Real>::max();
+        for (std::size_t k = 0; k < n; ++k) {
+            const Real dx = x[0] - mX[k], dy = x[1] - mY[k], dz = x[2] - mZ[k];
+            best = std::min(best, dx * dx + dy * dy + dz * dz);
+        }
+        return best;
+#endif
+    }
+
+private:
+    /// Padding coordinate: far enough that its distance never wins, small enough that its
+    /// square stays finite in float.
+    static constexpr Real FAR = Real(1e18);
+    std::vector<Real> mX, mY, mZ;
+    std::size_t mCount = 0;
 };
 
 /// Random unit vector perpendicular to the unit normal n.
@@ -417,41 +496,44 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
     std::vector<Item> order;
     std::vector<std::size_t> blockStart;
 
-    auto relaxOne = [&](std::size_t i, int sweep, std::vector<Vec3>& ball) {
+    // Lipschitz bound of the interpolated distance: trilinear interpolation of a distance
+    // sampled on a grid changes by at most one voxel per voxel along each axis, so by at most
+    // sqrt(3) times the distance moved (with a little room for float rounding).
+    const Real lipschitz = Real(1.75);
+    auto relaxOne = [&](std::size_t i, int sweep, Ball& ball) {
         const Vec3 p = samples.positions[i];
         const bool surface = samples.onSurface[i] != 0;
-        ball.clear();
-        grid.gather(p, Real(2) * r, entry[i], ball);
+        ball.gather(grid, p, Real(2) * r, entry[i]);
         if (ball.empty()) return;
 
-        // Squared distance from x to B(p), or a value <= `beat` as soon as one is found:
-        // most candidates lose to the current best early, so stop there.
-        auto minDistance2 = [&ball](const Vec3& x, Real beat) {
-            Real d2 = std::numeric_limits<Real>::max();
-            for (const Vec3& q : ball) {
-                d2 = std::min(d2, (x - q).lengthSqr());
-                if (d2 <= beat) break;
-            }
-            return d2;
-        };
-        Real d2 = minDistance2(p, Real(0));
+        Real d2 = ball.minDistance2(p);
         Vec3 best = p;
         // Candidates lie within r of p: when p is deeper than r and the sampling is not
         // band-limited, none can leave the shape, and phi need not be looked up per candidate.
-        const bool deep = !surface && !band.limited() && shape.phi(p) < -Real(1.01) * r;
+        const Real phiP = surface ? Real(0) : shape.phi(p);
+        const bool deep = !surface && !band.limited() && phiP < -Real(1.01) * r;
+        // Band-limited and deeper than the bound: no candidate is outside the shape, so none
+        // is projected, and only a candidate that beats the best so far needs the band test.
+        const bool inside = !surface && band.limited() && phiP < -lipschitz * r;
         // One random stream per (pass, sweep, sample).
         Rng rng(mSettings.seed, RELAX + (std::uint64_t(pass) << 40) +
                                     (std::uint64_t(sweep) << 32) + i);
         for (int a = 0; a < t; ++a) {
             const Real tau = Real(t - a) / Real(t);
             Vec3 cand = p + rng.unitVector() * (r * tau);
+            if (inside) {
+                const Real c2 = ball.minDistance2(cand);
+                if (!(c2 > d2) || !band.accepts(cand, shape.phi(cand)) || !grid.contains(cand)) continue;
+                d2 = c2;
+                best = cand;
+                continue;
+            }
             if (!deep) {
                 const Real phi = shape.phi(cand);
                 if (surface || phi > Real(0)) {
                     // The projection moves cand by about |phi|: skip it when even that
                     // much could not beat the best distance so far.
-                    const Real reach = std::sqrt(minDistance2(cand, Real(0))) +
-                                       Real(1.05) * std::abs(phi);
+                    const Real reach = std::sqrt(ball.minDistance2(cand)) + Real(1.05) * std::abs(phi);
                     if (reach * reach <= d2) continue;
                     const SurfaceProjection proj = shape.projectToSurface(cand);
                     // A projection that lands more than 2r away left the neighbourhood this
@@ -463,7 +545,7 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
                 }
                 if (!grid.contains(cand)) continue;
             }
-            const Real c2 = minDistance2(cand, d2);
+            const Real c2 = ball.minDistance2(cand);
             if (c2 > d2) {
                 d2 = c2;
                 best = cand;
@@ -502,7 +584,7 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
             std::size_t last = first + 1;
             while (last + 1 < blockStart.size() && order[blockStart[last]].key >> 60 == colour) ++last;
             parallel::forEach(first, last, [&](std::size_t block) {
-                std::vector<Vec3> ball; // B(p): the samples within 2r of p
+                Ball ball; // B(p): the samples within 2r of p
                 for (std::size_t k = blockStart[block]; k < blockStart[block + 1]; ++k) {
                     relaxOne(order[k].index, sweep, ball);
                 }

@@ -213,7 +213,9 @@ private:
     void applyKillBox();
     bool blockedBySolid(const Vec3& x) const;
     void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;
-    void resampleAir();
+    /// Resample the air in the blocks of one phase (phase < 0: everywhere), see GhostAir.cc.
+    void resampleAir(int phase);
+    int airPhase(const Vec3& x) const;
     void fadeAir();
     void searchNeighbors();
     void computeDensity();
@@ -230,7 +232,8 @@ private:
     ParticleSet mParticles;              ///< liquid and ghost air
     sph::NeighborGrid mGrid;             ///< over mParticles, rebuilt (and mParticles sorted) each step
     sph::NeighborLists mFluidLists;      ///< this step: liquid particle -> mParticles
-    std::vector<std::uint8_t> mQueryMask;///< this step: 1 for the liquid particles
+    std::vector<std::uint8_t> mQueryMask;///< this step: 1 for liquid and air (fluid lists)
+    std::vector<std::uint8_t> mLiquidMask;///< this step: 1 for liquid (solid-block lists)
     std::vector<Real> mScratch;          ///< per particle scratch of a pass
     SolidBlock mStatic, mMoving;         ///< solid particles of static and of moving solids
     ParticleSet mPendingSolids;          ///< restored solid particles until their solid is added
