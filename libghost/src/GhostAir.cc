@@ -10,9 +10,9 @@
 ///          New air starts at weight 0 and is appended after the lists were built; it takes part
 ///          in the sums from the next step on.
 ///
-///          The layer is resampled region by region: space is cut into blocks two kernel radii
-///          wide, each block belongs to one of `airResampleSteps` phases (a hash of its
-///          coordinates), and step s resamples the blocks of phase s mod airResampleSteps. Every
+///          The layer is resampled region by region: space is cut into blocks four kernel radii
+///          wide, each block belongs to one of `airResampleSteps` phases (AirRegion), and step
+///          s resamples the blocks of phase s mod airResampleSteps. Every
 ///          part of the layer is still resampled every airResampleSteps steps ([SB12] Sec. 4.3),
 ///          but each step does a tenth of the work, so no step is much slower than the others.
 #include "ghostfx/ghost/GhostSolver.h"
@@ -24,6 +24,7 @@
 #include <ghostfx/sph/PoissonSampler.h>
 
 #include <algorithm>
+#include <limits>
 
 namespace ghostfx {
 namespace ghost {
@@ -41,16 +42,60 @@ constexpr Real SURFACE_SEED_FRACTION = Real(0.97);
 
 } // namespace
 
-int GhostSolver::airPhase(const Vec3& x) const
+/// The region of one resampling phase: blocks of side 4R whose coordinates (i, j, k) give
+/// (i + 3 j + 5 k) mod N == phase. With N = 10 no two blocks that touch (even at a corner)
+/// share a phase, and the phases take turns evenly through space.
+class AirRegion
 {
-    const Real block = Real(2) * mSettings.supportRadius();
-    const auto c = [block](Real v) { return std::int64_t(std::floor(v / block)); };
-    std::uint64_t h = std::uint64_t(c(x[0])) * 0x9e3779b97f4a7c15ULL;
-    h ^= std::uint64_t(c(x[1])) * 0xc2b2ae3d27d4eb4fULL + (h << 6) + (h >> 2);
-    h ^= std::uint64_t(c(x[2])) * 0x165667b19e3779f9ULL + (h << 6) + (h >> 2);
-    h ^= h >> 29;
-    return int(h % std::uint64_t(mSettings.airResampleSteps));
-}
+public:
+    AirRegion(Real supportRadius, int phases, int phase)
+        : mBlock(Real(4) * supportRadius), mInvBlock(Real(1) / mBlock), mPhases(phases), mPhase(phase)
+    {}
+
+    bool everywhere() const { return mPhase < 0; }
+
+    int phaseOf(const Vec3& x) const
+    {
+        const std::int64_t c = block(x[0]) + 3 * block(x[1]) + 5 * block(x[2]);
+        return int(((c % mPhases) + mPhases) % mPhases);
+    }
+    bool contains(const Vec3& x) const { return mPhase < 0 || phaseOf(x) == mPhase; }
+    /// Whether x lies within `margin` (at most half a block) of the region: the blocks the box
+    /// x +- margin touches are the own block and, per axis, the neighbour on the side where x
+    /// is closer than the margin to the face.
+    bool near(const Vec3& x, Real margin) const
+    {
+        if (mPhase < 0) return true;
+        std::int64_t base = 0;
+        int lo[3], hi[3];
+        const std::int64_t weight[3] = {1, 3, 5};
+        for (int a = 0; a < 3; ++a) {
+            const Real u = x[a] * mInvBlock;
+            const Real c = std::floor(u);
+            base += weight[a] * std::int64_t(c);
+            const Real f = u - c, m = margin * mInvBlock;
+            lo[a] = f < m ? -1 : 0;
+            hi[a] = f > Real(1) - m ? 1 : 0;
+        }
+        for (int i = lo[0]; i <= hi[0]; ++i) {
+            for (int j = lo[1]; j <= hi[1]; ++j) {
+                for (int k = lo[2]; k <= hi[2]; ++k) {
+                    const std::int64_t c = base + i + 3 * j + 5 * k;
+                    if (int(((c % mPhases) + mPhases) % mPhases) == mPhase) return true;
+                }
+            }
+        }
+        return false;
+    }
+
+private:
+    std::int64_t block(Real v) const { return std::int64_t(std::floor(v * mInvBlock)); }
+    Real mBlock, mInvBlock;
+    int mPhases, mPhase;
+};
+
+/// Where a particle lies relative to the region resampled now (bit flags).
+enum Zone : std::uint8_t { IN_REGION = 1, NEAR_SEEDING = 2, NEAR_BODY = 4 };
 
 void GhostSolver::resampleAir(int phase)
 {
@@ -62,18 +107,18 @@ void GhostSolver::resampleAir(int phase)
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
     const auto& kind = mParticles.kinds();
-    // The region resampled now (phase < 0: everywhere), and the points within `margin` of it
-    // (margin at most a block's half width: then the box corners meet every block it touches).
-    auto inPhase = [&](const Vec3& q) { return phase < 0 || airPhase(q) == phase; };
-    auto nearPhase = [&](const Vec3& q, Real margin) {
-        if (phase < 0 || airPhase(q) == phase) return true;
-        for (int c = 0; c < 8; ++c) {
-            const Vec3 corner(q[0] + ((c & 1) ? margin : -margin), q[1] + ((c & 2) ? margin : -margin),
-                              q[2] + ((c & 4) ? margin : -margin));
-            if (airPhase(corner) == phase) return true;
-        }
-        return false;
-    };
+    // The region resampled now (phase < 0: everywhere) and, per particle, whether it lies in
+    // it, within 2r of it (what new air there keeps away from, where its seeds are) or within
+    // R (the body particles its air and candidates look for).
+    const AirRegion region(R, mSettings.airResampleSteps, phase);
+    std::vector<std::uint8_t> zone(n, 0);
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (!region.near(x[i], R)) return;
+        if (region.contains(x[i])) zone[i] = IN_REGION | NEAR_SEEDING | NEAR_BODY;
+        else if (region.near(x[i], Real(2) * r)) zone[i] = NEAR_SEEDING | NEAR_BODY;
+        else zone[i] = NEAR_BODY;
+    }, 2048);
+    auto inPhase = [&](const Vec3& q) { return region.contains(q); };
 
     // 1. Per liquid particle: its liquid-and-solid indicator sum_j W_ij (ghost solids count:
     //    the thin gap between liquid and a wall is not free surface, and air there would hold
@@ -81,19 +126,39 @@ void GhostSolver::resampleAir(int phase)
     //    move ballistically and get no air ([SB12] Sec. 4.5): like the solids they are
     //    obstacles the new air keeps r away from. Air lives within a kernel radius of the body
     //    only, so escaped spray neither attracts air nor stretches the sampling region.
-    std::vector<Real> indicator(n, Real(0));
+    std::vector<Real> indicator(n, std::numeric_limits<Real>::max());
     std::vector<std::uint8_t> body(n, 0);
     parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
         const CubicSplineKernel kernel = mKernel;
         PairBatch batch;
         for (std::size_t i = lo; i < hi; ++i) {
-            // Only the liquid within a kernel radius of the region is asked about.
-            if (kind[i] != ParticleKind::Liquid || !nearPhase(x[i], R)) continue;
+            // Only the liquid within a kernel radius of the region is asked about, and only the
+            // seeding candidates need the indicator.
+            if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)) continue;
+            for (Index j : mFluidLists[i]) {
+                if (j != i && kind[j] == ParticleKind::Liquid) {
+                    body[i] = 1;
+                    break;
+                }
+            }
+            if (!body[i] || !(zone[i] & NEAR_SEEDING)) continue;
+            // A particle with no air neighbour and a full neighbourhood is interior: no seed.
+            // (Full: at least 90 % of the mean neighbour count of the last step.)
+            bool air = false;
+            for (Index j : mFluidLists[i]) {
+                if (kind[j] == ParticleKind::GhostAir) {
+                    air = true;
+                    break;
+                }
+            }
+            const std::size_t count = mFluidLists[i].size() + mStatic.lists[i].size() + mMoving.lists[i].size();
+            if (!air && mMass > Real(0) && mMeanNeighbors > 0 && double(count) >= 0.9 * mMeanNeighbors) {
+                indicator[i] = std::numeric_limits<Real>::max();
+                continue;
+            }
             Real sum = 0;
-            int liquidNeighbours = 0;
             batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
                 for (int k = 0; k < b.n; ++k) b.f[k] = Real(kind[b.j[k]] == ParticleKind::Liquid);
-                for (int k = 0; k < b.n; ++k) liquidNeighbours += int(b.f[k]);
                 for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
                 sum += b.sum(b.f);
             });
@@ -105,7 +170,6 @@ void GhostSolver::resampleAir(int phase)
                 });
             }
             indicator[i] = sum;
-            body[i] = liquidNeighbours > 1;
         }
     }, 512);
     Aabb bounds;
@@ -142,7 +206,7 @@ void GhostSolver::resampleAir(int phase)
     } else {
         std::vector<Real> sums;
         for (std::size_t i = 0; i < n; ++i) {
-            if (kind[i] == ParticleKind::Liquid) sums.push_back(indicator[i]);
+            if (body[i]) sums.push_back(indicator[i]);
         }
         std::nth_element(sums.begin(), sums.begin() + sums.size() * 3 / 4, sums.end());
         n0 = sums[sums.size() * 3 / 4];
@@ -170,7 +234,7 @@ void GhostSolver::resampleAir(int phase)
     auto& target = mParticles.scalarChannel(AIR_TARGET);
     std::vector<std::uint8_t> keep(n, 0);
     parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0) || !inPhase(x[i])) return;
+        if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0) || !(zone[i] & IN_REGION)) return;
         Real d = -1;
         keep[i] = nearBody(x[i], &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x[i]) &&
                   !insideLiquid(x[i]);
@@ -186,8 +250,7 @@ void GhostSolver::resampleAir(int phase)
         std::vector<std::size_t> airIndex;
         std::size_t others = 0;
         for (std::size_t i = 0; i < n; ++i) {
-            if (kind[i] == ParticleKind::GhostAir && target[i] != Real(0) && !inPhase(x[i]) &&
-                nearPhase(x[i], thinDistance)) {
+            if (kind[i] == ParticleKind::GhostAir && target[i] != Real(0) && zone[i] == (NEAR_SEEDING | NEAR_BODY)) {
                 airX.push_back(x[i]);
                 airIndex.push_back(i);
             }
@@ -215,18 +278,28 @@ void GhostSolver::resampleAir(int phase)
     std::vector<Vec3> seeds, obstacles;
     const Aabb near = bounds.padded(R + Real(2) * r);
     for (std::size_t i = 0; i < n; ++i) {
-        if (!near.contains(x[i])) continue;
+        if (!(zone[i] & NEAR_SEEDING)) continue;
         if (kind[i] == ParticleKind::GhostAir) {
-            if (!inPhase(x[i]) && target[i] != Real(0)) obstacles.push_back(x[i]);
-            else if (keep[i]) seeds.push_back(x[i]);
-            else if (inPhase(x[i])) target[i] = Real(0);
-        } else if (body[i] && indicator[i] < SURFACE_SEED_FRACTION * n0 && nearPhase(x[i], Real(2) * r)) {
+            if (!(zone[i] & IN_REGION)) {
+                if (target[i] != Real(0)) obstacles.push_back(x[i]);
+            } else if (keep[i]) {
+                seeds.push_back(x[i]);
+            } else {
+                target[i] = Real(0);
+            }
+        } else if (body[i] && indicator[i] < SURFACE_SEED_FRACTION * n0) {
             seeds.push_back(x[i]);
         } else {
             obstacles.push_back(x[i]);
         }
     }
-    appendSolidPositionsInBox(near, obstacles);
+    {
+        std::vector<Vec3> solids;
+        appendSolidPositionsInBox(near, solids);
+        for (const Vec3& q : solids) {
+            if (region.near(q, Real(2) * r)) obstacles.push_back(q);
+        }
+    }
 
     auto accept = [&](const Vec3& q) {
         return inPhase(q) && nearBody(q) != INVALID_INDEX && !insideSolid(q) && !insideLiquid(q);
@@ -261,20 +334,19 @@ void GhostSolver::resampleAir(int phase)
     //    sigma_a = sum_j W(x_a - x_j). Air in a layer as dense as the liquid keeps weight 1.
     if (mMass > Real(0)) {
         const auto& xs = mParticles.positions();
-        std::vector<Vec3> medium;
-        for (std::size_t i = 0; i < xs.size(); ++i) {
-            const ParticleKind k = mParticles.kinds()[i];
-            const bool alive = k == ParticleKind::Liquid || (k == ParticleKind::GhostAir && target[i] != Real(0));
-            if (alive && nearPhase(xs[i], R)) medium.push_back(xs[i]);
-        }
-        NeighborGrid mediumGrid(R);
-        mediumGrid.build(medium);
+        NeighborGrid freshGrid(R);
+        freshGrid.build(air);
         parallel::forEach(0, xs.size(), [&](std::size_t i) {
-            if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0) || !inPhase(xs[i])) return;
+            if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
+            if (i < n && !(zone[i] & IN_REGION)) return;
+            // The liquid and the living air of the step's grid, and the new air.
             Real sigma = 0;
-            mediumGrid.forEachInRadius(xs[i], R, [&](Index, const Vec3&, Real rij) { sigma += mKernel.W(rij); });
+            mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
+                if (kind[j] == ParticleKind::Liquid || target[j] != Real(0)) sigma += mKernel.W(rij);
+            });
+            freshGrid.forEachInRadius(xs[i], R, [&](Index, const Vec3&, Real rij) { sigma += mKernel.W(rij); });
             target[i] = sigma > n0 ? n0 / sigma : Real(1);
-        });
+        }, 64);
     }
     mTimings.airResampling += secondsSince(start);
 }

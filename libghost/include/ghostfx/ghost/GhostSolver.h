@@ -215,7 +215,6 @@ private:
     void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;
     /// Resample the air in the blocks of one phase (phase < 0: everywhere), see GhostAir.cc.
     void resampleAir(int phase);
-    int airPhase(const Vec3& x) const;
     void fadeAir();
     void searchNeighbors();
     void computeDensity();

@@ -111,7 +111,7 @@ public:
     SlotRange cellSlotsAt(std::size_t k) const { return {mCellStart[k], mCellStart[k + 1]}; }
     /// Entries past the last slot in each sorted coordinate array (zeros), so a vectorised
     /// distance loop may read a few slots past the end.
-    static constexpr std::size_t PADDING = 4;
+    static constexpr std::size_t PADDING = 8;
     /// Sorted coordinates (m), one array per axis, indexed by slot.
     const Real* sortedX() const { return mX.data(); }
     const Real* sortedY() const { return mY.data(); }
