@@ -164,10 +164,18 @@ SurfaceProjection LevelSet::pushOutside(const Vec3& x, int maxSteps) const
         if (-p >= clampLimit || it == maxSteps) break;
         // Newton along the smooth gradient: near an edge the interpolated distance rounds off
         // and its gradient is shorter than one, so a plain step of -phi would creep outward.
+        // Where even that makes little progress (corners), the step doubles until phi grows by
+        // at least the slack.
         const Vec3 g = gradient(result.point);
         const Real g2 = g.lengthSqr();
         if (!(g2 > Real(1e-12))) break;
-        result.point += g * ((slack - p) / std::max(g2, Real(0.25)));
+        Real step = (slack - p) / std::max(g2, Real(0.25));
+        Vec3 next = result.point + g * step;
+        for (int grow = 0; grow < 8 && phi(next) < std::min(Real(0), p + slack); ++grow) {
+            step *= Real(2);
+            next = result.point + g * step;
+        }
+        result.point = next;
     }
     return result;
 }

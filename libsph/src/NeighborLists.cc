@@ -7,6 +7,7 @@
 #include "ghostfx/sph/Parallel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -124,6 +125,8 @@ bool haveAvx2()
 }
 #endif
 
+std::atomic<bool> gWideSimd{true};
+
 /// The occupied cells of the 3 x 3 x 3 block around one cell: their slot ranges and their
 /// offset (di, dj, dk) + 1 from the centre.
 struct Stencil
@@ -173,7 +176,7 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
     const Real* Z = targets.sortedZ();
     const bool empty = targets.size() == 0;
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-    const bool avx2 = haveAvx2();
+    const bool avx2 = haveAvx2() && gWideSimd.load();
 #endif
 
     parallel::forEach(0, chunks, [&](std::size_t chunk) {
@@ -257,6 +260,17 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
             for (std::size_t k = 0; k < used; ++k) dst[k] = targets.particleAt(dst[k]);
         }
     }, 1);
+}
+
+void NeighborLists::setWideSimd(bool enabled) { gWideSimd.store(enabled); }
+
+bool NeighborLists::wideSimd()
+{
+#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
+    return haveAvx2() && gWideSimd.load();
+#else
+    return false;
+#endif
 }
 
 void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)

@@ -61,6 +61,11 @@ public:
         const std::uint32_t first = q % CHUNK == 0 ? 0 : mEnd[q - 1];
         return {base + first, base + mEnd[q]};
     }
+    /// Use the AVX2 search where the processor has it (default), or always the portable one.
+    /// Both give the same lists; this switch lets a test compare them.
+    static void setWideSimd(bool enabled);
+    static bool wideSimd();
+
     /// Total number of (query, neighbour) pairs.
     std::size_t pairCount() const;
     /// Bytes held (capacity).

@@ -1,0 +1,246 @@
+/// @file   test_neighbor_lists.cc
+/// @brief  The pieces of the one-search-per-step liquid step: NeighborLists against brute force
+///         (sorted and unsorted targets, masks, radii, outliers), its determinism and its two
+///         search paths; PairBatch sums against plain double sums; BoundaryBlock's order; the
+///         ParticleSet operations the solid blocks use; LevelSet::pushOutside at box edges.
+/// @details Brute force uses the lists' own arithmetic (x_i - x_j and its squared length below
+///          R^2, in Real), so the neighbour sets must be equal exactly.
+#include <ghostfx/sph/BoundaryBlock.h>
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/Kernels.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/sph/NeighborGrid.h>
+#include <ghostfx/sph/NeighborLists.h>
+#include <ghostfx/sph/PairBatch.h>
+#include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/ParticleSet.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <vector>
+
+namespace {
+
+using namespace ghostfx::sph;
+using ghostfx::ValueError;
+namespace parallel = ghostfx::parallel;
+
+std::vector<Vec3> randomPoints(std::size_t n, Real extent, unsigned seed)
+{
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, double(extent));
+    std::vector<Vec3> xs(n);
+    for (auto& x : xs) x = Vec3(Real(u(rng)), Real(u(rng)), Real(u(rng)));
+    return xs;
+}
+
+std::vector<Index> bruteForce(const Vec3& x, const std::vector<Vec3>& targets, Real radius)
+{
+    std::vector<Index> out;
+    const Real r2 = radius * radius;
+    for (std::size_t j = 0; j < targets.size(); ++j) {
+        const Real dx = x[0] - targets[j][0], dy = x[1] - targets[j][1], dz = x[2] - targets[j][2];
+        if (dx * dx + dy * dy + dz * dz < r2) out.push_back(Index(j));
+    }
+    return out;
+}
+
+std::vector<Index> sorted(NeighborLists::List list)
+{
+    std::vector<Index> v(list.begin(), list.end());
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
+/// Lists of `queries` against a grid over `targets` equal brute force, for every query.
+void expectListsMatchBruteForce(const std::vector<Vec3>& targets, const std::vector<Vec3>& queries,
+                                Real cellSize, Real radius, const std::vector<std::uint8_t>& wanted)
+{
+    NeighborGrid grid(cellSize);
+    grid.build(targets);
+    NeighborLists lists;
+    lists.build(grid, queries.data(), queries.size(), radius, wanted.empty() ? nullptr : wanted.data());
+    ASSERT_EQ(lists.size(), queries.size());
+    std::size_t pairs = 0;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        const bool want = wanted.empty() || wanted[q];
+        const std::vector<Index> expected = want ? bruteForce(queries[q], targets, radius) : std::vector<Index>{};
+        ASSERT_EQ(sorted(lists[q]), expected) << "query " << q;
+        pairs += expected.size();
+    }
+    EXPECT_EQ(lists.pairCount(), pairs);
+    EXPECT_GT(lists.memoryBytes(), pairs * sizeof(Index) - 1);
+}
+
+} // namespace
+
+TEST(NeighborLists, MatchBruteForceForUnsortedTargetsMasksAndSmallerRadii)
+{
+    const Real cell = Real(0.05);
+    const std::vector<Vec3> targets = randomPoints(4000, Real(0.4), 1);
+    std::vector<Vec3> queries = randomPoints(1500, Real(0.4), 2);
+    queries.push_back(Vec3(Real(50), 0, 0)); // far from every target: an empty list
+    std::vector<std::uint8_t> every2nd(queries.size());
+    for (std::size_t q = 0; q < every2nd.size(); ++q) every2nd[q] = q % 2;
+    for (Real radius : {cell, Real(0.7) * cell}) {
+        SCOPED_TRACE(::testing::Message() << "radius " << radius);
+        expectListsMatchBruteForce(targets, queries, cell, radius, {});
+        expectListsMatchBruteForce(targets, queries, cell, radius, every2nd);
+    }
+}
+
+TEST(NeighborLists, SortedSetAgainstItselfHoldsEachParticleAndIsTheSameOnBothSearchPaths)
+{
+    // As the solver uses them: a set sorted by the grid, queried with its own positions.
+    ParticleSet set;
+    set.addBatch(randomPoints(6000, Real(0.3), 3), Real(1), ParticleKind::Liquid);
+    NeighborGrid grid(Real(0.03));
+    grid.sortParticles(set);
+    ASSERT_TRUE(grid.identityOrder());
+    const auto& x = set.positions();
+    const bool wide = NeighborLists::wideSimd();
+    NeighborLists a, b;
+    a.build(grid, x.data(), x.size(), Real(0.03));
+    NeighborLists::setWideSimd(false);
+    b.build(grid, x.data(), x.size(), Real(0.03));
+    NeighborLists::setWideSimd(true);
+    std::printf("[measured] %zu pairs, wide SIMD path %s\n", a.pairCount(), wide ? "available" : "absent");
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        ASSERT_EQ(std::vector<Index>(a[i].begin(), a[i].end()), std::vector<Index>(b[i].begin(), b[i].end()))
+            << "particle " << i;
+        ASSERT_TRUE(std::find(a[i].begin(), a[i].end(), Index(i)) != a[i].end()) << "particle " << i;
+        ASSERT_EQ(sorted(a[i]), bruteForce(x[i], x, Real(0.03))) << "particle " << i;
+    }
+}
+
+TEST(NeighborLists, IdenticalForOneThreadAndAllThreads)
+{
+    const std::vector<Vec3> xs = randomPoints(20000, Real(0.5), 4);
+    NeighborGrid grid(Real(0.04));
+    grid.build(xs);
+    NeighborLists all, one;
+    all.build(grid, xs.data(), xs.size(), Real(0.04));
+    parallel::setSerial(true);
+    one.build(grid, xs.data(), xs.size(), Real(0.04));
+    parallel::setSerial(false);
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+        ASSERT_EQ(std::vector<Index>(all[i].begin(), all[i].end()),
+                  std::vector<Index>(one[i].begin(), one[i].end())) << "query " << i;
+    }
+}
+
+TEST(NeighborLists, RadiusBeyondTheCellSizeIsRefused)
+{
+    NeighborGrid grid(Real(0.1));
+    grid.build(randomPoints(10, Real(1), 5));
+    const Vec3 q(0);
+    NeighborLists lists;
+    EXPECT_THROW(lists.build(grid, &q, 1, Real(0.2)), ValueError);
+    EXPECT_THROW(lists.build(grid, &q, 1, Real(0)), ValueError);
+}
+
+TEST(PairBatch, SumsEqualPlainSumsOverLongLists)
+{
+    // 150 neighbours: three batches, one of them partial.
+    const std::vector<Vec3> xs = randomPoints(150, Real(0.1), 6);
+    std::vector<Index> list(xs.size());
+    for (std::size_t k = 0; k < list.size(); ++k) list[k] = Index(k);
+    std::vector<Vec3> values(xs.size());
+    for (std::size_t k = 0; k < values.size(); ++k) values[k] = Vec3(Real(k), Real(0.5) * Real(k), -Real(k));
+    const Vec3 xi(Real(0.05)), vi(1, 2, 3);
+    const CubicSplineKernel kernel(Real(0.2));
+    double w = 0;
+    Vec3d offsets(0), differences(0);
+    for (Index j : list) {
+        const Vec3 xij = xi - xs[j];
+        const double f = double(kernel.W(xij.length()));
+        w += f;
+        offsets += f * Vec3d(xij);
+        differences += f * (Vec3d(values[j]) - Vec3d(vi));
+    }
+    PairBatch batch;
+    double bw = 0;
+    Vec3d bOffsets(0), bDifferences(0);
+    int batches = 0;
+    const NeighborLists::List view{list.data(), list.data() + list.size()};
+    batch.forEachBatch(xi, xs.data(), view, [&](PairBatch& b) {
+        ++batches;
+        for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
+        bw += b.sum(b.f);
+        bOffsets += Vec3d(b.sumScaledOffsets(b.f));
+        bDifferences += Vec3d(b.sumScaledDifferences(b.f, values.data(), vi));
+    });
+    EXPECT_EQ(batches, 3);
+    // Float sums of 150 terms in another order: about 1e-6 relative.
+    EXPECT_NEAR(bw, w, 1e-5 * w);
+    EXPECT_NEAR((bOffsets - offsets).length(), 0.0, 1e-5 * offsets.length() + 1e-9);
+    EXPECT_NEAR((bDifferences - differences).length(), 0.0, 1e-5 * differences.length());
+}
+
+TEST(BoundaryBlock, OrderDependsOnIdsAndCellsNotOnInsertionOrder)
+{
+    const std::vector<Vec3> xs = randomPoints(3000, Real(0.2), 7);
+    BoundaryBlock a(Real(0.02)), b(Real(0.02));
+    a.particles().addBatch(xs, Real(1), ParticleKind::GhostSolid);
+    b.particles().addBatch(xs, Real(1), ParticleKind::GhostSolid);
+    // b holds the same particles (same ids) in reverse order.
+    std::vector<Index> reverse(xs.size());
+    for (std::size_t k = 0; k < reverse.size(); ++k) reverse[k] = Index(xs.size() - 1 - k);
+    b.particles().reorder(reverse);
+    a.rebuild();
+    b.rebuild();
+    EXPECT_FALSE(a.stale());
+    EXPECT_EQ(a.particles().ids(), b.particles().ids());
+    EXPECT_TRUE(a.particles().positions() == b.particles().positions());
+    EXPECT_TRUE(a.grid().identityOrder());
+    a.touch();
+    EXPECT_TRUE(a.stale());
+}
+
+TEST(ParticleSet, AppendSelectAndRemoveChannelKeepIdsAndDefaults)
+{
+    ParticleSet liquid, solid;
+    liquid.addVectorChannel("vstar");
+    liquid.addBatch({Vec3(0), Vec3(1)}, Real(1), ParticleKind::Liquid);
+    solid.setNextId(10);
+    solid.addScalarChannel("solid_index", Real(-1));
+    solid.addBatch({Vec3(2)}, Real(1), ParticleKind::GhostSolid);
+    ParticleSet all = liquid;
+    all.append(solid);
+    ASSERT_EQ(all.size(), 3u);
+    EXPECT_EQ(all.ids(), (std::vector<ParticleId>{0, 1, 10}));
+    EXPECT_EQ(all.nextId(), 11);
+    EXPECT_EQ(all.scalarChannel("solid_index"), (std::vector<Real>{-1, -1, -1}));
+    EXPECT_EQ(all.vectorChannel("vstar").size(), 3u);
+    const ParticleSet back = all.select({0, 0, 1});
+    EXPECT_EQ(back.ids(), (std::vector<ParticleId>{10}));
+    EXPECT_EQ(back.kinds()[0], ParticleKind::GhostSolid);
+    EXPECT_EQ(back.nextId(), 11);
+    all.removeChannel("vstar");
+    EXPECT_FALSE(all.hasVectorChannel("vstar"));
+    EXPECT_THROW(all.select({1}), ValueError);
+}
+
+TEST(LevelSet, PushOutsideLeavesEdgesAndCornersOfABox)
+{
+    // Where Newton projection with the trilinear gradient oscillates (at the box's edges and
+    // corners the gradient jumps between cells), pushOutside still ends just outside.
+    const Real h = Real(0.01);
+    const LevelSet box = makeLevelSet(makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f),
+                                                      Vec3(0.08f, -0.04f, 0.08f), h / 2), "box");
+    const Vec3 points[] = {Vec3(-0.0793571f, -0.0408085f, -0.0113048f), // an edge (seen in a run)
+                           Vec3(0.0797f, -0.0403f, 0.0796f),            // a corner
+                           Vec3(0, -0.0405f, 0)};                       // a face
+    for (const Vec3& x : points) {
+        ASSERT_LT(box.phi(x), Real(0));
+        const SurfaceProjection out = box.pushOutside(x);
+        EXPECT_TRUE(out.converged) << x;
+        EXPECT_GE(box.phi(out.point), Real(0)) << x;
+        // It moves about as far as the point was inside, not more than a voxel.
+        EXPECT_LT((out.point - x).length(), h / 2) << x;
+    }
+    // Beyond the band there is no direction to the surface.
+    EXPECT_FALSE(box.pushOutside(Vec3(0, -0.08f, 0)).converged);
+}
