@@ -156,6 +156,8 @@ struct RunResult
     double meanNeighbors = 0;
     double maxSpeed = 0, maxDensityRatio = 0; ///< at the end (m/s, rho / rho0)
     std::size_t escaped = 0, insideSolid = 0;
+    std::size_t memoryBytes = 0; ///< the solver's memoryBytes() at the end
+    std::size_t listBytes = 0;   ///< of which neighbour lists
     int steps = 0; ///< measured steps completed
 };
 
@@ -228,6 +230,8 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
     out.air = solver.count(ParticleKind::GhostAir);
     out.solid = solver.count(method == Method::Ghost ? ParticleKind::GhostSolid
                                                      : ParticleKind::Boundary);
+    out.memoryBytes = solver.memoryBytes();
+    out.listBytes = solver.neighborListBytes();
 }
 
 double percent(double part, double whole) { return whole > 0 ? 100 * part / whole : 0; }
@@ -242,6 +246,11 @@ void printRun(const RunResult& r)
                 percent(double(r.solid), double(r.liquid)), r.liquid + r.air + r.solid);
     std::printf("  set-up: solid sampling %.2f s, liquid sampling %.2f s, first step (air layer, "
                 "mass scaling) %.2f s\n", r.solidSampling, r.liquidSampling, r.firstStep);
+    const double all = double(r.liquid + r.air + r.solid);
+    std::printf("  memory: %.1f MB, %.1f bytes per particle (particles, solid blocks, grids, "
+                "scratch %.1f + the step's neighbour lists %.1f)\n", double(r.memoryBytes) / 1e6,
+                double(r.memoryBytes) / all, double(r.memoryBytes - r.listBytes) / all,
+                double(r.listBytes) / all);
     std::printf("  state at the end: max liquid speed %.3f m/s, max rho/rho0 %.3f, %zu liquid "
                 "outside the container, %zu inside the solid\n", r.maxSpeed, r.maxDensityRatio,
                 r.escaped, r.insideSolid);

@@ -42,6 +42,7 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene)
     g.cflNumber = Real(s.inRange("cfl", g.cflNumber, 1e-3, 10));
     g.maxSpeed = Real(s.nonNegative("max_speed", g.maxSpeed));
     g.seed = s.get<std::uint64_t>("seed", g.seed);
+    g.tiledSampling = s.get<bool>("tiled_sampling", g.tiledSampling);
     g.killBox = scene.killBox;
     s.finish();
     g.validate();

@@ -141,6 +141,7 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     // like liquid (surface, relaxation, interior, relaxation). Basic SPH uses the same layer as
     // its boundary particles.
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+    ps.tiledInterior = mSettings.tiledSampling;
     ps.bandDepth = mSettings.supportRadius();
     ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mStep;
     const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(solid);
@@ -281,6 +282,7 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
                              "bodies when resuming)"));
     }
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+    ps.tiledInterior = mSettings.tiledSampling;
     ps.seed = mSettings.seed + 7919ULL * (mParticles.count(ParticleKind::Liquid) + 1);
     SampleSet samples = PoissonDiskSampler(ps).sampleVolume(shape);
     // Liquid inside a solid is not liquid, and liquid samples on a surface shared with a solid
@@ -508,6 +510,11 @@ ParticleSet GhostSolver::solidParticles() const
     }
     out.append(mPendingSolids);
     return out;
+}
+
+std::size_t GhostSolver::neighborListBytes() const
+{
+    return mFluidLists.memoryBytes() + mStatic.lists.memoryBytes() + mMoving.lists.memoryBytes();
 }
 
 ParticleSet GhostSolver::allParticles() const

@@ -254,6 +254,9 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
             }
             mEnd[q] = std::uint32_t(used);
         }
+        // A chunk that holds far more than it needs gives the room back (its lists shrank,
+        // e.g. after a splash settled): capacity is what the process holds.
+        if (out.capacity > 2 * used + 4096) out.shrink(used);
         // Slots to particle indices (nothing to do for a grid over a sorted set).
         if (!targets.identityOrder()) {
             Index* dst = out.data.get();
@@ -273,10 +276,19 @@ bool NeighborLists::wideSimd()
 #endif
 }
 
+void NeighborLists::Chunk::shrink(std::size_t used)
+{
+    const std::size_t fitted = used + used / 8 + 256;
+    std::unique_ptr<Index[]> smaller(new Index[fitted]);
+    std::copy(data.get(), data.get() + used, smaller.get());
+    data = std::move(smaller);
+    capacity = fitted;
+}
+
 void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)
 {
     if (size <= capacity) return;
-    const std::size_t grown = std::max(size, capacity + capacity / 2 + 1024);
+    const std::size_t grown = std::max(size, capacity + capacity / 8 + 1024);
     std::unique_ptr<Index[]> bigger(new Index[grown]);
     if (used > 0) std::copy(data.get(), data.get() + used, bigger.get());
     data = std::move(bigger);

@@ -64,6 +64,17 @@ void ParticleSet::forEachChannel(Fn&& fn)
     for (auto& [name, ch] : mVectors) fn(ch.data);
 }
 
+void ParticleSet::growFor(std::size_t count)
+{
+    // Room for `count` more, growing by an eighth rather than doubling: a solver appends a few
+    // particles every step (emission, air), and doubling would leave up to half of every
+    // channel unused (ParticleSet::memoryBytes counts capacity).
+    const std::size_t n = mPositions.size() + count;
+    if (n <= mPositions.capacity()) return;
+    const std::size_t grown = std::max(n, mPositions.size() + mPositions.size() / 8);
+    forEachChannel([grown](auto& data) { data.reserve(grown); });
+}
+
 void ParticleSet::appendDefaults(std::size_t count)
 {
     const std::size_t n = mPositions.size();
@@ -80,6 +91,7 @@ void ParticleSet::appendDefaults(std::size_t count)
 Index ParticleSet::add(const Vec3& x, const Vec3& v, Real m, ParticleKind kind)
 {
     const Index i = Index(mPositions.size());
+    growFor(1);
     mPositions.push_back(x);
     appendDefaults(1);
     mVelocities[i] = v;
@@ -91,6 +103,7 @@ Index ParticleSet::add(const Vec3& x, const Vec3& v, Real m, ParticleKind kind)
 Index ParticleSet::addBatch(const std::vector<Vec3>& xs, Real m, ParticleKind kind)
 {
     const Index first = Index(mPositions.size());
+    growFor(xs.size());
     mPositions.insert(mPositions.end(), xs.begin(), xs.end());
     appendDefaults(xs.size());
     std::fill(mMasses.begin() + first, mMasses.end(), m);

@@ -21,7 +21,11 @@ namespace sph {
 namespace {
 
 /// Streams of the random generator, one per phase, so phases do not share draws.
-enum Stream : std::uint64_t { SURFACE = 1, INTERIOR = 2, SEEDED = 3, RELAX = 16 };
+enum Stream : std::uint64_t { SURFACE = 1, INTERIOR = 2, SEEDED = 3, TILE_OFFSET = 4, TILE = 8, RELAX = 16 };
+/// Side of the periodic interior tile, in Poisson radii: about 1,000 points, small enough to
+/// relax in milliseconds, large enough that its period (11 spacings) is far beyond a kernel
+/// radius.
+constexpr Real TILE_RADII = Real(12);
 
 /// Dense grid of cells of side `cellSize` over a box, each cell the head of a linked list of
 /// point entries. Lists stay short (a cell of side r holds at most a few Poisson samples), so
@@ -372,6 +376,7 @@ PoissonDiskSampler::PoissonDiskSampler(const PoissonSettings& settings) : mSetti
 
 SampleSet PoissonDiskSampler::sampleVolume(const LevelSet& shape) const
 {
+    if (mSettings.tiledInterior) return sampleVolumeTiled(shape);
     SampleSet samples = sampleSurface(shape);
     relax(samples, shape, mSettings.surfaceRelaxSweeps, 0);
     sampleInterior(samples, shape);
@@ -445,16 +450,22 @@ SampleSet PoissonDiskSampler::sampleSurface(const LevelSet& shape) const
 
 void PoissonDiskSampler::sampleInterior(SampleSet& samples, const LevelSet& shape) const
 {
+    growInterior(samples, shape, {});
+}
+
+void PoissonDiskSampler::growInterior(SampleSet& samples, const LevelSet& shape,
+                                      const std::vector<std::uint8_t>& seeds) const
+{
     const Real r = mSettings.radius;
     const DepthLimit band(samples, shape, mSettings.bandDepth, r);
     PointGrid grid(samplingBounds(shape, r), r);
     std::vector<Vec3> active;
     active.reserve(samples.size());
-    for (const Vec3& x : samples.positions) {
-        if (grid.contains(x)) {
-            grid.add(x);
-            active.push_back(x);
-        }
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        const Vec3& x = samples.positions[i];
+        if (!grid.contains(x)) continue;
+        grid.add(x);
+        if (seeds.empty() || seeds[i]) active.push_back(x);
     }
     Rng rng(mSettings.seed, INTERIOR);
     growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
@@ -469,16 +480,184 @@ void PoissonDiskSampler::sampleInterior(SampleSet& samples, const LevelSet& shap
     });
 }
 
+// Tiled interior ---------------------------------------------------------------------------------
+
+std::vector<Vec3> PoissonDiskSampler::periodicTile(Real side) const
+{
+    // Bridson's growth and Algorithm 2 in a periodic cube: distances wrap around, so copies of
+    // the tile laid side by side keep the Poisson radius across their faces.
+    const Real r = mSettings.radius;
+    const int cells = std::max(3, int(std::floor(side / r)));
+    const Real cell = side / Real(cells);
+    std::vector<std::vector<int>> grid(std::size_t(cells) * cells * cells);
+    std::vector<Vec3> points;
+    auto wrap = [side](Real v) { return v - side * std::floor(v / side); };
+    auto cellOf = [&](const Vec3& x) {
+        auto c = [&](Real v) { return std::min(cells - 1, int(v / cell)); };
+        return (std::size_t(c(x[2])) * cells + std::size_t(c(x[1]))) * cells + std::size_t(c(x[0]));
+    };
+    // The nearest periodic image of q - p.
+    auto offset = [side](const Vec3& q, const Vec3& p) {
+        Vec3 d = q - p;
+        for (int a = 0; a < 3; ++a) d[a] -= side * std::round(d[a] / side);
+        return d;
+    };
+    // Visit the points within `reach` cells of x (reach <= cells / 2 keeps visits distinct).
+    auto forNear = [&](const Vec3& x, int reach, auto&& fn) {
+        const int cx = std::min(cells - 1, int(x[0] / cell)), cy = std::min(cells - 1, int(x[1] / cell)),
+                  cz = std::min(cells - 1, int(x[2] / cell));
+        for (int k = -reach; k <= reach; ++k) {
+            for (int j = -reach; j <= reach; ++j) {
+                for (int i = -reach; i <= reach; ++i) {
+                    const std::size_t c = (std::size_t((cz + k + cells) % cells) * cells +
+                                           std::size_t((cy + j + cells) % cells)) * cells +
+                                          std::size_t((cx + i + cells) % cells);
+                    for (int id : grid[c]) fn(id);
+                }
+            }
+        }
+    };
+    auto anyWithin = [&](const Vec3& x, Real radius, int ignore) {
+        bool found = false;
+        forNear(x, 1, [&](int id) {
+            if (id != ignore && offset(points[id], x).lengthSqr() < radius * radius) found = true;
+        });
+        return found;
+    };
+    auto add = [&](const Vec3& x) {
+        grid[cellOf(x)].push_back(int(points.size()));
+        points.push_back(x);
+    };
+
+    Rng rng(mSettings.seed, TILE);
+    const Vec3 first(Real(rng.uniform01()) * side, Real(rng.uniform01()) * side, Real(rng.uniform01()) * side);
+    add(first);
+    std::vector<Vec3> active{first};
+    growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
+        const Vec3 w(wrap(q[0]), wrap(q[1]), wrap(q[2]));
+        if (anyWithin(w, r, -1)) return false;
+        add(w);
+        return true;
+    });
+
+    // Algorithm 2, periodic: every point in turn moves to the best of t candidates.
+    const int t = mSettings.relaxAttempts;
+    const int reach = int(std::ceil(Real(2) * r / cell));
+    std::vector<Vec3> ball;
+    for (int sweep = 0; sweep < mSettings.volumeRelaxSweeps; ++sweep) {
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const Vec3 p = points[i];
+            ball.clear();
+            forNear(p, reach, [&](int id) {
+                const Vec3 d = offset(points[id], p);
+                if (id != int(i) && d.lengthSqr() < Real(4) * r * r) ball.push_back(p + d);
+            });
+            if (ball.empty()) continue;
+            auto minDistance2 = [&](const Vec3& x) {
+                Real d2 = std::numeric_limits<Real>::max();
+                for (const Vec3& q : ball) d2 = std::min(d2, (x - q).lengthSqr());
+                return d2;
+            };
+            Real d2 = minDistance2(p);
+            Vec3 best = p;
+            Rng step(mSettings.seed, TILE + 1 + (std::uint64_t(sweep) << 32) + i);
+            for (int a = 0; a < t; ++a) {
+                const Vec3 cand = p + step.unitVector() * (r * Real(t - a) / Real(t));
+                const Real c2 = minDistance2(cand);
+                if (c2 > d2) {
+                    d2 = c2;
+                    best = cand;
+                }
+            }
+            if (best == p) continue;
+            const Vec3 w(wrap(best[0]), wrap(best[1]), wrap(best[2]));
+            auto& from = grid[cellOf(p)];
+            from.erase(std::find(from.begin(), from.end(), int(i)));
+            points[i] = w;
+            grid[cellOf(w)].push_back(int(i));
+        }
+    }
+    return points;
+}
+
+SampleSet PoissonDiskSampler::sampleVolumeTiled(const LevelSet& shape) const
+{
+    const Real r = mSettings.radius;
+    SampleSet samples = sampleSurface(shape);
+    relax(samples, shape, mSettings.surfaceRelaxSweeps, 0);
+    const std::size_t surface = samples.size();
+
+    // 1. Deeper than 2r: copies of a relaxed periodic tile, shifted by a random offset.
+    const Real depth = Real(2) * r;
+    const Real side = TILE_RADII * r;
+    const std::vector<Vec3> tile = periodicTile(side);
+    const DepthLimit band(samples, shape, mSettings.bandDepth, r);
+    Rng rng(mSettings.seed, TILE_OFFSET);
+    const Vec3 shift(Real(rng.uniform01()) * side, Real(rng.uniform01()) * side, Real(rng.uniform01()) * side);
+    const Aabb bounds = shape.bounds();
+    const auto first = [&](int a) { return std::floor((bounds.min[a] - shift[a]) / side); };
+    const auto last = [&](int a) { return std::floor((bounds.max[a] - shift[a]) / side); };
+    std::vector<Vec3> tiled;
+    for (Real k = first(2); k <= last(2); k += 1) {
+        for (Real j = first(1); j <= last(1); j += 1) {
+            for (Real i = first(0); i <= last(0); i += 1) {
+                const Vec3 base = shift + Vec3(i, j, k) * side;
+                for (const Vec3& p : tile) tiled.push_back(base + p);
+            }
+        }
+    }
+    checkCount(tiled.size(), mSettings, "tiled interior");
+    // Depth from the surface samples (about r apart): phi is clamped a few voxels inside.
+    PointGrid near(samplingBounds(shape, r), depth + Real(2) * r);
+    for (std::size_t i = 0; i < surface; ++i) {
+        if (near.contains(samples.positions[i])) near.add(samples.positions[i]);
+    }
+    // 0: not kept; 1: kept; 2: kept, next to the gap (it seeds the growth into it).
+    std::vector<std::uint8_t> keep(tiled.size(), 0);
+    parallel::forEach(0, tiled.size(), [&](std::size_t k) {
+        const Vec3& x = tiled[k];
+        if (!bounds.contains(x)) return;
+        const Real phi = shape.phi(x);
+        if (!(phi < Real(0)) || near.anyWithin(x, depth) || !band.accepts(x, phi)) return;
+        keep[k] = near.anyWithin(x, depth + Real(2) * r) ? 2 : 1;
+    }, 1024);
+    std::vector<std::uint8_t> seeds(surface, 1);
+    for (std::size_t k = 0; k < tiled.size(); ++k) {
+        if (!keep[k]) continue;
+        samples.positions.push_back(tiled[k]);
+        samples.onSurface.push_back(0);
+        seeds.push_back(keep[k] == 2);
+    }
+    const std::size_t fixed = samples.size();
+    checkCount(fixed, mSettings, "tiled interior");
+
+    // 2. Between the surface and 2r deep: Bridson's growth from the surface samples and the
+    //    tile points along the gap, then Algorithm 2 for the samples placed so far by sampling
+    //    (the tile points hold still: they are relaxed already, in the tile).
+    growInterior(samples, shape, seeds);
+    std::vector<std::uint8_t> movable(samples.size(), 1);
+    std::fill(movable.begin() + std::ptrdiff_t(surface), movable.begin() + std::ptrdiff_t(fixed), 0);
+    relaxSome(samples, shape, mSettings.volumeRelaxSweeps, 1, movable);
+    return samples;
+}
+
 // [SB12] Algorithm 2 ---------------------------------------------------------------------------
 
 void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sweeps, int pass) const
+{
+    relaxSome(samples, shape, sweeps, pass, {});
+}
+
+void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, int sweeps, int pass,
+                                   const std::vector<std::uint8_t>& movable) const
 {
     if (sweeps <= 0 || samples.size() < 2) return;
     const Real r = mSettings.radius;
     const int t = mSettings.relaxAttempts;
     const DepthLimit band(samples, shape, mSettings.bandDepth, r);
 
-    PointGrid grid(samplingBounds(shape, r), r);
+    // Cells of side 2r: B(p) (radius 2r) lies in the 27 cells around p, not in 125 of side r.
+    PointGrid grid(samplingBounds(shape, r), Real(2) * r);
     std::vector<int> entry(samples.size(), -1);
     for (std::size_t i = 0; i < samples.size(); ++i) {
         if (grid.contains(samples.positions[i])) entry[i] = grid.add(samples.positions[i]);
@@ -498,8 +677,9 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
 
     // Lipschitz bound of the interpolated distance: trilinear interpolation of a distance
     // sampled on a grid changes by at most one voxel per voxel along each axis, so by at most
-    // sqrt(3) times the distance moved (with a little room for float rounding).
-    const Real lipschitz = Real(1.75);
+    // sqrt(3) times the distance moved; 2 leaves room for grids that are only nearly
+    // distances. It only decides which candidates can skip a phi lookup, never a result.
+    const Real lipschitz = Real(2);
     auto relaxOne = [&](std::size_t i, int sweep, Ball& ball) {
         const Vec3 p = samples.positions[i];
         const bool surface = samples.onSurface[i] != 0;
@@ -529,6 +709,26 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
                 continue;
             }
             if (!deep) {
+                // phi(cand) <= phi(p) + L |cand - p| (phi(p) = 0 on the surface).
+                const Real reachOut = lipschitz * r * tau;
+                if (!surface && phiP + reachOut < Real(0)) {
+                    // Certainly inside, so never projected: the checks below are those of the
+                    // general path, the cheap one first.
+                    const Real c2 = ball.minDistance2(cand);
+                    if (!(c2 > d2)) continue;
+                    if (band.limited() && !band.accepts(cand, shape.phi(cand))) continue;
+                    if (!grid.contains(cand)) continue;
+                    d2 = c2;
+                    best = cand;
+                    continue;
+                }
+                // The projection moves cand by about |phi| <= L r tau: skip it without looking
+                // phi up when even that much could not beat the best distance so far (then the
+                // test below on the actual phi would skip it too).
+                if (surface) {
+                    const Real bound = std::sqrt(ball.minDistance2(cand)) + Real(1.05) * reachOut;
+                    if (bound * bound <= d2) continue;
+                }
                 const Real phi = shape.phi(cand);
                 if (surface || phi > Real(0)) {
                     // The projection moves cand by about |phi|: skip it when even that
@@ -561,7 +761,7 @@ void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sw
         // Block and colour of every sample at the start of the sweep.
         order.clear();
         for (std::size_t i = 0; i < samples.size(); ++i) {
-            if (entry[i] < 0) continue;
+            if (entry[i] < 0 || (!movable.empty() && !movable[i])) continue;
             std::uint64_t b[3];
             for (int a = 0; a < 3; ++a) {
                 b[a] = std::uint64_t((samples.positions[i][a] - bounds.min[a]) / blockSize);

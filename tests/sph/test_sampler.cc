@@ -415,3 +415,49 @@ TEST(Sampler, SettingsAreValidated)
     EXPECT_THROW(PoissonSettings::forSpacing(Real(-1)), ValueError);
     EXPECT_NEAR(PoissonSettings::forSpacing(SPACING).radius, Real(0.92) * SPACING, 1e-9);
 }
+
+TEST(Sampler, TiledInteriorKeepsThePoissonRadiusTheFitAndTheDensity)
+{
+    // settings.tiled_sampling: the interior deeper than 2r from a relaxed periodic tile, the
+    // [SB12] pipeline only near the surface. It must keep the Poisson radius (across tile
+    // faces and the seam with the surface layer), the surface fit, and a relaxed, even
+    // interior density close to that of the full pipeline.
+    const Shape shape = sphereShape(Real(0.12));
+    const LevelSet ls = makeLevelSet(shape.grid, shape.name);
+    PoissonSettings full = PoissonSettings::forSpacing(SPACING);
+    PoissonSettings tiled = full;
+    tiled.tiledInterior = true;
+    const SampleSet a = PoissonDiskSampler(full).sampleVolume(ls);
+    const SampleSet b = PoissonDiskSampler(tiled).sampleVolume(ls);
+    const Real r = tiled.radius;
+    const std::vector<Real> nn = nearestNeighbourDistances(b.positions, 2 * r);
+    const double minDist = *std::min_element(nn.begin(), nn.end());
+    double worstSurface = 0;
+    for (std::size_t i = 0; i < b.size(); ++i) {
+        if (b.onSurface[i]) worstSurface = std::max(worstSurface, std::abs(shape.sdf(b.positions[i])));
+    }
+    const CubicSplineKernel kernel = CubicSplineKernel::fromSpacing(SPACING);
+    auto interiorDensity = [&](const SampleSet& s, double& spread) {
+        NeighborGrid grid(kernel.supportRadius());
+        grid.build(s.positions);
+        const std::vector<Real> rho = densitySum(s.positions, std::vector<Real>(s.size(), Real(1)), grid, kernel);
+        const auto interior = interiorMask(s.positions, shape, kernel.supportRadius());
+        spread = relativeSpread(rho, interior);
+        double sum = 0, n = 0;
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            if (interior[i]) { sum += rho[i]; n += 1; }
+        }
+        return sum / n;
+    };
+    double spreadA = 0, spreadB = 0;
+    const double rhoA = interiorDensity(a, spreadA), rhoB = interiorDensity(b, spreadB);
+    std::printf("[measured] tiled interior: %zu samples (full pipeline %zu), min distance %.4f r, "
+                "worst surface |phi| %.4f voxel, interior density %+.2f %% of the full pipeline's, "
+                "spread %.2f %% (full %.2f %%)\n", b.size(), a.size(), minDist / r,
+                worstSurface / VOXEL, 100 * (rhoB / rhoA - 1), 100 * spreadB, 100 * spreadA);
+    EXPECT_GE(minDist, r * Real(1 - 1e-5));
+    EXPECT_LT(worstSurface, 0.08 * VOXEL);          // the bound of PoissonDiskBoundaryFitAndCoverage
+    EXPECT_NEAR(rhoB / rhoA, 1.0, 0.02);            // one tile's packing: about 1 % off, bound 2 %
+    EXPECT_LT(spreadB, 0.045);                      // MassScalingGivesRestDensityOnAverage's bound
+    EXPECT_NEAR(double(b.size()) / double(a.size()), 1.0, 0.03);
+}

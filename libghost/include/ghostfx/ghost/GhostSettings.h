@@ -74,6 +74,10 @@ struct GhostSettings
     sph::Aabb killBox;
 
     std::uint64_t seed = 0;            ///< random seed of all sampling
+    /// Sample the interior of liquid bodies and solids deeper than 2r from a relaxed periodic
+    /// tile (PoissonSettings::tiledInterior): about twice as fast a set-up, with an interior
+    /// packing up to about 1 % off the layer near the surface. Off: [SB12]'s pipeline throughout.
+    bool tiledSampling = false;
 
     /// Kernel support radius (m).
     Real supportRadius() const { return supportFactor * spacing; }

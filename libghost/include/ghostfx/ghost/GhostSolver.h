@@ -168,6 +168,8 @@ public:
     std::size_t count(ParticleKind kind) const;
     /// Bytes held by the solver: particles, boundary blocks, neighbour grid and lists, scratch.
     std::size_t memoryBytes() const;
+    /// Of which the step's neighbour lists (rebuilt every step: about 4.5 bytes per pair).
+    std::size_t neighborListBytes() const;
 
     double time() const { return mTime; }
     std::uint64_t stepCount() const { return mStep; }

@@ -79,6 +79,8 @@ private:
         std::size_t capacity = 0;
         /// Make room for `size` entries, keeping the first `used`.
         void reserve(std::size_t size, std::size_t used);
+        /// Give back room beyond `used` entries (and a little slack).
+        void shrink(std::size_t used);
     };
 
     std::vector<std::uint32_t> mEnd; ///< per query: end of its list within its chunk

@@ -127,6 +127,7 @@ public:
 
 private:
     template <typename Fn> void forEachChannel(Fn&& fn);
+    void growFor(std::size_t count);
     void appendDefaults(std::size_t count);
 
     struct ScalarChannel { std::vector<Real> data; Real defaultValue; };
