@@ -90,14 +90,15 @@ struct Scene
 /// the ghost-solid band is one kernel radius deep ([SB12] Sec. 4.4), so thicker walls would add
 /// particles no liquid ever sees. The block is flush with the walls and the floor; addLiquid drops
 /// the samples closer than h / 2 to the solid (the layer on the shared faces).
-/// `floorFactor` scales the tank's floor area (both floor sides by its square root) with the same
-/// block: the liquid-speed check that a step costs what its liquid costs, not its tank.
+/// `floorFactor` scales the tank's floor area (its length; the block still spans the whole
+/// depth between the front and back walls, so the liquid and its free surface are the same):
+/// the liquid-speed check that a step costs what its liquid costs, not its tank.
 Scene damBreak(double targetLiquid, double floorFactor)
 {
     const double blockX = 0.4, blockY = 0.8, blockZ = 0.4; // m
     const double h = std::cbrt(SAMPLES_PER_CUBIC_SPACING * blockX * blockY * blockZ / targetLiquid);
-    const double wall = 3 * h, voxel = 0.5 * h, side = std::sqrt(floorFactor);
-    const openvdb::Vec3d innerLo(0, 0, 0), innerHi(3 * blockX * side, 1.25 * blockY, blockZ * side);
+    const double wall = 3 * h, voxel = 0.5 * h;
+    const openvdb::Vec3d innerLo(0, 0, 0), innerHi(3 * blockX * floorFactor, 1.25 * blockY, blockZ);
     const openvdb::Vec3d outerLo = innerLo - openvdb::Vec3d(wall);
     const openvdb::Vec3d outerHi(innerHi.x() + wall, innerHi.y(), innerHi.z() + wall);
     // The inner box reaches above the top, so the tank is open there.

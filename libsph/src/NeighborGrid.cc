@@ -42,7 +42,7 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     // Table size: the smallest power of two >= 2 N (at least 64), so buckets average <= 0.5
     // particle-cells and a compact block of cells never wraps onto itself.
     std::size_t tableSize = 64;
-    while (tableSize < 2 * count) tableSize *= 2;
+    while (tableSize < 2 * count / mPerCellHint) tableSize *= 2;
     mTableMask = tableSize - 1;
 
     // 1. Cell key and bucket of every particle; reject what the grid cannot represent.

@@ -28,7 +28,7 @@ class BoundaryBlock
 {
 public:
     /// @param cellSize  grid cell side (m): the kernel support radius of the queries
-    explicit BoundaryBlock(Real cellSize) : mGrid(cellSize) {}
+    explicit BoundaryBlock(Real cellSize) : mGrid(cellSize) { mGrid.setParticlesPerCellHint(8); }
 
     ParticleSet& particles() { return mParticles; }
     const ParticleSet& particles() const { return mParticles; }

@@ -62,6 +62,11 @@ public:
 
     Real cellSize() const { return mCellSize; }
 
+    /// Expected particles per occupied cell (default 1): the hash table gets about two buckets
+    /// per expected cell. Dense sets (a solid's band: about 20 per cell of one kernel radius)
+    /// set it higher, so the table stays small and cache-resident.
+    void setParticlesPerCellHint(std::size_t perCell) { mPerCellHint = perCell > 0 ? perCell : 1; }
+
     /// Sort `count` positions into the grid. Throws NumericalError on a non-finite position and
     /// ValueError on a position beyond MAX_CELL_COORD cells.
     void build(const Vec3* positions, std::size_t count);
@@ -207,6 +212,7 @@ private:
     std::vector<Index> mIndex;               ///< particle index of each sorted slot
     std::vector<std::uint32_t> mSlotOf;      ///< sorted slot of each particle index
     bool mIdentity = false;                  ///< mIndex[s] == s for every slot
+    std::size_t mPerCellHint = 1;            ///< see setParticlesPerCellHint
 };
 
 // ---------------------------------------------------------------------------------------------
