@@ -52,6 +52,23 @@ void BM_SampleVolume(benchmark::State& state)
     reportRate(state, n);
 }
 
+/// The same pipeline with the interior deeper than 2r from a relaxed periodic tile
+/// (PoissonSettings::tiledInterior, scene key settings.tiled_sampling).
+void BM_SampleVolumeTiled(benchmark::State& state)
+{
+    parallel::ThreadLimit limit(int(state.range(0)));
+    PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
+    settings.tiledInterior = true;
+    const PoissonDiskSampler sampler(settings);
+    std::size_t n = 0;
+    for (auto _ : state) {
+        const SampleSet s = sampler.sampleVolume(sphere());
+        n = s.size();
+        benchmark::DoNotOptimize(s.positions.data());
+    }
+    reportRate(state, n);
+}
+
 void BM_SampleWithoutRelaxation(benchmark::State& state)
 {
     parallel::ThreadLimit limit(int(state.range(0)));
@@ -83,6 +100,7 @@ void BM_VolumeRelaxationSweep(benchmark::State& state)
 } // namespace
 
 BENCHMARK(BM_SampleVolume)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_SampleVolumeTiled)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 BENCHMARK(BM_SampleWithoutRelaxation)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 BENCHMARK(BM_VolumeRelaxationSweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
 
