@@ -31,6 +31,37 @@ openvdb::FloatGrid::Ptr tankGrid(Real a, Real top)
     return levelSetFromSdf(sdf, bounds, H / 2);
 }
 
+/// Least-squares slope of pressure against height over the liquid away from the walls and
+/// the surface (their pressure carries the boundary's sampling noise).
+struct HydrostaticFit
+{
+    double slope = 0, meanDensity = 0, particles = 0, top = 0;
+};
+
+HydrostaticFit fitPressureSlope(const ParticleSet& p, Real a)
+{
+    HydrostaticFit fit;
+    double top = -1e9;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] == ParticleKind::Liquid) top = std::max(top, double(p.positions()[i][1]));
+    }
+    double sy = 0, sp = 0, syy = 0, syp = 0, n = 0, rhoSum = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Liquid) continue;
+        const Vec3& x = p.positions()[i];
+        if (std::abs(x[0]) > a - 2 * H || std::abs(x[2]) > a - 2 * H) continue;
+        if (x[1] < 2 * H || x[1] > top - 2 * H) continue;
+        const double y = x[1], pressure = p.pressures()[i];
+        sy += y; sp += pressure; syy += y * y; syp += y * pressure; n += 1;
+        rhoSum += p.densities()[i];
+    }
+    fit.slope = (n * syp - sy * sp) / (n * syy - sy * sy);
+    fit.meanDensity = rhoSum / n;
+    fit.particles = n;
+    fit.top = top;
+    return fit;
+}
+
 } // namespace
 
 TEST(HydrostaticTank, PressureGrowsAsRhoGDepthAndNoParticleEntersTheWalls)
@@ -46,41 +77,48 @@ TEST(HydrostaticTank, PressureGrowsAsRhoGDepthAndNoParticleEntersTheWalls)
     // [SB12] defaults: k = 2000 Pa (sound speed 3.7 m/s), 20 substeps at 30 fps would be
     // dt = 1/600 s; half that keeps the acoustic CFL number at 0.31.
     const Real dt = Real(1) / Real(1200);
-    for (int k = 0; k < 720; ++k) solver.step(dt); // 0.6 s: about 14 acoustic crossings
-
+    // The column settles for 0.3 s, then is measured over 0.3 s. With the paper's soft k it
+    // still rings in its lowest acoustic mode (period about 0.18 s here): the instantaneous
+    // slope swings by +-20 % around rho g, so one snapshot measures the phase of the ringing,
+    // not hydrostatics. The mean over the window (60 snapshots, 1.7 periods) is what must
+    // match; its residual is the mean acceleration of the column over the window.
+    const int settleSteps = 360, measureSteps = 360, every = 6;
     const ParticleSet& p = solver.particles();
-    double top = -1e9, worstInside = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] != ParticleKind::Liquid) continue;
-        top = std::max(top, double(p.positions()[i][1]));
-        worstInside = std::min(worstInside, double(tank.phi(p.positions()[i])));
+    double slopeSum = 0, rhoSum = 0, fitted = 0, top = -1e9, worstInside = 0;
+    int snapshots = 0;
+    for (int k = 0; k < settleSteps + measureSteps; ++k) {
+        solver.step(dt);
+        if (k < settleSteps || (k - settleSteps) % every != 0) continue;
+        const HydrostaticFit fit = fitPressureSlope(p, a);
+        slopeSum += fit.slope;
+        rhoSum += fit.meanDensity;
+        fitted += fit.particles;
+        top = fit.top;
+        ++snapshots;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            if (p.kinds()[i] == ParticleKind::Liquid) {
+                worstInside = std::min(worstInside, double(tank.phi(p.positions()[i])));
+            }
+        }
     }
-    // Least-squares slope of p against height over particles away from the walls and the
-    // surface (their pressure carries the boundary's sampling noise).
-    double sy = 0, sp = 0, syy = 0, syp = 0, n = 0, maxSpeed = 0, rhoSum = 0;
+    double maxSpeed = 0;
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] != ParticleKind::Liquid) continue;
-        const Vec3& x = p.positions()[i];
-        maxSpeed = std::max(maxSpeed, double(p.velocities()[i].length()));
-        if (std::abs(x[0]) > a - 2 * H || std::abs(x[2]) > a - 2 * H) continue;
-        if (x[1] < 2 * H || x[1] > top - 2 * H) continue;
-        sy += x[1]; sp += p.pressures()[i]; syy += double(x[1]) * x[1];
-        syp += double(x[1]) * p.pressures()[i]; n += 1;
-        rhoSum += p.densities()[i];
+        if (p.kinds()[i] == ParticleKind::Liquid) maxSpeed = std::max(maxSpeed, double(p.velocities()[i].length()));
     }
-    const double slope = (n * syp - sy * sp) / (n * syy - sy * sy);
+    const double slope = slopeSum / snapshots;
     // Hydrostatics: dp/dy = -rho g. With the paper's soft k = 2000 Pa the column compresses
     // (rho up to 1.08 rho0 at 12 cm depth), so compare with the mean density of the fitted
     // particles, and report rho0 g beside it.
-    const double rhoMean = rhoSum / n;
+    const double rhoMean = rhoSum / snapshots;
     const double expected = -rhoMean * 9.81;
-    std::printf("[measured] tank: dp/dy %.1f Pa/m vs -rho g %.1f (%.2f %%; -rho0 g %.1f), mean "
-                "rho %.1f, %g particles in fit, deepest liquid inside wall %.2e m, max speed "
-                "%.3f m/s, top %.4f m\n", slope, expected, 100 * (slope - expected) / expected,
-                -double(s.restDensity) * 9.81, rhoMean, n, worstInside, maxSpeed, top);
+    std::printf("[measured] tank: mean dp/dy %.1f Pa/m over %d snapshots vs -rho g %.1f (%.2f %%; "
+                "-rho0 g %.1f), mean rho %.1f, %.0f particles per fit, deepest liquid inside wall "
+                "%.2e m, max speed %.3f m/s, top %.4f m\n", slope, snapshots, expected,
+                100 * (slope - expected) / expected, -double(s.restDensity) * 9.81, rhoMean,
+                fitted / snapshots, worstInside, maxSpeed, top);
     // SPH pressure noise over 0.1 m of height: bound 5 %.
     EXPECT_NEAR(slope / expected, 1.0, 0.05);
-    // Collision projection keeps every particle out: tolerance 1e-3 voxel of projection.
+    // Collision projection keeps every particle out (at every snapshot): tolerance 1e-3 voxel of projection.
     EXPECT_GE(worstInside, -0.01 * double(H));
     // At rest: residual speeds well below sqrt(g h) = 0.31 m/s.
     EXPECT_LT(maxSpeed, 0.1);
