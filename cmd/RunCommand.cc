@@ -76,22 +76,34 @@ std::string duration(double s)
     return buffer;
 }
 
-/// Parse "--frames A-B" or "--frames B".
+/// Parse "--frames A-B" or "--frames B" (whole numbers in [1, MAX_FRAME], first <= last).
 void parseFrames(const std::string& text, int& first, int& last)
 {
-    int a = 0, b = 0;
-    char tail = 0;
-    if (std::sscanf(text.c_str(), "%d-%d%c", &a, &b, &tail) == 2) {
-        first = a;
-        last = b;
-    } else if (std::sscanf(text.c_str(), "%d%c", &b, &tail) == 1) {
-        last = b;
-    } else {
-        throw ValueError(msg("--frames '", text, "': expected A-B (e.g. 1-48) or a last frame"));
+    // One whole number at p, no sign, at most MAX_FRAME; returns the end of it or nullptr.
+    auto number = [](const char* p, long long& out) -> const char* {
+        if (*p < '0' || *p > '9') return nullptr;
+        out = 0;
+        for (; *p >= '0' && *p <= '9'; ++p) {
+            out = out * 10 + (*p - '0');
+            if (out > vdbio::MAX_FRAME) return nullptr;
+        }
+        return p;
+    };
+    long long a = first, b = 0;
+    const char* p = number(text.c_str(), b);
+    if (p && *p == '-') {
+        a = b;
+        p = number(p + 1, b);
     }
-    if (first < 1 || last < first) {
+    if (!p || *p != '\0') {
+        throw ValueError(msg("--frames '", text, "': expected A-B (e.g. 1-48) or a last frame, whole "
+                             "numbers up to ", vdbio::MAX_FRAME));
+    }
+    if (a < 1 || b < a) {
         throw ValueError(msg("--frames '", text, "': expected 1 <= first <= last"));
     }
+    first = int(a);
+    last = int(b);
 }
 
 /// Progress on a terminal (one line redrawn) or as log lines.

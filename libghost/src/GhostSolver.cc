@@ -414,13 +414,18 @@ void GhostSolver::applyKillBox()
 
 // Initialisation: the first air layer and the mass scaling ---------------------------------------
 
-void GhostSolver::initialize()
+bool GhostSolver::initialize()
 {
-    if (mInitialized) return;
+    if (mInitialized) return true;
     if (mParticles.count(ParticleKind::Liquid) == 0) emit();
     if (mParticles.count(ParticleKind::Liquid) == 0) {
+        // Nothing to simulate yet, but an emitter starts later: wait for it (the mass scaling
+        // and the first air layer are made from its first liquid).
+        for (const auto& em : mEmitters) {
+            if (em->end > mTime && em->start < std::numeric_limits<double>::infinity()) return false;
+        }
         throw ValueError("liquid solver: no liquid particles (add a liquid body, particles, or an "
-                         "emitter active at the start)");
+                         "emitter that is active now or starts later)");
     }
     if (mSettings.method == Method::Ghost) {
         prepareSolidBlocks();
@@ -485,6 +490,7 @@ void GhostSolver::initialize()
         }
     }
     mInitialized = true;
+    return true;
 }
 
 // Counts and views ------------------------------------------------------------------------------

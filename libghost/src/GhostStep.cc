@@ -336,8 +336,18 @@ void GhostSolver::step(Real dt)
     }
     checkRestoredInputs();
     const bool fresh = !mInitialized;
-    initialize();
     const auto start = std::chrono::steady_clock::now();
+    if (!initialize()) {
+        // Waiting for an emitter that starts later: only time and the solids move.
+        const double t1 = mTime + double(dt);
+        moveSolids(t1);
+        mTime = t1;
+        ++mStep;
+        mTimings.total += secondsSince(start);
+        ++mTimings.steps;
+        if (mObserver) mObserver(*this, dt);
+        return;
+    }
     // Algorithm 3 line 1: new liquid from the emitters (the first step's was added by
     // initialize(), before the mass scaling).
     if (!fresh && !mEmitters.empty()) {

@@ -237,6 +237,14 @@ TEST_F(Cli, BadInputGetsOneClearLine)
     EXPECT_CONTAINS(errorLine("run " + good + " --out " + (mDir / "afile").string()),
                     "output folder '" + (mDir / "afile").string() + "': exists and is not a folder");
     EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 5-2"), "--frames '5-2': expected 1 <= first <= last");
+    // Frame numbers that do not fit: refused, not wrapped into "nothing to do" with exit 0.
+    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 1-3000000000"),
+                    "--frames '1-3000000000': expected A-B (e.g. 1-48) or a last frame, whole numbers up to 9999999");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 1-2x"), "--frames '1-2x': expected A-B");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.frame_range=[1,3000000000]"),
+                    "settings.frame_range = [1,3000000000]: expected [first, last] with 1 <= first <= last <= 9999999");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.frame_range=[1,99999999999999999999]"),
+                    "settings.frame_range = [1,1e+20]: expected [first, last]");
     // Nothing was written by any of the failed runs.
     EXPECT_FALSE(fs::exists(mDir / "out") && !fs::is_empty(mDir / "out"));
 }

@@ -2,6 +2,7 @@
 /// @brief  Continuous emission ([SB12] Sec. 4.5.2) and the kill box: volume emitted per second,
 ///         no overlap between new and old liquid, particles leaving the domain removed.
 #include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/PoissonSampler.h>
@@ -96,5 +97,42 @@ TEST(Emitter, KillBoxRemovesLiquidLeavingTheDomain)
         if (solver.particles().kinds()[i] == ParticleKind::Liquid) {
             ASSERT_TRUE(s.killBox.contains(solver.particles().positions()[i]));
         }
+    }
+}
+
+TEST(Emitter, LaterEmitterInAnEmptySceneWaitsForItsStart)
+{
+    // No liquid until the tap opens at t = 0.05 s: the solver steps time (and the solids)
+    // until then, then emits, scales the mass and runs as usual.
+    GhostSettings s;
+    s.spacing = H;
+    s.seed = 4;
+    GhostSolver solver(s);
+    const Real half = 3 * H;
+    const LevelSet nozzle = makeLevelSet(makeBoxLevelSet(Vec3(-half, 0, -half), Vec3(half, 3 * H, half), H / 2), "tap");
+    solver.addEmitter(nozzle, Vec3(0, -1, 0), 0.05);
+    const Real dt = Real(1) / 1200;
+    std::size_t stepsWithoutLiquid = 0;
+    while (solver.time() < 0.1) {
+        solver.step(dt);
+        if (solver.count(ParticleKind::Liquid) == 0) ++stepsWithoutLiquid;
+    }
+    std::printf("[measured] late emitter: %zu steps without liquid (0.05 s at dt 1/1200 s = 60), "
+                "%zu liquid at t = 0.1 s, particle mass %.3e kg\n", stepsWithoutLiquid,
+                solver.count(ParticleKind::Liquid), double(solver.particleMass()));
+    // Exactly the steps before t = 0.05 s (one more for the round-off of summed steps).
+    EXPECT_GE(stepsWithoutLiquid, 59u);
+    EXPECT_LE(stepsWithoutLiquid, 61u);
+    EXPECT_GT(solver.count(ParticleKind::Liquid), 0u);
+    EXPECT_GT(solver.particleMass(), Real(0));
+
+    // Nothing that could ever bring liquid (no body, no emitter): refused at the first step.
+    GhostSolver ended(s);
+    ended.addSolid(nozzle);
+    try {
+        ended.step(dt);
+        FAIL() << "a scene with no liquid and no emitter to come must be refused";
+    } catch (const ValueError& e) {
+        EXPECT_NE(std::string(e.what()).find("no liquid particles"), std::string::npos) << e.what();
     }
 }

@@ -141,6 +141,8 @@ TEST_F(SceneTest, WrongTypesAndRangesNameTheValue)
     s = baseScene();
     s["settings"]["frame_range"] = {5, 2};
     EXPECT_CONTAINS(errorOf(s), "settings.frame_range = [5,2]: expected [first, last]");
+    s["settings"]["frame_range"] = {1, 3000000000.0};
+    EXPECT_CONTAINS(errorOf(s), "settings.frame_range = [1,3000000000.0]: expected [first, last] with 1 <= first <= last <= 9999999");
     s = baseScene();
     s["liquids"][0]["velocity"] = {1, 2};
     EXPECT_CONTAINS(errorOf(s), "liquids[0].velocity = [1,2]: expected an array of 3 numbers");

@@ -382,9 +382,10 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     scene.spacing = s.positive("spacing", 0.02);
     scene.frameRate = s.positive("frame_rate", 30);
     const std::vector<double> range = s.get<std::vector<double>>("frame_range", {1, 24});
-    if (range.size() != 2 || range[0] < 1 || range[1] < range[0] || range[0] != std::floor(range[0]) ||
-        range[1] != std::floor(range[1])) {
-        s.failValue("frame_range", "expected [first, last] with 1 <= first <= last, whole numbers");
+    if (range.size() != 2 || !(range[0] >= 1) || !(range[1] >= range[0]) || !(range[1] <= MAX_FRAME) ||
+        range[0] != std::floor(range[0]) || range[1] != std::floor(range[1])) {
+        s.failValue("frame_range", msg("expected [first, last] with 1 <= first <= last <= ", MAX_FRAME,
+                                       ", whole numbers"));
     }
     scene.firstFrame = int(range[0]);
     scene.lastFrame = int(range[1]);

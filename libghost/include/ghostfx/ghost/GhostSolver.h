@@ -203,7 +203,9 @@ private:
         std::vector<Vec3> vstar;
     };
 
-    void initialize();
+    /// Emit, sample the first air layer and scale the mass, once; false while there is no
+    /// liquid yet and an emitter starts later.
+    bool initialize();
     void checkRestoredInputs() const;
     void addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving);
     SolidBlock& blockOf(std::size_t solidIndex);

@@ -63,6 +63,10 @@ struct KeyedMotion
     static openvdb::math::Mat3d rotation(const sph::Vec3d& degrees);
 };
 
+/// The largest frame number a scene or `--frames` may name: frame files carry the number in
+/// their names and frames count in an int; ten million frames is days of film at any rate.
+constexpr int MAX_FRAME = 9999999;
+
 struct SceneSolid
 {
     SceneSolid(std::string name_, std::string geometry_, sph::LevelSet shape_)
