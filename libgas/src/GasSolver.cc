@@ -157,11 +157,7 @@ void GasSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
     if (!isFinite(velocity)) {
         throw ValueError(msg("gas solid '", solid.name(), "': velocity is not finite"));
     }
-    addMovingSolid(solid, [velocity](double t) {
-        RigidTransform xf;
-        xf.translation = velocity * Real(t);
-        return xf;
-    });
+    addMovingSolid(solid, sph::constantVelocity(velocity));
 }
 
 void GasSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)

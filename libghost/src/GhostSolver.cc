@@ -75,11 +75,7 @@ void GhostSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
     if (!isFinite(velocity)) {
         throw ValueError(msg("solid '", solid.name(), "': velocity is not finite"));
     }
-    addSolidBody(solid, [velocity](double t) {
-        RigidTransform xf;
-        xf.translation = velocity * Real(t);
-        return xf;
-    }, velocity != Vec3(0));
+    addSolidBody(solid, sph::constantVelocity(velocity), velocity != Vec3(0));
 }
 
 void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)

@@ -41,6 +41,40 @@ RigidKey KeyedMotion::at(double time) const
     return k;
 }
 
+RigidKey KeyedMotion::rate(double time) const
+{
+    RigidKey r;
+    r.time = time;
+    if (keys.size() < 2 || time < keys.front().time || time >= keys.back().time) return r;
+    const auto upper = std::upper_bound(keys.begin(), keys.end(), time,
+                                        [](double t, const RigidKey& k) { return t < k.time; });
+    const RigidKey& b = *upper;
+    const RigidKey& a = *(upper - 1);
+    const double span = b.time - a.time;
+    r.translate = (b.translate - a.translate) / span;
+    r.rotateDegrees = (b.rotateDegrees - a.rotateDegrees) / span;
+    return r;
+}
+
+openvdb::math::Mat3d KeyedMotion::rotationRate(const Vec3d& degrees, const Vec3d& degreesPerSecond)
+{
+    // R = Rz Ry Rx, so dR/dt = Rz' Ry Rx wz + Rz Ry' Rx wy + Rz Ry Rx' wx with each factor's
+    // derivative with respect to its own angle.
+    const double d2r = M_PI / 180.0;
+    const double cx = std::cos(degrees[0] * d2r), sx = std::sin(degrees[0] * d2r);
+    const double cy = std::cos(degrees[1] * d2r), sy = std::sin(degrees[1] * d2r);
+    const double cz = std::cos(degrees[2] * d2r), sz = std::sin(degrees[2] * d2r);
+    const double one = 1, zero = 0;
+    const openvdb::math::Mat3d rx(one, zero, zero, zero, cx, -sx, zero, sx, cx);
+    const openvdb::math::Mat3d ry(cy, zero, sy, zero, one, zero, -sy, zero, cy);
+    const openvdb::math::Mat3d rz(cz, -sz, zero, sz, cz, zero, zero, zero, one);
+    const openvdb::math::Mat3d drx(zero, zero, zero, zero, -sx, -cx, zero, cx, -sx);
+    const openvdb::math::Mat3d dry(-sy, zero, cy, zero, zero, zero, -cy, zero, -sy);
+    const openvdb::math::Mat3d drz(-sz, -cz, zero, cz, -sz, zero, zero, zero, zero);
+    const Vec3d w = degreesPerSecond * d2r;
+    return drz * ry * rx * w[2] + rz * dry * rx * w[1] + rz * ry * drx * w[0];
+}
+
 openvdb::math::Mat3d KeyedMotion::rotation(const Vec3d& degrees)
 {
     const double d2r = M_PI / 180.0;

@@ -59,8 +59,13 @@ struct KeyedMotion
 
     /// The interpolated key at time t (s).
     RigidKey at(double time) const;
+    /// Its time derivative: translate in m/s, rotateDegrees in degrees/s (zero outside the keys;
+    /// at a key, the rate of the segment that starts there).
+    RigidKey rate(double time) const;
     /// Rotation for column vectors, world = R * local + translate: R = Rz * Ry * Rx.
     static openvdb::math::Mat3d rotation(const sph::Vec3d& degrees);
+    /// dR/dt of rotation(degrees) while the angles change at degreesPerSecond.
+    static openvdb::math::Mat3d rotationRate(const sph::Vec3d& degrees, const sph::Vec3d& degreesPerSecond);
 };
 
 /// The largest frame number a scene or `--frames` may name: frame files carry the number in
