@@ -16,6 +16,9 @@ here="$(cd "$(dirname "$0")" && pwd)"
 rm -rf "$work"
 mkdir -p "$work"
 cmake --install "$build" --prefix "$work/prefix" > "$work/install.log"
+# The installed program runs from the prefix without LD_LIBRARY_PATH (install RPATH), also when
+# the environment points elsewhere.
+env -u LD_LIBRARY_PATH "$work/prefix/bin/ghostfx" --version | grep -q "^ghostfx "
 generator=()
 command -v ninja > /dev/null && generator=(-G Ninja)
 cmake -S "$here/consumer" -B "$work/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
