@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -258,6 +259,20 @@ int runScene(const RunOptions& o)
                          ", spacing ", scene.spacing, " m, frames ", std::max(first, startFrame + 1), "-", last,
                          (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"), ", ", parallel::maxThreads(),
                          " threads, output in '", folder, "'"));
+    // A fixed step far beyond the stability limit blows up within a few steps, after a frame
+    // or more of output: say so before the first step, with both numbers.
+    if (const double fixed = sim->fixedTimeStep(); fixed > 0) {
+        const double limit = sim->stabilityLimit();
+        if (fixed > limit) {
+            const int substeps = int(std::lround(1.0 / (fixed * scene.frameRate)));
+            std::fprintf(stderr, "%s\n",
+                         msg("ghostfx: warning: scene '", scene.file, "': the fixed step ", fixed, " s (frame_rate ",
+                             scene.frameRate, ", substeps ", substeps, ") is ", std::round(10 * fixed / limit) / 10,
+                             "x the stability limit ", limit, " s (Courant number 1: sound speed and forces); "
+                             "expect a blow-up: use substeps >= ", int(std::ceil(substeps * fixed / limit)),
+                             ", or substeps 0 for CFL steps").c_str());
+        }
+    }
     const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0;
     if (!out.checkpointFile.empty() && !checkpoints) {
         progress.message("note: boiling scenes write no checkpoints yet (the phase transition's state is not saved)");

@@ -49,6 +49,13 @@ FieldStats fieldStats(const sph::ParticleSet& p, ParticleKind kind, double rho0,
 
 // Liquid ------------------------------------------------------------------------------------------
 
+/// 1 / (frame rate substeps), or 0 for CFL-limited steps.
+template <typename Settings>
+double fixedStep(const Settings& s)
+{
+    return s.substeps > 0 ? 1.0 / (double(s.frameRate) * s.substeps) : 0.0;
+}
+
 class LiquidSimulation : public Simulation
 {
 public:
@@ -62,6 +69,11 @@ public:
     double time() const override { return mSolver->time(); }
     std::uint64_t stepCount() const override { return mSolver->stepCount(); }
     void beforeFrame(int frame) override { updateSolidSequences(mScene, *mSolver, frame); }
+    double fixedTimeStep() const override { return fixedStep(mSolver->settings()); }
+    double stabilityLimit() const override
+    {
+        return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
+    }
 
     void setStepObserver(std::function<void(double)> observer) override
     {
@@ -280,6 +292,11 @@ public:
     int frame() const override { return mSolver->frame(); }
     double time() const override { return mSolver->time(); }
     std::uint64_t stepCount() const override { return mSolver->stepCount(); }
+    double fixedTimeStep() const override { return fixedStep(mSolver->settings()); }
+    double stabilityLimit() const override
+    {
+        return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
+    }
 
     void setStepObserver(std::function<void(double)> observer) override
     {
@@ -378,6 +395,12 @@ public:
     }
     int frame() const override { return mFrame; }
     double time() const override { return mLiquid->time(); }
+    double fixedTimeStep() const override { return mSubsteps > 0 ? 1.0 / (double(mFrameRate) * mSubsteps) : 0.0; }
+    double stabilityLimit() const override
+    {
+        return std::min(double(mLiquid->stableTimeStep()) / double(mLiquid->settings().cflNumber),
+                        double(mGas->stableTimeStep()) / double(mGas->settings().cflNumber));
+    }
     std::uint64_t stepCount() const override { return mLiquid->stepCount(); }
     void beforeFrame(int frame) override { updateSolidSequences(mScene, *mLiquid, frame); }
     void setStepObserver(std::function<void(double)> observer) override { mObserver = std::move(observer); }

@@ -46,6 +46,12 @@ public:
     virtual double time() const = 0;
     virtual std::uint64_t stepCount() const = 0;
 
+    /// The scene's fixed step, 1 / (frame_rate substeps) (s), or 0 with CFL-limited steps.
+    virtual double fixedTimeStep() const = 0;
+    /// The largest stable step now (s): the solvers' limits at Courant number 1 (sound speed,
+    /// forces, explicit diffusion), the CFL step divided by the scene's cfl.
+    virtual double stabilityLimit() const = 0;
+
     /// Called after every step with its dt (s).
     virtual void setStepObserver(std::function<void(double dt)> observer) = 0;
     /// The statistics row of the step just taken.

@@ -249,6 +249,22 @@ TEST_F(Cli, BadInputGetsOneClearLine)
     EXPECT_FALSE(fs::exists(mDir / "out") && !fs::is_empty(mDir / "out"));
 }
 
+TEST_F(Cli, FixedStepBeyondTheStabilityLimitIsWarnedAboutBeforeTheFirstStep)
+{
+    const std::string path = write(smallScene());
+    const std::string out = " --out " + (mDir / "out").string() + " -q --frames 1-1";
+    // 1 fps and one substep: dt = 1 s against a limit of a few ms (spacing 0.015 m, sound
+    // speed 3.7 m/s): the warning names both numbers and the substeps that would do.
+    const Result bad = run("run " + path + out + " -D settings.frame_rate=1 -D settings.substeps=1");
+    EXPECT_CONTAINS(bad.err, "ghostfx: warning: scene '" + path + "': the fixed step 1 s (frame_rate 1, substeps 1) is ");
+    EXPECT_CONTAINS(bad.err, "x the stability limit 0.00");
+    EXPECT_CONTAINS(bad.err, "use substeps >= ");
+    // The scene's own 10 substeps at 30 fps (dt 3.3 ms) are within it: no warning.
+    const Result good = run("run " + path + out);
+    EXPECT_EQ(good.code, 0) << good.err;
+    EXPECT_EQ(good.err.find("warning"), std::string::npos) << good.err;
+}
+
 TEST_F(Cli, CtrlCFinishesTheFrameWritesACheckpointAndExitsNonZero)
 {
     Json scene = smallScene();
