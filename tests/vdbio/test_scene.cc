@@ -303,6 +303,24 @@ TEST_F(SceneTest, RoleTaggedVdbIsASceneWithDefaults)
     }
 }
 
+TEST_F(SceneTest, DeformingSolidIsRefusedWhereOnlyTheLiquidWouldApplyIt)
+{
+    // A gas scene: the gas solver has no per-frame shapes, so the key is refused, not ignored.
+    Json s = Json::parse(R"({ "ghostfx_scene": 1, "settings": { "method": "gas", "spacing": 0.03 },
+        "solids": [ { "name": "paddle", "geometry": { "sphere": { "center": [0, 0, 0], "radius": 0.1 } },
+                      "sequence": { "file": "paddle.$F4.vdb", "grid": "paddle" } } ],
+        "gas_sources": [ { "geometry": { "sphere": { "center": [0.5, 0.5, 0.5], "radius": 0.1 } } } ] })");
+    EXPECT_CONTAINS(errorOf(s), "solids[0].sequence: solid 'paddle' deforms per frame, which only a liquid scene "
+                                "supports; a gas scene takes static or rigidly moving solids");
+    // A boiling scene: the liquid would follow the sequence while its vapour kept the first shape.
+    Json b = baseScene();
+    b["solids"][0]["sequence"] = {{"file", "tank.$F4.vdb"}, {"grid", "tank"}};
+    b["heaters"] = Json::array({Json::parse(R"({ "geometry": { "box": { "min": [0.1, 0, 0.1], "max": [0.9, 0.05, 0.9] } },
+                                                 "temperature": 400 })")});
+    EXPECT_CONTAINS(errorOf(b), "solids[0].sequence: solid 'tank' deforms per frame, which only a liquid scene "
+                                "supports; a boiling scene");
+}
+
 TEST(KeyedMotion, InterpolatesAndHolds)
 {
     vdbio::KeyedMotion m;

@@ -530,6 +530,17 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     if (auto outputs = root.optionalObject("outputs")) readOutputs(*outputs, scene.outputs);
     root.finish();
 
+    // Per-frame shapes are applied by the liquid solver only; a gas (or a boiling liquid's
+    // vapour) would keep the first shape while the scene says it deforms.
+    if (scene.method == "gas" || !scene.heaters.empty()) {
+        for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+            if (scene.solids[i].sequenceFile.empty()) continue;
+            root.fail(msg("solids[", i, "].sequence"),
+                      msg("solid '", scene.solids[i].name, "' deforms per frame, which only a liquid scene "
+                          "supports; ", scene.method == "gas" ? "a gas" : "a boiling", " scene takes static or "
+                          "rigidly moving solids ('velocity' or 'motion')"));
+        }
+    }
     if (scene.method == "gas") {
         if (!scene.liquids.empty() || !scene.emitters.empty() || !scene.heaters.empty()) {
             root.fail(scene.liquids.empty() ? (scene.emitters.empty() ? "heaters" : "emitters") : "liquids",
