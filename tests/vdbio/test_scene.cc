@@ -303,6 +303,32 @@ TEST_F(SceneTest, RoleTaggedVdbIsASceneWithDefaults)
     }
 }
 
+TEST_F(SceneTest, SpacingTooFineForOpenVdbOrForMemoryIsRefusedBeforeSampling)
+{
+    // Below OpenVDB's smallest usable voxel: a clear error, not "ArithmeticError: Non-zero
+    // scale values required" from inside a transform.
+    Json s = baseScene();
+    s["settings"]["spacing"] = 1e-7;
+    EXPECT_CONTAINS(errorOf(s), "settings.spacing = 1e-07: expected at least 4e-05 m");
+    // A 10 m sphere of liquid at 2 mm: 5.2e11 particles. Refused from its size alone, before
+    // its level set is built, with the estimate and a spacing that would fit.
+    s = baseScene();
+    s["settings"]["spacing"] = 0.002;
+    s.erase("solids");
+    s["liquids"][0]["geometry"] = Json::parse(R"({ "sphere": { "center": [0, 0, 0], "radius": 10 } })");
+    const std::string e = errorOf(s);
+    EXPECT_CONTAINS(e, "liquids[0].geometry.sphere: at spacing 0.002 m this shape needs about 5.23599e+11 particles");
+    EXPECT_CONTAINS(e, "expected a spacing of at least");
+    // A solid only gets a band of ghosts under its surface: a 10 x 1 x 10 m floor slab at 1 cm
+    // holds 1e8 particles' volume (35 GB) but its band 2 spacings deep holds 4.8e6; accepted.
+    s = baseScene();
+    s["settings"]["spacing"] = 0.01;
+    s["solids"][0]["geometry"] = Json::parse(R"({ "box": { "min": [-5, -1, -5], "max": [5, 0, 5] } })");
+    s["solids"][0]["geometry"]["voxel_size"] = 0.5; // a coarse grid keeps the test fast
+    s["liquids"][0]["geometry"] = Json::parse(R"({ "box": { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] } })");
+    EXPECT_NO_THROW(vdbio::readScene(write(s)));
+}
+
 TEST_F(SceneTest, DeformingSolidIsRefusedWhereOnlyTheLiquidWouldApplyIt)
 {
     // A gas scene: the gas solver has no per-frame shapes, so the key is refused, not ignored.

@@ -16,10 +16,18 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace ghostfx {
 namespace vdbio {
 
 namespace fs = std::filesystem;
+
+namespace {
+/// Memory per particle for the budget check (bytes): the most a run measured, neighbour lists
+/// included (bench/RESULTS.md, "memory").
+constexpr double BYTES_PER_PARTICLE = 350;
+} // namespace
 using sph::Vec3d;
 
 // Keyed motion ---------------------------------------------------------------------------------
@@ -150,9 +158,57 @@ std::string resolve(const std::string& folder, const std::string& path)
     return (fs::path(folder) / path).lexically_normal().string();
 }
 
+/// How much of a shape the solvers fill with particles: all of it (liquid, gas source) or a
+/// band under its surface (solid ghosts and boundary particles: a kernel radius, 2 spacings).
+enum class Sampled { Volume, Band, None };
+
+/// The physical memory of this machine (bytes), 0 if unknown.
+double physicalMemory()
+{
+    const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? double(pages) * double(size) : 0.0;
+}
+
+/// Refuse a built-in shape whose particles cannot fit in this machine's memory, before its
+/// level set is built (which alone can take hours at a spacing far too fine for the shape).
+/// Particles: the volume, or the surface area times the band depth, over spacing^3; bytes per
+/// particle: 350, the most a run measured with its neighbour lists (bench/RESULTS.md).
+void checkParticleBudget(const JsonObject& g, double spacing, Sampled sampled, const char* kind)
+{
+    if (sampled == Sampled::None) return;
+    const JsonObject shape = g.object(kind);
+    double volume = 0, area = 0;
+    if (std::string(kind) == "sphere") {
+        const double r = shape.get<double>("radius", 0);
+        volume = 4.0 / 3.0 * M_PI * r * r * r;
+        area = 4.0 * M_PI * r * r;
+    } else {
+        const auto lo = shape.get<std::array<double, 3>>("min", {0, 0, 0});
+        const auto hi = shape.get<std::array<double, 3>>("max", {0, 0, 0});
+        const double a = std::abs(hi[0] - lo[0]), b = std::abs(hi[1] - lo[1]), c = std::abs(hi[2] - lo[2]);
+        volume = a * b * c;
+        area = 2 * (a * b + b * c + c * a);
+        if (std::string(kind) == "container") {
+            const double w = shape.get<double>("wall", 3 * spacing);
+            volume = (a + 2 * w) * (b + 2 * w) * (c + 2 * w) - volume;
+            area += 2 * ((a + 2 * w) * (b + 2 * w) + (b + 2 * w) * (c + 2 * w) + (c + 2 * w) * (a + 2 * w));
+        }
+    }
+    if (sampled == Sampled::Band) volume = std::min(volume, area * 2 * spacing);
+    const double particles = volume / (spacing * spacing * spacing);
+    const double bytes = particles * BYTES_PER_PARTICLE, memory = physicalMemory();
+    if (memory > 0 && bytes > memory) {
+        const double fits = spacing * std::cbrt(bytes / memory);
+        g.fail(kind, msg("at spacing ", spacing, " m this shape needs about ", particles, " particles (",
+                         bytes / double(1ULL << 30), " GiB at ", BYTES_PER_PARTICLE, " bytes each), more than this "
+                         "machine's ", memory / double(1ULL << 30), " GiB: expected a spacing of at least ", fits, " m"));
+    }
+}
+
 /// A shape: a grid in a file, or a built-in sphere, box or container (a closed tank: solid walls
 /// of thickness `wall` around the empty box [min, max]).
-sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string& description, bool allowFog = false)
+sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string& description,
+                           Sampled sampled, bool allowFog = false)
 {
     const double defaultVoxel = 0.5 * scene.spacing;
     const bool file = g.has("file"), sphere = g.has("sphere"), box = g.has("box"),
@@ -183,6 +239,10 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
         return loadLevelSet(path, grid, context);
     }
     const double voxel = g.positive("voxel_size", defaultVoxel);
+    if (voxel < MIN_SPACING / 2) {
+        g.failValue("voxel_size", msg("expected at least ", MIN_SPACING / 2, " m (OpenVDB's smallest usable voxel)"));
+    }
+    checkParticleBudget(g, scene.spacing, sampled, sphere ? "sphere" : box ? "box" : "container");
     openvdb::FloatGrid::Ptr grid;
     if (sphere) {
         const JsonObject s = g.object("sphere");
@@ -414,6 +474,10 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     const JsonObject& s = scene.settings;
     scene.method = s.choice("method", "ghost", {"ghost", "basic", "gas"});
     scene.spacing = s.positive("spacing", 0.02);
+    if (scene.spacing < MIN_SPACING) {
+        s.failValue("spacing", msg("expected at least ", MIN_SPACING, " m (OpenVDB refuses transforms with voxels "
+                                   "below about 1.5e-5 m, and grids use voxels of half the spacing)"));
+    }
     scene.frameRate = s.positive("frame_rate", 30);
     const std::vector<double> range = s.get<std::vector<double>>("frame_range", {1, 24});
     if (range.size() != 2 || !(range[0] >= 1) || !(range[1] >= range[0]) || !(range[1] <= MAX_FRAME) ||
@@ -440,7 +504,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     for (const JsonObject& o : root.objects("solids")) {
         const std::string name = o.get<std::string>("name", o.path());
         std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Band);
         SceneSolid solid{name, geometry, shape};
         solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         if (auto motion = o.optionalObject("motion")) {
@@ -461,7 +525,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     for (const JsonObject& o : root.objects("liquids")) {
         const std::string name = o.get<std::string>("name", o.path());
         std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume);
         SceneLiquid liquid{name, geometry, shape};
         liquid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         o.finish();
@@ -470,7 +534,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     for (const JsonObject& o : root.objects("emitters")) {
         const std::string name = o.get<std::string>("name", o.path());
         std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume);
         SceneEmitter emitter{name, geometry, shape};
         emitter.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         emitter.start = o.nonNegative("start", 0);
@@ -482,7 +546,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     for (const JsonObject& o : root.objects("gas_sources")) {
         const std::string name = o.get<std::string>("name", o.path());
         std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, /*allowFog=*/true);
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume, /*allowFog=*/true);
         SceneGasSource source{name, geometry, shape};
         source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         source.temperature = o.positive("temperature", source.temperature);
@@ -497,7 +561,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     for (const JsonObject& o : root.objects("heaters")) {
         const std::string name = o.get<std::string>("name", o.path());
         std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry);
+        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::None);
         SceneHeater heater{name, geometry, shape};
         heater.temperature = o.positive("temperature", heater.temperature);
         o.finish();

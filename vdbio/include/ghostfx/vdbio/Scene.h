@@ -72,6 +72,11 @@ struct KeyedMotion
 /// their names and frames count in an int; ten million frames is days of film at any rate.
 constexpr int MAX_FRAME = 9999999;
 
+/// The finest particle spacing a scene may ask for (m): grids use voxels of half the spacing,
+/// and OpenVDB refuses transforms whose voxels are below about 1.5e-5 m (the determinant of the
+/// scale must exceed 3e-15).
+constexpr double MIN_SPACING = 4e-5;
+
 struct SceneSolid
 {
     SceneSolid(std::string name_, std::string geometry_, sph::LevelSet shape_)
