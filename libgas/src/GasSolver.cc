@@ -832,7 +832,7 @@ void GasSolver::moveSolids(double t1)
     });
 }
 
-void GasSolver::projectOutOfSolids()
+void GasSolver::projectOutOfSolids(Real dt)
 {
     if (mSolids.empty()) return;
     auto& x = mParticles.positions();
@@ -842,22 +842,30 @@ void GasSolver::projectOutOfSolids()
     std::vector<RigidTransform> placement;
     for (const auto& solid : mSolids) placement.push_back(solid->at(time));
     // A gas particle that crossed into a solid goes back to its surface and loses the velocity
-    // into it (the boundary particles' pressure alone cannot stop a fast particle in one step).
-    parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
+    // into it (the boundary particles' pressure alone cannot stop a fast particle in one step):
+    // sph::collideWithSolid, shared with the liquid. The step moved it by dt v.
+    const std::size_t n = mParticles.size();
+    std::atomic<std::size_t> stuck{n};
+    parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) return;
+        const Vec3 previous = x[i] - dt * v[i];
         for (std::size_t b = 0; b < mSolids.size(); ++b) {
-            const Solid& solid = *mSolids[b];
-            const RigidTransform& xf = placement[b];
-            const Vec3 local = xf.toLocal(x[i]);
-            if (!(solid.shape.phi(local) < Real(0))) continue;
-            const SurfaceProjection proj = solid.shape.projectToSurface(local);
-            if (!proj.converged) continue;
-            const Vec3 nrm = xf.rotation * solid.shape.normal(proj.point);
-            x[i] = xf.toWorld(proj.point);
-            const Real vn = (v[i] - solid.velocity(proj.point, time)).dot(nrm);
-            if (vn < Real(0)) v[i] -= vn * nrm;
+            if (collideWithSolid(*mSolids[b], placement[b], time, previous, x[i], v[i]) == Collision::Stuck) {
+                std::size_t expected = stuck.load();
+                while (i < expected && !stuck.compare_exchange_weak(expected, i)) {}
+            }
         }
     });
+    if (const std::size_t i = stuck.load(); i < n) {
+        std::size_t b = 0;
+        while (b + 1 < mSolids.size() && !(mSolids[b]->phi(x[i], time) < Real(0))) ++b;
+        const LevelSet& shape = mSolids[b]->shape;
+        throw NumericalError(msg("gas solver at step ", mStep, " (t = ", mTime, " s): gas particle id ",
+                                 mParticles.ids()[i], " is inside solid '", shape.name(),
+                                 "' deeper than its level set's band (", shape.bandWidth(),
+                                 " m), and so was its position before the step: it cannot be put back; "
+                                 "reduce the time step (substeps / cflNumber)"));
+    }
 }
 
 void GasSolver::applyDomain()
@@ -987,7 +995,7 @@ void GasSolver::step(Real dt)
     const double t1 = mTime + double(dt);
     moveSolids(t1);
     mTime = t1;
-    projectOutOfSolids();
+    projectOutOfSolids(dt);
     checkBlowUp(dt);
     ++mStep;
     applyLifeStrength(dt); // before any removal: mIsolated is indexed like the density pass

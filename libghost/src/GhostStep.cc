@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <sstream>
 
 namespace ghostfx {
 namespace ghost {
@@ -396,30 +397,38 @@ void GhostSolver::projectOutOfSolids(Real dt)
     const bool all = mProjectAll;
     const std::size_t listed = mFluidLists.size(); // particles added after the search are air
     const Real solidSpeed = mMaxSolidSpeed;
-    // [SB12] Sec. 3 "Solid Collisions": a liquid particle inside a solid goes back to its
-    // surface (level-set closest point) and loses the velocity that points into the solid.
+    // [SB12] Sec. 3 "Solid Collisions" (sph::collideWithSolid). The step moved each particle
+    // by dt v, so it started at x - dt v.
+    std::atomic<std::size_t> stuck{mParticles.size()};
+    std::atomic<std::uint64_t> restored{0};
     parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
         if (kind[i] != ParticleKind::Liquid) return;
         const bool near = all || i >= listed || !mStatic.lists[i].empty() || !mMoving.lists[i].empty() ||
                           dt * (v[i].length() + solidSpeed) >= margin;
         if (!near) return;
+        const Vec3 previous = x[i] - dt * v[i];
         for (std::size_t b = 0; b < mSolids.size(); ++b) {
-            const Solid& solid = *mSolids[b];
-            const RigidTransform& xf = placement[b];
-            const Vec3 local = xf.toLocal(x[i]);
-            if (!(solid.shape.phi(local) < Real(0))) continue;
-            SurfaceProjection proj = solid.shape.projectToSurface(local);
-            // At edges and corners the projection can oscillate between cells: step out along
-            // the smooth normal instead. Deeper than the band no direction is known; that
-            // particle is left for the blow-up check.
-            if (!proj.converged) proj = solid.shape.pushOutside(local);
-            if (!proj.converged) continue;
-            const Vec3 nrm = xf.rotation * solid.shape.normal(proj.point);
-            x[i] = xf.toWorld(proj.point);
-            const Real vn = (v[i] - solid.velocity(proj.point, time)).dot(nrm);
-            if (vn < Real(0)) v[i] -= vn * nrm;
+            const Collision c = collideWithSolid(*mSolids[b], placement[b], time, previous, x[i], v[i]);
+            if (c == Collision::Restored) ++restored;
+            if (c == Collision::Stuck) {
+                std::size_t expected = stuck.load();
+                while (i < expected && !stuck.compare_exchange_weak(expected, i)) {}
+            }
         }
     });
+    mRestoredFromSolids += restored.load();
+    if (const std::size_t i = stuck.load(); i < mParticles.size()) {
+        std::size_t b = 0;
+        while (b + 1 < mSolids.size() && !(mSolids[b]->phi(x[i], time) < Real(0))) ++b;
+        std::ostringstream where;
+        where << "(" << x[i][0] << ", " << x[i][1] << ", " << x[i][2] << ")";
+        const LevelSet& shape = mSolids[b]->shape;
+        throw NumericalError(msg("liquid solver at frame ", mFrame, ", step ", mStep, " (t = ", mTime,
+                                 " s): liquid particle id ", mParticles.ids()[i], " at ", where.str(),
+                                 " is inside solid '", shape.name(), "' deeper than its level set's band (",
+                                 shape.bandWidth(), " m), and so was its position before the step: it cannot "
+                                 "be put back; reduce the time step (substeps / cflNumber)"));
+    }
     mProjectAll = false;
     mTimings.xsphAndBoundary += secondsSince(start);
 }

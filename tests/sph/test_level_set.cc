@@ -578,3 +578,33 @@ TEST(RigidMotion, ConstantVelocityIsExactFarFromTheOrigin)
     }};
     EXPECT_NEAR(double(lambda.velocity(Vec3(0), 1.0)[0]), 2.0, 1e-3);
 }
+
+TEST(SolidCollision, ProjectsRestoresOrReportsStuck)
+{
+    // A 2 m cube (solid) whose level set has a narrow band of 3 voxels of 1 cm.
+    const Real voxel = Real(0.01);
+    const MovingLevelSet cube{makeLevelSet(makeBoxLevelSet(Vec3(-1), Vec3(1), voxel), "cube"), constantVelocity(Vec3(0))};
+    const RigidTransform xf = cube.at(0);
+    const Real band = cube.shape.bandWidth();
+    // Just inside the top face, moving down: to the face, downward velocity removed.
+    Vec3 x(Real(0.2), Real(1) - Real(0.5) * band, Real(0.1)), v(1, -2, 0);
+    EXPECT_EQ(collideWithSolid(cube, xf, 0, x + Vec3(0, Real(0.01), 0), x, v), Collision::Projected);
+    EXPECT_NEAR(double(x[1]), 1.0, 1e-3 * double(voxel));
+    EXPECT_EQ(v, Vec3(1, 0, 0));
+    // 0.5 m deep (far beyond the band, where phi is clamped), having started above the face:
+    // back to the start, at the solid's velocity.
+    const Vec3 start(Real(0.2), Real(1.05), Real(0.1));
+    x = Vec3(Real(0.2), Real(0.5), Real(0.1));
+    v = Vec3(0, -55, 0);
+    EXPECT_EQ(collideWithSolid(cube, xf, 0, start, x, v), Collision::Restored);
+    EXPECT_EQ(x, start);
+    EXPECT_EQ(v, Vec3(0));
+    // Deep, and deep before: nothing can be done; the caller stops.
+    x = Vec3(0);
+    v = Vec3(0, -1, 0);
+    EXPECT_EQ(collideWithSolid(cube, xf, 0, Vec3(0, Real(0.1), 0), x, v), Collision::Stuck);
+    EXPECT_EQ(x, Vec3(0));
+    // Outside: untouched.
+    x = Vec3(0, 2, 0);
+    EXPECT_EQ(collideWithSolid(cube, xf, 0, x, x, v), Collision::None);
+}

@@ -227,7 +227,7 @@ private:
     void computeDensity();
     void computeForcesAndIntegrate(Real dt);
     void moveSolids(double t1);
-    void projectOutOfSolids();
+    void projectOutOfSolids(Real dt);
     void applyDomain();
     void applyLifeStrength(Real dt);
     void checkBlowUp(Real dt) const;

@@ -185,6 +185,9 @@ public:
     /// Liquid particles emitted and removed by the kill box since the start.
     std::size_t emittedCount() const { return mEmitted; }
     std::size_t killedCount() const { return mKilled; }
+    /// Liquid particles put back where they started a step because they ended it deeper in a
+    /// solid than its level set's band (sph::collideWithSolid), since the solver was made.
+    std::uint64_t restoredFromSolidsCount() const { return mRestoredFromSolids; }
 
 private:
     struct Solid;
@@ -243,6 +246,7 @@ private:
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Emitter>> mEmitters;
     std::size_t mEmitted = 0, mKilled = 0;
+    std::uint64_t mRestoredFromSolids = 0;
     Real mMass = 0;
     Real mLennardJones = 0;
     Real mMaxAcceleration = 0; ///< largest liquid acceleration of the last step (m/s^2)

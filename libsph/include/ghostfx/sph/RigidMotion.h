@@ -69,5 +69,44 @@ struct MovingLevelSet
     }
 };
 
+/// What collideWithSolid did with one particle.
+enum class Collision
+{
+    None,      ///< outside the solid: untouched
+    Projected, ///< moved to the surface, velocity into the solid removed
+    Restored,  ///< deeper than the level set's band: back where it started the step
+    Stuck      ///< deeper than the band, and so was its start: left where it is
+};
+
+/// [SB12] Sec. 3 "Solid Collisions" for one particle x (velocity v) and one solid placed by xf
+/// at `time`: a particle inside goes to the surface (closest point, or steps along the smooth
+/// normal where that oscillates at edges and corners) and loses its velocity into the solid.
+/// Beyond the band the level set is clamped and gives no direction: the particle goes back to
+/// `previous` (its position at the start of the step) if that is outside the solid now, moving
+/// with the solid; otherwise it is Stuck, and the caller must stop with an error (a particle
+/// inside a wall is a wrong answer, not a slow one).
+inline Collision collideWithSolid(const MovingLevelSet& solid, const RigidTransform& xf, double time,
+                                  const Vec3& previous, Vec3& x, Vec3& v)
+{
+    const Vec3 local = xf.toLocal(x);
+    if (!(solid.shape.phi(local) < Real(0))) return Collision::None;
+    SurfaceProjection proj = solid.shape.projectToSurface(local);
+    if (!proj.converged) proj = solid.shape.pushOutside(local);
+    if (proj.converged) {
+        const Vec3 nrm = xf.rotation * solid.shape.normal(proj.point);
+        x = xf.toWorld(proj.point);
+        const Real vn = (v - solid.velocity(proj.point, time)).dot(nrm);
+        if (vn < Real(0)) v -= vn * nrm;
+        return Collision::Projected;
+    }
+    const Vec3 before = xf.toLocal(previous);
+    if (!(solid.shape.phi(before) < Real(0))) {
+        x = previous;
+        v = solid.velocity(before, time);
+        return Collision::Restored;
+    }
+    return Collision::Stuck;
+}
+
 } // namespace sph
 } // namespace ghostfx
