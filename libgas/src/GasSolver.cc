@@ -7,9 +7,11 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
 #include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/Random.h>
+#include <ghostfx/sph/Timing.h>
 
 #include <algorithm>
 #include <atomic>
@@ -23,47 +25,6 @@ namespace gas {
 using namespace sph;
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// Kernels of Mueller et al. 2003 ([RYY15] ref. [20]) with the support radius R as an argument:
-// with variable smoothing lengths every pair has its own R = (h_i + h_j) / 2, so the value
-// objects of Kernels.h (whose constructors take powers of R) would be rebuilt per pair.
-
-/// poly6: 315 / (64 pi R^9) (R^2 - r^2)^3 (1/m^3).
-inline Real poly6W(Real r, Real R)
-{
-    if (r >= R) return Real(0);
-    const Real invR = Real(1) / R;
-    const Real invR3 = invR * invR * invR;
-    return Real(315.0 / (64.0 * 3.14159265358979323846)) * cube(R * R - r * r) * invR3 * invR3 * invR3;
-}
-
-/// |dW/dr| of the spiky kernel 15 / (pi R^6) (R - r)^3: 45 / (pi R^6) (R - r)^2 (1/m^4).
-inline Real spikySlope(Real r, Real R)
-{
-    if (r >= R) return Real(0);
-    const Real invR2 = Real(1) / (R * R);
-    return Real(45.0 / 3.14159265358979323846) * sqr(R - r) * invR2 * invR2 * invR2;
-}
-
-/// Spiky gradient with respect to x_i, xij = x_i - x_j, r = |xij|: points from i towards j.
-inline Vec3 spikyGrad(const Vec3& xij, Real r, Real R)
-{
-    if (r <= Real(0) || r >= R) return Vec3(0);
-    return xij * (-spikySlope(r, R) / r);
-}
-
-/// Laplacian of the viscosity kernel: 45 / (pi R^6) (R - r) (1/m^5).
-inline Real viscosityLaplacian(Real r, Real R)
-{
-    if (r >= R) return Real(0);
-    const Real invR2 = Real(1) / (R * R);
-    return Real(45.0 / 3.14159265358979323846) * (R - r) * invR2 * invR2 * invR2;
-}
 
 /// A double-precision sum back to Real.
 inline Vec3 toReal(const Vec3d& v) { return Vec3(Real(v[0]), Real(v[1]), Real(v[2])); }

@@ -7,6 +7,7 @@
 #include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/Timing.h>
 
 #include <algorithm>
 #include <chrono>
@@ -18,6 +19,8 @@
 namespace ghostfx {
 namespace gas {
 
+using sph::secondsSince;
+
 namespace {
 
 template <typename... Args>
@@ -26,11 +29,6 @@ std::string msg(Args&&... args)
     std::ostringstream s;
     (s << ... << args);
     return s.str();
-}
-
-double secondsSince(std::chrono::steady_clock::time_point t0)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 /// Deterministic value in [0, 1) from a particle id (splitmix64 finaliser).

@@ -4,6 +4,7 @@
 #include "ghostfx/gas/SplitPatterns.h"
 
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/Kernels.h>
 
 #include <Eigen/Dense>
 
@@ -136,17 +137,7 @@ const char* splitKernelName(SplitKernel kernel)
 
 double unitKernel(SplitKernel kernel, double q)
 {
-    if (q >= 1.0 || q < 0.0) return 0.0;
-    if (kernel == SplitKernel::Poly6) {
-        const double t = 1.0 - q * q;
-        return 315.0 / (64.0 * PI_D) * t * t * t;
-    }
-    // M4 spline with support 1: smoothing length s = 1/2, sigma = 1 / (pi s^3) = 8 / pi, u = 2 q.
-    const double u = 2.0 * q;
-    const double sigma = 8.0 / PI_D;
-    if (u < 1.0) return sigma * (1.0 - 1.5 * u * u + 0.75 * u * u * u);
-    const double t = 2.0 - u;
-    return sigma * 0.25 * t * t * t;
+    return kernel == SplitKernel::Poly6 ? sph::unitPoly6(q) : sph::unitCubicSpline(q);
 }
 
 void Quadrature::validate() const

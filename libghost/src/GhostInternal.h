@@ -6,6 +6,7 @@
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include <ghostfx/sph/RigidMotion.h>
+#include <ghostfx/sph/Timing.h>
 #include <ghostfx/sph/Types.h>
 
 #include <chrono>
@@ -59,10 +60,7 @@ inline std::uint64_t nearestKey(Real r, Index liquid)
 }
 inline Index nearestIndex(std::uint64_t key) { return Index(key & 0xffffffffu); }
 
-inline double secondsSince(std::chrono::steady_clock::time_point start)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using sph::secondsSince;
 
 } // namespace detail
 } // namespace ghost

@@ -402,3 +402,33 @@ TEST(CubicSplineKernel, FromSpacingRejectsNegativeSpacing)
 }
 
 } // namespace
+
+TEST(KernelFunctions, PerPairSupportFormsAgreeWithTheKernelObjects)
+{
+    // The free functions (support as an argument, used by the gas solver's variable smoothing
+    // lengths and the splitting integrals) and the kernel objects are one set of kernels: they
+    // agree to a few float roundings (1e-5 relative of the kernel's peak) over the support.
+    for (const Real R : {Real(0.01), Real(0.05), Real(1)}) {
+        const Poly6Kernel poly6(R);
+        const SpikyKernel spiky(R);
+        const ViscosityKernel viscosity(R);
+        for (int k = 0; k <= 40; ++k) {
+            const Real r = R * Real(k) / Real(40);
+            EXPECT_NEAR(poly6W(r, R), poly6.W(r), 1e-5 * poly6.W(Real(0))) << "R " << R << " r " << r;
+            EXPECT_NEAR(spikySlope(r, R), -spiky.dWdr(r), 1e-5 * -spiky.dWdr(Real(0)));
+            EXPECT_NEAR(viscosityLaplacian(r, R), viscosity.laplacianW(r), 1e-5 * viscosity.laplacianW(Real(0)));
+            if (k > 0 && k < 40) {
+                const Vec3 xij(r * Real(0.6), r * Real(0.8), 0);
+                const Vec3 a = spikyGrad(xij, r, R), b = spiky.gradW(xij, r);
+                EXPECT_NEAR((a - b).length(), 0.0, 1e-5 * -spiky.dWdr(Real(0)));
+            }
+        }
+    }
+    const Poly6Kernel poly6(1);
+    const CubicSplineKernel spline(1);
+    for (int k = 0; k <= 40; ++k) {
+        const double q = k / 40.0;
+        EXPECT_NEAR(unitPoly6(q), double(poly6.W(Real(q))), 1e-5 * double(poly6.W(0)));
+        EXPECT_NEAR(unitCubicSpline(q), double(spline.W(Real(q))), 1e-5 * double(spline.W(0)));
+    }
+}

@@ -248,5 +248,63 @@ private:
     Real mSupport, mCoefW, mCoefLap;
 };
 
+// Kernels with the support radius R as an argument --------------------------------------------
+// Mueller et al. 2003, as the classes above. With variable smoothing lengths ([RYY15]) every
+// pair has its own R = (h_i + h_j) / 2, so a kernel object would be rebuilt per pair.
+
+/// poly6: 315 / (64 pi R^9) (R^2 - r^2)^3 (1/m^3); Poly6Kernel(R).W(r).
+inline Real poly6W(Real r, Real R)
+{
+    if (r >= R) return Real(0);
+    const Real invR = Real(1) / R;
+    const Real invR3 = invR * invR * invR;
+    return Real(315.0 / (64.0 * 3.14159265358979323846)) * cube(R * R - r * r) * invR3 * invR3 * invR3;
+}
+
+/// |dW/dr| of the spiky kernel 15 / (pi R^6) (R - r)^3: 45 / (pi R^6) (R - r)^2 (1/m^4);
+/// -SpikyKernel(R).dWdr(r).
+inline Real spikySlope(Real r, Real R)
+{
+    if (r >= R) return Real(0);
+    const Real invR2 = Real(1) / (R * R);
+    return Real(45.0 / 3.14159265358979323846) * sqr(R - r) * invR2 * invR2 * invR2;
+}
+
+/// Spiky gradient with respect to x_i, xij = x_i - x_j, r = |xij|; SpikyKernel(R).gradW(xij, r).
+inline Vec3 spikyGrad(const Vec3& xij, Real r, Real R)
+{
+    if (r <= Real(0) || r >= R) return Vec3(0);
+    return xij * (-spikySlope(r, R) / r);
+}
+
+/// Laplacian of the viscosity kernel: 45 / (pi R^6) (R - r) (1/m^5);
+/// ViscosityKernel(R).laplacianW(r).
+inline Real viscosityLaplacian(Real r, Real R)
+{
+    if (r >= R) return Real(0);
+    const Real invR2 = Real(1) / (R * R);
+    return Real(45.0 / 3.14159265358979323846) * (R - r) * invR2 * invR2 * invR2;
+}
+
+/// The poly6 and cubic-spline kernels with support 1, in double precision, for integrals over
+/// kernel overlaps (particle splitting): poly6W(q, 1) and CubicSplineKernel(1).W(q).
+inline double unitPoly6(double q)
+{
+    if (q >= 1.0 || q < 0.0) return 0.0;
+    const double t = 1.0 - q * q;
+    return 315.0 / (64.0 * 3.14159265358979323846) * t * t * t;
+}
+
+inline double unitCubicSpline(double q)
+{
+    if (q >= 1.0 || q < 0.0) return 0.0;
+    // M4 spline with support 1: smoothing length s = 1/2, sigma = 1 / (pi s^3) = 8 / pi, u = 2 q.
+    const double u = 2.0 * q;
+    const double sigma = 8.0 / 3.14159265358979323846;
+    if (u < 1.0) return sigma * (1.0 - 1.5 * u * u + 0.75 * u * u * u);
+    const double t = 2.0 - u;
+    return sigma * 0.25 * t * t * t;
+}
+
 } // namespace sph
 } // namespace ghostfx
