@@ -64,36 +64,44 @@ RigidKey KeyedMotion::rate(double time) const
     return r;
 }
 
+namespace {
+
+/// The three factors of R = Rz Ry Rx for angles in degrees, and each one's derivative with
+/// respect to its own angle (radians).
+struct AxisRotations
+{
+    openvdb::math::Mat3d rx, ry, rz, drx, dry, drz;
+
+    explicit AxisRotations(const Vec3d& degrees)
+    {
+        const double d2r = M_PI / 180.0;
+        const double cx = std::cos(degrees[0] * d2r), sx = std::sin(degrees[0] * d2r);
+        const double cy = std::cos(degrees[1] * d2r), sy = std::sin(degrees[1] * d2r);
+        const double cz = std::cos(degrees[2] * d2r), sz = std::sin(degrees[2] * d2r);
+        const double one = 1, zero = 0;
+        rx = openvdb::math::Mat3d(one, zero, zero, zero, cx, -sx, zero, sx, cx);
+        ry = openvdb::math::Mat3d(cy, zero, sy, zero, one, zero, -sy, zero, cy);
+        rz = openvdb::math::Mat3d(cz, -sz, zero, sz, cz, zero, zero, zero, one);
+        drx = openvdb::math::Mat3d(zero, zero, zero, zero, -sx, -cx, zero, cx, -sx);
+        dry = openvdb::math::Mat3d(-sy, zero, cy, zero, zero, zero, -cy, zero, -sy);
+        drz = openvdb::math::Mat3d(-sz, -cz, zero, cz, -sz, zero, zero, zero, zero);
+    }
+};
+
+} // namespace
+
 openvdb::math::Mat3d KeyedMotion::rotationRate(const Vec3d& degrees, const Vec3d& degreesPerSecond)
 {
-    // R = Rz Ry Rx, so dR/dt = Rz' Ry Rx wz + Rz Ry' Rx wy + Rz Ry Rx' wx with each factor's
-    // derivative with respect to its own angle.
-    const double d2r = M_PI / 180.0;
-    const double cx = std::cos(degrees[0] * d2r), sx = std::sin(degrees[0] * d2r);
-    const double cy = std::cos(degrees[1] * d2r), sy = std::sin(degrees[1] * d2r);
-    const double cz = std::cos(degrees[2] * d2r), sz = std::sin(degrees[2] * d2r);
-    const double one = 1, zero = 0;
-    const openvdb::math::Mat3d rx(one, zero, zero, zero, cx, -sx, zero, sx, cx);
-    const openvdb::math::Mat3d ry(cy, zero, sy, zero, one, zero, -sy, zero, cy);
-    const openvdb::math::Mat3d rz(cz, -sz, zero, sz, cz, zero, zero, zero, one);
-    const openvdb::math::Mat3d drx(zero, zero, zero, zero, -sx, -cx, zero, cx, -sx);
-    const openvdb::math::Mat3d dry(-sy, zero, cy, zero, zero, zero, -cy, zero, -sy);
-    const openvdb::math::Mat3d drz(-sz, -cz, zero, cz, -sz, zero, zero, zero, zero);
-    const Vec3d w = degreesPerSecond * d2r;
-    return drz * ry * rx * w[2] + rz * dry * rx * w[1] + rz * ry * drx * w[0];
+    // dR/dt = Rz' Ry Rx wz + Rz Ry' Rx wy + Rz Ry Rx' wx.
+    const AxisRotations a(degrees);
+    const Vec3d w = degreesPerSecond * (M_PI / 180.0);
+    return a.drz * a.ry * a.rx * w[2] + a.rz * a.dry * a.rx * w[1] + a.rz * a.ry * a.drx * w[0];
 }
 
 openvdb::math::Mat3d KeyedMotion::rotation(const Vec3d& degrees)
 {
-    const double d2r = M_PI / 180.0;
-    const double cx = std::cos(degrees[0] * d2r), sx = std::sin(degrees[0] * d2r);
-    const double cy = std::cos(degrees[1] * d2r), sy = std::sin(degrees[1] * d2r);
-    const double cz = std::cos(degrees[2] * d2r), sz = std::sin(degrees[2] * d2r);
-    const double one = 1, zero = 0;
-    const openvdb::math::Mat3d rx(one, zero, zero, zero, cx, -sx, zero, sx, cx);
-    const openvdb::math::Mat3d ry(cy, zero, sy, zero, one, zero, -sy, zero, cy);
-    const openvdb::math::Mat3d rz(cz, -sz, zero, sz, cz, zero, zero, zero, one);
-    return rz * ry * rx;
+    const AxisRotations a(degrees);
+    return a.rz * a.ry * a.rx;
 }
 
 // Level sets -----------------------------------------------------------------------------------
