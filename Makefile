@@ -1,7 +1,7 @@
 # ghostfx: the two commands of the README.
 #   make demo   install missing Debian packages, configure, build, run the default example
 #   make test   install missing Debian packages, configure, build, run the test suite (ctest)
-# Other targets: build, bench, test-double, test-sanitize, clean.
+# Other targets: build, bench, test-double, test-sanitize, format, clean.
 #
 # Variables: BUILD_DIR (default build), JOBS (default: number of cores), CMAKE_ARGS (extra -D...).
 
@@ -11,7 +11,7 @@ CMAKE_ARGS ?=
 GENERATOR  := $(shell command -v ninja >/dev/null 2>&1 && echo Ninja || echo "Unix Makefiles")
 CTEST_ARGS ?=
 
-.PHONY: all deps configure build demo test bench test-double test-sanitize clean
+.PHONY: all deps configure build demo test bench test-double test-sanitize format clean
 
 all: build
 
@@ -47,6 +47,10 @@ test-double:
 test-sanitize:
 	@$(MAKE) --no-print-directory test BUILD_DIR=build-asan \
 	    CMAKE_ARGS="-DGHOSTFX_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGHOSTFX_BUILD_BENCH=OFF $(CMAKE_ARGS)"
+
+# The house style (.clang-format, from STYLE.md) over every tracked C++ file.
+format:
+	@git ls-files '*.h' '*.cc' | xargs clang-format -i
 
 clean:
 	rm -rf build build-double build-asan build*.configure.log

@@ -41,8 +41,10 @@ constexpr std::size_t GRAIN = parallel::DEFAULT_GRAIN;
 const char* queryName(PointIndexQuery query)
 {
     switch (query) {
-    case PointIndexQuery::BoxThenDistance: return "box+distance";
-    case PointIndexQuery::RadialSubvoxel: return "radial(subvoxel)";
+    case PointIndexQuery::BoxThenDistance:
+        return "box+distance";
+    case PointIndexQuery::RadialSubvoxel:
+        return "radial(subvoxel)";
     }
     return "?";
 }
@@ -63,7 +65,8 @@ struct PointIndexDensity::Impl
             const openvdb::Vec3d lo(x[0] - radius, x[1] - radius, x[2] - radius);
             const openvdb::Vec3d hi(x[0] + radius, x[1] + radius, x[2] + radius);
             it.searchAndUpdate(openvdb::CoordBBox(xform.worldToIndexCellCentered(lo),
-                                                  xform.worldToIndexCellCentered(hi)), acc);
+                                                  xform.worldToIndexCellCentered(hi)),
+                               acc);
         } else {
             it.worldSpaceSearchAndUpdate(openvdb::Vec3d(x), double(radius), acc, points, xform,
                                          /*subvoxelAccuracy=*/true);
@@ -101,33 +104,38 @@ void PointIndexDensity::density(const sph::CubicSplineKernel& kernel, const Real
 {
     const Impl& impl = *mImpl;
     const Real radius = kernel.supportRadius();
-    parallel::forRange(0, impl.points.count, [&](std::size_t begin, std::size_t end) {
-        Iterator::ConstAccessor acc(impl.grid->constTree());
-        Iterator it;
-        for (std::size_t i = begin; i < end; ++i) {
-            Real sum = 0;
-            impl.forEachNeighbor(i, radius, query, it, acc, [&](std::size_t j, Real r) {
-                sum += mass[j] * kernel.W(r);
-            });
-            rho[i] = sum;
-        }
-    }, GRAIN);
+    parallel::forRange(
+        0, impl.points.count,
+        [&](std::size_t begin, std::size_t end) {
+            Iterator::ConstAccessor acc(impl.grid->constTree());
+            Iterator it;
+            for (std::size_t i = begin; i < end; ++i) {
+                Real sum = 0;
+                impl.forEachNeighbor(i, radius, query, it, acc,
+                                     [&](std::size_t j, Real r) { sum += mass[j] * kernel.W(r); });
+                rho[i] = sum;
+            }
+        },
+        GRAIN);
 }
 
 std::uint64_t PointIndexDensity::countPairs(Real radius) const
 {
     const Impl& impl = *mImpl;
     std::atomic<std::uint64_t> total{0};
-    parallel::forRange(0, impl.points.count, [&](std::size_t begin, std::size_t end) {
-        Iterator::ConstAccessor acc(impl.grid->constTree());
-        Iterator it;
-        std::uint64_t pairs = 0;
-        for (std::size_t i = begin; i < end; ++i) {
-            impl.forEachNeighbor(i, radius, PointIndexQuery::BoxThenDistance, it, acc,
-                                 [&](std::size_t, Real) { ++pairs; });
-        }
-        total.fetch_add(pairs, std::memory_order_relaxed);
-    }, GRAIN);
+    parallel::forRange(
+        0, impl.points.count,
+        [&](std::size_t begin, std::size_t end) {
+            Iterator::ConstAccessor acc(impl.grid->constTree());
+            Iterator it;
+            std::uint64_t pairs = 0;
+            for (std::size_t i = begin; i < end; ++i) {
+                impl.forEachNeighbor(i, radius, PointIndexQuery::BoxThenDistance, it, acc,
+                                     [&](std::size_t, Real) { ++pairs; });
+            }
+            total.fetch_add(pairs, std::memory_order_relaxed);
+        },
+        GRAIN);
     return total.load();
 }
 

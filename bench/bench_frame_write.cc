@@ -30,8 +30,8 @@ using namespace ghostfx;
 
 namespace {
 
-constexpr double SPACING = 0.01;       // h (m)
-constexpr double REST_DENSITY = 1000;  // rho0 (kg/m^3)
+constexpr double SPACING = 0.01;      // h (m)
+constexpr double REST_DENSITY = 1000; // rho0 (kg/m^3)
 
 /// Jittered lattice cube of exactly `count` liquid particles (cached per count).
 const sph::ParticleSet& liquidCube(std::size_t count)
@@ -88,8 +88,8 @@ double processCpuSeconds()
 {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
-    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-           1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec)
+           + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 void writeVolume(benchmark::State& state, bool surface, bool density, bool velocity)

@@ -43,21 +43,21 @@ using namespace ghostfx::sph;
 
 namespace {
 
-
 double now()
 {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
 }
 
-void report(const char* name, const gas::PhaseTransition& c, const gas::GasSolver& g,
-            double wall, int steps, std::size_t liquid)
+void report(const char* name, const gas::PhaseTransition& c, const gas::GasSolver& g, double wall,
+            int steps, std::size_t liquid)
 {
     const auto& t = c.timings();
     const double per = 1000.0 / std::max<double>(1, double(t.steps));
     std::printf("%s: %d steps in %.2f s = %.2f steps/s (%.1f ms/step); liquid %zu, vapour %zu, "
-                "ambient air %zu, gas boundary %zu\n", name, steps, wall, steps / wall,
-                1000 * wall / steps, liquid, g.visibleGasCount(), g.ambientCount(),
-                c.boundaryCount());
+                "ambient air %zu, gas boundary %zu\n",
+                name, steps, wall, steps / wall, 1000 * wall / steps, liquid, g.visibleGasCount(),
+                g.ambientCount(), c.boundaryCount());
     std::printf("  per step (ms): liquid %.1f, heat %.1f, transition %.1f, boundary %.1f, gas %.1f "
                 "(gas: neighbours %.1f, density %.1f, forces %.1f, integration %.1f)\n",
                 per * t.liquid, per * t.heat, per * t.transition, per * t.boundary, per * t.gas,
@@ -65,8 +65,8 @@ void report(const char* name, const gas::PhaseTransition& c, const gas::GasSolve
                 1000 * g.timings().density / std::max<double>(1, double(g.timings().steps)),
                 1000 * g.timings().forces / std::max<double>(1, double(g.timings().steps)),
                 1000 * g.timings().integration / std::max<double>(1, double(g.timings().steps)));
-    std::printf("  gas-only rate: %.2f steps/s; mean gas neighbours %.0f\n", double(t.steps) / t.gas,
-                g.meanNeighbors());
+    std::printf("  gas-only rate: %.2f steps/s; mean gas neighbours %.0f\n",
+                double(t.steps) / t.gas, g.meanNeighbors());
 }
 
 } // namespace
@@ -94,8 +94,9 @@ int main(int argc, char** argv)
         openvdb::initialize();
         const Real H = Real(spacing), a = Real(halfWidth);
         const Real dt = Real(1) / Real(1200);
-        std::printf("bench_gas: %d threads, liquid spacing %.4f m, pan %.2f x %.2f m, depth %.3f m\n",
-                    parallel::maxThreads(), spacing, 2 * halfWidth, 2 * halfWidth, depth);
+        std::printf(
+            "bench_gas: %d threads, liquid spacing %.4f m, pan %.2f x %.2f m, depth %.3f m\n",
+            parallel::maxThreads(), spacing, 2 * halfWidth, 2 * halfWidth, depth);
 
         ghost::GhostSettings ls;
         ls.spacing = H;
@@ -129,9 +130,10 @@ int main(int argc, char** argv)
         ps.heatingTime = Real(0.05);
         ps.heaterBand = Real(1.5) * H;
         ps.evaporationRate = Real(0.5);
-        const LevelSet plate = makeLevelSet(
-            makeBoxLevelSet(Vec3(-a - 4 * H, -4 * H, -a - 4 * H), Vec3(a + 4 * H, 0, a + 4 * H),
-                            H / 2, Real(8)), "plate");
+        const LevelSet plate =
+            makeLevelSet(makeBoxLevelSet(Vec3(-a - 4 * H, -4 * H, -a - 4 * H),
+                                         Vec3(a + 4 * H, 0, a + 4 * H), H / 2, Real(8)),
+                         "plate");
         gas::PhaseTransition fast(fastGas, side, ps);
         fast.addHeater(plate, Real(heater));
 
@@ -193,8 +195,8 @@ int main(int argc, char** argv)
                liquid.count(ParticleKind::Liquid));
         const double fastRate = steps / fastWall, baseRate = baselineSteps / baseWall;
         std::printf("ratio fast / baseline: %.2fx coupled, %.2fx gas only\n", fastRate / baseRate,
-                    (double(fast.timings().steps) / fast.timings().gas) /
-                        (double(baseline.timings().steps) / baseline.timings().gas));
+                    (double(fast.timings().steps) / fast.timings().gas)
+                        / (double(baseline.timings().steps) / baseline.timings().gas));
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_gas: %s\n", e.what());
         return 1;

@@ -50,18 +50,18 @@ constexpr double PAPER_DT = 1.0 / (30.0 * 20.0);
 
 struct Options
 {
-    double damLiquid = 100000;     ///< dam break: target liquid particle count
-    double tankFloor = 1;          ///< dam break: tank floor area as a multiple of the default
-    double sphereLiquid = 20000;   ///< sphere scene: target liquid particle count
-    double sphereSpacing = 0.01;   ///< sphere scene: h (m)
-    int steps = 30;                ///< measured steps
-    int warmup = 20;               ///< steps before the measurement (>= 1)
-    double cfl = 0;                ///< > 0: CFL-limited dt with this number instead of PAPER_DT
-    double stiffness = 0;          ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
-    double lennardJones = 0;       ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
-    int threads = 0;               ///< TBB threads, 0 = all
-    std::string scenes = "all";    ///< dam, sphere or all
-    std::string methods = "both";  ///< ghost, basic or both
+    double damLiquid = 100000;    ///< dam break: target liquid particle count
+    double tankFloor = 1;         ///< dam break: tank floor area as a multiple of the default
+    double sphereLiquid = 20000;  ///< sphere scene: target liquid particle count
+    double sphereSpacing = 0.01;  ///< sphere scene: h (m)
+    int steps = 30;               ///< measured steps
+    int warmup = 20;              ///< steps before the measurement (>= 1)
+    double cfl = 0;               ///< > 0: CFL-limited dt with this number instead of PAPER_DT
+    double stiffness = 0;         ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
+    double lennardJones = 0;      ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
+    int threads = 0;              ///< TBB threads, 0 = all
+    std::string scenes = "all";   ///< dam, sphere or all
+    std::string methods = "both"; ///< ghost, basic or both
     std::uint64_t seed = 1;
 };
 
@@ -78,11 +78,11 @@ struct Scene
 {
     std::string name;
     std::string description;
-    Real spacing;                  ///< h (m)
+    Real spacing; ///< h (m)
     LevelSet solid;
     LevelSet liquid;
-    Vec3 liquidVelocity;           ///< initial liquid velocity (m/s)
-    Aabb container;                ///< liquid outside this box counts as escaped
+    Vec3 liquidVelocity; ///< initial liquid velocity (m/s)
+    Aabb container;      ///< liquid outside this box counts as escaped
 };
 
 /// Dam break: liquid block 0.4 x 0.8 x 0.4 m (scaled with h) in the corner of an open-top tank
@@ -111,13 +111,17 @@ Scene damBreak(double targetLiquid, double floorFactor)
     char text[256];
     std::snprintf(text, sizeof(text),
                   "block %.2f x %.2f x %.2f m in an open tank %.2f x %.2f x %.2f m (inside), "
-                  "walls %.4f m, h = %.5f m", blockX, blockY, blockZ, innerHi.x(), innerHi.y(),
-                  innerHi.z(), wall, h);
-    Scene s{floorFactor == 1 ? "dam_break" : msg("dam_break_floor", floorFactor), text, Real(h),
-            makeLevelSet(levelSetFromSdf(tankSdf, Aabb{toVec3(outerLo), toVec3(outerHi)},
-                                         Real(voxel)), "tank"),
-            makeLevelSet(makeBoxLevelSet(blockLo, blockHi, Real(voxel)), "water"), Vec3(0),
-            Aabb{toVec3(outerLo), toVec3(outerHi)}.padded(Real(2 * h))};
+                  "walls %.4f m, h = %.5f m",
+                  blockX, blockY, blockZ, innerHi.x(), innerHi.y(), innerHi.z(), wall, h);
+    Scene s{
+        floorFactor == 1 ? "dam_break" : msg("dam_break_floor", floorFactor),
+        text,
+        Real(h),
+        makeLevelSet(levelSetFromSdf(tankSdf, Aabb{toVec3(outerLo), toVec3(outerHi)}, Real(voxel)),
+                     "tank"),
+        makeLevelSet(makeBoxLevelSet(blockLo, blockHi, Real(voxel)), "water"),
+        Vec3(0),
+        Aabb{toVec3(outerLo), toVec3(outerHi)}.padded(Real(2 * h))};
     return s;
 }
 
@@ -132,12 +136,15 @@ Scene sphereDrop(double targetLiquid, double h)
     char text[256];
     std::snprintf(text, sizeof(text),
                   "liquid sphere r = %.3f m at (%.2f, %.3f, 0) m, v = (0, -1.5, 0) m/s, onto a "
-                  "solid sphere r = %.2f m at the origin, h = %.5f m", radius, double(centre[0]),
-                  double(centre[1]), solidRadius, h);
-    Scene s{"sphere_drop", text, Real(h),
+                  "solid sphere r = %.2f m at the origin, h = %.5f m",
+                  radius, double(centre[0]), double(centre[1]), solidRadius, h);
+    Scene s{"sphere_drop",
+            text,
+            Real(h),
             makeLevelSet(makeSphereLevelSet(Vec3(0), Real(solidRadius), Real(voxel)), "ball"),
             makeLevelSet(makeSphereLevelSet(centre, Real(radius), Real(voxel)), "drop"),
-            Vec3(0, Real(-1.5), 0), Aabb{Vec3(Real(-1)), Vec3(Real(1))}};
+            Vec3(0, Real(-1.5), 0),
+            Aabb{Vec3(Real(-1)), Vec3(Real(1))}};
     return s;
 }
 
@@ -149,17 +156,17 @@ struct RunResult
     Method method = Method::Ghost;
     bool ok = false;
     std::string error;
-    std::size_t liquid = 0, air = 0, solid = 0; ///< at the end of the measurement
+    std::size_t liquid = 0, air = 0, solid = 0;                  ///< at the end of the measurement
     double solidSampling = 0, liquidSampling = 0, firstStep = 0; ///< s
     double meanStep = 0, minStep = 0, maxStep = 0, medianStep = 0; ///< s, chrono around step()
-    double dt = 0;                                               ///< mean dt (s)
+    double dt = 0;                                                 ///< mean dt (s)
     PhaseTimings phases;
     double meanNeighbors = 0;
     double maxSpeed = 0, maxDensityRatio = 0; ///< at the end (m/s, rho / rho0)
     std::size_t escaped = 0, insideSolid = 0;
     std::size_t memoryBytes = 0; ///< the solver's memoryBytes() at the end
     std::size_t listBytes = 0;   ///< of which neighbour lists
-    int steps = 0; ///< measured steps completed
+    int steps = 0;               ///< measured steps completed
 };
 
 /// Warm up and measure `solver` (its solid already added). The liquid is `liquidPositions`
@@ -229,8 +236,8 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
     }
     out.liquid = solver.count(ParticleKind::Liquid);
     out.air = solver.count(ParticleKind::GhostAir);
-    out.solid = solver.count(method == Method::Ghost ? ParticleKind::GhostSolid
-                                                     : ParticleKind::Boundary);
+    out.solid =
+        solver.count(method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary);
     out.memoryBytes = solver.memoryBytes();
     out.listBytes = solver.neighborListBytes();
 }
@@ -246,31 +253,37 @@ void printRun(const RunResult& r)
                 r.method == Method::Ghost ? "ghost solid" : "boundary", r.solid,
                 percent(double(r.solid), double(r.liquid)), r.liquid + r.air + r.solid);
     std::printf("  set-up: solid sampling %.2f s, liquid sampling %.2f s, first step (air layer, "
-                "mass scaling) %.2f s\n", r.solidSampling, r.liquidSampling, r.firstStep);
+                "mass scaling) %.2f s\n",
+                r.solidSampling, r.liquidSampling, r.firstStep);
     const double all = double(r.liquid + r.air + r.solid);
     std::printf("  memory: %.1f MB, %.1f bytes per particle (particles, solid blocks, grids, "
-                "scratch %.1f + the step's neighbour lists %.1f)\n", double(r.memoryBytes) / 1e6,
-                double(r.memoryBytes) / all, double(r.memoryBytes - r.listBytes) / all,
-                double(r.listBytes) / all);
+                "scratch %.1f + the step's neighbour lists %.1f)\n",
+                double(r.memoryBytes) / 1e6, double(r.memoryBytes) / all,
+                double(r.memoryBytes - r.listBytes) / all, double(r.listBytes) / all);
     std::printf("  state at the end: max liquid speed %.3f m/s, max rho/rho0 %.3f, %zu liquid "
-                "outside the container, %zu inside the solid\n", r.maxSpeed, r.maxDensityRatio,
-                r.escaped, r.insideSolid);
+                "outside the container, %zu inside the solid\n",
+                r.maxSpeed, r.maxDensityRatio, r.escaped, r.insideSolid);
     if (r.steps == 0) return;
     if (!r.ok) {
         // The phases of the failed step are in r.phases but its total is not: no breakdown.
         std::printf("  step: mean %.1f ms over the %d measured steps completed before the "
-                    "blow-up\n", 1e3 * r.meanStep, r.steps);
+                    "blow-up\n",
+                    1e3 * r.meanStep, r.steps);
         return;
     }
     const PhaseTimings& t = r.phases;
     const double n = double(t.steps);
     std::printf("  step: mean %.1f ms (median %.1f, min %.1f, max %.1f = %.2f x median) over %d "
-                "measured steps, dt = %.6g s; solver total %.1f ms/step\n", 1e3 * r.meanStep,
-                1e3 * r.medianStep, 1e3 * r.minStep, 1e3 * r.maxStep, r.maxStep / r.medianStep,
-                r.steps, r.dt, 1e3 * t.total / n);
-    const double other = t.total - t.neighborsAndDensity - t.pressureForce - t.xsphAndBoundary -
-                         t.airResampling;
-    const struct { const char* name; double s; } rows[] = {
+                "measured steps, dt = %.6g s; solver total %.1f ms/step\n",
+                1e3 * r.meanStep, 1e3 * r.medianStep, 1e3 * r.minStep, 1e3 * r.maxStep,
+                r.maxStep / r.medianStep, r.steps, r.dt, 1e3 * t.total / n);
+    const double other =
+        t.total - t.neighborsAndDensity - t.pressureForce - t.xsphAndBoundary - t.airResampling;
+    const struct
+    {
+        const char* name;
+        double s;
+    } rows[] = {
         {"neighbours + density", t.neighborsAndDensity},
         {"pressure force", t.pressureForce},
         {"XSPH + boundary", t.xsphAndBoundary},
@@ -287,7 +300,8 @@ void printRun(const RunResult& r)
     }
     const double pairs = double(r.liquid) * r.meanNeighbors;
     std::printf("  mean neighbours %.1f; %.2f ns per particle-neighbour pair; %.1f wall s per "
-                "simulated s\n", r.meanNeighbors, 1e9 * r.meanStep / pairs, r.meanStep / r.dt);
+                "simulated s\n",
+                r.meanNeighbors, 1e9 * r.meanStep / pairs, r.meanStep / r.dt);
 }
 
 std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
@@ -337,31 +351,44 @@ int main(int argc, char** argv)
     CLI::App app{"Liquid solver scene benchmark ([SB12] Sec. 5): Ghost SPH and Basic SPH"};
     Options opt;
     app.add_option("--liquid", opt.damLiquid, "dam break: target liquid particle count")
-        ->capture_default_str()->check(CLI::Range(100.0, 1e8));
+        ->capture_default_str()
+        ->check(CLI::Range(100.0, 1e8));
     app.add_option("--tank-floor", opt.tankFloor,
                    "dam break: tank floor area as a multiple of the default (same liquid)")
-        ->capture_default_str()->check(CLI::Range(1.0, 100.0));
+        ->capture_default_str()
+        ->check(CLI::Range(1.0, 100.0));
     app.add_option("--sphere-liquid", opt.sphereLiquid,
                    "sphere scene: target liquid particle count")
-        ->capture_default_str()->check(CLI::Range(100.0, 1e8));
+        ->capture_default_str()
+        ->check(CLI::Range(100.0, 1e8));
     app.add_option("--sphere-spacing", opt.sphereSpacing, "sphere scene: particle spacing h (m)")
-        ->capture_default_str()->check(CLI::PositiveNumber);
-    app.add_option("--steps", opt.steps, "measured steps")->capture_default_str()
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_option("--steps", opt.steps, "measured steps")
+        ->capture_default_str()
         ->check(CLI::Range(1, 1000000));
-    app.add_option("--warmup", opt.warmup, "steps before the measurement (the first includes "
-                   "initialisation)")->capture_default_str()->check(CLI::Range(1, 1000000));
+    app.add_option("--warmup", opt.warmup,
+                   "steps before the measurement (the first includes "
+                   "initialisation)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000000));
     app.add_option("--cfl", opt.cfl,
                    "CFL-limited dt with this number (default: fixed dt = 1/600 s)")
         ->check(CLI::Range(1e-6, 2.0));
     app.add_option("--stiffness", opt.stiffness, "Tait stiffness k (Pa; default: [SB12] 2000)")
         ->check(CLI::PositiveNumber);
-    app.add_option("--lj", opt.lennardJones, "Basic SPH Lennard-Jones strength D (m^2/s^2; "
-                   "default: 5 g H)")->check(CLI::PositiveNumber);
-    app.add_option("--threads", opt.threads, "TBB threads (0 = all)")->capture_default_str()
+    app.add_option("--lj", opt.lennardJones,
+                   "Basic SPH Lennard-Jones strength D (m^2/s^2; "
+                   "default: 5 g H)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--threads", opt.threads, "TBB threads (0 = all)")
+        ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    app.add_option("--scene", opt.scenes, "dam, sphere or all")->capture_default_str()
+    app.add_option("--scene", opt.scenes, "dam, sphere or all")
+        ->capture_default_str()
         ->check(CLI::IsMember({"dam", "sphere", "all"}));
-    app.add_option("--method", opt.methods, "ghost, basic or both")->capture_default_str()
+    app.add_option("--method", opt.methods, "ghost, basic or both")
+        ->capture_default_str()
         ->check(CLI::IsMember({"ghost", "basic", "both"}));
     app.add_option("--seed", opt.seed, "random seed of all sampling")->capture_default_str();
     try {
@@ -382,7 +409,8 @@ int main(int argc, char** argv)
 
         std::vector<RunResult> all;
         if (opt.scenes != "sphere") {
-            for (const RunResult& r : runScene(damBreak(opt.damLiquid, opt.tankFloor), opt)) all.push_back(r);
+            for (const RunResult& r : runScene(damBreak(opt.damLiquid, opt.tankFloor), opt))
+                all.push_back(r);
         }
         if (opt.scenes != "dam") {
             const Scene scene = sphereDrop(opt.sphereLiquid, opt.sphereSpacing);
@@ -403,9 +431,9 @@ int main(int argc, char** argv)
             }
             if (!r.ok) {
                 std::printf("| %s | %s (blew up after %d measured steps) | %zu | %zu | %zu | %.1f "
-                            "| | | | | %.1f | %.2f | %.0f |\n", r.scene.c_str(),
-                            methodName(r.method), r.steps, r.liquid, r.air, r.solid,
-                            1e3 * r.meanStep, r.meanNeighbors,
+                            "| | | | | %.1f | %.2f | %.0f |\n",
+                            r.scene.c_str(), methodName(r.method), r.steps, r.liquid, r.air,
+                            r.solid, 1e3 * r.meanStep, r.meanNeighbors,
                             1e9 * r.meanStep / (double(r.liquid) * r.meanNeighbors),
                             r.meanStep / r.dt);
                 continue;

@@ -53,11 +53,11 @@ using ghostfx::sph::Real;
 using ghostfx::sph::Vec3;
 namespace parallel = ghostfx::parallel;
 
-constexpr double SPACING = 0.01;           ///< lattice spacing h (m)
-constexpr double JITTER_FRACTION = 0.1;    ///< jitter half-width, fraction of h
+constexpr double SPACING = 0.01;            ///< lattice spacing h (m)
+constexpr double JITTER_FRACTION = 0.1;     ///< jitter half-width, fraction of h
 constexpr unsigned LATTICE_SEED = 20240611; ///< jitter seed (deterministic scenario)
-constexpr unsigned SHUFFLE_SEED = 7;       ///< permutation seed of the `shuffled` order
-constexpr double REST_DENSITY = 1000.0;    ///< m = REST_DENSITY h^3 (kg/m^3)
+constexpr unsigned SHUFFLE_SEED = 7;        ///< permutation seed of the `shuffled` order
+constexpr double REST_DENSITY = 1000.0;     ///< m = REST_DENSITY h^3 (kg/m^3)
 /// Per-particle agreement demanded of the two searches: float sums of about 100 terms added
 /// in different orders differ by ~1e-6 relative; 1e-4 leaves room and still catches a missed
 /// or doubled neighbour (one neighbour is >= ~0.1% of rho when r < 0.9 R).
@@ -84,9 +84,9 @@ struct Scenario
     std::size_t count;
     Order order;
     CubicSplineKernel kernel;
-    std::vector<Vec3> x;       ///< positions (m), in `order`
-    std::vector<Real> mass;    ///< m (kg)
-    ParticleSet particles;     ///< the same particles as a solver holds them, in `order`
+    std::vector<Vec3> x;              ///< positions (m), in `order`
+    std::vector<Real> mass;           ///< m (kg)
+    ParticleSet particles;            ///< the same particles as a solver holds them, in `order`
     double neighboursPerParticle = 0; ///< mean |{j : r_ij < R}|, j == i included
 };
 
@@ -119,9 +119,8 @@ void ghostfxDensity(const NeighborGrid& grid, const CubicSplineKernel& kernel, c
 {
     parallel::forEach(0, count, [&](std::size_t i) {
         Real sum = 0;
-        grid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
-            sum += mass[j] * kernel.W(r);
-        });
+        grid.forEachNeighbor(Index(i),
+                             [&](Index j, const Vec3&, Real r) { sum += mass[j] * kernel.W(r); });
         rho[i] = sum;
     });
 }
@@ -134,9 +133,8 @@ void ghostfxDensityInRadius(const NeighborGrid& grid, const Vec3* x,
     const Real radius = kernel.supportRadius();
     parallel::forEach(0, count, [&](std::size_t i) {
         Real sum = 0;
-        grid.forEachInRadius(x[i], radius, [&](Index j, const Vec3&, Real r) {
-            sum += mass[j] * kernel.W(r);
-        });
+        grid.forEachInRadius(x[i], radius,
+                             [&](Index j, const Vec3&, Real r) { sum += mass[j] * kernel.W(r); });
         rho[i] = sum;
     });
 }
@@ -156,10 +154,10 @@ void requireAgreement(const std::vector<Real>& reference, const std::vector<Real
         const double a = reference[i], b = rho[i];
         const double rel = std::abs(a - b) / std::max(std::abs(a), 1e-30);
         if (!(rel <= DENSITY_REL_TOL)) {
-            throw std::runtime_error(ghostfx::msg(
-                "density check failed for ", reference.size(), " particles: ", what, " gives rho[",
-                i, "] = ", exact(b), " kg/m^3, NeighborGrid gives ", exact(a),
-                " (relative difference ", rel, " > ", DENSITY_REL_TOL, ")"));
+            throw std::runtime_error(
+                ghostfx::msg("density check failed for ", reference.size(), " particles: ", what,
+                             " gives rho[", i, "] = ", exact(b), " kg/m^3, NeighborGrid gives ",
+                             exact(a), " (relative difference ", rel, " > ", DENSITY_REL_TOL, ")"));
         }
     }
 }
@@ -304,8 +302,8 @@ void BM_GhostfxGrid_DensitySorted(benchmark::State& state, Order order)
     ParticleSet particles = sc.particles;
     grid.sortParticles(particles);
     for (auto _ : state) {
-        ghostfxDensity(grid, sc.kernel, particles.masses().data(),
-                       particles.densities().data(), sc.count);
+        ghostfxDensity(grid, sc.kernel, particles.masses().data(), particles.densities().data(),
+                       sc.count);
         benchmark::DoNotOptimize(particles.densities().data());
         benchmark::ClobberMemory();
     }
@@ -341,8 +339,8 @@ void BM_GhostfxGrid_BuildSortDensity(benchmark::State& state, Order order)
         particles = sc.particles;
         state.ResumeTiming();
         grid.sortParticles(particles);
-        ghostfxDensity(grid, sc.kernel, particles.masses().data(),
-                       particles.densities().data(), sc.count);
+        ghostfxDensity(grid, sc.kernel, particles.masses().data(), particles.densities().data(),
+                       sc.count);
         benchmark::DoNotOptimize(particles.densities().data());
         benchmark::ClobberMemory();
     }
@@ -395,8 +393,7 @@ void pigBuild(benchmark::State& state, Order order, int voxelsPerRadius)
 }
 
 /// One density pass, index grid already built.
-void pigDensity(benchmark::State& state, Order order, int voxelsPerRadius,
-                PointIndexQuery query)
+void pigDensity(benchmark::State& state, Order order, int voxelsPerRadius, PointIndexQuery query)
 {
     const Scenario& sc = scenario(std::size_t(state.range(0)), order);
     PointIndexDensity pig(pigVoxelSize(sc, voxelsPerRadius));
@@ -450,8 +447,8 @@ void BM_PointIndexGrid_DensityVariant(benchmark::State& state)
 
 void sizes(benchmark::internal::Benchmark* b)
 {
-    b->Arg(100000)->Arg(1000000)->UseRealTime()->MeasureProcessCPUTime()
-        ->Unit(benchmark::kMillisecond);
+    b->Arg(100000)->Arg(1000000)->UseRealTime()->MeasureProcessCPUTime()->Unit(
+        benchmark::kMillisecond);
 }
 
 /// Variants: {N, voxels per R, query}, to choose the fairest PointIndexGrid configuration.
@@ -460,7 +457,9 @@ void pigBuildVariants(benchmark::internal::Benchmark* b)
     for (long n : {100000L, 1000000L}) {
         for (long vpr : {1L, 2L, 3L}) b->Args({n, vpr});
     }
-    b->ArgNames({"N", "voxelsPerR"})->UseRealTime()->MeasureProcessCPUTime()
+    b->ArgNames({"N", "voxelsPerR"})
+        ->UseRealTime()
+        ->MeasureProcessCPUTime()
         ->Unit(benchmark::kMillisecond);
 }
 
@@ -468,13 +467,15 @@ void pigDensityVariants(benchmark::internal::Benchmark* b)
 {
     for (long n : {100000L, 1000000L}) {
         for (long vpr : {1L, 2L, 3L}) {
-            for (long q : {long(PointIndexQuery::BoxThenDistance),
-                           long(PointIndexQuery::RadialSubvoxel)}) {
+            for (long q :
+                 {long(PointIndexQuery::BoxThenDistance), long(PointIndexQuery::RadialSubvoxel)}) {
                 b->Args({n, vpr, q});
             }
         }
     }
-    b->ArgNames({"N", "voxelsPerR", "query"})->UseRealTime()->MeasureProcessCPUTime()
+    b->ArgNames({"N", "voxelsPerR", "query"})
+        ->UseRealTime()
+        ->MeasureProcessCPUTime()
         ->Unit(benchmark::kMillisecond);
 }
 
@@ -498,7 +499,9 @@ BENCHMARK_CAPTURE(BM_PointIndexGrid_Density, shuffled, Order::Shuffled)->Apply(s
 BENCHMARK_CAPTURE(BM_PointIndexGrid_BuildDensity, shuffled, Order::Shuffled)->Apply(sizes);
 BENCHMARK(BM_GhostfxGrid_DensityVariant)
     ->ArgsProduct({{100000, 1000000}, {1, 2}})
-    ->ArgNames({"N", "cellsPerR"})->UseRealTime()->MeasureProcessCPUTime()
+    ->ArgNames({"N", "cellsPerR"})
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointIndexGrid_BuildVariant)->Apply(pigBuildVariants);
 BENCHMARK(BM_PointIndexGrid_DensityVariant)->Apply(pigDensityVariants);

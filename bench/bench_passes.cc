@@ -80,69 +80,81 @@ void densityScalar(const Scene& s, std::vector<Real>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forEach(0, COUNT, [&](std::size_t i) {
-        Real sum = 0;
-        for (Index j : s.lists[i]) sum += m[j] * s.kernel.W((x[i] - x[j]).length());
-        out[i] = sum;
-    }, 512);
+    parallel::forEach(
+        0, COUNT,
+        [&](std::size_t i) {
+            Real sum = 0;
+            for (Index j : s.lists[i]) sum += m[j] * s.kernel.W((x[i] - x[j]).length());
+            out[i] = sum;
+        },
+        512);
 }
 
 void densityBatch(const Scene& s, std::vector<Real>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forRange(0, COUNT, [&](std::size_t lo, std::size_t hi) {
-        PairBatch b;
-        const CubicSplineKernel kernel = s.kernel;
-        for (std::size_t i = lo; i < hi; ++i) {
-            const NeighborLists::List list = s.lists[i];
-            Real sum = 0;
-            for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
-                const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
-                for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]];
-                for (int k = 0; k < n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                sum += b.sum(b.f);
+    parallel::forRange(
+        0, COUNT,
+        [&](std::size_t lo, std::size_t hi) {
+            PairBatch b;
+            const CubicSplineKernel kernel = s.kernel;
+            for (std::size_t i = lo; i < hi; ++i) {
+                const NeighborLists::List list = s.lists[i];
+                Real sum = 0;
+                for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
+                    const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
+                    for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]];
+                    for (int k = 0; k < n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                    sum += b.sum(b.f);
+                }
+                out[i] = sum;
             }
-            out[i] = sum;
-        }
-    }, 512);
+        },
+        512);
 }
 
 void pressureScalar(const Scene& s, std::vector<Vec3>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forEach(0, COUNT, [&](std::size_t i) {
-        Vec3 a(0);
-        const Real pi = s.ratio[i];
-        for (Index j : s.lists[i]) {
-            if (j == i) continue;
-            const Vec3 xij = x[i] - x[j];
-            a -= m[j] * (pi + s.ratio[j]) * s.kernel.gradW(xij, xij.length());
-        }
-        out[i] = a;
-    }, 512);
+    parallel::forEach(
+        0, COUNT,
+        [&](std::size_t i) {
+            Vec3 a(0);
+            const Real pi = s.ratio[i];
+            for (Index j : s.lists[i]) {
+                if (j == i) continue;
+                const Vec3 xij = x[i] - x[j];
+                a -= m[j] * (pi + s.ratio[j]) * s.kernel.gradW(xij, xij.length());
+            }
+            out[i] = a;
+        },
+        512);
 }
 
 void pressureBatch(const Scene& s, std::vector<Vec3>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forRange(0, COUNT, [&](std::size_t lo, std::size_t hi) {
-        PairBatch b;
-        for (std::size_t i = lo; i < hi; ++i) {
-            const NeighborLists::List list = s.lists[i];
-            const Real pi = s.ratio[i];
-            Vec3 a(0);
-            for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
-                const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
-                for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]] * (pi + s.ratio[b.j[k]]);
-                for (int k = 0; k < n; ++k) b.f[k] *= -s.kernel.gradFactor(b.r[k]);
-                a += b.sumScaledOffsets(b.f);
+    parallel::forRange(
+        0, COUNT,
+        [&](std::size_t lo, std::size_t hi) {
+            PairBatch b;
+            for (std::size_t i = lo; i < hi; ++i) {
+                const NeighborLists::List list = s.lists[i];
+                const Real pi = s.ratio[i];
+                Vec3 a(0);
+                for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
+                    const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
+                    for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]] * (pi + s.ratio[b.j[k]]);
+                    for (int k = 0; k < n; ++k) b.f[k] *= -s.kernel.gradFactor(b.r[k]);
+                    a += b.sumScaledOffsets(b.f);
+                }
+                out[i] = a;
             }
-            out[i] = a;
-        }
-    }, 512);
+        },
+        512);
 }
 
 void BM_GridSort(benchmark::State& state)
@@ -151,18 +163,20 @@ void BM_GridSort(benchmark::State& state)
     ParticleSet copy = s.particles;
     NeighborGrid grid(s.kernel.supportRadius());
     for (auto _ : state) grid.sortParticles(copy);
-    state.counters["particles/s"] = benchmark::Counter(double(COUNT), benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["particles/s"] =
+        benchmark::Counter(double(COUNT), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 void BM_ListsBuild(benchmark::State& state)
 {
     Scene& s = scene();
     NeighborLists lists;
-    for (auto _ : state) lists.build(s.grid, s.particles.positions().data(), COUNT, s.kernel.supportRadius());
+    for (auto _ : state)
+        lists.build(s.grid, s.particles.positions().data(), COUNT, s.kernel.supportRadius());
     state.counters["pairs"] = double(lists.pairCount());
     state.counters["ns/pair"] = benchmark::Counter(double(lists.pairCount()) * 1e-9,
-                                                   benchmark::Counter::kIsIterationInvariantRate |
-                                                       benchmark::Counter::kInvert);
+                                                   benchmark::Counter::kIsIterationInvariantRate
+                                                       | benchmark::Counter::kInvert);
 }
 
 template <void (*Pass)(const Scene&, std::vector<Real>&)>
@@ -172,8 +186,8 @@ void BM_Density(benchmark::State& state)
     std::vector<Real> out(COUNT);
     for (auto _ : state) Pass(s, out);
     state.counters["ns/pair"] = benchmark::Counter(double(s.lists.pairCount()) * 1e-9,
-                                                   benchmark::Counter::kIsIterationInvariantRate |
-                                                       benchmark::Counter::kInvert);
+                                                   benchmark::Counter::kIsIterationInvariantRate
+                                                       | benchmark::Counter::kInvert);
 }
 
 template <void (*Pass)(const Scene&, std::vector<Vec3>&)>
@@ -183,8 +197,8 @@ void BM_Pressure(benchmark::State& state)
     std::vector<Vec3> out(COUNT);
     for (auto _ : state) Pass(s, out);
     state.counters["ns/pair"] = benchmark::Counter(double(s.lists.pairCount()) * 1e-9,
-                                                   benchmark::Counter::kIsIterationInvariantRate |
-                                                       benchmark::Counter::kInvert);
+                                                   benchmark::Counter::kIsIterationInvariantRate
+                                                       | benchmark::Counter::kInvert);
 }
 
 BENCHMARK(BM_GridSort)->Unit(benchmark::kMillisecond);
@@ -207,10 +221,11 @@ void checkAgreement()
     double scale = 0;
     for (const Vec3& v : pa) scale = std::max(scale, double(v.length()));
     for (std::size_t i = 0; i < COUNT; ++i) {
-        if (std::abs(a[i] - b[i]) > 1e-4 * std::abs(a[i]) || (pa[i] - pb[i]).length() > 1e-4 * scale) {
-            throw std::runtime_error(ghostfx::msg("batched pass disagrees at particle ", i, ": density ",
-                                                  a[i], " vs ", b[i], ", pressure force |diff| ",
-                                                  (pa[i] - pb[i]).length()));
+        if (std::abs(a[i] - b[i]) > 1e-4 * std::abs(a[i])
+            || (pa[i] - pb[i]).length() > 1e-4 * scale) {
+            throw std::runtime_error(
+                ghostfx::msg("batched pass disagrees at particle ", i, ": density ", a[i], " vs ",
+                             b[i], ", pressure force |diff| ", (pa[i] - pb[i]).length()));
         }
     }
 }

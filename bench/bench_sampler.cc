@@ -27,7 +27,8 @@ const LevelSet& sphere()
 {
     static const LevelSet ls = [] {
         openvdb::initialize();
-        return makeLevelSet(makeSphereLevelSet(Vec3(0), SPHERE_RADIUS, Real(0.5) * SPACING), "sphere");
+        return makeLevelSet(makeSphereLevelSet(Vec3(0), SPHERE_RADIUS, Real(0.5) * SPACING),
+                            "sphere");
     }();
     return ls;
 }
@@ -35,8 +36,8 @@ const LevelSet& sphere()
 void reportRate(benchmark::State& state, std::size_t particles)
 {
     state.counters["particles"] = double(particles);
-    state.counters["particles/s"] =
-        benchmark::Counter(double(particles) * double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["particles/s"] = benchmark::Counter(
+        double(particles) * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 void BM_SampleVolume(benchmark::State& state)
@@ -100,8 +101,22 @@ void BM_VolumeRelaxationSweep(benchmark::State& state)
 } // namespace
 
 BENCHMARK(BM_SampleVolume)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
-BENCHMARK(BM_SampleVolumeTiled)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
-BENCHMARK(BM_SampleWithoutRelaxation)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
-BENCHMARK(BM_VolumeRelaxationSweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+BENCHMARK(BM_SampleVolumeTiled)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+BENCHMARK(BM_SampleWithoutRelaxation)
+    ->Arg(1)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+BENCHMARK(BM_VolumeRelaxationSweep)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(5)
+    ->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -27,12 +27,14 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene)
     g.supportFactor = Real(s.inRange("kernel_support", g.supportFactor, 1.5, 5));
     g.restDensity = Real(s.positive("rest_density", g.restDensity));
     g.stiffness = Real(s.positive("stiffness", g.stiffness));
-    const auto gravity = s.get<std::array<double, 3>>("gravity", {g.gravity[0], g.gravity[1], g.gravity[2]});
+    const auto gravity =
+        s.get<std::array<double, 3>>("gravity", {g.gravity[0], g.gravity[1], g.gravity[2]});
     g.gravity = Vec3(Real(gravity[0]), Real(gravity[1]), Real(gravity[2]));
     g.xsphEpsilon = Real(s.inRange("xsph_epsilon", g.xsphEpsilon, 0, 1));
     g.solidEpsilon = Real(s.inRange("solid_epsilon", g.solidEpsilon, 0, 1));
-    g.solidSlip = s.choice("solid_slip", "free", {"free", "no_slip"}) == "free" ? ghost::SolidSlip::Free
-                                                                               : ghost::SolidSlip::NoSlip;
+    g.solidSlip = s.choice("solid_slip", "free", {"free", "no_slip"}) == "free"
+                      ? ghost::SolidSlip::Free
+                      : ghost::SolidSlip::NoSlip;
     g.airResampleSteps = int(s.inRange("air_resample_steps", g.airResampleSteps, 1, 1000));
     g.airKeepFraction = Real(s.inRange("air_keep_fraction", g.airKeepFraction, 0, 10));
     g.basicXsphEpsilon = Real(s.inRange("basic_xsph_epsilon", g.basicXsphEpsilon, 0, 1));
@@ -74,7 +76,8 @@ sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed)
         xf.translation = Vec3(k.translate);
         // The rates from the keys themselves, not a difference of placements.
         const vdbio::RigidKey rate = keyed.rate(t);
-        const openvdb::math::Mat3d dr = vdbio::KeyedMotion::rotationRate(k.rotateDegrees, rate.rotateDegrees);
+        const openvdb::math::Mat3d dr =
+            vdbio::KeyedMotion::rotationRate(k.rotateDegrees, rate.rotateDegrees);
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) xf.rotationRate(i, j) = Real(dr(i, j));
         }
@@ -84,7 +87,8 @@ sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed)
     };
 }
 
-std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene, const GhostSettings& settings,
+std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
+                                              const GhostSettings& settings,
                                               const sph::SolverState* restored)
 {
     auto solver = std::make_unique<GhostSolver>(settings);
@@ -99,9 +103,10 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene, const G
         for (const vdbio::SceneLiquid& liquid : scene.liquids) {
             const std::size_t n = solver->addLiquid(liquid.shape, Vec3(liquid.velocity));
             if (n == 0) {
-                throw SceneError(msg("scene '", scene.file, "': liquid '", liquid.name, "' (", liquid.geometry,
-                                     ") gives no particles at spacing ", scene.spacing,
-                                     " m: it is empty, thinner than the spacing, or inside a solid"));
+                throw SceneError(
+                    msg("scene '", scene.file, "': liquid '", liquid.name, "' (", liquid.geometry,
+                        ") gives no particles at spacing ", scene.spacing,
+                        " m: it is empty, thinner than the spacing, or inside a solid"));
             }
         }
     }
@@ -117,8 +122,9 @@ void updateSolidSequences(const vdbio::Scene& scene, GhostSolver& solver, int fr
         const vdbio::SceneSolid& solid = scene.solids[i];
         if (solid.sequenceFile.empty()) continue;
         const std::string file = vdbio::expandFramePattern(solid.sequenceFile, frame);
-        solver.setSolidShape(i, vdbio::loadLevelSet(file, solid.sequenceGrid,
-                                                    msg("scene '", scene.file, "': solids[", i, "].sequence")));
+        solver.setSolidShape(
+            i, vdbio::loadLevelSet(file, solid.sequenceGrid,
+                                   msg("scene '", scene.file, "': solids[", i, "].sequence")));
     }
 }
 
@@ -131,8 +137,9 @@ void checkSolidSequences(const vdbio::Scene& scene, int first, int last)
             const std::string file = vdbio::expandFramePattern(solid.sequenceFile, f);
             std::error_code ec;
             if (!std::filesystem::exists(file, ec)) {
-                throw IoError(msg("scene '", scene.file, "': solids[", i, "].sequence: file '", file,
-                                  "' does not exist (frames ", first, "-", last, " are needed)"));
+                throw IoError(msg("scene '", scene.file, "': solids[", i, "].sequence: file '",
+                                  file, "' does not exist (frames ", first, "-", last,
+                                  " are needed)"));
             }
         }
     }

@@ -37,16 +37,15 @@ Command addMesh2SdfCommand(CLI::App& parent)
     c->add_option("--name", o.gridName, "grid name")->capture_default_str();
     c->add_option("--role", o.role,
                   "scene role stored as grid metadata 'ghostfx_role': " + vdbio::meshRoles());
-    c->add_option("--scale", o.scale, "uniform scale from mesh units to m")
-        ->capture_default_str();
+    c->add_option("--scale", o.scale, "uniform scale from mesh units to m")->capture_default_str();
     return {c, [args] {
                 const vdbio::MeshToSdfOptions& o = args->options;
                 const auto t0 = std::chrono::steady_clock::now();
                 vdbio::MeshStats stats;
                 const openvdb::FloatGrid::Ptr grid =
                     vdbio::convertMeshFile(args->input, args->output, o, &stats);
-                const double seconds = std::chrono::duration<double>(
-                                           std::chrono::steady_clock::now() - t0).count();
+                const double seconds =
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                 const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
                 const openvdb::Vec3d lo = grid->indexToWorld(box.min());
                 const openvdb::Vec3d hi = grid->indexToWorld(box.max());

@@ -97,8 +97,10 @@ void parseFrames(const std::string& text, int& first, int& last)
         p = number(p + 1, b);
     }
     if (!p || *p != '\0') {
-        throw ValueError(msg("--frames '", text, "': expected A-B (e.g. 1-48) or a last frame, whole "
-                             "numbers up to ", vdbio::MAX_FRAME));
+        throw ValueError(msg("--frames '", text,
+                             "': expected A-B (e.g. 1-48) or a last frame, whole "
+                             "numbers up to ",
+                             vdbio::MAX_FRAME));
     }
     if (a < 1 || b < a) {
         throw ValueError(msg("--frames '", text, "': expected 1 <= first <= last"));
@@ -141,8 +143,8 @@ public:
     {
         if (mMode == Mode::None) return;
         if (mMode == Mode::Bar) std::fprintf(stderr, "\r\033[K");
-        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %d steps, %s, %.2f s%s\n", frame, mLast, sim.time(),
-                     steps, sim.counts().c_str(), frameSeconds,
+        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %d steps, %s, %.2f s%s\n", frame, mLast,
+                     sim.time(), steps, sim.counts().c_str(), frameSeconds,
                      written ? "" : " (not written: before the first frame)");
         std::fflush(stderr);
     }
@@ -166,8 +168,9 @@ private:
 namespace {
 
 /// Write one medium's points and volume files for `frame`; returns its grids (for previews).
-openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out, const std::string& pointsPath,
-                                const std::string& volumePath, const openvdb::MetaMap& fileMeta)
+openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
+                                const std::string& pointsPath, const std::string& volumePath,
+                                const openvdb::MetaMap& fileMeta)
 {
     const std::vector<std::string>& channels = m.liquid ? out.pointChannels : out.gasPointChannels;
     if (!pointsPath.empty()) {
@@ -189,7 +192,9 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
     openvdb::GridPtrVec grids;
     if (volumePath.empty()) return grids;
     const std::vector<std::string>& wanted = m.liquid ? out.volumeGrids : out.gasVolumeGrids;
-    auto wants = [&](const char* g) { return std::find(wanted.begin(), wanted.end(), g) != wanted.end(); };
+    auto wants = [&](const char* g) {
+        return std::find(wanted.begin(), wanted.end(), g) != wanted.end();
+    };
     vdbio::VolumeOptions vo;
     const double voxel = m.liquid ? out.voxelSize : out.gasVoxelSize;
     vo.voxelSize = voxel > 0 ? voxel : 0.5 * m.spacing;
@@ -231,7 +236,8 @@ int runScene(const RunOptions& o)
     std::unique_ptr<Simulation> sim;
     if (!o.resume.empty()) {
         if (stateCount(scene) == 0) {
-            throw SceneError(msg("scene '", scene.file, "': a boiling scene (with heaters) cannot be resumed yet"));
+            throw SceneError(msg("scene '", scene.file,
+                                 "': a boiling scene (with heaters) cannot be resumed yet"));
         }
         const std::vector<sph::SolverState> states{vdbio::readCheckpoint(o.resume, fingerprint)};
         sim = makeSimulation(scene, &states);
@@ -241,24 +247,31 @@ int runScene(const RunOptions& o)
     checkSolidSequences(scene, sim->frame() + 1, last);
     vdbio::ensureWritableDirectory(folder);
     auto inFolder = [&](const std::string& pattern, int frame) {
-        return pattern.empty() ? std::string() : (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
+        return pattern.empty()
+                   ? std::string()
+                   : (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
     };
     const int startFrame = sim->frame();
 
     Progress::Mode mode = Progress::Mode::Log;
     if (o.quiet || o.progress == "none") mode = Progress::Mode::None;
-    else if (o.progress == "bar" || (o.progress == "auto" && ::isatty(STDERR_FILENO))) mode = Progress::Mode::Bar;
+    else if (o.progress == "bar" || (o.progress == "auto" && ::isatty(STDERR_FILENO)))
+        mode = Progress::Mode::Bar;
     Progress progress(mode, std::max(first, startFrame + 1), last);
     if (startFrame >= last) {
-        progress.message(msg("nothing to do: the checkpoint is at frame ", startFrame, ", the last frame is ", last));
+        progress.message(msg("nothing to do: the checkpoint is at frame ", startFrame,
+                             ", the last frame is ", last));
         return 0;
     }
-    progress.message(msg("ghostfx run '", scene.file, "': ", scene.method, scene.heaters.empty() ? "" : " + boiling",
-                         scene.forceFields.empty() ? "" : msg(" + ", scene.forceFields.size(),
-                                                              scene.forceFields.size() == 1 ? " attractor" : " attractors"),
-                         ", spacing ", scene.spacing, " m, frames ", std::max(first, startFrame + 1), "-", last,
-                         (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"), ", ", parallel::maxThreads(),
-                         " threads, output in '", folder, "'"));
+    progress.message(msg(
+        "ghostfx run '", scene.file, "': ", scene.method, scene.heaters.empty() ? "" : " + boiling",
+        scene.forceFields.empty()
+            ? ""
+            : msg(" + ", scene.forceFields.size(),
+                  scene.forceFields.size() == 1 ? " attractor" : " attractors"),
+        ", spacing ", scene.spacing, " m, frames ", std::max(first, startFrame + 1), "-", last,
+        (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"), ", ",
+        parallel::maxThreads(), " threads, output in '", folder, "'"));
     // A fixed step far beyond the stability limit blows up within a few steps, after a frame
     // or more of output: say so before the first step, with both numbers.
     if (const double fixed = sim->fixedTimeStep(); fixed > 0) {
@@ -266,16 +279,20 @@ int runScene(const RunOptions& o)
         if (fixed > limit) {
             const int substeps = int(std::lround(1.0 / (fixed * scene.frameRate)));
             std::fprintf(stderr, "%s\n",
-                         msg("ghostfx: warning: scene '", scene.file, "': the fixed step ", fixed, " s (frame_rate ",
-                             scene.frameRate, ", substeps ", substeps, ") is ", std::round(10 * fixed / limit) / 10,
-                             "x the stability limit ", limit, " s (Courant number 1: sound speed and forces); "
-                             "expect a blow-up: use substeps >= ", int(std::ceil(substeps * fixed / limit)),
-                             ", or substeps 0 for CFL steps").c_str());
+                         msg("ghostfx: warning: scene '", scene.file, "': the fixed step ", fixed,
+                             " s (frame_rate ", scene.frameRate, ", substeps ", substeps, ") is ",
+                             std::round(10 * fixed / limit) / 10, "x the stability limit ", limit,
+                             " s (Courant number 1: sound speed and forces); "
+                             "expect a blow-up: use substeps >= ",
+                             int(std::ceil(substeps * fixed / limit)),
+                             ", or substeps 0 for CFL steps")
+                             .c_str());
         }
     }
     const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0;
     if (!out.checkpointFile.empty() && !checkpoints) {
-        progress.message("note: boiling scenes write no checkpoints yet (the phase transition's state is not saved)");
+        progress.message("note: boiling scenes write no checkpoints yet (the phase transition's "
+                         "state is not saved)");
     }
 
     // Statistics.
@@ -322,9 +339,9 @@ int runScene(const RunOptions& o)
             openvdb::GridPtrVec previewGrids;
             for (const OutputMedium& m : sim->media()) {
                 const bool liquid = m.liquid;
-                const openvdb::GridPtrVec grids =
-                    writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile, frame),
-                                inFolder(liquid ? out.volumeFile : out.gasVolumeFile, frame), fileMeta);
+                const openvdb::GridPtrVec grids = writeMedium(
+                    m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile, frame),
+                    inFolder(liquid ? out.volumeFile : out.gasVolumeFile, frame), fileMeta);
                 if (previewGrids.empty()) previewGrids = grids;
             }
             if (!out.previewFile.empty() && !previewGrids.empty()) {
@@ -347,23 +364,29 @@ int runScene(const RunOptions& o)
         if (stats) stats->flush();
         const bool interrupted = gInterrupted.load();
         std::string checkpoint;
-        if (interrupted || frame == last || (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
+        if (interrupted || frame == last
+            || (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
             checkpoint = writeCheckpoint(frame);
         }
-        progress.frame(*sim, frame, int(sim->stepCount() - stepsBefore), seconds(frameStart, Clock::now()), write);
+        progress.frame(*sim, frame, int(sim->stepCount() - stepsBefore),
+                       seconds(frameStart, Clock::now()), write);
         if (interrupted) {
             std::fprintf(stderr, "ghostfx: interrupted after frame %d%s\n", frame,
-                         checkpoint.empty() ? " (no checkpoint: nothing to resume from)"
-                                            : ("; resume with: ghostfx run " + o.scene + " --resume " + checkpoint).c_str());
+                         checkpoint.empty()
+                             ? " (no checkpoint: nothing to resume from)"
+                             : ("; resume with: ghostfx run " + o.scene + " --resume " + checkpoint)
+                                   .c_str());
             return EXIT_INTERRUPTED;
         }
     }
     const double total = seconds(runStart, Clock::now());
     const std::uint64_t steps = sim->stepCount() - stepsAtStart;
-    progress.message(msg("done: ", steps, " steps in ", duration(total), " (", total > 0 ? double(steps) / total : 0.0,
-                         " steps/s), ", sim->particleCount(), " particles, ",
-                         sim->particleCount() ? double(sim->memoryBytes()) / double(sim->particleCount()) : 0.0,
-                         " bytes per particle"));
+    progress.message(
+        msg("done: ", steps, " steps in ", duration(total), " (",
+            total > 0 ? double(steps) / total : 0.0, " steps/s), ", sim->particleCount(),
+            " particles, ",
+            sim->particleCount() ? double(sim->memoryBytes()) / double(sim->particleCount()) : 0.0,
+            " bytes per particle"));
     return 0;
 }
 
@@ -374,7 +397,8 @@ Command addRunCommand(CLI::App& parent)
     c->add_option("scene", o->scene, "scene file (.json, or a .vdb whose grids carry ghostfx_role)")
         ->required();
     c->add_option("--frames", o->frames, "frames to write, A-B (default: settings.frame_range)");
-    c->add_option("--threads", o->threads, "worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+    c->add_option("--threads", o->threads, "worker threads (0: all cores)")
+        ->check(CLI::NonNegativeNumber);
     c->add_option("--out", o->out, "output folder (default: outputs.directory)");
     c->add_option("-D,--define", o->defines, "override a scene key: -D settings.stiffness=5000")
         ->allow_extra_args(false);

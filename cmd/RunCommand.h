@@ -13,12 +13,12 @@ namespace cmd {
 
 struct RunOptions
 {
-    std::string scene;                 ///< scene .json (or role-tagged .vdb)
-    std::string frames;                ///< "A-B" or "B": overrides settings.frame_range
-    int threads = 0;                   ///< 0: all cores
-    std::string out;                   ///< overrides outputs.directory
-    std::vector<std::string> defines;  ///< -D path=value
-    std::string resume;                ///< checkpoint to continue from
+    std::string scene;                ///< scene .json (or role-tagged .vdb)
+    std::string frames;               ///< "A-B" or "B": overrides settings.frame_range
+    int threads = 0;                  ///< 0: all cores
+    std::string out;                  ///< overrides outputs.directory
+    std::vector<std::string> defines; ///< -D path=value
+    std::string resume;               ///< checkpoint to continue from
     bool quiet = false;
     /// Progress display: "auto" (bar on a terminal, log lines otherwise), "bar", "log", "none".
     std::string progress = "auto";

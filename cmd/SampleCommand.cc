@@ -25,21 +25,28 @@ Command addSampleCommand(CLI::App& app)
 {
     auto options = std::make_shared<SampleOptions>();
     SampleOptions& o = *options;
-    CLI::App* c = app.add_subcommand("sample",
+    CLI::App* c = app.add_subcommand(
+        "sample",
         "Poisson-disk sample a level-set shape ([SB12] Sec. 4.5) and print particle statistics");
     c->add_option("--shape", o.shape, "sphere, box or torus")
-        ->check(CLI::IsMember({"sphere", "box", "torus"}))->capture_default_str();
+        ->check(CLI::IsMember({"sphere", "box", "torus"}))
+        ->capture_default_str();
     c->add_option("--size", o.size, "sphere radius, box half edge or torus ring radius (m)")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     c->add_option("--spacing", o.spacing, "particle spacing h (m); Poisson radius r = 0.92 h")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     c->add_option("--voxel-factor", o.voxelFactor, "level-set voxel size / h")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     c->add_option("--band-depth", o.bandDepth,
                   "sample only this deep below the surface (m), as for solids; 0: whole interior")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     c->add_option("--rest-density", o.restDensity, "rest density rho0 (kg/m^3)")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     c->add_option("--seed", o.seed, "random seed")->capture_default_str();
     c->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
     return {c, [options] { return runSample(*options); }};
@@ -61,8 +68,10 @@ int runSample(const SampleOptions& o)
     const Real voxel = Real(o.spacing * o.voxelFactor);
     const Real size = Real(o.size);
     if (size < 2 * h) {
-        throw ValueError(msg("sample --size = ", o.size, " m: expected at least two particle "
-                             "spacings (", 2 * o.spacing, " m)"));
+        throw ValueError(msg("sample --size = ", o.size,
+                             " m: expected at least two particle "
+                             "spacings (",
+                             2 * o.spacing, " m)"));
     }
 
     openvdb::FloatGrid::Ptr grid;
@@ -78,8 +87,8 @@ int runSample(const SampleOptions& o)
     PoissonDiskSampler sampler(settings);
 
     std::printf("ghostfx sample: %s of size %g m, spacing h = %g m, Poisson radius r = %g m, "
-                "voxel %g m (%lld active voxels), %d thread(s)\n", o.shape.c_str(), o.size,
-                o.spacing, double(settings.radius), double(voxel),
+                "voxel %g m (%lld active voxels), %d thread(s)\n",
+                o.shape.c_str(), o.size, o.spacing, double(settings.radius), double(voxel),
                 static_cast<long long>(grid->activeVoxelCount()), parallel::maxThreads());
 
     using Clock = std::chrono::steady_clock;
@@ -114,7 +123,10 @@ int runSample(const SampleOptions& o)
         nnGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real rij) {
             if (j != i) d = std::min(d, double(rij));
         });
-        if (d < 1e30) { nnSum += d; nnMin = std::min(nnMin, d); }
+        if (d < 1e30) {
+            nnSum += d;
+            nnMin = std::min(nnMin, d);
+        }
     }
     std::printf("  nearest neighbour  min %.4f r, mean %.4f r (Poisson-disk: min >= r)\n",
                 nnMin / double(r), nnSum / double(s.size()) / double(r));
@@ -133,15 +145,15 @@ int runSample(const SampleOptions& o)
     std::size_t interiorCount = 0;
     for (std::size_t i = 0; i < s.size(); ++i) {
         bool nearSurface = false;
-        surfaceGrid.forEachInRadius(s.positions[i], R, [&](Index, const Vec3&, Real) {
-            nearSurface = true;
-        });
+        surfaceGrid.forEachInRadius(s.positions[i], R,
+                                    [&](Index, const Vec3&, Real) { nearSurface = true; });
         interior[i] = !nearSurface;
         interiorCount += interior[i];
     }
     if (interiorCount == 0) {
         std::printf("  mass scaling       no particle deeper than the kernel support (%g m): "
-                    "measured over all particles\n", double(R));
+                    "measured over all particles\n",
+                    double(R));
         interior.clear();
     }
     const Real mass = massForRestDensity(s.positions, kernel, Real(o.restDensity), interior);
@@ -162,9 +174,10 @@ int runSample(const SampleOptions& o)
     std::printf("  mass scaling       m = %.6g kg = %.4f rho0 h^3 ([SB12] Sec. 4.6)\n",
                 double(mass), double(mass) / (o.restDensity * std::pow(o.spacing, 3)));
     std::printf("  interior density   %.0f particles: mean %.4f rho0, spread %.2f %%, "
-                "range [%.3f, %.3f] rho0\n", n, mean / o.restDensity,
-                100.0 * std::sqrt(std::max(0.0, sum2 / n - mean * mean)) / mean,
-                lo / o.restDensity, hi / o.restDensity);
+                "range [%.3f, %.3f] rho0\n",
+                n, mean / o.restDensity,
+                100.0 * std::sqrt(std::max(0.0, sum2 / n - mean * mean)) / mean, lo / o.restDensity,
+                hi / o.restDensity);
     return 0;
 }
 

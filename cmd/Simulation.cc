@@ -31,7 +31,8 @@ struct FieldStats
     double maxSpeed = 0, errorMean = 0, errorMax = 0;
 };
 
-FieldStats fieldStats(const sph::ParticleSet& p, ParticleKind kind, double rho0, const std::vector<Real>* skip)
+FieldStats fieldStats(const sph::ParticleSet& p, ParticleKind kind, double rho0,
+                      const std::vector<Real>* skip)
 {
     FieldStats s;
     double sum = 0;
@@ -60,9 +61,9 @@ class LiquidSimulation : public Simulation
 {
 public:
     LiquidSimulation(const vdbio::Scene& scene, const sph::SolverState* restored)
-        : mScene(scene), mSolver(makeLiquidSolver(scene, liquidSettings(scene), restored))
-    {
-    }
+        : mScene(scene)
+        , mSolver(makeLiquidSolver(scene, liquidSettings(scene), restored))
+    {}
 
     void advanceFrame() override { mSolver->advanceFrame(); }
     int frame() const override { return mSolver->frame(); }
@@ -83,7 +84,8 @@ public:
     vdbio::StatsRow statsRow(int frame, double dt) override
     {
         const GhostSolver& s = *mSolver;
-        const FieldStats f = fieldStats(s.particles(), ParticleKind::Liquid, s.settings().restDensity, nullptr);
+        const FieldStats f =
+            fieldStats(s.particles(), ParticleKind::Liquid, s.settings().restDensity, nullptr);
         const ghost::PhaseTimings& t = s.timings();
         vdbio::StatsRow row;
         row.values = {
@@ -104,7 +106,8 @@ public:
             {"t_air_resampling", t.airResampling - mBefore.airResampling},
             {"t_emission", t.emission - mBefore.emission},
             {"t_step", t.total - mBefore.total},
-            {"bytes_per_particle", particleCount() ? double(memoryBytes()) / double(particleCount()) : 0.0},
+            {"bytes_per_particle",
+             particleCount() ? double(memoryBytes()) / double(particleCount()) : 0.0},
         };
         mBefore = t;
         return row;
@@ -112,8 +115,10 @@ public:
 
     std::string counts() const override
     {
-        return msg(mSolver->count(ParticleKind::Liquid), " liquid, ", mSolver->count(ParticleKind::GhostAir),
-                   " air, ", mSolver->count(ParticleKind::GhostSolid) + mSolver->count(ParticleKind::Boundary),
+        return msg(mSolver->count(ParticleKind::Liquid), " liquid, ",
+                   mSolver->count(ParticleKind::GhostAir), " air, ",
+                   mSolver->count(ParticleKind::GhostSolid)
+                       + mSolver->count(ParticleKind::Boundary),
                    " solid ghosts");
     }
     std::size_t particleCount() const override { return liquidParticleCount(*mSolver); }
@@ -124,7 +129,8 @@ public:
     /// Liquid, air and solid particles.
     static std::size_t liquidParticleCount(const GhostSolver& s)
     {
-        return s.particles().size() + s.count(ParticleKind::GhostSolid) + s.count(ParticleKind::Boundary);
+        return s.particles().size() + s.count(ParticleKind::GhostSolid)
+               + s.count(ParticleKind::Boundary);
     }
 
     std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
@@ -154,11 +160,12 @@ private:
 // Gas ---------------------------------------------------------------------------------------------
 
 /// The gas keys of the scene: settings.gas { ... }.
-gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject& g, double defaultSpacing,
-                             const std::string& defaultVariant)
+gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject& g,
+                             double defaultSpacing, const std::string& defaultVariant)
 {
     gas::GasSettings s;
-    s.method = gas::methodFromName(g.choice("variant", defaultVariant, {"fast", "ambient", "uncorrected"}));
+    s.method = gas::methodFromName(
+        g.choice("variant", defaultVariant, {"fast", "ambient", "uncorrected"}));
     s.spacing = Real(g.positive("spacing", defaultSpacing));
     s.supportFactor = Real(g.inRange("kernel_support", s.supportFactor, 1.5, 5));
     s.particleMass = Real(g.nonNegative("particle_mass", s.particleMass));
@@ -167,11 +174,13 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
     s.clampNegativePressure = g.get<bool>("clamp_negative_pressure", s.clampNegativePressure);
     s.delta = Real(g.inRange("delta", s.delta, 0.4, 0.7));
     s.atmosphericPressure = Real(g.nonNegative("atmospheric_pressure", s.atmosphericPressure));
-    s.interiorPressureScale = Real(g.inRange("interior_pressure_scale", s.interiorPressureScale, 0, 1));
+    s.interiorPressureScale =
+        Real(g.inRange("interior_pressure_scale", s.interiorPressureScale, 0, 1));
     s.normalThreshold = Real(g.nonNegative("normal_threshold", s.normalThreshold));
     s.damping = Real(g.nonNegative("damping", s.damping));
     s.viscosity = Real(g.nonNegative("viscosity", s.viscosity));
-    const auto gravity = g.get<std::array<double, 3>>("gravity", {s.gravity[0], s.gravity[1], s.gravity[2]});
+    const auto gravity =
+        g.get<std::array<double, 3>>("gravity", {s.gravity[0], s.gravity[1], s.gravity[2]});
     s.gravity = Vec3(Real(gravity[0]), Real(gravity[1]), Real(gravity[2]));
     s.ambientTemperature = Real(g.positive("ambient_temperature", s.ambientTemperature));
     s.diffusion = Real(g.nonNegative("diffusion", s.diffusion));
@@ -200,14 +209,16 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
     }
     g.finish();
     if (s.method == gas::Method::Ambient && s.domain.empty()) {
-        g.failValue("variant", "the ambient-air baseline fills a box with air: expected domain.kill_box");
+        g.failValue("variant",
+                    "the ambient-air baseline fills a box with air: expected domain.kill_box");
     }
     s.validate();
     return s;
 }
 
-std::unique_ptr<gas::GasSolver> makeGasSolver(const vdbio::Scene& scene, const gas::GasSettings& settings,
-                                             const sph::SolverState* restored)
+std::unique_ptr<gas::GasSolver> makeGasSolver(const vdbio::Scene& scene,
+                                              const gas::GasSettings& settings,
+                                              const sph::SolverState* restored)
 {
     auto solver = std::make_unique<gas::GasSolver>(settings);
     if (restored) solver->restoreState(*restored);
@@ -234,8 +245,8 @@ void copyVisibleGas(const sph::ParticleSet& from, sph::ParticleSet& to)
     const bool hasAmbient = from.hasScalarChannel(gas::channel::AMBIENT);
     std::vector<std::uint8_t> remove(from.size(), 0);
     for (std::size_t i = 0; i < from.size(); ++i) {
-        remove[i] = from.kinds()[i] != ParticleKind::Gas ||
-                    (hasAmbient && from.scalarChannel(gas::channel::AMBIENT)[i] != Real(0));
+        remove[i] = from.kinds()[i] != ParticleKind::Gas
+                    || (hasAmbient && from.scalarChannel(gas::channel::AMBIENT)[i] != Real(0));
     }
     to = from;
     to.removeIf(remove);
@@ -255,10 +266,14 @@ OutputMedium gasMedium(const gas::GasSolver& s, const sph::ParticleSet& visible)
     return m;
 }
 
-std::vector<std::pair<std::string, double>> gasStats(const gas::GasSolver& s, const gas::GasTimings& before, const std::string& prefix)
+std::vector<std::pair<std::string, double>> gasStats(const gas::GasSolver& s,
+                                                     const gas::GasTimings& before,
+                                                     const std::string& prefix)
 {
     const sph::ParticleSet& p = s.particles();
-    const std::vector<Real>* ambient = p.hasScalarChannel(gas::channel::AMBIENT) ? &p.scalarChannel(gas::channel::AMBIENT) : nullptr;
+    const std::vector<Real>* ambient = p.hasScalarChannel(gas::channel::AMBIENT)
+                                           ? &p.scalarChannel(gas::channel::AMBIENT)
+                                           : nullptr;
     const FieldStats f = fieldStats(p, ParticleKind::Gas, s.settings().restDensity, ambient);
     const gas::GasTimings& t = s.timings();
     return {
@@ -300,15 +315,21 @@ public:
 
     void setStepObserver(std::function<void(double)> observer) override
     {
-        mSolver->setStepObserver([observer](const gas::GasSolver&, Real dt) { observer(double(dt)); });
+        mSolver->setStepObserver(
+            [observer](const gas::GasSolver&, Real dt) { observer(double(dt)); });
     }
 
     vdbio::StatsRow statsRow(int frame, double dt) override
     {
         vdbio::StatsRow row;
-        row.values = {{"frame", frame}, {"step", double(mSolver->stepCount())}, {"time", mSolver->time()}, {"dt", dt}};
+        row.values = {{"frame", frame},
+                      {"step", double(mSolver->stepCount())},
+                      {"time", mSolver->time()},
+                      {"dt", dt}};
         for (auto& v : gasStats(*mSolver, mBefore, "")) row.values.push_back(v);
-        row.values.push_back({"bytes_per_particle", particleCount() ? double(memoryBytes()) / double(particleCount()) : 0.0});
+        row.values.push_back(
+            {"bytes_per_particle",
+             particleCount() ? double(memoryBytes()) / double(particleCount()) : 0.0});
         mBefore = mSolver->timings();
         return row;
     }
@@ -374,13 +395,16 @@ public:
         const vdbio::JsonObject g = s.has("gas") ? s.object("gas") : vdbio::JsonObject();
         const ghost::GhostSettings liquid = liquidSettings(scene); // finishes settings
         mLiquid = makeLiquidSolver(scene, liquid);
-        mGas = makeGasSolver(scene, gasSettings(scene, g, vapourSpacing(scene, liquid), "fast"), nullptr);
+        mGas = makeGasSolver(scene, gasSettings(scene, g, vapourSpacing(scene, liquid), "fast"),
+                             nullptr);
         mSide = std::make_unique<coupling::GhostLiquidSide>(*mLiquid);
         double band = std::numeric_limits<double>::max();
-        for (const vdbio::SceneHeater& h : scene.heaters) band = std::min(band, double(h.shape.bandWidth()));
-        mPhase = std::make_unique<gas::PhaseTransition>(*mGas, *mSide,
-                                                        phaseSettings(scene.phaseTransition, scene.spacing, band));
-        for (const vdbio::SceneHeater& h : scene.heaters) mPhase->addHeater(h.shape, Real(h.temperature));
+        for (const vdbio::SceneHeater& h : scene.heaters)
+            band = std::min(band, double(h.shape.bandWidth()));
+        mPhase = std::make_unique<gas::PhaseTransition>(
+            *mGas, *mSide, phaseSettings(scene.phaseTransition, scene.spacing, band));
+        for (const vdbio::SceneHeater& h : scene.heaters)
+            mPhase->addHeater(h.shape, Real(h.temperature));
         mFrameRate = liquid.frameRate;
         mSubsteps = liquid.substeps;
     }
@@ -388,14 +412,18 @@ public:
     void advanceFrame() override
     {
         const double frameEnd = double(mFrame + 1) / double(mFrameRate);
-        sph::stepFrame(frameEnd, mFrameRate, mSubsteps, [this] { return mLiquid->time(); },
-                       [this] { return std::min(mLiquid->stableTimeStep(), mGas->stableTimeStep()); },
-                       [this](Real dt) { stepOnce(dt); });
+        sph::stepFrame(
+            frameEnd, mFrameRate, mSubsteps, [this] { return mLiquid->time(); },
+            [this] { return std::min(mLiquid->stableTimeStep(), mGas->stableTimeStep()); },
+            [this](Real dt) { stepOnce(dt); });
         ++mFrame;
     }
     int frame() const override { return mFrame; }
     double time() const override { return mLiquid->time(); }
-    double fixedTimeStep() const override { return mSubsteps > 0 ? 1.0 / (double(mFrameRate) * mSubsteps) : 0.0; }
+    double fixedTimeStep() const override
+    {
+        return mSubsteps > 0 ? 1.0 / (double(mFrameRate) * mSubsteps) : 0.0;
+    }
     double stabilityLimit() const override
     {
         return std::min(double(mLiquid->stableTimeStep()) / double(mLiquid->settings().cflNumber),
@@ -403,14 +431,21 @@ public:
     }
     std::uint64_t stepCount() const override { return mLiquid->stepCount(); }
     void beforeFrame(int frame) override { updateSolidSequences(mScene, *mLiquid, frame); }
-    void setStepObserver(std::function<void(double)> observer) override { mObserver = std::move(observer); }
+    void setStepObserver(std::function<void(double)> observer) override
+    {
+        mObserver = std::move(observer);
+    }
 
     vdbio::StatsRow statsRow(int frame, double dt) override
     {
-        const FieldStats f = fieldStats(mLiquid->particles(), ParticleKind::Liquid, mLiquid->settings().restDensity, nullptr);
+        const FieldStats f = fieldStats(mLiquid->particles(), ParticleKind::Liquid,
+                                        mLiquid->settings().restDensity, nullptr);
         const gas::MassBudget budget = mPhase->massBudget();
         vdbio::StatsRow row;
-        row.values = {{"frame", frame}, {"step", double(stepCount())}, {"time", time()}, {"dt", dt},
+        row.values = {{"frame", frame},
+                      {"step", double(stepCount())},
+                      {"time", time()},
+                      {"dt", dt},
                       {"count_liquid", double(f.count)},
                       {"count_ghost_air", double(mLiquid->count(ParticleKind::GhostAir))},
                       {"count_ghost_solid", double(mLiquid->count(ParticleKind::GhostSolid))},
@@ -423,7 +458,9 @@ public:
                       {"mass_gas", budget.gas + budget.gasRemoved}};
         for (auto& v : gasStats(*mGas, mGasBefore, "")) row.values.push_back(v);
         row.values.push_back({"t_step", mPhase->timings().total - mPhaseBefore.total});
-        row.values.push_back({"bytes_per_particle", particleCount() ? double(memoryBytes()) / double(particleCount()) : 0.0});
+        row.values.push_back(
+            {"bytes_per_particle",
+             particleCount() ? double(memoryBytes()) / double(particleCount()) : 0.0});
         mGasBefore = mGas->timings();
         mPhaseBefore = mPhase->timings();
         return row;
@@ -431,8 +468,8 @@ public:
 
     std::string counts() const override
     {
-        return msg(mLiquid->count(ParticleKind::Liquid), " liquid, ", mGas->visibleGasCount(), " vapour, ",
-                   mPhase->boiledCount(), " boiled");
+        return msg(mLiquid->count(ParticleKind::Liquid), " liquid, ", mGas->visibleGasCount(),
+                   " vapour, ", mPhase->boiledCount(), " boiled");
     }
     std::size_t particleCount() const override
     {
@@ -484,7 +521,8 @@ void checkSimulationSettings(const vdbio::Scene& scene)
     const vdbio::JsonObject& s = scene.settings;
     const vdbio::JsonObject g = s.has("gas") ? s.object("gas") : vdbio::JsonObject();
     if (!scene.heaters.empty()) {
-        if (scene.method == "gas") s.failValue("method", "heaters boil a liquid: expected 'ghost' or 'basic'");
+        if (scene.method == "gas")
+            s.failValue("method", "heaters boil a liquid: expected 'ghost' or 'basic'");
         const ghost::GhostSettings liquid = liquidSettings(scene);
         gasSettings(scene, g, vapourSpacing(scene, liquid), "fast");
         phaseSettings(scene.phaseTransition, scene.spacing, std::numeric_limits<double>::max());
@@ -499,16 +537,21 @@ void checkSimulationSettings(const vdbio::Scene& scene)
 
 std::size_t stateCount(const vdbio::Scene& scene) { return scene.heaters.empty() ? 1 : 0; }
 
-std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene, const std::vector<sph::SolverState>* restored)
+std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
+                                           const std::vector<sph::SolverState>* restored)
 {
     if (restored && restored->size() != stateCount(scene)) {
-        throw SceneError(msg("scene '", scene.file, "': ", scene.heaters.empty() ? "the checkpoint holds "
-                             + std::to_string(restored->size()) + " solver states, the scene needs 1"
-                             : "a boiling scene (with heaters) cannot be resumed yet"));
+        throw SceneError(msg("scene '", scene.file, "': ",
+                             scene.heaters.empty()
+                                 ? "the checkpoint holds " + std::to_string(restored->size())
+                                       + " solver states, the scene needs 1"
+                                 : "a boiling scene (with heaters) cannot be resumed yet"));
     }
     const sph::SolverState* state = restored ? &restored->front() : nullptr;
     if (!scene.heaters.empty()) {
-        if (scene.method == "gas") scene.settings.failValue("method", "heaters boil a liquid: expected 'ghost' or 'basic'");
+        if (scene.method == "gas")
+            scene.settings.failValue("method",
+                                     "heaters boil a liquid: expected 'ghost' or 'basic'");
         return std::make_unique<BoilingSimulation>(scene);
     }
     if (scene.method == "gas") return std::make_unique<GasSimulation>(scene, state);

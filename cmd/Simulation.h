@@ -22,7 +22,7 @@ namespace cmd {
 /// Particles of one medium and how to turn them into output files.
 struct OutputMedium
 {
-    std::string name;                          ///< "liquid" or "gas"
+    std::string name; ///< "liquid" or "gas"
     const sph::ParticleSet* particles = nullptr;
     std::vector<sph::ParticleKind> kinds;      ///< kinds written as this medium
     std::vector<sph::ParticleKind> ghostKinds; ///< kinds written too with outputs.points.ghosts
@@ -30,8 +30,8 @@ struct OutputMedium
     /// (the liquid solver keeps its solid particles in blocks); empty: `particles` has them.
     std::function<sph::ParticleSet()> withGhosts;
     double spacing = 0, support = 0, restDensity = 0;
-    sph::Vec3 gravity{0};                      ///< the medium's gravity (m/s^2)
-    bool liquid = true;                        ///< liquids get a surface; gases get temperature
+    sph::Vec3 gravity{0}; ///< the medium's gravity (m/s^2)
+    bool liquid = true;   ///< liquids get a surface; gases get temperature
 };
 
 class Simulation

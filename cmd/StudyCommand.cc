@@ -21,11 +21,11 @@
 #include <ghostfx/vdbio/Scene.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -59,9 +59,9 @@ const char* const BUILD_PRECISION = sizeof(sph::Real) == sizeof(double) ? "doubl
 
 struct StudyCase
 {
-    std::string label;                               ///< "settings.spacing=0.02 settings.cfl=0.4"
-    std::map<std::string, Json> values;              ///< swept key -> value
-    std::vector<std::string> overrides;              ///< "-D" assignments for the scene
+    std::string label;                  ///< "settings.spacing=0.02 settings.cfl=0.4"
+    std::map<std::string, Json> values; ///< swept key -> value
+    std::vector<std::string> overrides; ///< "-D" assignments for the scene
     std::string precision = BUILD_PRECISION;
     bool reference = false;
 };
@@ -69,28 +69,32 @@ struct StudyCase
 struct StudySpec
 {
     std::string file, scene;
-    std::vector<std::string> axes;                   ///< swept keys, in column order
-    std::vector<StudyCase> cases;                    ///< the reference (if any) first
+    std::vector<std::string> axes; ///< swept keys, in column order
+    std::vector<StudyCase> cases;  ///< the reference (if any) first
     std::vector<MetricSpec> metrics;
-    std::map<std::string, std::string> executables;  ///< precision -> program
+    std::map<std::string, std::string> executables; ///< precision -> program
     double maxSecondsPerRun = 0;
     std::string directory, table, plot, plotTitle;
     std::string plotCost = "wall_per_sim_second", plotError, plotSeries;
     std::string convergenceKey, convergenceError;
-    bool convergenceInverse = false;                 ///< the step size is 1 / key (substeps)
-    std::optional<std::vector<std::string>> convergenceGroupBy; ///< keys that form groups (default: all others)
+    bool convergenceInverse = false; ///< the step size is 1 / key (substeps)
+    std::optional<std::vector<std::string>>
+        convergenceGroupBy; ///< keys that form groups (default: all others)
     bool hasReference() const { return !cases.empty() && cases.front().reference; }
 };
 
 std::string valueText(const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
 /// key=value pairs of a JSON object, in the file's key order (nlohmann sorts; fine for columns).
-std::vector<std::pair<std::string, Json>> assignments(const vdbio::JsonObject& o, const std::string& key)
+std::vector<std::pair<std::string, Json>> assignments(const vdbio::JsonObject& o,
+                                                      const std::string& key)
 {
     std::vector<std::pair<std::string, Json>> out;
     const Json* v = o.raw(key);
     if (!v || v->is_null()) return out;
-    if (!v->is_object()) o.failValue(key, "expected an object of scene keys and values { \"settings.spacing\": 0.02 }");
+    if (!v->is_object())
+        o.failValue(key,
+                    "expected an object of scene keys and values { \"settings.spacing\": 0.02 }");
     for (auto it = v->begin(); it != v->end(); ++it) out.emplace_back(it.key(), it.value());
     return out;
 }
@@ -127,7 +131,8 @@ StudySpec readStudy(const std::string& path)
     std::vector<std::map<std::string, Json>> combos(1);
     for (const auto& [key, values] : assignments(root, "sweep")) {
         if (!values.is_array() || values.empty()) {
-            root.fail("sweep", msg("'", key, "' = ", values.dump(), ": expected a non-empty array of values"));
+            root.fail("sweep", msg("'", key, "' = ", values.dump(),
+                                   ": expected a non-empty array of values"));
         }
         s.axes.push_back(key);
         std::vector<std::map<std::string, Json>> next;
@@ -145,7 +150,8 @@ StudySpec readStudy(const std::string& path)
         const Json* raw = shared->contains("runs") ? &(*shared)["runs"][runs.size()] : nullptr;
         for (auto it = raw->begin(); it != raw->end(); ++it) {
             values[it.key()] = it.value();
-            if (std::find(s.axes.begin(), s.axes.end(), it.key()) == s.axes.end()) s.axes.push_back(it.key());
+            if (std::find(s.axes.begin(), s.axes.end(), it.key()) == s.axes.end())
+                s.axes.push_back(it.key());
         }
         (void)run;
         runs.push_back(std::move(values));
@@ -161,8 +167,9 @@ StudySpec readStudy(const std::string& path)
             c.label += (c.label.empty() ? "" : " ") + key + "=" + valueText(value);
             if (key == PRECISION_KEY) {
                 if (value != "float" && value != "double") {
-                    root.fail(reference ? "reference" : "sweep",
-                              msg("precision = ", value.dump(), ": expected \"float\" or \"double\""));
+                    root.fail(
+                        reference ? "reference" : "sweep",
+                        msg("precision = ", value.dump(), ": expected \"float\" or \"double\""));
                 }
                 c.precision = value.get<std::string>();
             } else {
@@ -199,7 +206,8 @@ StudySpec readStudy(const std::string& path)
             spec.name = m["metric"].get<std::string>();
             spec.options = m;
         } else {
-            root.fail("metrics", msg("[", k, "] = ", m.dump(), ": expected a name or { \"metric\": name, ... }"));
+            root.fail("metrics", msg("[", k, "] = ", m.dump(),
+                                     ": expected a name or { \"metric\": name, ... }"));
         }
         makeMetric(spec, msg("study '", path, "': metrics[", k, "]")); // checks name and options
         s.metrics.push_back(std::move(spec));
@@ -220,19 +228,25 @@ StudySpec readStudy(const std::string& path)
     out.finish();
 
     const vdbio::JsonObject plot = root.has("plot") ? root.object("plot") : vdbio::JsonObject();
-    s.plotCost = plot.choice("cost", s.plotCost, {"wall_per_sim_second", "cpu_per_sim_second", "wall_s", "cpu_s", "peak_rss_mb", "particles_max",
-                                                  "particle_memory_mb", "steps"});
-    s.plotError = plot.get<std::string>("error", primaryErrorColumn(s.metrics.front().name, s.hasReference()));
+    s.plotCost = plot.choice("cost", s.plotCost,
+                             {"wall_per_sim_second", "cpu_per_sim_second", "wall_s", "cpu_s",
+                              "peak_rss_mb", "particles_max", "particle_memory_mb", "steps"});
+    s.plotError = plot.get<std::string>(
+        "error", primaryErrorColumn(s.metrics.front().name, s.hasReference()));
     s.plotSeries = plot.get<std::string>("series", "");
     s.plotTitle = plot.get<std::string>("title", fs::path(path).stem().string());
     plot.finish();
-    if (!s.plotSeries.empty() && std::find(s.axes.begin(), s.axes.end(), s.plotSeries) == s.axes.end()) {
+    if (!s.plotSeries.empty()
+        && std::find(s.axes.begin(), s.axes.end(), s.plotSeries) == s.axes.end()) {
         root.fail("plot", msg("series = \"", s.plotSeries, "\": not a swept key (swept: ",
-                              s.axes.empty() ? std::string("none") : s.axes.front(), s.axes.size() > 1 ? ", ..." : "", ")"));
+                              s.axes.empty() ? std::string("none") : s.axes.front(),
+                              s.axes.size() > 1 ? ", ..." : "", ")"));
     }
 
-    const vdbio::JsonObject conv = root.has("convergence") ? root.object("convergence") : vdbio::JsonObject();
-    const bool sweptSpacing = std::find(s.axes.begin(), s.axes.end(), "settings.spacing") != s.axes.end();
+    const vdbio::JsonObject conv =
+        root.has("convergence") ? root.object("convergence") : vdbio::JsonObject();
+    const bool sweptSpacing =
+        std::find(s.axes.begin(), s.axes.end(), "settings.spacing") != s.axes.end();
     s.convergenceKey = conv.get<std::string>("key", sweptSpacing ? "settings.spacing" : "");
     s.convergenceError = conv.get<std::string>("error", s.plotError);
     s.convergenceInverse = conv.get<bool>("inverse", false);
@@ -245,7 +259,8 @@ StudySpec readStudy(const std::string& path)
         }
     }
     conv.finish();
-    if (!s.convergenceKey.empty() && std::find(s.axes.begin(), s.axes.end(), s.convergenceKey) == s.axes.end()) {
+    if (!s.convergenceKey.empty()
+        && std::find(s.axes.begin(), s.axes.end(), s.convergenceKey) == s.axes.end()) {
         root.fail("convergence", msg("key = \"", s.convergenceKey, "\": not a swept key"));
     }
     root.finish();
@@ -264,8 +279,9 @@ StudySpec readStudy(const std::string& path)
         if (!columns.count(*column)) {
             std::string list;
             for (const std::string& c : columns) list += (list.empty() ? "" : ", ") + c;
-            throw SceneError(msg("study '", path, "': ", column == &s.plotError ? "plot.error" : "convergence.error",
-                                 " = \"", *column, "\": not a column of these metrics (", list, ")"));
+            throw SceneError(msg(
+                "study '", path, "': ", column == &s.plotError ? "plot.error" : "convergence.error",
+                " = \"", *column, "\": not a column of these metrics (", list, ")"));
         }
     }
     return s;
@@ -278,9 +294,11 @@ StudySpec readStudy(const std::string& path)
 /// core); the metrics' sampling, single-threaded, is subtracted from both.
 double cpuSeconds()
 {
-    struct rusage u{};
+    struct rusage u
+    {};
     ::getrusage(RUSAGE_SELF, &u);
-    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec)
+           + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 /// Run case `index` and return its result document. Throws like `ghostfx run`.
@@ -288,7 +306,8 @@ Json runCase(const StudySpec& spec, std::size_t index)
 {
     const StudyCase& c = spec.cases.at(index);
     if (c.precision != BUILD_PRECISION) {
-        throw ValueError(msg("case '", c.label, "' asks for ", c.precision, ", this ghostfx is ", BUILD_PRECISION));
+        throw ValueError(msg("case '", c.label, "' asks for ", c.precision, ", this ghostfx is ",
+                             BUILD_PRECISION));
     }
     const auto t0 = Clock::now();
     const vdbio::Scene scene = vdbio::readScene(spec.scene, c.overrides);
@@ -297,15 +316,18 @@ Json runCase(const StudySpec& spec, std::size_t index)
 
     std::vector<std::unique_ptr<Metric>> metrics;
     for (std::size_t k = 0; k < spec.metrics.size(); ++k) {
-        metrics.push_back(makeMetric(spec.metrics[k], msg("study '", spec.file, "': metrics[", k, "]")));
+        metrics.push_back(
+            makeMetric(spec.metrics[k], msg("study '", spec.file, "': metrics[", k, "]")));
     }
     auto sample = [&](int frame, bool first) {
         const std::vector<OutputMedium> media = sim->media();
         for (const auto& metric : metrics) {
-            auto it = std::find_if(media.begin(), media.end(), [&](const OutputMedium& m) { return m.name == metric->medium(); });
+            auto it = std::find_if(media.begin(), media.end(), [&](const OutputMedium& m) {
+                return m.name == metric->medium();
+            });
             if (it == media.end()) {
-                throw SceneError(msg("metric ", metric->name(), " watches the ", metric->medium(), ", and scene '",
-                                     scene.file, "' has none"));
+                throw SceneError(msg("metric ", metric->name(), " watches the ", metric->medium(),
+                                     ", and scene '", scene.file, "' has none"));
             }
             MetricSample s{&*it, sim->time(), frame, scene.lastFrame};
             if (first) metric->start(s);
@@ -328,7 +350,8 @@ Json runCase(const StudySpec& spec, std::size_t index)
         sampling += std::chrono::duration<double>(Clock::now() - sampleStart).count();
         particlesMax = std::max(particlesMax, sim->particleCount());
         memoryMax = std::max(memoryMax, sim->memoryBytes());
-        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %llu steps, %s, %.2f s\n", frame, scene.lastFrame, sim->time(),
+        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %llu steps, %s, %.2f s\n", frame,
+                     scene.lastFrame, sim->time(),
                      static_cast<unsigned long long>(sim->stepCount()), sim->counts().c_str(),
                      std::chrono::duration<double>(Clock::now() - frameStart).count());
     }
@@ -351,7 +374,8 @@ Json runCase(const StudySpec& spec, std::size_t index)
     cost["particle_memory_mb"] = double(memoryMax) / 1048576.0;
     for (const OutputMedium& m : sim->media()) {
         std::size_t n = 0;
-        for (sph::ParticleKind k : m.particles->kinds()) n += std::count(m.kinds.begin(), m.kinds.end(), k) > 0;
+        for (sph::ParticleKind k : m.particles->kinds())
+            n += std::count(m.kinds.begin(), m.kinds.end(), k) > 0;
         cost["count_" + m.name] = double(n);
     }
     result["counts"] = sim->counts();
@@ -378,7 +402,8 @@ struct CaseOutcome
 std::string selfExecutable()
 {
     if (::access("/proc/self/exe", X_OK) != 0) {
-        throw IoError(msg("ghostfx study: cannot run its own program again (/proc/self/exe: ", std::strerror(errno), ")"));
+        throw IoError(msg("ghostfx study: cannot run its own program again (/proc/self/exe: ",
+                          std::strerror(errno), ")"));
     }
     return "/proc/self/exe";
 }
@@ -394,36 +419,49 @@ std::string lastLine(const std::string& path)
     return last;
 }
 
-CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string& program, int threads,
-                     const std::string& resultPath, const std::string& logPath)
+CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string& program,
+                     int threads, const std::string& resultPath, const std::string& logPath)
 {
-    std::vector<std::string> args = {program, "study", spec.file, "--case", std::to_string(index),
-                                     "--result", resultPath, "--threads", std::to_string(threads)};
+    std::vector<std::string> args = {program,
+                                     "study",
+                                     spec.file,
+                                     "--case",
+                                     std::to_string(index),
+                                     "--result",
+                                     resultPath,
+                                     "--threads",
+                                     std::to_string(threads)};
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
 
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, logPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, logPath.c_str(),
+                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
     std::error_code ec;
     fs::remove(resultPath, ec);
     pid_t pid = 0;
     const int err = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
-    if (err != 0) throw IoError(msg("ghostfx study: cannot start '", program, "': ", std::strerror(err)));
+    if (err != 0)
+        throw IoError(msg("ghostfx study: cannot start '", program, "': ", std::strerror(err)));
 
     const auto start = Clock::now();
     int status = 0;
-    struct rusage usage{};
+    struct rusage usage
+    {};
     bool timedOut = false;
     for (;;) {
         const pid_t done = ::wait4(pid, &status, WNOHANG, &usage);
         if (done == pid) break;
-        if (done < 0 && errno != EINTR) throw IoError(msg("ghostfx study: waiting for case ", index, ": ", std::strerror(errno)));
-        if (spec.maxSecondsPerRun > 0 && !timedOut &&
-            std::chrono::duration<double>(Clock::now() - start).count() > spec.maxSecondsPerRun) {
+        if (done < 0 && errno != EINTR)
+            throw IoError(
+                msg("ghostfx study: waiting for case ", index, ": ", std::strerror(errno)));
+        if (spec.maxSecondsPerRun > 0 && !timedOut
+            && std::chrono::duration<double>(Clock::now() - start).count()
+                   > spec.maxSecondsPerRun) {
             ::kill(pid, SIGKILL);
             timedOut = true;
         }
@@ -448,7 +486,8 @@ CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string
     }
     if (!result.is_object()) {
         o.status = "failed";
-        o.note = WIFSIGNALED(status) ? msg("killed by signal ", WTERMSIG(status)) : lastLine(logPath);
+        o.note =
+            WIFSIGNALED(status) ? msg("killed by signal ", WTERMSIG(status)) : lastLine(logPath);
         return o;
     }
     o.status = result.value("status", "failed");
@@ -486,9 +525,11 @@ void compareWithReference(const StudySpec& spec, std::vector<CaseOutcome>& outco
 
 const std::vector<std::string>& costColumns()
 {
-    static const std::vector<std::string> c = {"setup_s", "wall_s", "sim_s", "wall_per_sim_second", "cpu_s",
-                                               "cpu_per_sim_second", "steps",
-                                               "steps_per_second", "peak_rss_mb", "particle_memory_mb",
+    static const std::vector<std::string> c = {"setup_s",      "wall_s",
+                                               "sim_s",        "wall_per_sim_second",
+                                               "cpu_s",        "cpu_per_sim_second",
+                                               "steps",        "steps_per_second",
+                                               "peak_rss_mb",  "particle_memory_mb",
                                                "particles_max"};
     return c;
 }
@@ -515,7 +556,8 @@ double numberOr(const CaseOutcome& o, const std::string& key)
     return it == o.numbers.end() ? NAN : it->second;
 }
 
-void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path)
+void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
+                const std::string& path)
 {
     std::vector<std::string> columns = costColumns();
     std::set<std::string> seen(columns.begin(), columns.end());
@@ -526,7 +568,8 @@ void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
     }
     std::string text = "case,role,status";
     // The precision is a column of its own unless it is swept (then it is one of the axes).
-    const bool precisionColumn = std::find(spec.axes.begin(), spec.axes.end(), PRECISION_KEY) == spec.axes.end();
+    const bool precisionColumn =
+        std::find(spec.axes.begin(), spec.axes.end(), PRECISION_KEY) == spec.axes.end();
     for (const std::string& a : spec.axes) text += "," + csvField(a);
     if (precisionColumn) text += ",precision";
     for (const std::string& c : columns) text += "," + c;
@@ -553,20 +596,19 @@ void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
     });
 }
 
-
-
 /// The same table in Markdown, with the columns a reader compares (cost, then every metric),
 /// numbers to 3 significant digits: for documentation and review.
-void writeMarkdown(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path)
+void writeMarkdown(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
+                   const std::string& path)
 {
-    const std::vector<std::string> cost = {"cpu_per_sim_second", "wall_per_sim_second", "steps", "peak_rss_mb",
-                                           "particles_max"};
+    const std::vector<std::string> cost = {"cpu_per_sim_second", "wall_per_sim_second", "steps",
+                                           "peak_rss_mb", "particles_max"};
     std::vector<std::string> metrics;
     std::set<std::string> skip(costColumns().begin(), costColumns().end());
     for (const CaseOutcome& o : outcomes) {
         for (const auto& [name, value] : o.numbers) {
-            if (!skip.count(name) && name.rfind("count_", 0) != 0 &&
-                std::find(metrics.begin(), metrics.end(), name) == metrics.end()) {
+            if (!skip.count(name) && name.rfind("count_", 0) != 0
+                && std::find(metrics.begin(), metrics.end(), name) == metrics.end()) {
                 metrics.push_back(name);
             }
         }
@@ -579,11 +621,20 @@ void writeMarkdown(const StudySpec& spec, const std::vector<CaseOutcome>& outcom
     };
     std::string text = "| run |";
     std::string rule = "|---|";
-    for (const std::string& a : spec.axes) { text += " " + a + " |"; rule += "---|"; }
+    for (const std::string& a : spec.axes) {
+        text += " " + a + " |";
+        rule += "---|";
+    }
     text += " status |";
     rule += "---|";
-    for (const std::string& c : cost) { text += " " + c + " |"; rule += "---:|"; }
-    for (const std::string& m : metrics) { text += " " + m + " |"; rule += "---:|"; }
+    for (const std::string& c : cost) {
+        text += " " + c + " |";
+        rule += "---:|";
+    }
+    for (const std::string& m : metrics) {
+        text += " " + m + " |";
+        rule += "---:|";
+    }
     text += "\n" + rule + "\n";
     for (std::size_t k = 0; k < outcomes.size(); ++k) {
         const StudyCase& c = spec.cases[k];
@@ -594,7 +645,8 @@ void writeMarkdown(const StudySpec& spec, const std::vector<CaseOutcome>& outcom
         }
         text += " " + outcomes[k].status + " |";
         for (const std::string& col : cost) text += " " + cell(numberOr(outcomes[k], col)) + " |";
-        for (const std::string& col : metrics) text += " " + cell(numberOr(outcomes[k], col)) + " |";
+        for (const std::string& col : metrics)
+            text += " " + cell(numberOr(outcomes[k], col)) + " |";
         text += "\n";
     }
     vdbio::writeAtomically(path, [&](const std::string& tmp) {
@@ -606,7 +658,8 @@ void writeMarkdown(const StudySpec& spec, const std::vector<CaseOutcome>& outcom
 
 /// Observed order of convergence between successive values of the convergence key (halving the
 /// spacing, say), among cases that agree on every other swept key: p = ln(e1 / e2) / ln(h1 / h2).
-std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path)
+std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
+                              const std::string& path)
 {
     if (spec.convergenceKey.empty()) return {};
     std::map<std::string, std::vector<std::pair<double, double>>> groups; // others -> (h, error)
@@ -618,28 +671,33 @@ std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutco
         std::string others;
         for (const auto& [name, value] : c.values) {
             const bool grouping = spec.convergenceGroupBy
-                                      ? std::count(spec.convergenceGroupBy->begin(), spec.convergenceGroupBy->end(), name) > 0
+                                      ? std::count(spec.convergenceGroupBy->begin(),
+                                                   spec.convergenceGroupBy->end(), name)
+                                            > 0
                                       : name != spec.convergenceKey;
             if (grouping) others += (others.empty() ? "" : " ") + name + "=" + valueText(value);
         }
         const double value = key->second.get<double>();
-        groups[others].push_back({spec.convergenceInverse ? 1.0 / value : value, numberOr(outcomes[k], spec.convergenceError)});
+        groups[others].push_back({spec.convergenceInverse ? 1.0 / value : value,
+                                  numberOr(outcomes[k], spec.convergenceError)});
     }
-    const std::string h = spec.convergenceInverse ? "1/" + spec.convergenceKey : spec.convergenceKey;
-    std::string csv = "group," + h + "_coarse," + h + "_fine," +
-                      spec.convergenceError + "_coarse," + spec.convergenceError + "_fine,observed_order\n";
+    const std::string h =
+        spec.convergenceInverse ? "1/" + spec.convergenceKey : spec.convergenceKey;
+    std::string csv = "group," + h + "_coarse," + h + "_fine," + spec.convergenceError + "_coarse,"
+                      + spec.convergenceError + "_fine,observed_order\n";
     std::string report;
     for (auto& [group, points] : groups) {
         std::sort(points.begin(), points.end(), [](auto& a, auto& b) { return a.first > b.first; });
         for (std::size_t k = 0; k + 1 < points.size(); ++k) {
             const auto [h1, e1] = points[k];
             const auto [h2, e2] = points[k + 1];
-            const double order = (e1 > 0 && e2 > 0 && h1 != h2) ? std::log(e1 / e2) / std::log(h1 / h2) : NAN;
-            csv += csvField(group) + "," + number(h1) + "," + number(h2) + "," + number(e1) + "," + number(e2) + "," +
-                   number(order) + "\n";
+            const double order =
+                (e1 > 0 && e2 > 0 && h1 != h2) ? std::log(e1 / e2) / std::log(h1 / h2) : NAN;
+            csv += csvField(group) + "," + number(h1) + "," + number(h2) + "," + number(e1) + ","
+                   + number(e2) + "," + number(order) + "\n";
             report += msg("  ", group.empty() ? "" : group + ": ", h, " ", number(h1), " -> ",
-                          number(h2), ": ", spec.convergenceError, " ", number(e1), " -> ", number(e2),
-                          ", observed order ", number(order), "\n");
+                          number(h2), ": ", spec.convergenceError, " ", number(e1), " -> ",
+                          number(e2), ", observed order ", number(order), "\n");
         }
     }
     vdbio::writeAtomically(path, [&](const std::string& tmp) {
@@ -650,8 +708,8 @@ std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutco
     return report;
 }
 
-void writeStudyPlot(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes, const std::string& path,
-                    std::string& skipped)
+void writeStudyPlot(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
+                    const std::string& path, std::string& skipped)
 {
     vdbio::PlotSpec plot;
     plot.title = spec.plotTitle;
@@ -660,7 +718,8 @@ void writeStudyPlot(const StudySpec& spec, const std::vector<CaseOutcome>& outco
     for (std::size_t k = 0; k < outcomes.size(); ++k) {
         const StudyCase& c = spec.cases[k];
         if (c.reference) continue;
-        const double x = numberOr(outcomes[k], spec.plotCost), y = numberOr(outcomes[k], spec.plotError);
+        const double x = numberOr(outcomes[k], spec.plotCost),
+                     y = numberOr(outcomes[k], spec.plotError);
         if (outcomes[k].status != "ok" || !(x > 0) || !(y > 0)) {
             skipped += msg(skipped.empty() ? "" : ", ", k);
             continue;
@@ -695,7 +754,8 @@ struct StudyOptions
 std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& path)
 {
     std::ifstream in(path);
-    if (!in) throw IoError(msg("study table '", path, "': cannot open the file (run the study first)"));
+    if (!in)
+        throw IoError(msg("study table '", path, "': cannot open the file (run the study first)"));
     auto split = [](const std::string& line) {
         std::vector<std::string> fields(1);
         bool quoted = false;
@@ -716,22 +776,25 @@ std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& pat
     std::getline(in, line);
     const std::vector<std::string> header = split(line);
     // case, role, status, the axes, the precision (unless swept), then numbers (writeTable).
-    const bool precisionSwept = std::find(spec.axes.begin(), spec.axes.end(), PRECISION_KEY) != spec.axes.end();
+    const bool precisionSwept =
+        std::find(spec.axes.begin(), spec.axes.end(), PRECISION_KEY) != spec.axes.end();
     const std::size_t firstNumber = 3 + spec.axes.size() + (precisionSwept ? 0 : 1);
     std::vector<CaseOutcome> outcomes(spec.cases.size());
     std::size_t row = 0;
     while (std::getline(in, line)) {
         const std::vector<std::string> f = split(line);
         if (row >= outcomes.size() || f.size() != header.size()) {
-            throw SceneError(msg("study table '", path, "': row ", row + 1, " does not fit study '", spec.file,
-                                 "' (", spec.cases.size(), " cases, ", header.size(), " columns)"));
+            throw SceneError(msg("study table '", path, "': row ", row + 1, " does not fit study '",
+                                 spec.file, "' (", spec.cases.size(), " cases, ", header.size(),
+                                 " columns)"));
         }
         CaseOutcome& o = outcomes[row++];
         for (std::size_t k = 0; k < header.size(); ++k) {
             if (header[k] == "status") o.status = f[k];
             else if (header[k] == "note") o.note = f[k];
-            else if (std::find(costColumns().begin(), costColumns().end(), header[k]) != costColumns().end() ||
-                     header[k].rfind("count_", 0) == 0 || k >= firstNumber) {
+            else if (std::find(costColumns().begin(), costColumns().end(), header[k])
+                         != costColumns().end()
+                     || header[k].rfind("count_", 0) == 0 || k >= firstNumber) {
                 o.numbers[header[k]] = f[k].empty() ? NAN : std::strtod(f[k].c_str(), nullptr);
             }
         }
@@ -742,7 +805,8 @@ std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& pat
 int runStudyCase(const StudyOptions& o, const StudySpec& spec)
 {
     if (o.caseIndex < 0 || std::size_t(o.caseIndex) >= spec.cases.size()) {
-        throw ValueError(msg("--case ", o.caseIndex, ": the study has cases 0-", spec.cases.size() - 1));
+        throw ValueError(
+            msg("--case ", o.caseIndex, ": the study has cases 0-", spec.cases.size() - 1));
     }
     parallel::ThreadLimit threadLimit(o.threads);
     Json result;
@@ -763,26 +827,32 @@ int runStudyCase(const StudyOptions& o, const StudySpec& spec)
             if (!out) throw IoError(msg("study result '", o.result, "': write failed"));
         });
     }
-    if (code != 0) std::fprintf(stderr, "ghostfx study: case %d %s: %s\n", o.caseIndex,
-                                result["status"].get<std::string>().c_str(), result["error"].get<std::string>().c_str());
+    if (code != 0)
+        std::fprintf(stderr, "ghostfx study: case %d %s: %s\n", o.caseIndex,
+                     result["status"].get<std::string>().c_str(),
+                     result["error"].get<std::string>().c_str());
     return code;
 }
 
 /// The convergence table and the plot, from the outcomes of every case.
-int finishStudy(const StudyOptions& o, const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
-                const std::string& folder)
+int finishStudy(const StudyOptions& o, const StudySpec& spec,
+                const std::vector<CaseOutcome>& outcomes, const std::string& folder)
 {
     auto say = [&](const std::string& line) {
         if (!o.quiet) std::fprintf(stderr, "%s\n", line.c_str());
     };
-    const std::string order = convergenceReport(spec, outcomes, (fs::path(folder) / "convergence.csv").string());
+    const std::string order =
+        convergenceReport(spec, outcomes, (fs::path(folder) / "convergence.csv").string());
     if (!order.empty()) say("convergence (convergence.csv):\n" + order.substr(0, order.size() - 1));
     std::string skipped;
     const std::string plot = (fs::path(folder) / spec.plot).string();
     writeStudyPlot(spec, outcomes, plot, skipped);
-    writeMarkdown(spec, outcomes, (fs::path(fs::path(folder) / spec.table).replace_extension(".md")).string());
+    writeMarkdown(spec, outcomes,
+                  (fs::path(fs::path(folder) / spec.table).replace_extension(".md")).string());
     say(msg("table: ", (fs::path(folder) / spec.table).string(), "; plot: ", plot,
-            skipped.empty() ? "" : " (not plotted, failed or without a positive value: cases " + skipped + ")"));
+            skipped.empty()
+                ? ""
+                : " (not plotted, failed or without a positive value: cases " + skipped + ")"));
     return 0;
 }
 
@@ -792,7 +862,8 @@ int runStudy(const StudyOptions& o)
     if (o.caseIndex >= 0) return runStudyCase(o, spec);
     if (o.replot) {
         const std::string folder = o.out.empty() ? spec.directory : o.out;
-        const std::vector<CaseOutcome> outcomes = readTable(spec, (fs::path(folder) / spec.table).string());
+        const std::vector<CaseOutcome> outcomes =
+            readTable(spec, (fs::path(folder) / spec.table).string());
         return finishStudy(o, spec, outcomes, folder);
     }
 
@@ -800,8 +871,9 @@ int runStudy(const StudyOptions& o)
     // a child of the other build sees this build's cases as "other").
     for (const StudyCase& c : spec.cases) {
         if (c.precision != BUILD_PRECISION && !spec.executables.count(c.precision)) {
-            throw SceneError(msg("study '", spec.file, "': executables: case '", c.label, "' needs a ", c.precision,
-                                 " build: this ghostfx is ", BUILD_PRECISION, "; name one with \"executables\": { \"",
+            throw SceneError(msg("study '", spec.file, "': executables: case '", c.label,
+                                 "' needs a ", c.precision, " build: this ghostfx is ",
+                                 BUILD_PRECISION, "; name one with \"executables\": { \"",
                                  c.precision, "\": \"build-", c.precision, "/cmd/ghostfx\" }"));
         }
     }
@@ -822,29 +894,33 @@ int runStudy(const StudyOptions& o)
     auto say = [&](const std::string& line) {
         if (!o.quiet) std::fprintf(stderr, "%s\n", line.c_str());
     };
-    say(msg("ghostfx study '", spec.file, "': scene '", spec.scene, "', ", spec.cases.size(), " runs, ",
-            spec.metrics.size(), " metrics, output in '", folder, "'"));
+    say(msg("ghostfx study '", spec.file, "': scene '", spec.scene, "', ", spec.cases.size(),
+            " runs, ", spec.metrics.size(), " metrics, output in '", folder, "'"));
 
     std::vector<CaseOutcome> outcomes(spec.cases.size());
     for (std::size_t k = 0; k < spec.cases.size(); ++k) {
         const StudyCase& c = spec.cases[k];
-        const std::string program = c.precision == BUILD_PRECISION ? self : spec.executables.at(c.precision);
-        const std::string stem = (fs::path(folder) / "runs" / msg("case_", k < 10 ? "0" : "", k)).string();
+        const std::string program =
+            c.precision == BUILD_PRECISION ? self : spec.executables.at(c.precision);
+        const std::string stem =
+            (fs::path(folder) / "runs" / msg("case_", k < 10 ? "0" : "", k)).string();
         const auto start = Clock::now();
         outcomes[k] = runChild(spec, k, program, o.threads, stem + ".json", stem + ".log");
         compareWithReference(spec, outcomes);
         writeTable(spec, outcomes, table);
         const CaseOutcome& r = outcomes[k];
-        std::string line = msg("[", k + 1, "/", spec.cases.size(), "] ", c.label.empty() ? "base scene" : c.label, ": ",
-                               r.status);
+        std::string line = msg("[", k + 1, "/", spec.cases.size(), "] ",
+                               c.label.empty() ? "base scene" : c.label, ": ", r.status);
         if (r.status == "ok") {
-            line += msg(", ", number(numberOr(r, "wall_s")), " s wall, ", number(numberOr(r, "cpu_s")), " s CPU (",
-                        number(numberOr(r, "wall_per_sim_second")), " s per simulated s), ", number(numberOr(r, "peak_rss_mb")), " MB, ",
-                        number(numberOr(r, "particles_max")), " particles; ", spec.plotError, " = ",
-                        number(numberOr(r, spec.plotError)));
+            line += msg(
+                ", ", number(numberOr(r, "wall_s")), " s wall, ", number(numberOr(r, "cpu_s")),
+                " s CPU (", number(numberOr(r, "wall_per_sim_second")), " s per simulated s), ",
+                number(numberOr(r, "peak_rss_mb")), " MB, ", number(numberOr(r, "particles_max")),
+                " particles; ", spec.plotError, " = ", number(numberOr(r, spec.plotError)));
         } else {
-            line += msg(" after ", number(std::chrono::duration<double>(Clock::now() - start).count()), " s: ", r.note,
-                        " (log: ", stem, ".log)");
+            line +=
+                msg(" after ", number(std::chrono::duration<double>(Clock::now() - start).count()),
+                    " s: ", r.note, " (log: ", stem, ".log)");
         }
         say(line);
     }
@@ -857,13 +933,16 @@ int runStudy(const StudyOptions& o)
 Command addStudyCommand(CLI::App& parent)
 {
     auto o = std::make_shared<StudyOptions>();
-    CLI::App* c = parent.add_subcommand("study", "Run a scene over a sweep of settings: cost against error (CSV + PNG plot)");
+    CLI::App* c = parent.add_subcommand(
+        "study", "Run a scene over a sweep of settings: cost against error (CSV + PNG plot)");
     c->add_option("study", o->study, "study file (.json; docs/study.md)")->required();
     c->add_option("--out", o->out, "output folder (default: output.directory of the study)");
-    c->add_option("--threads", o->threads, "worker threads per run (0: all cores)")->check(CLI::NonNegativeNumber);
+    c->add_option("--threads", o->threads, "worker threads per run (0: all cores)")
+        ->check(CLI::NonNegativeNumber);
     c->add_flag("-q,--quiet", o->quiet, "print errors only");
-    c->add_flag("--replot", o->replot, "only redraw the plot and convergence table from the study's existing table "
-                                      "(after changing \"plot\" or \"convergence\")");
+    c->add_flag("--replot", o->replot,
+                "only redraw the plot and convergence table from the study's existing table "
+                "(after changing \"plot\" or \"convergence\")");
     // Internal: how the study runs one case in a child process.
     c->add_option("--case", o->caseIndex)->group("");
     c->add_option("--result", o->result)->group("");

@@ -28,7 +28,8 @@ std::vector<std::size_t> members(const OutputMedium& m)
     const sph::ParticleSet& p = *m.particles;
     out.reserve(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (std::find(m.kinds.begin(), m.kinds.end(), p.kinds()[i]) != m.kinds.end()) out.push_back(i);
+        if (std::find(m.kinds.begin(), m.kinds.end(), p.kinds()[i]) != m.kinds.end())
+            out.push_back(i);
     }
     return out;
 }
@@ -37,7 +38,8 @@ std::vector<std::size_t> members(const OutputMedium& m)
 double percentile(std::vector<double> values, double q)
 {
     if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-    const std::size_t k = std::min(values.size() - 1, std::size_t(std::floor(q / 100.0 * double(values.size() - 1) + 0.5)));
+    const std::size_t k = std::min(
+        values.size() - 1, std::size_t(std::floor(q / 100.0 * double(values.size() - 1) + 0.5)));
     std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
     return values[k];
 }
@@ -53,15 +55,18 @@ public:
         mKnown.insert(key);
         if (!mJson.contains(key)) return fallback;
         const Json& v = mJson[key];
-        if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number()) {
+        if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number()
+            || !v[2].is_number()) {
             fail(key, v, "expected [x, y, z]");
         }
-        const Vec3 d(sph::Real(v[0].get<double>()), sph::Real(v[1].get<double>()), sph::Real(v[2].get<double>()));
+        const Vec3 d(sph::Real(v[0].get<double>()), sph::Real(v[1].get<double>()),
+                     sph::Real(v[2].get<double>()));
         if (!(d.length() > 0)) fail(key, v, "expected a non-zero direction");
         return d / d.length();
     }
 
-    std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices)
+    std::string choice(const std::string& key, const std::string& fallback,
+                       const std::vector<std::string>& choices)
     {
         mKnown.insert(key);
         if (!mJson.contains(key)) return fallback;
@@ -89,8 +94,8 @@ public:
     {
         for (auto it = mJson.begin(); it != mJson.end(); ++it) {
             if (it.key() != "metric" && !mKnown.count(it.key())) {
-                throw SceneError(msg(mWhere, ".", it.key(), ": unknown option of this metric (options: ",
-                                     known(), ")"));
+                throw SceneError(msg(mWhere, ".", it.key(),
+                                     ": unknown option of this metric (options: ", known(), ")"));
             }
         }
     }
@@ -121,7 +126,11 @@ class DensityError : public Metric
 {
 public:
     explicit DensityError(std::string medium) : mMedium(std::move(medium)) {}
-    const std::string& name() const override { static const std::string n = "density_error"; return n; }
+    const std::string& name() const override
+    {
+        static const std::string n = "density_error";
+        return n;
+    }
     std::string medium() const override { return mMedium; }
 
     void frame(const MetricSample& s) override
@@ -142,7 +151,8 @@ public:
 
     std::vector<std::pair<std::string, double>> values() const override
     {
-        return {{"density_error_mean", mFrames ? mMeanSum / double(mFrames) : NAN}, {"density_error_max", mMax}};
+        return {{"density_error_mean", mFrames ? mMeanSum / double(mFrames) : NAN},
+                {"density_error_max", mMax}};
     }
 
 private:
@@ -161,7 +171,11 @@ class VolumeDrift : public Metric
 {
 public:
     explicit VolumeDrift(std::string medium) : mMedium(std::move(medium)) {}
-    const std::string& name() const override { static const std::string n = "volume_drift"; return n; }
+    const std::string& name() const override
+    {
+        static const std::string n = "volume_drift";
+        return n;
+    }
     std::string medium() const override { return mMedium; }
 
     void frame(const MetricSample& s) override
@@ -208,12 +222,17 @@ class HydrostaticPressure : public Metric
 {
 public:
     explicit HydrostaticPressure(double fromFraction) : mFrom(fromFraction) {}
-    const std::string& name() const override { static const std::string n = "hydrostatic_pressure"; return n; }
+    const std::string& name() const override
+    {
+        static const std::string n = "hydrostatic_pressure";
+        return n;
+    }
 
     void start(const MetricSample& s) override
     {
         if (!(s.medium->gravity.length() > 0)) {
-            throw SceneError("metric hydrostatic_pressure: the liquid has no gravity (settings.gravity = [0, 0, 0])");
+            throw SceneError("metric hydrostatic_pressure: the liquid has no gravity "
+                             "(settings.gravity = [0, 0, 0])");
         }
     }
 
@@ -226,7 +245,8 @@ public:
         const Vec3 up = -m.gravity / sph::Real(g);
         const std::vector<std::size_t> liquid = members(m);
         if (liquid.empty()) return;
-        double top = -std::numeric_limits<double>::max(), bottom = std::numeric_limits<double>::max();
+        double top = -std::numeric_limits<double>::max(),
+               bottom = std::numeric_limits<double>::max();
         for (std::size_t i : liquid) {
             const double h = p.positions()[i].dot(up);
             top = std::max(top, h);
@@ -243,7 +263,10 @@ public:
             const double d = top - p.positions()[i].dot(up);
             const double pi = p.pressures()[i];
             sq += (pi - mScale * d) * (pi - mScale * d);
-            sd += d; sp += pi; sdd += d * d; sdp += d * pi;
+            sd += d;
+            sp += pi;
+            sdd += d * d;
+            sdp += d * pi;
             Layer& layer = mLayers[int(std::floor(d / m.spacing))];
             layer.depth += d;
             layer.pressure += pi;
@@ -267,7 +290,8 @@ public:
         for (const auto& [index, layer] : mLayers) {
             const double d = layer.depth / layer.count, pl = layer.pressure / layer.count;
             const double rho = layer.density / layer.count;
-            for (; next < index; ++next) above += rho * mSpacing; // layers with no particle: this density
+            for (; next < index; ++next)
+                above += rho * mSpacing; // layers with no particle: this density
             const double balance = g * (above + rho * (d - index * mSpacing));
             above += rho * mSpacing;
             next = index + 1;
@@ -277,10 +301,11 @@ public:
         }
         const double depth = mFrames ? mDepthSum / mFrames : NAN;
         const double bottom = mScale * depth;
-        return {{"hydrostatic_pressure_error", count > 0 ? std::sqrt(sq / count) / bottom : NAN},
-                {"hydrostatic_balance_error", count > 0 ? std::sqrt(sqBalance / count) / bottom : NAN},
-                {"hydrostatic_pressure_noise", mFrames ? mNoiseSum / mFrames : NAN},
-                {"hydrostatic_slope_error", mFrames ? mSlopeSum / mFrames : NAN}};
+        return {
+            {"hydrostatic_pressure_error", count > 0 ? std::sqrt(sq / count) / bottom : NAN},
+            {"hydrostatic_balance_error", count > 0 ? std::sqrt(sqBalance / count) / bottom : NAN},
+            {"hydrostatic_pressure_noise", mFrames ? mNoiseSum / mFrames : NAN},
+            {"hydrostatic_slope_error", mFrames ? mSlopeSum / mFrames : NAN}};
     }
 
 private:
@@ -303,7 +328,11 @@ private:
 class FreeFall : public Metric
 {
 public:
-    const std::string& name() const override { static const std::string n = "free_fall"; return n; }
+    const std::string& name() const override
+    {
+        static const std::string n = "free_fall";
+        return n;
+    }
 
     void start(const MetricSample& s) override
     {
@@ -324,7 +353,8 @@ public:
 
     std::vector<std::pair<std::string, double>> values() const override
     {
-        return {{"free_fall_com_error", mError}, {"free_fall_com_error_spacings", mError / mSpacing}};
+        return {{"free_fall_com_error", mError},
+                {"free_fall_com_error_spacings", mError / mSpacing}};
     }
 
 private:
@@ -357,13 +387,18 @@ private:
 class CubeShape : public Metric
 {
 public:
-    const std::string& name() const override { static const std::string n = "cube_shape"; return n; }
+    const std::string& name() const override
+    {
+        static const std::string n = "cube_shape";
+        return n;
+    }
 
     void start(const MetricSample& s) override
     {
         const sph::ParticleSet& p = *s.medium->particles;
         if (s.medium->gravity.length() > 0) {
-            throw SceneError("metric cube_shape: expects zero gravity (set settings.gravity = [0, 0, 0])");
+            throw SceneError(
+                "metric cube_shape: expects zero gravity (set settings.gravity = [0, 0, 0])");
         }
         for (std::size_t i : members(*s.medium)) mStart[p.ids()[i]] = p.positions()[i];
         mExtent0 = extent(s);
@@ -415,9 +450,11 @@ class Front : public Metric
 {
 public:
     Front(std::string name, std::string medium, const Vec3& direction, double percentileRank)
-        : mName(std::move(name)), mMedium(std::move(medium)), mDirection(direction), mRank(percentileRank)
-    {
-    }
+        : mName(std::move(name))
+        , mMedium(std::move(medium))
+        , mDirection(direction)
+        , mRank(percentileRank)
+    {}
     const std::string& name() const override { return mName; }
     std::string medium() const override { return mMedium; }
 
@@ -450,16 +487,19 @@ private:
 
 const std::vector<std::string>& metricNames()
 {
-    static const std::vector<std::string> names = {"density_error", "volume_drift", "hydrostatic_pressure", "free_fall",
-                                                   "cube_shape", "surge_front", "plume_rise"};
+    static const std::vector<std::string> names = {
+        "density_error", "volume_drift", "hydrostatic_pressure", "free_fall", "cube_shape",
+        "surge_front",   "plume_rise"};
     return names;
 }
 
 std::string primaryErrorColumn(const std::string& metric, bool haveReference)
 {
     static const std::map<std::string, std::string> primary = {
-        {"density_error", "density_error_mean"}, {"volume_drift", "volume_error"},
-        {"hydrostatic_pressure", "hydrostatic_pressure_error"}, {"free_fall", "free_fall_com_error"},
+        {"density_error", "density_error_mean"},
+        {"volume_drift", "volume_error"},
+        {"hydrostatic_pressure", "hydrostatic_pressure_error"},
+        {"free_fall", "free_fall_com_error"},
         {"cube_shape", "cube_shape_error"}};
     auto it = primary.find(metric);
     if (it != primary.end()) return it->second;
@@ -481,7 +521,8 @@ std::unique_ptr<Metric> makeMetric(const MetricSpec& spec, const std::string& wh
     } else if (spec.name == "cube_shape") {
         metric = std::make_unique<CubeShape>();
     } else if (spec.name == "surge_front") {
-        metric = std::make_unique<Front>("surge_front", "liquid", o.direction("direction", Vec3(1, 0, 0)),
+        metric = std::make_unique<Front>("surge_front", "liquid",
+                                         o.direction("direction", Vec3(1, 0, 0)),
                                          o.number("percentile", 99, 50, 100));
     } else if (spec.name == "plume_rise") {
         metric = std::make_unique<Front>("plume_rise", "gas", o.direction("up", Vec3(0, 1, 0)),
@@ -489,7 +530,8 @@ std::unique_ptr<Metric> makeMetric(const MetricSpec& spec, const std::string& wh
     } else {
         std::string names;
         for (const std::string& n : metricNames()) names += (names.empty() ? "" : ", ") + n;
-        throw SceneError(msg(where, " = \"", spec.name, "\": unknown metric (expected one of ", names, ")"));
+        throw SceneError(
+            msg(where, " = \"", spec.name, "\": unknown metric (expected one of ", names, ")"));
     }
     o.finish();
     return metric;

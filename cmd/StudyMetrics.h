@@ -24,8 +24,8 @@ struct MetricSample
 {
     const OutputMedium* medium = nullptr;
     double time = 0;
-    int frame = 0;      ///< frames advanced (0: the initial state)
-    int lastFrame = 0;  ///< the frame the run ends with
+    int frame = 0;     ///< frames advanced (0: the initial state)
+    int lastFrame = 0; ///< the frame the run ends with
 };
 
 class Metric

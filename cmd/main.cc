@@ -21,14 +21,14 @@
 int main(int argc, char** argv)
 {
     CLI::App app{"ghostfx: Ghost SPH liquids and fast SPH gases on OpenVDB"};
-    app.set_version_flag("--version", std::string("ghostfx 0.1.0 (OpenVDB ") +
-                                          openvdb::getLibraryAbiVersionString() + ")");
+    app.set_version_flag("--version", std::string("ghostfx 0.1.0 (OpenVDB ")
+                                          + openvdb::getLibraryAbiVersionString() + ")");
     app.require_subcommand(1);
 
     using namespace ghostfx::cmd;
-    const std::vector<Command> commands = {addRunCommand(app), addInfoCommand(app),
+    const std::vector<Command> commands = {addRunCommand(app),     addInfoCommand(app),
                                            addPreviewCommand(app), addMesh2SdfCommand(app),
-                                           addSampleCommand(app), addStudyCommand(app)};
+                                           addSampleCommand(app),  addStudyCommand(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

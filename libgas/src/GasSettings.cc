@@ -14,9 +14,12 @@ namespace gas {
 const char* methodName(Method method)
 {
     switch (method) {
-    case Method::Fast: return "fast";
-    case Method::Ambient: return "ambient";
-    case Method::Uncorrected: return "uncorrected";
+    case Method::Fast:
+        return "fast";
+    case Method::Ambient:
+        return "ambient";
+    case Method::Uncorrected:
+        return "uncorrected";
     }
     return "unknown";
 }
@@ -32,8 +35,10 @@ Method methodFromName(const std::string& name)
 const char* falloffName(Falloff falloff)
 {
     switch (falloff) {
-    case Falloff::InverseSquare: return "inverse_square";
-    case Falloff::Constant: return "constant";
+    case Falloff::InverseSquare:
+        return "inverse_square";
+    case Falloff::Constant:
+        return "constant";
     }
     return "unknown";
 }
@@ -42,14 +47,15 @@ Falloff falloffFromName(const std::string& name)
 {
     if (name == "inverse_square") return Falloff::InverseSquare;
     if (name == "constant") return Falloff::Constant;
-    throw ValueError(msg("attractor falloff '", name, "': expected 'inverse_square' or 'constant'"));
+    throw ValueError(
+        msg("attractor falloff '", name, "': expected 'inverse_square' or 'constant'"));
 }
 
 Vec3 Attractor::acceleration(const Vec3& x) const
 {
-    const Vec3 d = position - x;   // towards c
+    const Vec3 d = position - x; // towards c
     const Real r = d.length();
-    if (r < radius) return d * (strength / radius);   // linear core, zero at c
+    if (r < radius) return d * (strength / radius); // linear core, zero at c
     const Real s = falloff == Falloff::InverseSquare ? strength * sph::sqr(radius / r) : strength;
     return d * (s / r);
 }
@@ -68,7 +74,8 @@ Real GasSettings::speedLimit(Real dt) const
 void GasSettings::validate() const
 {
     auto require = [](bool ok, const char* field, double value, const char* expected) {
-        if (!ok) throw ValueError(msg("gas setting ", field, " = ", value, ": expected ", expected));
+        if (!ok)
+            throw ValueError(msg("gas setting ", field, " = ", value, ": expected ", expected));
     };
     auto finite = [](Real v) { return std::isfinite(v); };
     require(spacing > 0 && finite(spacing), "spacing", spacing, "a finite value > 0 (m)");
@@ -90,7 +97,8 @@ void GasSettings::validate() const
     require(damping >= 0 && finite(damping), "damping", damping, ">= 0 (1/s, C_d of Eq. 14)");
     require(viscosity >= 0 && finite(viscosity), "viscosity", viscosity, ">= 0 (Pa s)");
     require(sph::isFinite(gravity), "gravity", gravity.length(), "finite components (m/s^2)");
-    require(finite(ambientTemperature), "ambientTemperature", ambientTemperature, "a finite value (K)");
+    require(finite(ambientTemperature), "ambientTemperature", ambientTemperature,
+            "a finite value (K)");
     require(diffusion >= 0 && finite(diffusion), "diffusion", diffusion,
             ">= 0 (kg/(m s), D_c of Eq. 15)");
     require(radiationTime >= 0 && finite(radiationTime), "radiationTime", radiationTime,
@@ -116,8 +124,8 @@ void GasSettings::validate() const
     }
     if (method == Method::Ambient) {
         const Vec3 e = domain.extent();
-        require(!domain.empty() && e[0] >= 2 * supportRadius() && e[1] >= 2 * supportRadius() &&
-                    e[2] >= 2 * supportRadius(),
+        require(!domain.empty() && e[0] >= 2 * supportRadius() && e[1] >= 2 * supportRadius()
+                    && e[2] >= 2 * supportRadius(),
                 "domain extent", domain.empty() ? 0.0 : double(std::min({e[0], e[1], e[2]})),
                 "a box at least two kernel radii wide on every axis (m) for method 'ambient'");
     }

@@ -6,8 +6,8 @@
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
-#include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Kernels.h>
+#include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/Random.h>
@@ -54,8 +54,7 @@ inline Real lifeEpsilon(std::uint64_t seed, ParticleId id, std::uint64_t step)
 
 /// A solid: its level set (in its local frame) and its rigid motion.
 struct GasSolver::Solid : sph::MovingLevelSet
-{
-};
+{};
 
 /// A source and its emission budget (rate-limited sources).
 struct GasSolver::Source
@@ -134,8 +133,10 @@ void GasSolver::sampleSolid(std::size_t solidIndex)
     const Solid& body = *mSolids[solidIndex];
     const RigidTransform xf = body.at(mTime);
     if (!isFinite(xf.translation)) {
-        throw ValueError(msg("gas solid '", body.shape.name(), "': motion gives a non-finite "
-                             "placement at t = ", mTime, " s"));
+        throw ValueError(msg("gas solid '", body.shape.name(),
+                             "': motion gives a non-finite "
+                             "placement at t = ",
+                             mTime, " s"));
     }
     // [RYY15] Sec. 3.3: rigid boundaries are boundary particles. Sampled like the liquid's
     // solids ([SB12] Sec. 4.5) in a band one kernel radius deep, so a gas particle at the wall
@@ -188,7 +189,8 @@ std::vector<Vec3> GasSolver::sampleShape(const LevelSet& shape, std::uint64_t se
 std::size_t GasSolver::addGas(const LevelSet& shape, const Vec3& velocity, Real temperature)
 {
     if (mRestored) {
-        throw ValueError(msg("gas '", shape.name(), "': cannot add gas after restoreState(); the "
+        throw ValueError(msg("gas '", shape.name(),
+                             "': cannot add gas after restoreState(); the "
                              "restored particles already hold it"));
     }
     const std::vector<Vec3> samples =
@@ -217,10 +219,10 @@ void GasSolver::addParticles(const std::vector<Vec3>& positions, const Vec3& vel
         throw ValueError("cannot add gas particles after restoreState(); the restored particles "
                          "already hold the gas");
     }
-    if (!isFinite(velocity) || !std::isfinite(temperature) || !(mass >= Real(0)) ||
-        !std::isfinite(mass)) {
-        throw ValueError(msg("gas particles: velocity, temperature (", temperature, " K) and mass (",
-                             mass, " kg) must be finite, mass >= 0"));
+    if (!isFinite(velocity) || !std::isfinite(temperature) || !(mass >= Real(0))
+        || !std::isfinite(mass)) {
+        throw ValueError(msg("gas particles: velocity, temperature (", temperature,
+                             " K) and mass (", mass, " kg) must be finite, mass >= 0"));
     }
     for (std::size_t k = 0; k < positions.size(); ++k) {
         if (!isFinite(positions[k])) {
@@ -243,20 +245,19 @@ Index GasSolver::addGasParticles(const std::vector<Vec3>& positions,
                                  const std::vector<Real>& supportRadii)
 {
     const std::size_t n = positions.size();
-    if (velocities.size() != n || temperatures.size() != n || masses.size() != n ||
-        supportRadii.size() != n) {
+    if (velocities.size() != n || temperatures.size() != n || masses.size() != n
+        || supportRadii.size() != n) {
         throw ValueError(msg("addGasParticles: ", n, " positions but ", velocities.size(),
-                             " velocities, ", temperatures.size(), " temperatures, ",
-                             masses.size(), " masses and ", supportRadii.size(),
+                             " velocities, ", temperatures.size(), " temperatures, ", masses.size(),
+                             " masses and ", supportRadii.size(),
                              " support radii: expected one of each per particle"));
     }
     for (std::size_t k = 0; k < n; ++k) {
-        if (!isFinite(positions[k]) || !isFinite(velocities[k]) ||
-            !std::isfinite(temperatures[k]) || !(masses[k] > Real(0)) ||
-            !std::isfinite(masses[k]) || !(supportRadii[k] > Real(0)) ||
-            !std::isfinite(supportRadii[k])) {
-            throw ValueError(msg("addGasParticles: particle ", k, " (mass ", masses[k],
-                                 " kg, h ", supportRadii[k], " m, temperature ", temperatures[k],
+        if (!isFinite(positions[k]) || !isFinite(velocities[k]) || !std::isfinite(temperatures[k])
+            || !(masses[k] > Real(0)) || !std::isfinite(masses[k]) || !(supportRadii[k] > Real(0))
+            || !std::isfinite(supportRadii[k])) {
+            throw ValueError(msg("addGasParticles: particle ", k, " (mass ", masses[k], " kg, h ",
+                                 supportRadii[k], " m, temperature ", temperatures[k],
                                  " K): expected finite values, mass > 0 and h > 0"));
         }
     }
@@ -282,7 +283,8 @@ Real GasSolver::referenceParticleMass() const
 void GasSolver::addSource(const LevelSet& shape, const GasSource& source)
 {
     if (!isFinite(source.velocity) || !std::isfinite(source.temperature)) {
-        throw ValueError(msg("gas source '", shape.name(), "': velocity and temperature must be "
+        throw ValueError(msg("gas source '", shape.name(),
+                             "': velocity and temperature must be "
                              "finite"));
     }
     if (!(source.rate >= Real(0)) || !std::isfinite(source.rate)) {
@@ -307,7 +309,8 @@ void GasSolver::setExternalBoundary(const std::vector<Vec3>& positions,
                              velocities.size(), " velocities"));
     }
     if (!(mass > Real(0)) || !std::isfinite(mass)) {
-        throw ValueError(msg("external boundary: mass = ", mass, " kg: expected a finite value > 0"));
+        throw ValueError(
+            msg("external boundary: mass = ", mass, " kg: expected a finite value > 0"));
     }
     for (std::size_t k = 0; k < positions.size(); ++k) {
         if (!isFinite(positions[k]) || !isFinite(velocities[k])) {
@@ -339,23 +342,25 @@ Real GasSolver::referenceMass() const
     // as the mass scaling of [SB12] Sec. 4.6 does for liquids.
     const Real R = mSettings.supportRadius();
     const Real half = Real(3) * R; // interior 4 R wide: a few hundred samples at the defaults
-    const LevelSet block = makeLevelSet(makeBoxLevelSet(Vec3(-half), Vec3(half),
-                                                        Real(0.5) * mSettings.spacing),
-                                        "gas reference block");
+    const LevelSet block =
+        makeLevelSet(makeBoxLevelSet(Vec3(-half), Vec3(half), Real(0.5) * mSettings.spacing),
+                     "gas reference block");
     const std::vector<Vec3> x = sampleShape(block, mSettings.seed + 424242ULL);
     NeighborGrid grid(R);
     grid.build(x);
     double sum = 0;
     std::size_t count = 0;
     for (std::size_t i = 0; i < x.size(); ++i) {
-        if (std::max({std::abs(x[i][0]), std::abs(x[i][1]), std::abs(x[i][2])}) > half - R) continue;
+        if (std::max({std::abs(x[i][0]), std::abs(x[i][1]), std::abs(x[i][2])}) > half - R)
+            continue;
         double s = 0;
         grid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real r) { s += poly6W(r, R); });
         sum += s;
         ++count;
     }
     if (count == 0 || !(sum > 0)) {
-        throw SamplingError("gas: the reference block for the particle mass has no interior sample");
+        throw SamplingError(
+            "gas: the reference block for the particle mass has no interior sample");
     }
     return Real(double(mSettings.restDensity) * double(count) / sum);
 }
@@ -367,8 +372,8 @@ void GasSolver::assignMissingMasses()
     const bool walls = mParticles.hasScalarChannel(channel::SOLID_INDEX);
     for (std::size_t i = 0; i < m.size(); ++i) {
         if (m[i] != Real(0)) continue;
-        if (walls && kind[i] == ParticleKind::Boundary &&
-            mParticles.scalarChannel(channel::SOLID_INDEX)[i] == DOMAIN_WALL) {
+        if (walls && kind[i] == ParticleKind::Boundary
+            && mParticles.scalarChannel(channel::SOLID_INDEX)[i] == DOMAIN_WALL) {
             continue;
         }
         m[i] = mMass;
@@ -404,14 +409,14 @@ void GasSolver::buildDomainWalls()
     for (int i = 0; i < n[0]; ++i) {
         for (int j = 0; j < n[1]; ++j) {
             for (int k = 0; k < n[2]; ++k) {
-                const Vec3 x = lo + s * Vec3(Real(i) + Real(0.5), Real(j) + Real(0.5),
-                                             Real(k) + Real(0.5));
+                const Vec3 x =
+                    lo + s * Vec3(Real(i) + Real(0.5), Real(j) + Real(0.5), Real(k) + Real(0.5));
                 if (!box.contains(x)) walls.push_back(x);
             }
         }
     }
-    const Index first = mParticles.addBatch(walls, mSettings.restDensity * cube(s),
-                                            ParticleKind::Boundary);
+    const Index first =
+        mParticles.addBatch(walls, mSettings.restDensity * cube(s), ParticleKind::Boundary);
     auto& index = mParticles.scalarChannel(channel::SOLID_INDEX);
     auto& local = mParticles.vectorChannel(channel::SOLID_LOCAL);
     for (std::size_t i = first; i < mParticles.size(); ++i) {
@@ -432,8 +437,8 @@ void GasSolver::fillAmbientAir()
     const Real r = PoissonSettings::SB12_RADIUS_FACTOR * s;
     std::vector<Vec3> occupied;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        const bool wall = mParticles.kinds()[i] == ParticleKind::Boundary &&
-                          mParticles.scalarChannel(channel::SOLID_INDEX)[i] == DOMAIN_WALL;
+        const bool wall = mParticles.kinds()[i] == ParticleKind::Boundary
+                          && mParticles.scalarChannel(channel::SOLID_INDEX)[i] == DOMAIN_WALL;
         if (!wall) occupied.push_back(mParticles.positions()[i]);
     }
     NeighborGrid grid(r);
@@ -511,12 +516,13 @@ void GasSolver::emit(Real dt)
                 // Nothing to grow from: fill the source like a block of gas.
                 NeighborGrid grid(r);
                 grid.build(obstacles);
-                for (const Vec3& xl : sampleShape(src.shape, mSettings.seed + 31337ULL * (e + 1) +
-                                                                 mStep)) {
+                for (const Vec3& xl :
+                     sampleShape(src.shape, mSettings.seed + 31337ULL * (e + 1) + mStep)) {
                     const Vec3 x = xf.toWorld(xl);
                     bool clear = !blockedBySolid(x);
                     if (clear && !obstacles.empty()) {
-                        grid.forEachInRadius(x, r, [&](Index, const Vec3&, Real) { clear = false; });
+                        grid.forEachInRadius(x, r,
+                                             [&](Index, const Vec3&, Real) { clear = false; });
                     }
                     if (clear) fresh.push_back(x);
                 }
@@ -595,11 +601,10 @@ void GasSolver::computeDensity()
         neighbours[i] = count;
         mIsolated[i] = count <= 1; // only itself
     });
-    const double gasCount = parallel::sum(0, n, [&](std::size_t i) {
-        return kind[i] == ParticleKind::Gas ? 1.0 : 0.0;
-    });
-    mMeanNeighbors = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); }) /
-                     std::max(1.0, gasCount);
+    const double gasCount = parallel::sum(
+        0, n, [&](std::size_t i) { return kind[i] == ParticleKind::Gas ? 1.0 : 0.0; });
+    mMeanNeighbors = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); })
+                     / std::max(1.0, gasCount);
 
     // Eq. 5: V_0 = |sum_j m_j / rho_bar_j grad W_ij| / |grad W_ik|, with the uncorrected
     // neighbour densities as in Eq. 4 and the derivation of Eqs. 7 - 8 (Appendix A); the virtual
@@ -696,7 +701,7 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
             const Real pj = boundary ? pi : p[j];
             const Vec3 fp = gradW * (-Vj * Real(0.5) * (pi + pj)); // Eq. 9
             accumulate(Fp, fp);
-            const Vec3 nj = gradW * Vj;                            // Eq. 12
+            const Vec3 nj = gradW * Vj; // Eq. 12
             accumulate(nI, nj);
             if (mu > Real(0)) {
                 const Vec3 fv = (v[j] - vi) * (mu * Vj * viscosityLaplacian(r, R));
@@ -705,9 +710,9 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
             if (boundary) return;
             if (Dc > Real(0)) {
                 // Eq. 15 (Cleary 1998): antisymmetric in i and j, so sum_i m_i T_i is conserved.
-                heat += double(m[j]) / (double(rho[i]) * double(rho[j])) * double(Dc) *
-                        double(T[i] - T[j]) * double(xij.dot(gradW)) /
-                        (double(r) * double(r) + double(DIFFUSION_GAMMA2 * R * R));
+                heat += double(m[j]) / (double(rho[i]) * double(rho[j])) * double(Dc)
+                        * double(T[i] - T[j]) * double(xij.dot(gradW))
+                        / (double(r) * double(r) + double(DIFFUSION_GAMMA2 * R * R));
             }
             if (omega) {
                 // Eq. 25: (omega_i . grad) v ~ sum_j V_j (v_j - v_i) (omega_i . grad W_ij).
@@ -735,21 +740,20 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
             // about 2 p_i n_i: stable, the block holds (x0.97).
             F -= mNbar[i] * (pi * rhoBar[i] / rho[i]);
             // Eq. 13: atmospheric pressure P_a n_i, scaled by beta inside the gas (Sec. 5).
-            const Real Pa = mSettings.atmosphericPressure *
-                            (surface ? Real(1) : mSettings.interiorPressureScale);
+            const Real Pa = mSettings.atmosphericPressure
+                            * (surface ? Real(1) : mSettings.interiorPressureScale);
             F += Pa * nVec;
         }
         F += toReal(Fv);
         // Eq. 24.
         Vec3 a = F / rho[i] + g + mSettings.buoyancy * (T[i] - Tamb) * mBuoyancyDir; // Eq. 17
-        if (fast && surface) a -= mSettings.damping * vi;                             // Eq. 14
+        if (fast && surface) a -= mSettings.damping * vi;                            // Eq. 14
         if (!attractors.empty() && !(ambient && (*ambient)[i] != Real(0))) {
             for (const Attractor& field : attractors) a += field.acceleration(x[i]); // Fig. 7
         }
         if (omega) {
             a += mSettings.vorticityStrength * toReal(vortex);
-            dOmega[i] = toReal(stretch) +
-                        mSettings.vorticityGeneration * nVec.cross(gVort);
+            dOmega[i] = toReal(stretch) + mSettings.vorticityGeneration * nVec.cross(gVort);
         }
         accel[i] = a;
         Real rate = Real(heat);
@@ -811,7 +815,8 @@ void GasSolver::projectOutOfSolids(Real dt)
         if (kind[i] != ParticleKind::Gas) return;
         const Vec3 previous = x[i] - dt * v[i];
         for (std::size_t b = 0; b < mSolids.size(); ++b) {
-            if (collideWithSolid(*mSolids[b], placement[b], time, previous, x[i], v[i]) == Collision::Stuck) {
+            if (collideWithSolid(*mSolids[b], placement[b], time, previous, x[i], v[i])
+                == Collision::Stuck) {
                 std::size_t expected = stuck.load();
                 while (i < expected && !stuck.compare_exchange_weak(expected, i)) {}
             }
@@ -821,11 +826,12 @@ void GasSolver::projectOutOfSolids(Real dt)
         std::size_t b = 0;
         while (b + 1 < mSolids.size() && !(mSolids[b]->phi(x[i], time) < Real(0))) ++b;
         const LevelSet& shape = mSolids[b]->shape;
-        throw NumericalError(msg("gas solver at step ", mStep, " (t = ", mTime, " s): gas particle id ",
-                                 mParticles.ids()[i], " is inside solid '", shape.name(),
-                                 "' deeper than its level set's band (", shape.bandWidth(),
-                                 " m), and so was its position before the step: it cannot be put back; "
-                                 "reduce the time step (substeps / cflNumber)"));
+        throw NumericalError(
+            msg("gas solver at step ", mStep, " (t = ", mTime, " s): gas particle id ",
+                mParticles.ids()[i], " is inside solid '", shape.name(),
+                "' deeper than its level set's band (", shape.bandWidth(),
+                " m), and so was its position before the step: it cannot be put back; "
+                "reduce the time step (substeps / cflNumber)"));
     }
 }
 
@@ -842,8 +848,14 @@ void GasSolver::applyDomain()
         parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
             if (kind[i] != ParticleKind::Gas) return;
             for (int a = 0; a < 3; ++a) {
-                if (x[i][a] < box.min[a]) { x[i][a] = box.min[a]; v[i][a] = std::max(v[i][a], Real(0)); }
-                if (x[i][a] > box.max[a]) { x[i][a] = box.max[a]; v[i][a] = std::min(v[i][a], Real(0)); }
+                if (x[i][a] < box.min[a]) {
+                    x[i][a] = box.min[a];
+                    v[i][a] = std::max(v[i][a], Real(0));
+                }
+                if (x[i][a] > box.max[a]) {
+                    x[i][a] = box.max[a];
+                    v[i][a] = std::min(v[i][a], Real(0));
+                }
             }
         });
         return;
@@ -898,27 +910,32 @@ void GasSolver::checkBlowUp(Real dt) const
     const Real Tamb = mSettings.ambientTemperature;
     const std::size_t n = mParticles.size();
     std::atomic<std::size_t> bad{n};
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Gas) return;
-        if (isFinite(x[i]) && isFinite(v[i]) && std::isfinite(T[i]) && std::isfinite(rho[i]) &&
-            v[i].lengthSqr() <= limit2 && std::abs(T[i] - Tamb) <= MAX_TEMPERATURE_EXCESS) {
-            return;
-        }
-        std::size_t expected = bad.load();
-        while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
-    }, 4096);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+            if (kind[i] != ParticleKind::Gas) return;
+            if (isFinite(x[i]) && isFinite(v[i]) && std::isfinite(T[i]) && std::isfinite(rho[i])
+                && v[i].lengthSqr() <= limit2 && std::abs(T[i] - Tamb) <= MAX_TEMPERATURE_EXCESS) {
+                return;
+            }
+            std::size_t expected = bad.load();
+            while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
+        },
+        4096);
     const std::size_t i = bad.load();
     if (i == n) return;
-    const std::string where = msg("gas solver (", methodName(mSettings.method), ") blew up at frame ",
-                                  mFrame, ", step ", mStep, " (t = ", mTime, " s): gas particle id ",
-                                  mParticles.ids()[i]);
+    const std::string where =
+        msg("gas solver (", methodName(mSettings.method), ") blew up at frame ", mFrame, ", step ",
+            mStep, " (t = ", mTime, " s): gas particle id ", mParticles.ids()[i]);
     if (!isFinite(x[i]) || !isFinite(v[i]) || !std::isfinite(T[i]) || !std::isfinite(rho[i])) {
-        throw NumericalError(msg(where, " has a non-finite position, velocity, temperature or "
+        throw NumericalError(msg(where,
+                                 " has a non-finite position, velocity, temperature or "
                                  "density; reduce the time step (substeps / cflNumber) or kappa"));
     }
     if (std::abs(T[i] - Tamb) > MAX_TEMPERATURE_EXCESS) {
         throw NumericalError(msg(where, " has temperature ", T[i], " K, more than ",
-                                 MAX_TEMPERATURE_EXCESS, " K from ambient (explicit diffusion, "
+                                 MAX_TEMPERATURE_EXCESS,
+                                 " K from ambient (explicit diffusion, "
                                  "Eq. 15, is unstable above dt = spacing^2 rho0 / (3 diffusion)); "
                                  "reduce the time step (substeps / cflNumber) or diffusion"));
     }
@@ -995,8 +1012,9 @@ void GasSolver::advanceFrame()
     checkRestoredInputs();
     initialize();
     const double frameEnd = double(mFrame + 1) / double(mSettings.frameRate);
-    sph::stepFrame(frameEnd, mSettings.frameRate, mSettings.substeps, [this] { return mTime; },
-                   [this] { return stableTimeStep(); }, [this](Real dt) { step(dt); });
+    sph::stepFrame(
+        frameEnd, mSettings.frameRate, mSettings.substeps, [this] { return mTime; },
+        [this] { return stableTimeStep(); }, [this](Real dt) { step(dt); });
     mTime = frameEnd;
     ++mFrame;
 }
@@ -1033,8 +1051,8 @@ void GasSolver::restoreState(const SolverState& state)
         throw ValueError(msg("restoreState: the state was saved by the '", state.solver,
                              "' solver, not by the gas solver"));
     }
-    if (mRestored || mInitialized || mStep != 0 || !mParticles.empty() || !mSolids.empty() ||
-        !mSources.empty()) {
+    if (mRestored || mInitialized || mStep != 0 || !mParticles.empty() || !mSolids.empty()
+        || !mSources.empty()) {
         throw ValueError("restoreState: call it on a freshly constructed gas solver, before adding "
                          "solids, sources or gas and before the first step");
     }
@@ -1051,14 +1069,15 @@ void GasSolver::restoreState(const SolverState& state)
     if (method != std::int64_t(mSettings.method)) {
         const bool known = method >= 0 && method <= std::int64_t(Method::Uncorrected);
         throw ValueError(msg("restoreState: the state was saved by gas method '",
-                             known ? methodName(Method(method)) : "unknown", "', this solver runs '",
-                             methodName(mSettings.method), "'; resume with the method the run "
+                             known ? methodName(Method(method)) : "unknown",
+                             "', this solver runs '", methodName(mSettings.method),
+                             "'; resume with the method the run "
                              "started with"));
     }
     auto requireRange = [](const char* key, std::int64_t value, std::int64_t lo, std::int64_t hi) {
         if (value < lo || value > hi) {
-            throw ValueError(msg("restoreState: integer '", key, "' = ", value, ": expected ", lo,
-                                 " to ", hi));
+            throw ValueError(
+                msg("restoreState: integer '", key, "' = ", value, ": expected ", lo, " to ", hi));
         }
     };
     constexpr std::int64_t BIG = std::numeric_limits<std::int64_t>::max();
@@ -1081,7 +1100,8 @@ void GasSolver::restoreState(const SolverState& state)
         }
     }
     if (p.count(ParticleKind::Boundary) > 0) {
-        if (!p.hasScalarChannel(channel::SOLID_INDEX) || !p.hasVectorChannel(channel::SOLID_LOCAL)) {
+        if (!p.hasScalarChannel(channel::SOLID_INDEX)
+            || !p.hasVectorChannel(channel::SOLID_LOCAL)) {
             throw ValueError("restoreState: the gas state has boundary particles but no solid "
                              "channels");
         }
@@ -1123,7 +1143,8 @@ void GasSolver::checkRestoredInputs() const
     if (mSolids.size() < mRestoredSolids || mSources.size() < mRestoredSources) {
         throw ValueError(msg("gas solver: the restored state has ", mRestoredSolids, " solids and ",
                              mRestoredSources, " sources but ", mSolids.size(), " and ",
-                             mSources.size(), " were added after restoreState(); add the same "
+                             mSources.size(),
+                             " were added after restoreState(); add the same "
                              "solids and sources, in the same order, before stepping"));
     }
 }

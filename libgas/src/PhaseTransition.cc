@@ -54,12 +54,14 @@ void PhaseSettings::validate() const
 {
     auto positive = [](const char* name, Real v) {
         if (!(v > Real(0)) || !std::isfinite(v)) {
-            throw ValueError(msg("phase settings: ", name, " = ", v, ": expected a finite value > 0"));
+            throw ValueError(
+                msg("phase settings: ", name, " = ", v, ": expected a finite value > 0"));
         }
     };
     auto nonNegative = [](const char* name, Real v) {
         if (!(v >= Real(0)) || !std::isfinite(v)) {
-            throw ValueError(msg("phase settings: ", name, " = ", v, ": expected a finite value >= 0"));
+            throw ValueError(
+                msg("phase settings: ", name, " = ", v, ": expected a finite value >= 0"));
         }
     };
     positive("boilingPoint", boilingPoint);
@@ -78,8 +80,8 @@ void PhaseSettings::validate() const
     positive("surfaceThreshold", surfaceThreshold);
     positive("liquidResplitEpsilon", liquidResplitEpsilon);
     if (mergeEverySteps < 1) {
-        throw ValueError(msg("phase settings: mergeEverySteps = ", mergeEverySteps,
-                             ": expected >= 1"));
+        throw ValueError(
+            msg("phase settings: mergeEverySteps = ", mergeEverySteps, ": expected >= 1"));
     }
     if (evaporationPattern && !evaporationPattern->hasCentre) {
         throw ValueError(msg("phase settings: evaporationPattern '", evaporationPattern->name,
@@ -92,17 +94,19 @@ void PhaseSettings::validate() const
 // Set-up ------------------------------------------------------------------------------------------
 
 PhaseTransition::PhaseTransition(GasSolver& gas, LiquidSide& liquid, const PhaseSettings& settings)
-    : mGas(gas), mLiquid(liquid), mSettings(settings)
+    : mGas(gas)
+    , mLiquid(liquid)
+    , mSettings(settings)
 {
     mSettings.validate();
     mBoilPattern = mSettings.boilingPattern ? *mSettings.boilingPattern : icosahedronPattern();
-    mEvapPattern = mSettings.evaporationPattern ? *mSettings.evaporationPattern
-                                                : paperCubePattern();
+    mEvapPattern =
+        mSettings.evaporationPattern ? *mSettings.evaporationPattern : paperCubePattern();
     mMerge = mSettings.merge;
     if (!mMerge.resplitPattern) {
-        mMerge.resplitPattern = optimisePattern(
-            "liquid re-split", patternOffsets(PatternShape::Icosahedron),
-            double(mSettings.liquidResplitEpsilon), std::cbrt(1.0 / 12.0));
+        mMerge.resplitPattern =
+            optimisePattern("liquid re-split", patternOffsets(PatternShape::Icosahedron),
+                            double(mSettings.liquidResplitEpsilon), std::cbrt(1.0 / 12.0));
     }
     mMerge.candidateKind = ParticleKind::Liquid;
     ensureChannels();
@@ -135,7 +139,8 @@ void PhaseTransition::addHeater(const sph::LevelSet& shape, Real temperature)
 void PhaseTransition::setLiquidTemperature(Real temperature)
 {
     if (!(temperature > Real(0)) || !std::isfinite(temperature)) {
-        throw ValueError(msg("liquid temperature = ", temperature, " K: expected a finite value > 0"));
+        throw ValueError(
+            msg("liquid temperature = ", temperature, " K: expected a finite value > 0"));
     }
     ParticleSet& p = mLiquid.particles();
     auto& T = p.scalarChannel(TEMPERATURE);
@@ -174,7 +179,8 @@ void PhaseTransition::heat(Real dt)
         if (kind[i] != ParticleKind::Liquid) return;
         const Real rhoI = density(i);
         double dTdt = 0;
-        Vec3d colour(0.0); // colour-field gradient sum_j V_j gradW_ij: ~0 inside, large at a surface
+        Vec3d colour(
+            0.0); // colour-field gradient sum_j V_j gradW_ij: ~0 inside, large at a surface
         grid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
             const ParticleKind kj = kind[j];
             const bool liquidJ = kj == ParticleKind::Liquid;
@@ -188,7 +194,8 @@ void PhaseTransition::heat(Real dt)
             dTdt += double(m[j] / (rhoI * rhoJ) * Dc * (T[i] - T[j]) * xg / (r * r + gamma2));
         });
         for (const Heater& h : mHeaters) {
-            if (h.shape.phi(x[i]) < band) dTdt += double((h.temperature - T[i]) / mSettings.heatingTime);
+            if (h.shape.phi(x[i]) < band)
+                dTdt += double((h.temperature - T[i]) / mSettings.heatingTime);
         }
         Tnew[i] = Real(double(T[i]) + double(dt) * dTdt);
         mSurface[i] = colour.length() * double(R) > double(mSettings.surfaceThreshold);
@@ -237,8 +244,8 @@ std::size_t PhaseTransition::transfer(Real dt)
         pending[i] += mSettings.evaporationRate * f * dt;
         // The threshold is staggered per particle by a hash of its id, so a surface that starts
         // with equal temperatures does not evaporate in lockstep (no quantisation of the rate).
-        if (pending[i] + evaporationPhase(p.ids()[i]) >= Real(1) &&
-            (!cap || boil.size() + evapIds.size() < cap)) {
+        if (pending[i] + evaporationPhase(p.ids()[i]) >= Real(1)
+            && (!cap || boil.size() + evapIds.size() < cap)) {
             pending[i] -= Real(1);
             evapIds.push_back(p.ids()[i]);
         }
@@ -313,7 +320,13 @@ void PhaseTransition::updateBoundary()
 {
     const ParticleSet& p = mLiquid.particles();
     const Real cell = mGas.settings().spacing;
-    struct Bin { std::int64_t key; Vec3d x; Vec3d v; int count; };
+    struct Bin
+    {
+        std::int64_t key;
+        Vec3d x;
+        Vec3d v;
+        int count;
+    };
     std::vector<std::pair<std::int64_t, Index>> keyed;
     keyed.reserve(p.size());
     constexpr std::int64_t OFFSET = std::int64_t(1) << 20, BITS = 21;
@@ -377,7 +390,8 @@ MassBudget PhaseTransition::massBudget() const
 void PhaseTransition::step(Real dt)
 {
     if (!(dt > Real(0)) || !std::isfinite(dt)) {
-        throw ValueError(msg("phase transition step: dt = ", dt, " s: expected a finite value > 0"));
+        throw ValueError(
+            msg("phase transition step: dt = ", dt, " s: expected a finite value > 0"));
     }
     const auto start = std::chrono::steady_clock::now();
     auto t0 = start;

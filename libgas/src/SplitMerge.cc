@@ -35,15 +35,16 @@ struct Channels
     std::size_t hSlot = 0, splitSlot = 0;
 
     explicit Channels(const ParticleSet& p)
-        : scalarNames(p.scalarChannelNames()), vectorNames(p.vectorChannelNames())
+        : scalarNames(p.scalarChannelNames())
+        , vectorNames(p.vectorChannelNames())
     {
         hSlot = slotOf(SMOOTHING_RADIUS_CHANNEL);
         splitSlot = slotOf(SPLIT_COUNT_CHANNEL);
     }
     std::size_t slotOf(const std::string& name) const
     {
-        return std::size_t(std::find(scalarNames.begin(), scalarNames.end(), name) -
-                           scalarNames.begin());
+        return std::size_t(std::find(scalarNames.begin(), scalarNames.end(), name)
+                           - scalarNames.begin());
     }
 };
 
@@ -104,7 +105,8 @@ void commit(ParticleSet& p, const Channels& ch, const std::vector<NewParticle>& 
     }
     for (std::size_t s = 0; s < ch.vectorNames.size(); ++s) {
         auto& data = p.vectorChannel(ch.vectorNames[s]);
-        for (std::size_t k = 0; k < news.size(); ++k) data[n0 + k] = sph::toVec3(news[k].vectors[s]);
+        for (std::size_t k = 0; k < news.size(); ++k)
+            data[n0 + k] = sph::toVec3(news[k].vectors[s]);
     }
     for (std::size_t k = 0; k < news.size(); ++k) {
         p.densities()[n0 + k] = Real(news[k].density);
@@ -132,8 +134,8 @@ void checkPattern(const SplitPattern& pattern)
 std::vector<Real>& addSplitChannels(ParticleSet& particles, Real smoothingRadius)
 {
     if (!(smoothingRadius > Real(0)) || !std::isfinite(smoothingRadius)) {
-        throw ValueError(msg("smoothing radius = ", smoothingRadius,
-                             " m: expected a finite value > 0"));
+        throw ValueError(
+            msg("smoothing radius = ", smoothingRadius, " m: expected a finite value > 0"));
     }
     particles.addScalarChannel(SPLIT_COUNT_CHANNEL, Real(0));
     return particles.addScalarChannel(SMOOTHING_RADIUS_CHANNEL, smoothingRadius);
@@ -152,8 +154,10 @@ Index splitParticles(ParticleSet& particles, const std::vector<Index>& which,
     const auto& h = particles.scalarChannel(SMOOTHING_RADIUS_CHANNEL);
     for (Index i : which) {
         if (i >= n || remove[i]) {
-            throw ValueError(msg("splitParticles: index ", i, " is out of range or repeated: "
-                                 "expected distinct indices below ", n));
+            throw ValueError(msg("splitParticles: index ", i,
+                                 " is out of range or repeated: "
+                                 "expected distinct indices below ",
+                                 n));
         }
         if (!(h[i] > Real(0)) || !std::isfinite(h[i])) {
             throw ValueError(msg("splitParticles: particle ", i, " (id ", particles.ids()[i],
@@ -198,8 +202,8 @@ std::array<double, 9> inertiaMatrix(const ParticleSet& particles, const Vec3& xM
 double massDecentration(const std::array<double, 9>& I)
 {
     const double tr3 = (I[0] + I[4] + I[8]) / 3.0;
-    const double det = I[0] * (I[4] * I[8] - I[5] * I[7]) - I[1] * (I[3] * I[8] - I[5] * I[6]) +
-                       I[2] * (I[3] * I[7] - I[4] * I[6]);
+    const double det = I[0] * (I[4] * I[8] - I[5] * I[7]) - I[1] * (I[3] * I[8] - I[5] * I[6])
+                       + I[2] * (I[3] * I[7] - I[4] * I[6]);
     return std::abs(tr3 * tr3 * tr3 - det);
 }
 
@@ -230,15 +234,17 @@ void MergeSettings::validate() const
         throw ValueError(msg("merge.maxSizeRatio = ", maxSizeRatio, ": expected >= 1"));
     }
     if (minMerged == 1) throw ValueError("merge.minMerged = 1: expected 0 (full groups) or >= 2");
-    if (maxMerged == 1) throw ValueError("merge.maxMerged = 1: expected 0 (re-split count) or >= 2");
+    if (maxMerged == 1)
+        throw ValueError("merge.maxMerged = 1: expected 0 (re-split count) or >= 2");
     if (minMerged != 0 && minMerged > groupLimit()) {
-        throw ValueError(msg("merge.minMerged = ", minMerged, ": expected at most the group limit (",
-                             groupLimit(), ")"));
+        throw ValueError(msg("merge.minMerged = ", minMerged,
+                             ": expected at most the group limit (", groupLimit(), ")"));
     }
-    if (sizeRule == MergeSizeRule::ReferenceDensity &&
-        (!(referenceMass > Real(0)) || !(referenceRadius > Real(0)))) {
-        throw ValueError(msg("merge.referenceMass = ", referenceMass, " kg, referenceRadius = ",
-                             referenceRadius, " m: expected both > 0 with sizeRule "
+    if (sizeRule == MergeSizeRule::ReferenceDensity
+        && (!(referenceMass > Real(0)) || !(referenceRadius > Real(0)))) {
+        throw ValueError(msg("merge.referenceMass = ", referenceMass,
+                             " kg, referenceRadius = ", referenceRadius,
+                             " m: expected both > 0 with sizeRule "
                              "ReferenceDensity"));
     }
     if (resplitPattern) checkPattern(*resplitPattern);
@@ -291,26 +297,30 @@ std::vector<MergeGroup> planMerges(const ParticleSet& particles, const sph::Neig
     // Gather per candidate (each writes only its own group): the nearest similar neighbours
     // within the neighbourhood radius, and the decentration of that group (Eqs. 19-20).
     std::vector<MergeGroup> groups(candidates.size());
-    parallel::forEach(0, candidates.size(), [&](std::size_t c) {
-        const Index M = candidates[c];
-        const Real radius = settings.neighbourhoodFactor * h[M];
-        std::vector<std::tuple<Real, sph::ParticleId, Index>> near;
-        grid.forEachInRadius(x[M], radius, [&](Index j, const Vec3&, Real r) {
-            if (j == M || kinds[j] != kinds[M]) return;
-            const Real ratio = h[j] / h[M];
-            if (ratio > settings.maxSizeRatio || ratio * settings.maxSizeRatio < Real(1)) return;
-            near.emplace_back(r, ids[j], j);
-        });
-        std::sort(near.begin(), near.end());
-        MergeGroup& g = groups[c];
-        g.candidate = M;
-        g.members.push_back(M);
-        for (const auto& t : near) {
-            if (g.members.size() >= limit) break;
-            g.members.push_back(std::get<2>(t));
-        }
-        g.eta = massDecentration(inertiaMatrix(particles, x[M], g.members));
-    }, 16);
+    parallel::forEach(
+        0, candidates.size(),
+        [&](std::size_t c) {
+            const Index M = candidates[c];
+            const Real radius = settings.neighbourhoodFactor * h[M];
+            std::vector<std::tuple<Real, sph::ParticleId, Index>> near;
+            grid.forEachInRadius(x[M], radius, [&](Index j, const Vec3&, Real r) {
+                if (j == M || kinds[j] != kinds[M]) return;
+                const Real ratio = h[j] / h[M];
+                if (ratio > settings.maxSizeRatio || ratio * settings.maxSizeRatio < Real(1))
+                    return;
+                near.emplace_back(r, ids[j], j);
+            });
+            std::sort(near.begin(), near.end());
+            MergeGroup& g = groups[c];
+            g.candidate = M;
+            g.members.push_back(M);
+            for (const auto& t : near) {
+                if (g.members.size() >= limit) break;
+                g.members.push_back(std::get<2>(t));
+            }
+            g.eta = massDecentration(inertiaMatrix(particles, x[M], g.members));
+        },
+        16);
 
     std::vector<std::size_t> order(groups.size());
     std::iota(order.begin(), order.end(), std::size_t(0));
@@ -384,8 +394,9 @@ MergeResult applyMerges(ParticleSet& particles, const std::vector<MergeGroup>& p
         for (std::size_t s = 0; s < scalarSum.size(); ++s) merged.scalars[s] = scalarSum[s] / mass;
         for (std::size_t s = 0; s < vectorSum.size(); ++s) merged.vectors[s] = vectorSum[s] / mass;
         merged.scalars[ch.hSlot] = settings.sizeRule == MergeSizeRule::VolumeSum
-            ? std::cbrt(h3)
-            : double(settings.referenceRadius) * std::cbrt(mass / double(settings.referenceMass));
+                                       ? std::cbrt(h3)
+                                       : double(settings.referenceRadius)
+                                             * std::cbrt(mass / double(settings.referenceMass));
         if (ch.splitSlot < merged.scalars.size()) merged.scalars[ch.splitSlot] = 0.0;
 
         ++result.merges;

@@ -161,10 +161,13 @@ double overlapIntegral(SplitKernel kernel, double d, double r1, double r2, const
     if (d < 1e-12) {
         // Concentric: 4 pi int f1 f2 r^2 dr.
         std::vector<double> breaks;
-        for (double k : knots) { breaks.push_back(k * r1); breaks.push_back(k * r2); }
+        for (double k : knots) {
+            breaks.push_back(k * r1);
+            breaks.push_back(k * r2);
+        }
         return 4.0 * PI_D * integratePieces(0.0, std::min(r1, r2), breaks, quad, [&](double r) {
-            return scaledKernel(kernel, r, r1) * scaledKernel(kernel, r, r2) * r * r;
-        });
+                   return scaledKernel(kernel, r, r1) * scaledKernel(kernel, r, r2) * r * r;
+               });
     }
 
     // Radii where the inner limits |r - d|, min(r + d, R2) cross a kink of f2 or the end of its
@@ -254,10 +257,14 @@ double refinementError(const std::vector<Vec3d>& offsets, const std::vector<doub
 const char* patternShapeName(PatternShape shape)
 {
     switch (shape) {
-    case PatternShape::Icosahedron: return "icosahedron";
-    case PatternShape::IcosahedronCentre: return "icosahedron+centre";
-    case PatternShape::Cube: return "cube";
-    case PatternShape::CubeCentre: return "cube+centre";
+    case PatternShape::Icosahedron:
+        return "icosahedron";
+    case PatternShape::IcosahedronCentre:
+        return "icosahedron+centre";
+    case PatternShape::Cube:
+        return "cube";
+    case PatternShape::CubeCentre:
+        return "cube+centre";
     }
     return "unknown";
 }
@@ -347,8 +354,10 @@ SplitPattern evaluatePattern(const std::string& name, const std::vector<Vec3d>& 
     double sum = 0.0;
     for (double l : lambda) sum += l;
     if (lambda.size() != offsets.size() || !(std::abs(sum - 1.0) <= 1e-9)) {
-        throw ValueError(msg("split pattern '", name, "': ", lambda.size(), " mass ratios summing "
-                             "to ", sum, ": expected one per daughter (", offsets.size(),
+        throw ValueError(msg("split pattern '", name, "': ", lambda.size(),
+                             " mass ratios summing "
+                             "to ",
+                             sum, ": expected one per daughter (", offsets.size(),
                              ") summing to 1"));
     }
     SplitPattern p;
@@ -370,8 +379,8 @@ const SplitPattern& paperCubePattern()
     static const SplitPattern pattern = [] {
         std::vector<double> lambda(9, 0.001);
         lambda[8] = 0.992; // the centre daughter comes last in patternOffsets
-        return evaluatePattern("cube+centre (RYY15 ratios)", patternOffsets(PatternShape::CubeCentre),
-                               0.4, 0.9, lambda);
+        return evaluatePattern("cube+centre (RYY15 ratios)",
+                               patternOffsets(PatternShape::CubeCentre), 0.4, 0.9, lambda);
     }();
     return pattern;
 }
@@ -386,8 +395,8 @@ const SplitPattern& cachedPattern(PatternShape shape, double epsilon, double alp
     std::lock_guard<std::mutex> lock(mutex);
     auto it = cache.find(key);
     if (it == cache.end()) {
-        auto p = std::make_unique<const SplitPattern>(
-            optimisePattern(patternShapeName(shape), patternOffsets(shape), epsilon, alpha, kernel));
+        auto p = std::make_unique<const SplitPattern>(optimisePattern(
+            patternShapeName(shape), patternOffsets(shape), epsilon, alpha, kernel));
         it = cache.emplace(key, std::move(p)).first;
     }
     return *it->second;
@@ -398,17 +407,14 @@ const SplitPattern& icosahedronPattern()
     return cachedPattern(PatternShape::Icosahedron, 0.3, 0.9);
 }
 
-const SplitPattern& cubePattern()
-{
-    return cachedPattern(PatternShape::CubeCentre, 0.4, 0.9);
-}
+const SplitPattern& cubePattern() { return cachedPattern(PatternShape::CubeCentre, 0.4, 0.9); }
 
 double bestEpsilon(PatternShape shape, double alpha, double epsMin, double epsMax,
                    SplitKernel kernel, double tolerance)
 {
     if (!(epsMin > 0.0) || !(epsMax > epsMin)) {
-        throw ValueError(msg("bestEpsilon: range [", epsMin, ", ", epsMax,
-                             "]: expected 0 < epsMin < epsMax"));
+        throw ValueError(
+            msg("bestEpsilon: range [", epsMin, ", ", epsMax, "]: expected 0 < epsMin < epsMax"));
     }
     const std::vector<Vec3d> offsets = patternOffsets(shape);
     auto f = [&](double eps) {
@@ -419,8 +425,19 @@ double bestEpsilon(PatternShape shape, double alpha, double epsMin, double epsMa
     double c = b - g * (b - a), d = a + g * (b - a);
     double fc = f(c), fd = f(d);
     while (b - a > tolerance) {
-        if (fc < fd) { b = d; d = c; fd = fc; c = b - g * (b - a); fc = f(c); }
-        else { a = c; c = d; fc = fd; d = a + g * (b - a); fd = f(d); }
+        if (fc < fd) {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
     }
     return 0.5 * (a + b);
 }

@@ -49,7 +49,10 @@ class AirRegion
 {
 public:
     AirRegion(Real supportRadius, int phases, int phase)
-        : mBlock(Real(4) * supportRadius), mInvBlock(Real(1) / mBlock), mPhases(phases), mPhase(phase)
+        : mBlock(Real(4) * supportRadius)
+        , mInvBlock(Real(1) / mBlock)
+        , mPhases(phases)
+        , mPhase(phase)
     {}
 
     bool everywhere() const { return mPhase < 0; }
@@ -112,12 +115,15 @@ void GhostSolver::resampleAir(int phase)
     // R (the body particles its air and candidates look for).
     const AirRegion region(R, mSettings.airResampleSteps, phase);
     std::vector<std::uint8_t> zone(n, 0);
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (!region.near(x[i], R)) return;
-        if (region.contains(x[i])) zone[i] = IN_REGION | NEAR_SEEDING | NEAR_BODY;
-        else if (region.near(x[i], Real(2) * r)) zone[i] = NEAR_SEEDING | NEAR_BODY;
-        else zone[i] = NEAR_BODY;
-    }, 2048);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+            if (!region.near(x[i], R)) return;
+            if (region.contains(x[i])) zone[i] = IN_REGION | NEAR_SEEDING | NEAR_BODY;
+            else if (region.near(x[i], Real(2) * r)) zone[i] = NEAR_SEEDING | NEAR_BODY;
+            else zone[i] = NEAR_BODY;
+        },
+        2048);
     auto inPhase = [&](const Vec3& q) { return region.contains(q); };
 
     // 1. Per liquid particle: its liquid-and-solid indicator sum_j W_ij (ghost solids count:
@@ -128,50 +134,56 @@ void GhostSolver::resampleAir(int phase)
     //    only, so escaped spray neither attracts air nor stretches the sampling region.
     std::vector<Real> indicator(n, std::numeric_limits<Real>::max());
     std::vector<std::uint8_t> body(n, 0);
-    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
-        for (std::size_t i = lo; i < hi; ++i) {
-            // Only the liquid within a kernel radius of the region is asked about, and only the
-            // seeding candidates need the indicator.
-            if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)) continue;
-            for (Index j : mFluidLists[i]) {
-                if (j != i && kind[j] == ParticleKind::Liquid) {
-                    body[i] = 1;
-                    break;
+    parallel::forRange(
+        0, n,
+        [&](std::size_t lo, std::size_t hi) {
+            const CubicSplineKernel kernel = mKernel;
+            PairBatch batch;
+            for (std::size_t i = lo; i < hi; ++i) {
+                // Only the liquid within a kernel radius of the region is asked about, and only the
+                // seeding candidates need the indicator.
+                if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)) continue;
+                for (Index j : mFluidLists[i]) {
+                    if (j != i && kind[j] == ParticleKind::Liquid) {
+                        body[i] = 1;
+                        break;
+                    }
                 }
-            }
-            if (!body[i] || !(zone[i] & NEAR_SEEDING)) continue;
-            // A particle with no air neighbour and a full neighbourhood is interior: no seed.
-            // (Full: at least 90 % of the mean neighbour count of the last step.)
-            bool air = false;
-            for (Index j : mFluidLists[i]) {
-                if (kind[j] == ParticleKind::GhostAir) {
-                    air = true;
-                    break;
+                if (!body[i] || !(zone[i] & NEAR_SEEDING)) continue;
+                // A particle with no air neighbour and a full neighbourhood is interior: no seed.
+                // (Full: at least 90 % of the mean neighbour count of the last step.)
+                bool air = false;
+                for (Index j : mFluidLists[i]) {
+                    if (kind[j] == ParticleKind::GhostAir) {
+                        air = true;
+                        break;
+                    }
                 }
-            }
-            const std::size_t count = mFluidLists[i].size() + mStatic.lists[i].size() + mMoving.lists[i].size();
-            if (!air && mMass > Real(0) && mMeanNeighbors > 0 && double(count) >= 0.9 * mMeanNeighbors) {
-                indicator[i] = std::numeric_limits<Real>::max();
-                continue;
-            }
-            Real sum = 0;
-            batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
-                for (int k = 0; k < b.n; ++k) b.f[k] = Real(kind[b.j[k]] == ParticleKind::Liquid);
-                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                sum += b.sum(b.f);
-            });
-            for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                batch.forEachBatch(x[i], block->block.particles().positions().data(), block->lists[i],
-                                   [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
+                const std::size_t count =
+                    mFluidLists[i].size() + mStatic.lists[i].size() + mMoving.lists[i].size();
+                if (!air && mMass > Real(0) && mMeanNeighbors > 0
+                    && double(count) >= 0.9 * mMeanNeighbors) {
+                    indicator[i] = std::numeric_limits<Real>::max();
+                    continue;
+                }
+                Real sum = 0;
+                batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k)
+                        b.f[k] = Real(kind[b.j[k]] == ParticleKind::Liquid);
+                    for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
                     sum += b.sum(b.f);
                 });
+                for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                    batch.forEachBatch(x[i], block->block.particles().positions().data(),
+                                       block->lists[i], [&](PairBatch& b) {
+                                           for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
+                                           sum += b.sum(b.f);
+                                       });
+                }
+                indicator[i] = sum;
             }
-            indicator[i] = sum;
-        }
-    }, 512);
+        },
+        512);
     Aabb bounds;
     std::size_t bodyCount = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -184,7 +196,8 @@ void GhostSolver::resampleAir(int phase)
         return;
     }
     auto nearBody = [&](const Vec3& q, Real* distance = nullptr) {
-        return mGrid.nearest(q, R, [&](Index j) { return body[j] != 0; }, distance);
+        return mGrid.nearest(
+            q, R, [&](Index j) { return body[j] != 0; }, distance);
     };
     auto insideSolid = [&](const Vec3& q) {
         for (const auto& solid : mSolids) {
@@ -217,7 +230,8 @@ void GhostSolver::resampleAir(int phase)
             if (kind[j] == ParticleKind::Liquid) sum += mKernel.W(rij);
         });
         for (const SolidBlock* b : {&mStatic, &mMoving}) {
-            b->block.grid().forEachInRadius(q, R, [&](Index, const Vec3&, Real rij) { sum += mKernel.W(rij); });
+            b->block.grid().forEachInRadius(
+                q, R, [&](Index, const Vec3&, Real rij) { sum += mKernel.W(rij); });
         }
         return sum > Real(0.5) * n0;
     };
@@ -234,10 +248,11 @@ void GhostSolver::resampleAir(int phase)
     auto& target = mParticles.scalarChannel(AIR_TARGET);
     std::vector<std::uint8_t> keep(n, 0);
     parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0) || !(zone[i] & IN_REGION)) return;
+        if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0) || !(zone[i] & IN_REGION))
+            return;
         Real d = -1;
-        keep[i] = nearBody(x[i], &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x[i]) &&
-                  !insideLiquid(x[i]);
+        keep[i] = nearBody(x[i], &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x[i])
+                  && !insideLiquid(x[i]);
     });
     //    The thinning distance is r, the distance new air keeps from everything: thinning at
     //    the keep fraction of r (as before) let every resampling pack the layer a little
@@ -250,7 +265,8 @@ void GhostSolver::resampleAir(int phase)
         std::vector<std::size_t> airIndex;
         std::size_t others = 0;
         for (std::size_t i = 0; i < n; ++i) {
-            if (kind[i] == ParticleKind::GhostAir && target[i] != Real(0) && zone[i] == (NEAR_SEEDING | NEAR_BODY)) {
+            if (kind[i] == ParticleKind::GhostAir && target[i] != Real(0)
+                && zone[i] == (NEAR_SEEDING | NEAR_BODY)) {
                 airX.push_back(x[i]);
                 airIndex.push_back(i);
             }
@@ -336,17 +352,22 @@ void GhostSolver::resampleAir(int phase)
         const auto& xs = mParticles.positions();
         NeighborGrid freshGrid(R);
         freshGrid.build(air);
-        parallel::forEach(0, xs.size(), [&](std::size_t i) {
-            if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
-            if (i < n && !(zone[i] & IN_REGION)) return;
-            // The liquid and the living air of the step's grid, and the new air.
-            Real sigma = 0;
-            mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
-                if (kind[j] == ParticleKind::Liquid || target[j] != Real(0)) sigma += mKernel.W(rij);
-            });
-            freshGrid.forEachInRadius(xs[i], R, [&](Index, const Vec3&, Real rij) { sigma += mKernel.W(rij); });
-            target[i] = sigma > n0 ? n0 / sigma : Real(1);
-        }, 64);
+        parallel::forEach(
+            0, xs.size(),
+            [&](std::size_t i) {
+                if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
+                if (i < n && !(zone[i] & IN_REGION)) return;
+                // The liquid and the living air of the step's grid, and the new air.
+                Real sigma = 0;
+                mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
+                    if (kind[j] == ParticleKind::Liquid || target[j] != Real(0))
+                        sigma += mKernel.W(rij);
+                });
+                freshGrid.forEachInRadius(
+                    xs[i], R, [&](Index, const Vec3&, Real rij) { sigma += mKernel.W(rij); });
+                target[i] = sigma > n0 ? n0 / sigma : Real(1);
+            },
+            64);
     }
     mTimings.airResampling += secondsSince(start);
 }

@@ -34,9 +34,10 @@ constexpr const char* SOLID_NORMAL = "normal";     ///< solid particle: outward 
 constexpr const char* SOLID_INDEX = "solid_index"; ///< solid particle: which solid (index)
 constexpr const char* SOLID_VELOCITY = "solid_v";  ///< moving solid particle: velocity (m/s)
 constexpr const char* SOLID_LOCAL = "solid_x";     ///< moving solid particle: position, solid frame
-constexpr const char* SOLID_LOCAL_NORMAL = "solid_n"; ///< moving solid particle: normal, solid frame
-constexpr const char* AIR_WEIGHT = "air_weight";   ///< ghost air: fade weight, mass = weight m
-constexpr const char* AIR_TARGET = "air_target";   ///< ghost air: 1 fading in / kept, 0 fading out
+constexpr const char* SOLID_LOCAL_NORMAL =
+    "solid_n";                                   ///< moving solid particle: normal, solid frame
+constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, mass = weight m
+constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
 
 /// Tait equation of state ([SB12] Sec. 3, Monaghan 1994): p = k ((rho / rho0)^7 - 1).
 inline Real taitPressure(Real rho, Real rho0, Real k)

@@ -12,8 +12,10 @@ namespace ghost {
 const char* methodName(Method method)
 {
     switch (method) {
-    case Method::Ghost: return "ghost";
-    case Method::Basic: return "basic";
+    case Method::Ghost:
+        return "ghost";
+    case Method::Basic:
+        return "basic";
     }
     return "unknown";
 }
@@ -39,7 +41,8 @@ Real GhostSettings::speedLimit() const
 void GhostSettings::validate() const
 {
     auto require = [](bool ok, const char* field, double value, const char* expected) {
-        if (!ok) throw ValueError(msg("liquid setting ", field, " = ", value, ": expected ", expected));
+        if (!ok)
+            throw ValueError(msg("liquid setting ", field, " = ", value, ": expected ", expected));
     };
     auto finite = [](Real v) { return std::isfinite(v); };
     require(spacing > 0 && finite(spacing), "spacing", spacing, "a finite value > 0 (m)");
@@ -48,7 +51,8 @@ void GhostSettings::validate() const
     require(restDensity > 0 && finite(restDensity), "restDensity", restDensity, "> 0 (kg/m^3)");
     require(stiffness > 0 && finite(stiffness), "stiffness", stiffness, "> 0 (Pa)");
     require(sph::isFinite(gravity), "gravity", gravity.length(), "finite components (m/s^2)");
-    require(xsphEpsilon >= 0 && xsphEpsilon <= 1, "xsphEpsilon", xsphEpsilon, "0 to 1 ([SB12]: 0.05)");
+    require(xsphEpsilon >= 0 && xsphEpsilon <= 1, "xsphEpsilon", xsphEpsilon,
+            "0 to 1 ([SB12]: 0.05)");
     require(solidEpsilon >= 0 && solidEpsilon <= 1, "solidEpsilon", solidEpsilon, "0 to 1");
     require(airResampleSteps >= 1, "airResampleSteps", airResampleSteps, ">= 1 ([SB12]: about 10)");
     require(airKeepFraction >= 0 && finite(airKeepFraction), "airKeepFraction", airKeepFraction,
@@ -60,9 +64,11 @@ void GhostSettings::validate() const
     require(lennardJonesStrength >= 0 && finite(lennardJonesStrength), "lennardJonesStrength",
             lennardJonesStrength, ">= 0 (m^2/s^2; 0 = automatic)");
     require(frameRate > 0 && finite(frameRate), "frameRate", frameRate, "> 0 (frames/s)");
-    require(substeps >= 0 && substeps <= 100000, "substeps", substeps, "0 (CFL-adaptive) to 100000");
+    require(substeps >= 0 && substeps <= 100000, "substeps", substeps,
+            "0 (CFL-adaptive) to 100000");
     require(cflNumber > 0 && cflNumber <= 2, "cflNumber", cflNumber, "0 < cfl <= 2");
-    require(maxSpeed >= 0 && finite(maxSpeed), "maxSpeed", maxSpeed, ">= 0 (m/s; 0 = 20 x sound speed)");
+    require(maxSpeed >= 0 && finite(maxSpeed), "maxSpeed", maxSpeed,
+            ">= 0 (m/s; 0 = 20 x sound speed)");
 }
 
 } // namespace ghost

@@ -129,8 +129,8 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     const LevelSet& solid = body.shape;
     const RigidTransform xf = body.at(mTime);
     if (!isFinite(xf.translation)) {
-        throw ValueError(msg("solid '", solid.name(), "': motion gives a non-finite placement at t = ",
-                             mTime, " s"));
+        throw ValueError(msg("solid '", solid.name(),
+                             "': motion gives a non-finite placement at t = ", mTime, " s"));
     }
 
     // [SB12] Sec. 4.4 / 4.5: ghost solid particles in a band one kernel radius deep, sampled
@@ -178,7 +178,8 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     mParticles.setNextId(set.nextId());
     const Real R = mSettings.supportRadius();
     for (std::size_t k = 0; k < samples.size(); ++k) {
-        const Index s = surfaceGrid.nearest(samples.positions[k], Real(2) * R, [](Index) { return true; });
+        const Index s =
+            surfaceGrid.nearest(samples.positions[k], Real(2) * R, [](Index) { return true; });
         const Vec3 localNormal = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
         normals[first + k] = xf.rotation * localNormal;
         index[first + k] = Real(solidIndex);
@@ -204,7 +205,8 @@ void GhostSolver::claimRestoredSolid(std::size_t solidIndex)
     mPendingSolids.removeIf(mine);
     const bool moving = mSolids[solidIndex]->moving;
     if (!moving) {
-        for (const char* c : {SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) claimed.removeChannel(c);
+        for (const char* c : {SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL})
+            claimed.removeChannel(c);
     } else {
         for (const char* c : {SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) {
             if (!claimed.hasVectorChannel(c)) {
@@ -273,7 +275,8 @@ void GhostSolver::appendSolidPositionsInBox(const Aabb& box, std::vector<Vec3>& 
 std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
 {
     if (mRestored) {
-        throw ValueError(msg("liquid '", shape.name(), "': cannot add liquid after restoreState(); "
+        throw ValueError(msg("liquid '", shape.name(),
+                             "': cannot add liquid after restoreState(); "
                              "the restored particles already hold the liquid (skip liquid "
                              "bodies when resuming)"));
     }
@@ -343,8 +346,8 @@ void GhostSolver::emit()
         std::vector<std::uint8_t> remove(mParticles.size(), 0);
         bool anyAir = false;
         for (std::size_t i = 0; i < mParticles.size(); ++i) {
-            if (mParticles.kinds()[i] == ParticleKind::GhostAir &&
-                em.shape.phi(mParticles.positions()[i]) < Real(0)) {
+            if (mParticles.kinds()[i] == ParticleKind::GhostAir
+                && em.shape.phi(mParticles.positions()[i]) < Real(0)) {
                 remove[i] = anyAir = true;
             }
         }
@@ -386,7 +389,8 @@ void GhostSolver::emit()
         }
         if (fresh.empty()) continue;
         const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);
-        std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(), em.velocity);
+        std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(),
+                  em.velocity);
         mEmitted += fresh.size();
     }
 }
@@ -418,7 +422,8 @@ bool GhostSolver::initialize()
         // Nothing to simulate yet, but an emitter starts later: wait for it (the mass scaling
         // and the first air layer are made from its first liquid).
         for (const auto& em : mEmitters) {
-            if (em->end > mTime && em->start < std::numeric_limits<double>::infinity()) return false;
+            if (em->end > mTime && em->start < std::numeric_limits<double>::infinity())
+                return false;
         }
         throw ValueError("liquid solver: no liquid particles (add a liquid body, particles, or an "
                          "emitter that is active now or starts later)");
@@ -442,7 +447,8 @@ bool GhostSolver::initialize()
             probe = std::make_unique<GhostSolver>(probeSettings);
             // The probe shares the solids and takes this solver's boundary particles as its
             // ghost solids: sampling them again would cost as much as the first time.
-            for (const auto& solid : mSolids) probe->mSolids.push_back(std::make_unique<Solid>(*solid));
+            for (const auto& solid : mSolids)
+                probe->mSolids.push_back(std::make_unique<Solid>(*solid));
             for (const SolidBlock* b : {&mStatic, &mMoving}) {
                 SolidBlock& to = b == &mStatic ? probe->mStatic : probe->mMoving;
                 to.block.particles() = b->block.particles();
@@ -452,7 +458,8 @@ bool GhostSolver::initialize()
             }
             std::vector<Vec3> liquidOnly;
             for (std::size_t i = 0; i < mParticles.size(); ++i) {
-                if (mParticles.kinds()[i] == ParticleKind::Liquid) liquidOnly.push_back(mParticles.positions()[i]);
+                if (mParticles.kinds()[i] == ParticleKind::Liquid)
+                    liquidOnly.push_back(mParticles.positions()[i]);
             }
             probe->addLiquidParticles(liquidOnly);
             probe->prepareSolidBlocks();
@@ -462,8 +469,10 @@ bool GhostSolver::initialize()
         }
         const ParticleSet all = measured->allParticles();
         std::vector<std::uint8_t> liquid(all.size());
-        for (std::size_t i = 0; i < liquid.size(); ++i) liquid[i] = all.kinds()[i] == ParticleKind::Liquid;
-        setParticleMass(massForRestDensity(all.positions(), mKernel, mSettings.restDensity, liquid));
+        for (std::size_t i = 0; i < liquid.size(); ++i)
+            liquid[i] = all.kinds()[i] == ParticleKind::Liquid;
+        setParticleMass(
+            massForRestDensity(all.positions(), mKernel, mSettings.restDensity, liquid));
     } else {
         setParticleMass(mMass);
     }
@@ -493,8 +502,8 @@ bool GhostSolver::initialize()
 
 std::size_t GhostSolver::count(ParticleKind kind) const
 {
-    return mParticles.count(kind) + mStatic.block.particles().count(kind) +
-           mMoving.block.particles().count(kind) + mPendingSolids.count(kind);
+    return mParticles.count(kind) + mStatic.block.particles().count(kind)
+           + mMoving.block.particles().count(kind) + mPendingSolids.count(kind);
 }
 
 ParticleSet GhostSolver::solidParticles() const
@@ -528,12 +537,15 @@ ParticleSet GhostSolver::allParticles() const
 
 std::size_t GhostSolver::memoryBytes() const
 {
-    std::size_t bytes = mParticles.memoryBytes() + mGrid.memoryBytes() + mFluidLists.memoryBytes() +
-                        mPendingSolids.memoryBytes() + mQueryMask.capacity() + mLiquidMask.capacity() + mScratch.capacity() * sizeof(Real);
+    std::size_t bytes = mParticles.memoryBytes() + mGrid.memoryBytes() + mFluidLists.memoryBytes()
+                        + mPendingSolids.memoryBytes() + mQueryMask.capacity()
+                        + mLiquidMask.capacity() + mScratch.capacity() * sizeof(Real);
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
-        bytes += b->block.memoryBytes() + b->lists.memoryBytes() +
-                 b->nearest.capacity() * sizeof(std::uint64_t) + b->touched.capacity() * sizeof(Index) +
-                 (b->rho.capacity() + b->p.capacity() + b->pOverRho2.capacity()) * sizeof(Real) + b->vstar.capacity() * sizeof(Vec3);
+        bytes += b->block.memoryBytes() + b->lists.memoryBytes()
+                 + b->nearest.capacity() * sizeof(std::uint64_t)
+                 + b->touched.capacity() * sizeof(Index)
+                 + (b->rho.capacity() + b->p.capacity() + b->pOverRho2.capacity()) * sizeof(Real)
+                 + b->vstar.capacity() * sizeof(Vec3);
     }
     return bytes;
 }
@@ -568,11 +580,12 @@ void GhostSolver::restoreState(const SolverState& state)
     const std::string method = methodName(mSettings.method);
     if (state.solver != method) {
         throw ValueError(msg("restoreState: the state was saved by the '", state.solver,
-                             "' solver, this solver runs '", method, "'; resume with the method "
+                             "' solver, this solver runs '", method,
+                             "'; resume with the method "
                              "the run started with"));
     }
-    if (mRestored || mInitialized || mStep != 0 || !mParticles.empty() || !mSolids.empty() ||
-        !mEmitters.empty()) {
+    if (mRestored || mInitialized || mStep != 0 || !mParticles.empty() || !mSolids.empty()
+        || !mEmitters.empty()) {
         throw ValueError("restoreState: call it on a freshly constructed solver, before adding "
                          "solids, emitters or liquid and before the first step");
     }
@@ -588,8 +601,8 @@ void GhostSolver::restoreState(const SolverState& state)
     const std::int64_t solids = state.integer("solids"), emitters = state.integer("emitters");
     auto requireRange = [](const char* key, std::int64_t value, std::int64_t lo, std::int64_t hi) {
         if (value < lo || value > hi) {
-            throw ValueError(msg("restoreState: integer '", key, "' = ", value, ": expected ", lo,
-                                 " to ", hi));
+            throw ValueError(
+                msg("restoreState: integer '", key, "' = ", value, ": expected ", lo, " to ", hi));
         }
     };
     constexpr std::int64_t BIG = std::numeric_limits<std::int64_t>::max();
@@ -625,7 +638,8 @@ void GhostSolver::restoreState(const SolverState& state)
     for (std::size_t i = 0; i < p.size(); ++i) moving[i] = !solid[i];
     mParticles = p.select(moving);
     mPendingSolids = p.select(solid);
-    for (const char* c : {SOLID_NORMAL, SOLID_INDEX, SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) {
+    for (const char* c :
+         {SOLID_NORMAL, SOLID_INDEX, SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) {
         mParticles.removeChannel(c);
     }
     for (const char* c : {VSTAR, AIR_WEIGHT, AIR_TARGET}) mPendingSolids.removeChannel(c);
@@ -655,12 +669,14 @@ void GhostSolver::checkRestoredInputs() const
 {
     if (mSolids.size() < mRestoredSolids) {
         throw ValueError(msg("liquid solver: the restored state has ", mRestoredSolids,
-                             " solids but ", mSolids.size(), " were added after restoreState(); "
+                             " solids but ", mSolids.size(),
+                             " were added after restoreState(); "
                              "add the same solids, in the same order, before stepping"));
     }
     if (mEmitters.size() < mRestoredEmitters) {
         throw ValueError(msg("liquid solver: the restored state has ", mRestoredEmitters,
-                             " emitters but ", mEmitters.size(), " were added after "
+                             " emitters but ", mEmitters.size(),
+                             " were added after "
                              "restoreState(); add the same emitters, in the same order, before "
                              "stepping"));
     }
@@ -690,8 +706,9 @@ void GhostSolver::advanceFrame()
     checkRestoredInputs();
     initialize();
     const double frameEnd = double(mFrame + 1) / double(mSettings.frameRate);
-    sph::stepFrame(frameEnd, mSettings.frameRate, mSettings.substeps, [this] { return mTime; },
-                   [this] { return stableTimeStep(); }, [this](Real dt) { step(dt); });
+    sph::stepFrame(
+        frameEnd, mSettings.frameRate, mSettings.substeps, [this] { return mTime; },
+        [this] { return stableTimeStep(); }, [this](Real dt) { step(dt); });
     mTime = frameEnd; // no drift from summing substeps
     ++mFrame;
 }

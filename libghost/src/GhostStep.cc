@@ -35,7 +35,8 @@ inline bool atomicMin(std::uint64_t* target, std::uint64_t key)
 {
     std::uint64_t old = __atomic_load_n(target, __ATOMIC_RELAXED);
     while (key < old) {
-        if (__atomic_compare_exchange_n(target, &old, key, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+        if (__atomic_compare_exchange_n(target, &old, key, true, __ATOMIC_RELAXED,
+                                        __ATOMIC_RELAXED)) {
             return old == NO_LIQUID;
         }
     }
@@ -74,14 +75,18 @@ void GhostSolver::searchNeighbors()
     const auto& kind = mParticles.kinds();
     mQueryMask.resize(n);
     mLiquidMask.resize(n);
-    parallel::forEach(0, n, [&](std::size_t i) {
-        mLiquidMask[i] = kind[i] == ParticleKind::Liquid;
-        mQueryMask[i] = mLiquidMask[i] || kind[i] == ParticleKind::GhostAir;
-    }, 4096);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+            mLiquidMask[i] = kind[i] == ParticleKind::Liquid;
+            mQueryMask[i] = mLiquidMask[i] || kind[i] == ParticleKind::GhostAir;
+        },
+        4096);
     const Real R = mSettings.supportRadius();
     const Vec3* x = mParticles.positions().data();
     mFluidLists.build(mGrid, x, n, R, mQueryMask.data());
-    for (SolidBlock* b : {&mStatic, &mMoving}) b->lists.build(b->block.grid(), x, n, R, mLiquidMask.data());
+    for (SolidBlock* b : {&mStatic, &mMoving})
+        b->lists.build(b->block.grid(), x, n, R, mLiquidMask.data());
 }
 
 void GhostSolver::computeDensity()
@@ -100,73 +105,80 @@ void GhostSolver::computeDensity()
     // Ghost SPH also finds each solid particle's nearest liquid particle (lines 5-7).
     std::vector<std::uint32_t> neighbours(n, 0);
     std::mutex touchedMutex;
-    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
-        std::vector<Index> firstTouch[2];
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) {
-                rho[i] = rho0;
-                continue;
-            }
-            const Vec3 xi = x[i];
-            const NeighborLists::List fluid = mFluidLists[i];
-            Real sum = 0;
-            batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
-                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
-                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                sum += b.sum(b.f);
-            });
-            std::size_t count = fluid.size();
-            for (int k = 0; ghost && k < 2; ++k) {
-                SolidBlock& block = *blocks[k];
-                const NeighborLists::List solid = block.lists[i];
-                Real w = 0;
-                batch.forEachBatch(xi, block.block.particles().positions().data(), solid, [&](PairBatch& b) {
-                    for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
-                    w += b.sum(b.f);
-                    for (int c = 0; c < b.n; ++c) {
-                        if (atomicMin(&block.nearest[b.j[c]], nearestKey(b.r[c], Index(i)))) {
-                            firstTouch[k].push_back(b.j[c]);
-                        }
-                    }
+    parallel::forRange(
+        0, n,
+        [&](std::size_t lo, std::size_t hi) {
+            const CubicSplineKernel kernel = mKernel;
+            PairBatch batch;
+            std::vector<Index> firstTouch[2];
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (kind[i] != ParticleKind::Liquid) {
+                    rho[i] = rho0;
+                    continue;
+                }
+                const Vec3 xi = x[i];
+                const NeighborLists::List fluid = mFluidLists[i];
+                Real sum = 0;
+                batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
+                    for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                    sum += b.sum(b.f);
                 });
-                sum += mMass * w;
-                count += solid.size();
+                std::size_t count = fluid.size();
+                for (int k = 0; ghost && k < 2; ++k) {
+                    SolidBlock& block = *blocks[k];
+                    const NeighborLists::List solid = block.lists[i];
+                    Real w = 0;
+                    batch.forEachBatch(xi, block.block.particles().positions().data(), solid,
+                                       [&](PairBatch& b) {
+                                           for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
+                                           w += b.sum(b.f);
+                                           for (int c = 0; c < b.n; ++c) {
+                                               if (atomicMin(&block.nearest[b.j[c]],
+                                                             nearestKey(b.r[c], Index(i)))) {
+                                                   firstTouch[k].push_back(b.j[c]);
+                                               }
+                                           }
+                                       });
+                    sum += mMass * w;
+                    count += solid.size();
+                }
+                rho[i] = sum;
+                neighbours[i] = std::uint32_t(count);
             }
-            rho[i] = sum;
-            neighbours[i] = std::uint32_t(count);
-        }
-        if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
-            std::lock_guard<std::mutex> lock(touchedMutex);
-            for (int k = 0; k < 2; ++k) {
-                blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(), firstTouch[k].end());
+            if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
+                std::lock_guard<std::mutex> lock(touchedMutex);
+                for (int k = 0; k < 2; ++k) {
+                    blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(),
+                                              firstTouch[k].end());
+                }
             }
-        }
-    }, 512);
-    const double liquidCount = parallel::sum(0, n, [&](std::size_t i) {
-        return kind[i] == ParticleKind::Liquid ? 1.0 : 0.0;
-    });
+        },
+        512);
+    const double liquidCount = parallel::sum(
+        0, n, [&](std::size_t i) { return kind[i] == ParticleKind::Liquid ? 1.0 : 0.0; });
     const double pairs = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); });
     mMeanNeighbors = pairs / std::max(1.0, liquidCount);
     mPairCount = std::size_t(pairs);
 
     // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0).
     auto& p = mParticles.pressures();
-    parallel::forEach(0, n, [&](std::size_t i) {
-        p[i] = taitPressure(rho[i], rho0, mSettings.stiffness);
-    }, 2048);
+    parallel::forEach(
+        0, n, [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, mSettings.stiffness); }, 2048);
 
     // Lines 5-7: a ghost solid takes the density (and so the pressure) of its nearest liquid
     // particle. The order of `touched` depends on the threads; nothing below depends on it.
     for (SolidBlock* b : blocks) {
-        parallel::forEach(0, b->touched.size(), [&](std::size_t t) {
-            const Index s = b->touched[t];
-            const Index j = nearestIndex(b->nearest[s]);
-            b->rho[s] = rho[j];
-            b->p[s] = p[j];
-            b->pOverRho2[s] = p[j] / sqr(rho[j]);
-        }, 1024);
+        parallel::forEach(
+            0, b->touched.size(),
+            [&](std::size_t t) {
+                const Index s = b->touched[t];
+                const Index j = nearestIndex(b->nearest[s]);
+                b->rho[s] = rho[j];
+                b->p[s] = p[j];
+                b->pOverRho2[s] = p[j] / sqr(rho[j]);
+            },
+            1024);
     }
 }
 
@@ -182,17 +194,20 @@ void GhostSolver::extrapolateSolidVelocity()
         const auto& normal = set.vectorChannel(SOLID_NORMAL);
         const std::vector<Vec3>* solidV =
             set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
-        parallel::forEach(0, b->touched.size(), [&](std::size_t t) {
-            const Index s = b->touched[t];
-            const Vec3 vs = solidV ? (*solidV)[s] : Vec3(0);
-            if (!freeSlip) {
-                b->vstar[s] = vs;
-                return;
-            }
-            const Vec3& nrm = normal[s];
-            const Vec3& vl = vstar[nearestIndex(b->nearest[s])];
-            b->vstar[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
-        }, 1024);
+        parallel::forEach(
+            0, b->touched.size(),
+            [&](std::size_t t) {
+                const Index s = b->touched[t];
+                const Vec3 vs = solidV ? (*solidV)[s] : Vec3(0);
+                if (!freeSlip) {
+                    b->vstar[s] = vs;
+                    return;
+                }
+                const Vec3& nrm = normal[s];
+                const Vec3& vl = vstar[nearestIndex(b->nearest[s])];
+                b->vstar[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
+            },
+            1024);
     }
 }
 
@@ -229,38 +244,44 @@ void GhostSolver::stepGhost(Real dt)
     // over every neighbour, v* = v + dt a.
     t0 = std::chrono::steady_clock::now();
     mScratch.resize(n);
-    parallel::forEach(0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);
+    parallel::forEach(
+        0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);
     std::vector<Real> accel(n, Real(0));
-    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) {
-                vstar[i] = v[i];
-                continue;
-            }
-            const Vec3 xi = x[i];
-            const Real pi = mScratch[i];
-            // The particle itself is in its list: r = 0 gives grad W = 0.
-            Vec3 a = g;
-            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + mScratch[b.j[k]]);
-                for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
-                a += b.sumScaledOffsets(b.f);
-            });
-            for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                const Real* ratio = block->pOverRho2.data();
-                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
-                                   [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = M * (pi + ratio[b.j[k]]);
+    parallel::forRange(
+        0, n,
+        [&](std::size_t lo, std::size_t hi) {
+            const CubicSplineKernel kernel = mKernel;
+            PairBatch batch;
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (kind[i] != ParticleKind::Liquid) {
+                    vstar[i] = v[i];
+                    continue;
+                }
+                const Vec3 xi = x[i];
+                const Real pi = mScratch[i];
+                // The particle itself is in its list: r = 0 gives grad W = 0.
+                Vec3 a = g;
+                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + mScratch[b.j[k]]);
                     for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
                     a += b.sumScaledOffsets(b.f);
                 });
+                for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                    const Real* ratio = block->pOverRho2.data();
+                    batch.forEachBatch(xi, block->block.particles().positions().data(),
+                                       block->lists[i], [&](PairBatch& b) {
+                                           for (int k = 0; k < b.n; ++k)
+                                               b.f[k] = M * (pi + ratio[b.j[k]]);
+                                           for (int k = 0; k < b.n; ++k)
+                                               b.f[k] *= -kernel.gradFactor(b.r[k]);
+                                           a += b.sumScaledOffsets(b.f);
+                                       });
+                }
+                vstar[i] = v[i] + dt * a;
+                accel[i] = a.length();
             }
-            vstar[i] = v[i] + dt * a;
-            accel[i] = a.length();
-        }
-    }, 512);
+        },
+        512);
     mMaxAcceleration = *std::max_element(accel.begin(), accel.end());
     mTimings.pressureForce += secondsSince(t0);
 
@@ -271,34 +292,42 @@ void GhostSolver::stepGhost(Real dt)
     // neighbours only: air would bias the outermost particles ([SB12] Sec. 4.3). The weight
     // eps m_j / rho_j of each neighbour is computed once (zero for air).
     const Real eps = mSettings.xsphEpsilon, epsSolid = mSettings.solidEpsilon;
-    parallel::forEach(0, n, [&](std::size_t j) {
-        mScratch[j] = kind[j] == ParticleKind::GhostAir ? Real(0) : eps * m[j] / rho[j];
-    }, 2048);
-    parallel::forRange(0, n, [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) continue;
-            const Vec3 xi = x[i], vi = vstar[i];
-            // The particle itself adds w W(0) (v_i - v_i) = 0.
-            Vec3 dv(0);
-            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                for (int k = 0; k < b.n; ++k) b.f[k] = mScratch[b.j[k]];
-                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                dv += b.sumScaledDifferences(b.f, vstar.data(), vi);
-            });
-            for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                const Real* rhoSolid = block->rho.data();
-                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
-                                   [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = epsSolid * M / rhoSolid[b.j[k]];
+    parallel::forEach(
+        0, n,
+        [&](std::size_t j) {
+            mScratch[j] = kind[j] == ParticleKind::GhostAir ? Real(0) : eps * m[j] / rho[j];
+        },
+        2048);
+    parallel::forRange(
+        0, n,
+        [&](std::size_t lo, std::size_t hi) {
+            const CubicSplineKernel kernel = mKernel;
+            PairBatch batch;
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (kind[i] != ParticleKind::Liquid) continue;
+                const Vec3 xi = x[i], vi = vstar[i];
+                // The particle itself adds w W(0) (v_i - v_i) = 0.
+                Vec3 dv(0);
+                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = mScratch[b.j[k]];
                     for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                    dv += b.sumScaledDifferences(b.f, block->vstar.data(), vi);
+                    dv += b.sumScaledDifferences(b.f, vstar.data(), vi);
                 });
+                for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                    const Real* rhoSolid = block->rho.data();
+                    batch.forEachBatch(xi, block->block.particles().positions().data(),
+                                       block->lists[i], [&](PairBatch& b) {
+                                           for (int k = 0; k < b.n; ++k)
+                                               b.f[k] = epsSolid * M / rhoSolid[b.j[k]];
+                                           for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                                           dv +=
+                                               b.sumScaledDifferences(b.f, block->vstar.data(), vi);
+                                       });
+                }
+                v[i] = vi + dv;
             }
-            v[i] = vi + dv;
-        }
-    }, 512);
+        },
+        512);
 
     // Lines 22-25: air takes the new velocity of its nearest liquid particle (searched up to two
     // kernel radii: air advects between resamplings and may drift a little).
@@ -306,25 +335,29 @@ void GhostSolver::stepGhost(Real dt)
     // Air added after the search (this step's resampling) already has its velocity.
     const Real R = mSettings.supportRadius();
     const std::size_t listed = mFluidLists.size();
-    parallel::forEach(0, std::min(n, listed), [&](std::size_t i) {
-        if (kind[i] != ParticleKind::GhostAir) return;
-        Index j = INVALID_INDEX;
-        Real best2 = R * R;
-        for (Index k : mFluidLists[i]) {
-            if (kind[k] != ParticleKind::Liquid) continue;
-            const Real r2 = (x[i] - x[k]).lengthSqr();
-            if (r2 < best2 || (r2 == best2 && k < j)) {
-                best2 = r2;
-                j = k;
+    parallel::forEach(
+        0, std::min(n, listed),
+        [&](std::size_t i) {
+            if (kind[i] != ParticleKind::GhostAir) return;
+            Index j = INVALID_INDEX;
+            Real best2 = R * R;
+            for (Index k : mFluidLists[i]) {
+                if (kind[k] != ParticleKind::Liquid) continue;
+                const Real r2 = (x[i] - x[k]).lengthSqr();
+                if (r2 < best2 || (r2 == best2 && k < j)) {
+                    best2 = r2;
+                    j = k;
+                }
             }
-        }
-        if (j == INVALID_INDEX) j = nearestLiquid(x[i], Real(2) * R);
-        if (j != INVALID_INDEX) v[i] = v[j];
-    }, 256);
+            if (j == INVALID_INDEX) j = nearestLiquid(x[i], Real(2) * R);
+            if (j != INVALID_INDEX) v[i] = v[j];
+        },
+        256);
 
     // Lines 26-28: positions of liquid and air.
     auto& xw = mParticles.positions();
-    parallel::forEach(0, n, [&](std::size_t i) { xw[i] += dt * v[i]; }, 4096);
+    parallel::forEach(
+        0, n, [&](std::size_t i) { xw[i] += dt * v[i]; }, 4096);
     mTimings.xsphAndBoundary += secondsSince(t0);
 }
 
@@ -403,12 +436,14 @@ void GhostSolver::projectOutOfSolids(Real dt)
     std::atomic<std::uint64_t> restored{0};
     parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
         if (kind[i] != ParticleKind::Liquid) return;
-        const bool near = all || i >= listed || !mStatic.lists[i].empty() || !mMoving.lists[i].empty() ||
-                          dt * (v[i].length() + solidSpeed) >= margin;
+        const bool near = all || i >= listed || !mStatic.lists[i].empty()
+                          || !mMoving.lists[i].empty()
+                          || dt * (v[i].length() + solidSpeed) >= margin;
         if (!near) return;
         const Vec3 previous = x[i] - dt * v[i];
         for (std::size_t b = 0; b < mSolids.size(); ++b) {
-            const Collision c = collideWithSolid(*mSolids[b], placement[b], time, previous, x[i], v[i]);
+            const Collision c =
+                collideWithSolid(*mSolids[b], placement[b], time, previous, x[i], v[i]);
             if (c == Collision::Restored) ++restored;
             if (c == Collision::Stuck) {
                 std::size_t expected = stuck.load();
@@ -423,10 +458,11 @@ void GhostSolver::projectOutOfSolids(Real dt)
         std::ostringstream where;
         where << "(" << x[i][0] << ", " << x[i][1] << ", " << x[i][2] << ")";
         const LevelSet& shape = mSolids[b]->shape;
-        throw NumericalError(msg("liquid solver at frame ", mFrame, ", step ", mStep, " (t = ", mTime,
-                                 " s): liquid particle id ", mParticles.ids()[i], " at ", where.str(),
-                                 " is inside solid '", shape.name(), "' deeper than its level set's band (",
-                                 shape.bandWidth(), " m), and so was its position before the step: it cannot "
+        throw NumericalError(msg("liquid solver at frame ", mFrame, ", step ", mStep,
+                                 " (t = ", mTime, " s): liquid particle id ", mParticles.ids()[i],
+                                 " at ", where.str(), " is inside solid '", shape.name(),
+                                 "' deeper than its level set's band (", shape.bandWidth(),
+                                 " m), and so was its position before the step: it cannot "
                                  "be put back; reduce the time step (substeps / cflNumber)"));
     }
     mProjectAll = false;
@@ -441,23 +477,27 @@ void GhostSolver::checkBlowUp() const
     const auto& v = mParticles.velocities();
     const std::size_t n = mParticles.size();
     std::atomic<std::size_t> bad{n};
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (isFinite(x[i]) && isFinite(v[i]) && v[i].lengthSqr() <= limit2) return;
-        std::size_t expected = bad.load();
-        while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
-    }, 4096);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+            if (isFinite(x[i]) && isFinite(v[i]) && v[i].lengthSqr() <= limit2) return;
+            std::size_t expected = bad.load();
+            while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
+        },
+        4096);
     const std::size_t i = bad.load();
     if (i == n) return;
     const char* kind = kindName(mParticles.kinds()[i]);
     if (!isFinite(x[i]) || !isFinite(v[i])) {
         throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep,
-                                 " (t = ", mTime, " s): ", kind, " particle id ", mParticles.ids()[i],
+                                 " (t = ", mTime, " s): ", kind, " particle id ",
+                                 mParticles.ids()[i],
                                  " has a non-finite position or velocity; reduce the time step "
                                  "(substeps / cflNumber) or the stiffness"));
     }
-    throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep, " (t = ",
-                             mTime, " s): ", kind, " particle id ", mParticles.ids()[i], " moves at ",
-                             v[i].length(), " m/s, beyond maxSpeed = ", limit,
+    throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep,
+                             " (t = ", mTime, " s): ", kind, " particle id ", mParticles.ids()[i],
+                             " moves at ", v[i].length(), " m/s, beyond maxSpeed = ", limit,
                              " m/s; reduce the time step (substeps / cflNumber) or the stiffness"));
 }
 

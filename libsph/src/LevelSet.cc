@@ -191,7 +191,8 @@ std::vector<std::array<std::int32_t, 3>> LevelSet::surfaceCells() const
         bool anyInside = false, anyOutside = false;
         for (int c = 0; c < 8 && !(anyInside && anyOutside); ++c) {
             const openvdb::Coord corner = ijk.offsetBy(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-            if (acc.getValue(corner) < 0.f) anyInside = true; else anyOutside = true;
+            if (acc.getValue(corner) < 0.f) anyInside = true;
+            else anyOutside = true;
         }
         if (anyInside && anyOutside) cells.push_back({ijk.x(), ijk.y(), ijk.z()});
     }
@@ -215,8 +216,9 @@ void validateLevelSetGrid(const openvdb::FloatGrid& grid, const std::string& nam
 {
     const std::string label = "grid '" + name + "'";
     if (grid.getGridClass() != openvdb::GRID_LEVEL_SET) {
-        throw GridError(msg(label, ": class is '", openvdb::GridBase::gridClassToString(
-                                grid.getGridClass()), "', expected 'level set'"));
+        throw GridError(msg(label, ": class is '",
+                            openvdb::GridBase::gridClassToString(grid.getGridClass()),
+                            "', expected 'level set'"));
     }
     if (!grid.transform().isLinear()) {
         throw GridError(msg(label, ": transform is '", grid.transform().mapType(),
@@ -232,7 +234,8 @@ void validateLevelSetGrid(const openvdb::FloatGrid& grid, const std::string& nam
                             ", expected a positive narrow-band width (m)"));
     }
     if (grid.activeVoxelCount() == 0) {
-        throw GridError(msg(label, ": has no active voxels, expected a narrow band around a surface"));
+        throw GridError(
+            msg(label, ": has no active voxels, expected a narrow band around a surface"));
     }
     for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
         if (!std::isfinite(*it)) {
@@ -299,7 +302,8 @@ openvdb::FloatGrid::Ptr makeSphereLevelSet(const Vec3& center, Real radius, Real
         float(voxelSize), float(halfWidthVoxels));
 }
 
-double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo, const openvdb::Vec3d& hi)
+double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo,
+                         const openvdb::Vec3d& hi)
 {
     const openvdb::Vec3d c = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
     const openvdb::Vec3d q(std::abs(x.x() - c.x()) - half.x(), std::abs(x.y() - c.y()) - half.y(),

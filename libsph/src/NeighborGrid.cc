@@ -14,29 +14,29 @@
 namespace ghostfx {
 namespace sph {
 
-NeighborGrid::NeighborGrid(Real cellSize)
-    : mCellSize(cellSize)
-    , mInvCellSize(Real(1) / cellSize)
+NeighborGrid::NeighborGrid(Real cellSize) : mCellSize(cellSize), mInvCellSize(Real(1) / cellSize)
 {
     if (!(cellSize > Real(0)) || !std::isfinite(cellSize)) {
-        throw ValueError(msg("neighbour grid cell size = ", cellSize, " m: expected a finite "
+        throw ValueError(msg("neighbour grid cell size = ", cellSize,
+                             " m: expected a finite "
                              "value > 0 (normally the kernel support radius)"));
     }
 }
 
 std::size_t NeighborGrid::memoryBytes() const
 {
-    return mBucketCell.capacity() * sizeof(std::uint32_t) +
-           mCellKey.capacity() * sizeof(std::uint64_t) +
-           mCellStart.capacity() * sizeof(std::uint32_t) +
-           (mX.capacity() + mY.capacity() + mZ.capacity()) * sizeof(Real) +
-           mIndex.capacity() * sizeof(Index) + mSlotOf.capacity() * sizeof(std::uint32_t);
+    return mBucketCell.capacity() * sizeof(std::uint32_t)
+           + mCellKey.capacity() * sizeof(std::uint64_t)
+           + mCellStart.capacity() * sizeof(std::uint32_t)
+           + (mX.capacity() + mY.capacity() + mZ.capacity()) * sizeof(Real)
+           + mIndex.capacity() * sizeof(Index) + mSlotOf.capacity() * sizeof(std::uint32_t);
 }
 
 void NeighborGrid::build(const Vec3* positions, std::size_t count)
 {
     if (count >= std::size_t(INVALID_INDEX)) {
-        throw ValueError(msg("neighbour grid: ", count, " particles exceed the 32-bit index range"));
+        throw ValueError(
+            msg("neighbour grid: ", count, " particles exceed the 32-bit index range"));
     }
     mIdentity = false;
     // Table size: the smallest power of two >= 2 N (at least 64), so buckets average <= 0.5
@@ -49,19 +49,22 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     std::vector<std::uint32_t> bucket(count);
     std::vector<std::uint64_t> key(count);
     std::atomic<std::size_t> badIndex{count};
-    parallel::forEach(0, count, [&](std::size_t i) {
-        const Vec3& x = positions[i];
-        const Real limit = Real(MAX_CELL_COORD) * mCellSize;
-        if (!isFinite(x) || std::abs(x[0]) >= limit || std::abs(x[1]) >= limit ||
-            std::abs(x[2]) >= limit) {
-            std::size_t expected = badIndex.load();
-            while (i < expected && !badIndex.compare_exchange_weak(expected, i)) {}
-            return;
-        }
-        const Cell c = cellOf(x);
-        key[i] = packKey(c);
-        bucket[i] = bucketOf(c);
-    }, 2048);
+    parallel::forEach(
+        0, count,
+        [&](std::size_t i) {
+            const Vec3& x = positions[i];
+            const Real limit = Real(MAX_CELL_COORD) * mCellSize;
+            if (!isFinite(x) || std::abs(x[0]) >= limit || std::abs(x[1]) >= limit
+                || std::abs(x[2]) >= limit) {
+                std::size_t expected = badIndex.load();
+                while (i < expected && !badIndex.compare_exchange_weak(expected, i)) {}
+                return;
+            }
+            const Cell c = cellOf(x);
+            key[i] = packKey(c);
+            bucket[i] = bucketOf(c);
+        },
+        2048);
     if (badIndex.load() < count) {
         const std::size_t i = badIndex.load();
         const Vec3& x = positions[i];
@@ -71,17 +74,17 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         }
         throw ValueError(msg("neighbour grid: particle ", i, " at (", x[0], ", ", x[1], ", ", x[2],
                              ") m is beyond the grid range of +/-",
-                             Real(MAX_CELL_COORD) * mCellSize, " m for cell size ", mCellSize, " m"));
+                             Real(MAX_CELL_COORD) * mCellSize, " m for cell size ", mCellSize,
+                             " m"));
     }
 
     // 2. Histogram of bucket sizes.
     std::unique_ptr<std::atomic<std::uint32_t>[]> counts(new std::atomic<std::uint32_t>[tableSize]);
-    parallel::forEach(0, tableSize, [&](std::size_t b) {
-        counts[b].store(0, std::memory_order_relaxed);
-    }, 8192);
-    parallel::forEach(0, count, [&](std::size_t i) {
-        counts[bucket[i]].fetch_add(1, std::memory_order_relaxed);
-    }, 4096);
+    parallel::forEach(
+        0, tableSize, [&](std::size_t b) { counts[b].store(0, std::memory_order_relaxed); }, 8192);
+    parallel::forEach(
+        0, count, [&](std::size_t i) { counts[bucket[i]].fetch_add(1, std::memory_order_relaxed); },
+        4096);
 
     // 3. Exclusive scan into bucket starts; the counts become scatter cursors.
     std::vector<std::uint32_t> bucketStart(tableSize + 1);
@@ -96,25 +99,32 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
 
     // 4. Scatter particle indices to their bucket's slots.
     mIndex.resize(count);
-    parallel::forEach(0, count, [&](std::size_t i) {
-        mIndex[counts[bucket[i]].fetch_add(1, std::memory_order_relaxed)] = Index(i);
-    }, 4096);
+    parallel::forEach(
+        0, count,
+        [&](std::size_t i) {
+            mIndex[counts[bucket[i]].fetch_add(1, std::memory_order_relaxed)] = Index(i);
+        },
+        4096);
 
     // 5. The scatter order inside a bucket depends on thread timing: sort each bucket by cell,
     //    then index, so the result is deterministic and every cell is one run of slots. Count
     //    the cells of each bucket on the way.
     std::vector<std::uint32_t> bucketCells(tableSize + 1, 0);
-    parallel::forEach(0, tableSize, [&](std::size_t b) {
-        const std::uint32_t lo = bucketStart[b], hi = bucketStart[b + 1];
-        if (hi - lo > 1) {
-            std::sort(mIndex.begin() + lo, mIndex.begin() + hi, [&key](Index a, Index c) {
-                return key[a] != key[c] ? key[a] < key[c] : a < c;
-            });
-        }
-        std::uint32_t cells = 0;
-        for (std::uint32_t s = lo; s < hi; ++s) cells += s == lo || key[mIndex[s]] != key[mIndex[s - 1]];
-        bucketCells[b] = cells;
-    }, 4096);
+    parallel::forEach(
+        0, tableSize,
+        [&](std::size_t b) {
+            const std::uint32_t lo = bucketStart[b], hi = bucketStart[b + 1];
+            if (hi - lo > 1) {
+                std::sort(mIndex.begin() + lo, mIndex.begin() + hi, [&key](Index a, Index c) {
+                    return key[a] != key[c] ? key[a] < key[c] : a < c;
+                });
+            }
+            std::uint32_t cells = 0;
+            for (std::uint32_t s = lo; s < hi; ++s)
+                cells += s == lo || key[mIndex[s]] != key[mIndex[s - 1]];
+            bucketCells[b] = cells;
+        },
+        4096);
 
     // 6. Cell table: buckets to cells (exclusive scan), cells to slots and keys.
     mBucketCell.resize(tableSize + 1);
@@ -127,17 +137,20 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     mCellKey.resize(cellCount);
     mCellStart.resize(std::size_t(cellCount) + 1);
     mCellStart[cellCount] = std::uint32_t(count);
-    parallel::forEach(0, tableSize, [&](std::size_t b) {
-        std::uint32_t cell = mBucketCell[b];
-        for (std::uint32_t s = bucketStart[b], hi = bucketStart[b + 1]; s < hi; ++s) {
-            const std::uint64_t k = key[mIndex[s]];
-            if (s == bucketStart[b] || k != key[mIndex[s - 1]]) {
-                mCellKey[cell] = k;
-                mCellStart[cell] = s;
-                ++cell;
+    parallel::forEach(
+        0, tableSize,
+        [&](std::size_t b) {
+            std::uint32_t cell = mBucketCell[b];
+            for (std::uint32_t s = bucketStart[b], hi = bucketStart[b + 1]; s < hi; ++s) {
+                const std::uint64_t k = key[mIndex[s]];
+                if (s == bucketStart[b] || k != key[mIndex[s - 1]]) {
+                    mCellKey[cell] = k;
+                    mCellStart[cell] = s;
+                    ++cell;
+                }
             }
-        }
-    }, 4096);
+        },
+        4096);
 
     // 7. Gather coordinates in sorted order; inverse map for forEachNeighbor(i). The coordinate
     //    arrays carry PADDING more entries, so vectorised distance loops may read past a range.
@@ -145,13 +158,16 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     mY.assign(count + PADDING, Real(0));
     mZ.assign(count + PADDING, Real(0));
     mSlotOf.resize(count);
-    parallel::forEach(0, count, [&](std::size_t s) {
-        const Index i = mIndex[s];
-        mX[s] = positions[i][0];
-        mY[s] = positions[i][1];
-        mZ[s] = positions[i][2];
-        mSlotOf[i] = std::uint32_t(s);
-    }, 4096);
+    parallel::forEach(
+        0, count,
+        [&](std::size_t s) {
+            const Index i = mIndex[s];
+            mX[s] = positions[i][0];
+            mY[s] = positions[i][1];
+            mZ[s] = positions[i][2];
+            mSlotOf[i] = std::uint32_t(s);
+        },
+        4096);
 }
 
 void NeighborGrid::sortParticles(ParticleSet& particles)
@@ -159,10 +175,13 @@ void NeighborGrid::sortParticles(ParticleSet& particles)
     build(particles.positions());
     particles.reorder(mIndex);
     // The set now is in slot order: particle k sits in slot k.
-    parallel::forEach(0, mIndex.size(), [&](std::size_t k) {
-        mIndex[k] = Index(k);
-        mSlotOf[k] = std::uint32_t(k);
-    }, 8192);
+    parallel::forEach(
+        0, mIndex.size(),
+        [&](std::size_t k) {
+            mIndex[k] = Index(k);
+            mSlotOf[k] = std::uint32_t(k);
+        },
+        8192);
     mIdentity = true;
 }
 

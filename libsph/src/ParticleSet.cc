@@ -14,11 +14,16 @@ namespace sph {
 const char* kindName(ParticleKind kind)
 {
     switch (kind) {
-    case ParticleKind::Liquid: return "liquid";
-    case ParticleKind::GhostAir: return "ghost_air";
-    case ParticleKind::GhostSolid: return "ghost_solid";
-    case ParticleKind::Gas: return "gas";
-    case ParticleKind::Boundary: return "boundary";
+    case ParticleKind::Liquid:
+        return "liquid";
+    case ParticleKind::GhostAir:
+        return "ghost_air";
+    case ParticleKind::GhostSolid:
+        return "ghost_solid";
+    case ParticleKind::Gas:
+        return "gas";
+    case ParticleKind::Boundary:
+        return "boundary";
     }
     return "unknown";
 }
@@ -30,7 +35,8 @@ template <typename T>
 void permute(std::vector<T>& data, const std::vector<Index>& order, std::vector<T>& scratch)
 {
     scratch.resize(data.size());
-    parallel::forEach(0, order.size(), [&](std::size_t k) { scratch[k] = data[order[k]]; }, 4096);
+    parallel::forEach(
+        0, order.size(), [&](std::size_t k) { scratch[k] = data[order[k]]; }, 4096);
     data.swap(scratch);
 }
 
@@ -57,9 +63,13 @@ std::string joinNames(const std::vector<std::string>& names)
 template <typename Fn>
 void ParticleSet::forEachChannel(Fn&& fn)
 {
-    fn(mPositions); fn(mVelocities);
-    fn(mMasses); fn(mDensities); fn(mPressures);
-    fn(mKinds); fn(mIds);
+    fn(mPositions);
+    fn(mVelocities);
+    fn(mMasses);
+    fn(mDensities);
+    fn(mPressures);
+    fn(mKinds);
+    fn(mIds);
     for (auto& [name, ch] : mScalars) fn(ch.data);
     for (auto& [name, ch] : mVectors) fn(ch.data);
 }
@@ -133,8 +143,8 @@ void ParticleSet::reorder(const std::vector<Index>& order)
     for (std::size_t k = 0; k < order.size(); ++k) {
         if (order[k] >= order.size() || seen[order[k]]) {
             throw ValueError(msg("ParticleSet::reorder: entry ", k, " = ", order[k],
-                                 " is out of range or repeated: expected a permutation of ",
-                                 size(), " particles"));
+                                 " is out of range or repeated: expected a permutation of ", size(),
+                                 " particles"));
         }
         seen[order[k]] = 1;
     }
@@ -211,8 +221,10 @@ void ParticleSet::setNextId(ParticleId next)
 {
     const auto maxId = mIds.empty() ? ParticleId(-1) : *std::max_element(mIds.begin(), mIds.end());
     if (next <= maxId) {
-        throw ValueError(msg("ParticleSet::setNextId(", next, "): expected a value greater than "
-                             "the largest id in the set (", maxId, ")"));
+        throw ValueError(msg("ParticleSet::setNextId(", next,
+                             "): expected a value greater than "
+                             "the largest id in the set (",
+                             maxId, ")"));
     }
     mNextId = next;
 }
@@ -249,8 +261,10 @@ const std::vector<Real>& ParticleSet::scalarChannel(const std::string& name) con
 {
     auto it = mScalars.find(name);
     if (it == mScalars.end()) {
-        throw ValueError(msg("particle channel '", name, "' (scalar) does not exist; scalar "
-                             "channels: ", joinNames(scalarChannelNames())));
+        throw ValueError(msg("particle channel '", name,
+                             "' (scalar) does not exist; scalar "
+                             "channels: ",
+                             joinNames(scalarChannelNames())));
     }
     return it->second.data;
 }
@@ -264,8 +278,10 @@ const std::vector<Vec3>& ParticleSet::vectorChannel(const std::string& name) con
 {
     auto it = mVectors.find(name);
     if (it == mVectors.end()) {
-        throw ValueError(msg("particle channel '", name, "' (vector) does not exist; vector "
-                             "channels: ", joinNames(vectorChannelNames())));
+        throw ValueError(msg("particle channel '", name,
+                             "' (vector) does not exist; vector "
+                             "channels: ",
+                             joinNames(vectorChannelNames())));
     }
     return it->second.data;
 }
@@ -287,8 +303,8 @@ std::size_t ParticleSet::memoryBytes() const
     auto bytes = [](const auto& data) {
         return data.capacity() * sizeof(typename std::decay_t<decltype(data)>::value_type);
     };
-    std::size_t total = bytes(mPositions) + bytes(mVelocities) + bytes(mMasses) +
-                        bytes(mDensities) + bytes(mPressures) + bytes(mKinds) + bytes(mIds);
+    std::size_t total = bytes(mPositions) + bytes(mVelocities) + bytes(mMasses) + bytes(mDensities)
+                        + bytes(mPressures) + bytes(mKinds) + bytes(mIds);
     for (const auto& [name, ch] : mScalars) total += bytes(ch.data);
     for (const auto& [name, ch] : mVectors) total += bytes(ch.data);
     return total;

@@ -21,7 +21,14 @@ namespace sph {
 namespace {
 
 /// Streams of the random generator, one per phase, so phases do not share draws.
-enum Stream : std::uint64_t { SURFACE = 1, INTERIOR = 2, SEEDED = 3, TILE_OFFSET = 4, TILE = 8, RELAX = 16 };
+enum Stream : std::uint64_t {
+    SURFACE = 1,
+    INTERIOR = 2,
+    SEEDED = 3,
+    TILE_OFFSET = 4,
+    TILE = 8,
+    RELAX = 16
+};
 /// Side of the periodic interior tile, in Poisson radii: about 1,000 points, small enough to
 /// relax in milliseconds, large enough that its period (11 spacings) is far beyond a kernel
 /// radius.
@@ -44,7 +51,8 @@ public:
         const Vec3 extent = bounds.extent();
         std::size_t total = 1;
         for (int a = 0; a < 3; ++a) {
-            mDims[a] = std::max<std::int64_t>(1, std::int64_t(std::ceil(extent[a] * mInvCellSize)) + 1);
+            mDims[a] =
+                std::max<std::int64_t>(1, std::int64_t(std::ceil(extent[a] * mInvCellSize)) + 1);
             total *= std::size_t(mDims[a]);
             if (total > MAX_CELLS) {
                 throw SamplingError(msg("sampling region of ", extent[0], " x ", extent[1], " x ",
@@ -149,7 +157,8 @@ private:
             lo[a] = std::max<std::int64_t>(
                 0, std::int64_t(std::floor((x[a] - radius - mOrigin[a]) * mInvCellSize)));
             hi[a] = std::min<std::int64_t>(
-                mDims[a] - 1, std::int64_t(std::floor((x[a] + radius - mOrigin[a]) * mInvCellSize)));
+                mDims[a] - 1,
+                std::int64_t(std::floor((x[a] + radius - mOrigin[a]) * mInvCellSize)));
         }
         for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
             for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
@@ -209,8 +218,8 @@ public:
             const __m128 dx = _mm_sub_ps(cx, _mm_loadu_ps(mX.data() + k));
             const __m128 dy = _mm_sub_ps(cy, _mm_loadu_ps(mY.data() + k));
             const __m128 dz = _mm_sub_ps(cz, _mm_loadu_ps(mZ.data() + k));
-            const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)),
-                                         _mm_mul_ps(dz, dz));
+            const __m128 d2 =
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
             best = _mm_min_ps(best, d2);
         }
         alignas(16) float lanes[4];
@@ -252,7 +261,8 @@ Vec3 randomTangent(Rng& rng, const Vec3& n)
 /// random direction and a distance uniform in [r, 2r); `tryAccept(q)` returns whether it took
 /// q, which then becomes active too. An active point whose tries all fail retires.
 template <typename TryAccept>
-void growFromActive(std::vector<Vec3>& active, Rng& rng, Real r, int attempts, TryAccept&& tryAccept)
+void growFromActive(std::vector<Vec3>& active, Rng& rng, Real r, int attempts,
+                    TryAccept&& tryAccept)
 {
     while (!active.empty()) {
         const std::uint32_t slot = rng.below(std::uint32_t(active.size()));
@@ -273,10 +283,7 @@ void growFromActive(std::vector<Vec3>& active, Rng& rng, Real r, int attempts, T
 }
 
 /// Grid bounds for sampling a level set: its active band, padded by one search cell.
-Aabb samplingBounds(const LevelSet& shape, Real radius)
-{
-    return shape.bounds().padded(radius);
-}
+Aabb samplingBounds(const LevelSet& shape, Real radius) { return shape.bounds().padded(radius); }
 
 void checkCount(std::size_t count, const PoissonSettings& s, const char* phase)
 {
@@ -320,9 +327,12 @@ public:
     bool accepts(const Vec3& x, Real phi) const
     {
         switch (mMode) {
-        case Mode::None: return true;
-        case Mode::Phi: return phi >= -mDepth;
-        case Mode::SurfaceSamples: return mSurface->anyWithin(x, mReach);
+        case Mode::None:
+            return true;
+        case Mode::Phi:
+            return phi >= -mDepth;
+        case Mode::SurfaceSamples:
+            return mSurface->anyWithin(x, mReach);
         }
         return true;
     }
@@ -351,7 +361,8 @@ PoissonSettings PoissonSettings::forSpacing(Real spacing)
 void PoissonSettings::validate() const
 {
     auto require = [](bool ok, const char* field, double value, const char* expected) {
-        if (!ok) throw ValueError(msg("sampler setting ", field, " = ", value, ": expected ", expected));
+        if (!ok)
+            throw ValueError(msg("sampler setting ", field, " = ", value, ": expected ", expected));
     };
     require(radius > Real(0) && std::isfinite(radius), "radius", radius, "a finite value > 0 (m)");
     require(surfaceAttempts >= 1, "surfaceAttempts", surfaceAttempts, ">= 1");
@@ -392,8 +403,10 @@ SampleSet PoissonDiskSampler::sampleSurface(const LevelSet& shape) const
     const int t = mSettings.surfaceAttempts;
     const auto cells = shape.surfaceCells();
     if (cells.empty()) {
-        throw SamplingError(msg("level set '", shape.name(), "' has no zero crossing: the shape "
-                                "is empty or smaller than a voxel (", shape.voxelSize(), " m)"));
+        throw SamplingError(msg("level set '", shape.name(),
+                                "' has no zero crossing: the shape "
+                                "is empty or smaller than a voxel (",
+                                shape.voxelSize(), " m)"));
     }
 
     SampleSet samples;
@@ -422,7 +435,8 @@ SampleSet PoissonDiskSampler::sampleSurface(const LevelSet& shape) const
         bool found = false;
         for (int a = 0; a < t && !found; ++a) {
             Vec3 ijk;
-            for (int axis = 0; axis < 3; ++axis) ijk[axis] = Real(cell[axis]) + Real(rng.uniform01());
+            for (int axis = 0; axis < 3; ++axis)
+                ijk[axis] = Real(cell[axis]) + Real(rng.uniform01());
             found = tryAdd(shape.indexToWorld(ijk), p);
         }
         if (!found) continue;
@@ -440,7 +454,8 @@ SampleSet PoissonDiskSampler::sampleSurface(const LevelSet& shape) const
         checkCount(samples.size(), mSettings, "surface sampling");
     }
     if (samples.positions.empty()) {
-        throw SamplingError(msg("level set '", shape.name(), "': no surface sample could be "
+        throw SamplingError(msg("level set '", shape.name(),
+                                "': no surface sample could be "
                                 "projected onto its zero crossing"));
     }
     return samples;
@@ -504,14 +519,16 @@ std::vector<Vec3> PoissonDiskSampler::periodicTile(Real side) const
     };
     // Visit the points within `reach` cells of x (reach <= cells / 2 keeps visits distinct).
     auto forNear = [&](const Vec3& x, int reach, auto&& fn) {
-        const int cx = std::min(cells - 1, int(x[0] / cell)), cy = std::min(cells - 1, int(x[1] / cell)),
+        const int cx = std::min(cells - 1, int(x[0] / cell)),
+                  cy = std::min(cells - 1, int(x[1] / cell)),
                   cz = std::min(cells - 1, int(x[2] / cell));
         for (int k = -reach; k <= reach; ++k) {
             for (int j = -reach; j <= reach; ++j) {
                 for (int i = -reach; i <= reach; ++i) {
-                    const std::size_t c = (std::size_t((cz + k + cells) % cells) * cells +
-                                           std::size_t((cy + j + cells) % cells)) * cells +
-                                          std::size_t((cx + i + cells) % cells);
+                    const std::size_t c = (std::size_t((cz + k + cells) % cells) * cells
+                                           + std::size_t((cy + j + cells) % cells))
+                                              * cells
+                                          + std::size_t((cx + i + cells) % cells);
                     for (int id : grid[c]) fn(id);
                 }
             }
@@ -530,7 +547,8 @@ std::vector<Vec3> PoissonDiskSampler::periodicTile(Real side) const
     };
 
     Rng rng(mSettings.seed, TILE);
-    const Vec3 first(Real(rng.uniform01()) * side, Real(rng.uniform01()) * side, Real(rng.uniform01()) * side);
+    const Vec3 first(Real(rng.uniform01()) * side, Real(rng.uniform01()) * side,
+                     Real(rng.uniform01()) * side);
     add(first);
     std::vector<Vec3> active{first};
     growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
@@ -593,7 +611,8 @@ SampleSet PoissonDiskSampler::sampleVolumeTiled(const LevelSet& shape) const
     const std::vector<Vec3> tile = periodicTile(side);
     const DepthLimit band(samples, shape, mSettings.bandDepth, r);
     Rng rng(mSettings.seed, TILE_OFFSET);
-    const Vec3 shift(Real(rng.uniform01()) * side, Real(rng.uniform01()) * side, Real(rng.uniform01()) * side);
+    const Vec3 shift(Real(rng.uniform01()) * side, Real(rng.uniform01()) * side,
+                     Real(rng.uniform01()) * side);
     const Aabb bounds = shape.bounds();
     const auto first = [&](int a) { return std::floor((bounds.min[a] - shift[a]) / side); };
     const auto last = [&](int a) { return std::floor((bounds.max[a] - shift[a]) / side); };
@@ -614,13 +633,16 @@ SampleSet PoissonDiskSampler::sampleVolumeTiled(const LevelSet& shape) const
     }
     // 0: not kept; 1: kept; 2: kept, next to the gap (it seeds the growth into it).
     std::vector<std::uint8_t> keep(tiled.size(), 0);
-    parallel::forEach(0, tiled.size(), [&](std::size_t k) {
-        const Vec3& x = tiled[k];
-        if (!bounds.contains(x)) return;
-        const Real phi = shape.phi(x);
-        if (!(phi < Real(0)) || near.anyWithin(x, depth) || !band.accepts(x, phi)) return;
-        keep[k] = near.anyWithin(x, depth + Real(2) * r) ? 2 : 1;
-    }, 1024);
+    parallel::forEach(
+        0, tiled.size(),
+        [&](std::size_t k) {
+            const Vec3& x = tiled[k];
+            if (!bounds.contains(x)) return;
+            const Real phi = shape.phi(x);
+            if (!(phi < Real(0)) || near.anyWithin(x, depth) || !band.accepts(x, phi)) return;
+            keep[k] = near.anyWithin(x, depth + Real(2) * r) ? 2 : 1;
+        },
+        1024);
     std::vector<std::uint8_t> seeds(surface, 1);
     for (std::size_t k = 0; k < tiled.size(); ++k) {
         if (!keep[k]) continue;
@@ -636,14 +658,16 @@ SampleSet PoissonDiskSampler::sampleVolumeTiled(const LevelSet& shape) const
     //    (the tile points hold still: they are relaxed already, in the tile).
     growInterior(samples, shape, seeds);
     std::vector<std::uint8_t> movable(samples.size(), 1);
-    std::fill(movable.begin() + std::ptrdiff_t(surface), movable.begin() + std::ptrdiff_t(fixed), 0);
+    std::fill(movable.begin() + std::ptrdiff_t(surface), movable.begin() + std::ptrdiff_t(fixed),
+              0);
     relaxSome(samples, shape, mSettings.volumeRelaxSweeps, 1, movable);
     return samples;
 }
 
 // [SB12] Algorithm 2 ---------------------------------------------------------------------------
 
-void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sweeps, int pass) const
+void PoissonDiskSampler::relax(SampleSet& samples, const LevelSet& shape, int sweeps,
+                               int pass) const
 {
     relaxSome(samples, shape, sweeps, pass, {});
 }
@@ -671,7 +695,11 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
     // block in index order, colours in order: the result does not depend on the thread count.
     const Real blockSize = Real(8) * r;
     const Aabb bounds = samplingBounds(shape, r);
-    struct Item { std::uint64_t key; std::uint32_t index; };
+    struct Item
+    {
+        std::uint64_t key;
+        std::uint32_t index;
+    };
     std::vector<Item> order;
     std::vector<std::size_t> blockStart;
 
@@ -696,14 +724,15 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
         // is projected, and only a candidate that beats the best so far needs the band test.
         const bool inside = !surface && band.limited() && phiP < -lipschitz * r;
         // One random stream per (pass, sweep, sample).
-        Rng rng(mSettings.seed, RELAX + (std::uint64_t(pass) << 40) +
-                                    (std::uint64_t(sweep) << 32) + i);
+        Rng rng(mSettings.seed,
+                RELAX + (std::uint64_t(pass) << 40) + (std::uint64_t(sweep) << 32) + i);
         for (int a = 0; a < t; ++a) {
             const Real tau = Real(t - a) / Real(t);
             Vec3 cand = p + rng.unitVector() * (r * tau);
             if (inside) {
                 const Real c2 = ball.minDistance2(cand);
-                if (!(c2 > d2) || !band.accepts(cand, shape.phi(cand)) || !grid.contains(cand)) continue;
+                if (!(c2 > d2) || !band.accepts(cand, shape.phi(cand)) || !grid.contains(cand))
+                    continue;
                 d2 = c2;
                 best = cand;
                 continue;
@@ -733,7 +762,8 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
                 if (surface || phi > Real(0)) {
                     // The projection moves cand by about |phi|: skip it when even that
                     // much could not beat the best distance so far.
-                    const Real reach = std::sqrt(ball.minDistance2(cand)) + Real(1.05) * std::abs(phi);
+                    const Real reach =
+                        std::sqrt(ball.minDistance2(cand)) + Real(1.05) * std::abs(phi);
                     if (reach * reach <= d2) continue;
                     const SurfaceProjection proj = shape.projectToSurface(cand);
                     // A projection that lands more than 2r away left the neighbourhood this
@@ -782,13 +812,17 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
             // Blocks [first, last) share a colour.
             const std::uint64_t colour = order[blockStart[first]].key >> 60;
             std::size_t last = first + 1;
-            while (last + 1 < blockStart.size() && order[blockStart[last]].key >> 60 == colour) ++last;
-            parallel::forEach(first, last, [&](std::size_t block) {
-                Ball ball; // B(p): the samples within 2r of p
-                for (std::size_t k = blockStart[block]; k < blockStart[block + 1]; ++k) {
-                    relaxOne(order[k].index, sweep, ball);
-                }
-            }, 1);
+            while (last + 1 < blockStart.size() && order[blockStart[last]].key >> 60 == colour)
+                ++last;
+            parallel::forEach(
+                first, last,
+                [&](std::size_t block) {
+                    Ball ball; // B(p): the samples within 2r of p
+                    for (std::size_t k = blockStart[block]; k < blockStart[block + 1]; ++k) {
+                        relaxOne(order[k].index, sweep, ball);
+                    }
+                },
+                1);
             first = last;
         }
     }
@@ -796,10 +830,9 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
 
 // [SB12] Sec. 4.5.2: seeded sampling for air layers and emission ------------------------------
 
-std::vector<Vec3> PoissonDiskSampler::sampleFromSeeds(const std::vector<Vec3>& seeds,
-                                                      const std::vector<Vec3>& obstacles,
-                                                      const std::function<bool(const Vec3&)>& accept,
-                                                      const Aabb& bounds) const
+std::vector<Vec3> PoissonDiskSampler::sampleFromSeeds(
+    const std::vector<Vec3>& seeds, const std::vector<Vec3>& obstacles,
+    const std::function<bool(const Vec3&)>& accept, const Aabb& bounds) const
 {
     std::vector<Vec3> added;
     if (seeds.empty() || bounds.empty()) return added;

@@ -46,7 +46,7 @@ struct Result
     std::string err;
 };
 
-#define EXPECT_CONTAINS(text, part) \
+#define EXPECT_CONTAINS(text, part)                                                                \
     EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
 /// Each test gets a fresh folder holding a small scene: a 0.3 m tank with a 0.1 m cube of water
@@ -56,8 +56,9 @@ class Cli : public ::testing::Test
 protected:
     void SetUp() override
     {
-        mDir = fs::temp_directory_path() /
-               ("ghostfx_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        mDir = fs::temp_directory_path()
+               / ("ghostfx_cli_"
+                  + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(mDir);
         fs::create_directories(mDir);
     }
@@ -87,8 +88,8 @@ protected:
     Result run(const std::string& args) const
     {
         const fs::path err = mDir / "stderr.txt";
-        const std::string command = std::string(GHOSTFX_EXE) + " " + args + " > " + (mDir / "stdout.txt").string() +
-                                    " 2> " + err.string();
+        const std::string command = std::string(GHOSTFX_EXE) + " " + args + " > "
+                                    + (mDir / "stdout.txt").string() + " 2> " + err.string();
         const int status = std::system(command.c_str());
         Result r;
         r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -101,7 +102,8 @@ protected:
     {
         const Result r = run(args);
         EXPECT_EQ(r.code, 1) << r.err;
-        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "expected one line: " << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1)
+            << "expected one line: " << r.err;
         EXPECT_EQ(r.err.rfind("ghostfx: error: ", 0), 0u) << r.err;
         return r.err;
     }
@@ -122,7 +124,8 @@ std::size_t pointCount(const fs::path& file)
 
 TEST_F(Cli, RunsASceneToAFrameSequence)
 {
-    const Result ok = run("run " + write(smallScene()) + " --out " + (mDir / "out").string() + " --progress log");
+    const Result ok =
+        run("run " + write(smallScene()) + " --out " + (mDir / "out").string() + " --progress log");
     ASSERT_EQ(ok.code, 0) << ok.err;
     EXPECT_CONTAINS(ok.err, "frame 3/3");
     const fs::path out = mDir / "out";
@@ -157,7 +160,8 @@ TEST_F(Cli, RunsASceneToAFrameSequence)
     volume.close();
 
     // Points: liquid only (the run also holds ghost air and ghost solid particles).
-    const vdbio::CheckpointHeader header = vdbio::readCheckpointHeader((out / "checkpoint.0003.h5").string());
+    const vdbio::CheckpointHeader header =
+        vdbio::readCheckpointHeader((out / "checkpoint.0003.h5").string());
     EXPECT_EQ(header.frame, 3);
     EXPECT_GT(header.countPerKind.at("ghost_solid"), 0u);
     EXPECT_EQ(pointCount(out / "liquid_points.0003.vdb"), header.countPerKind.at("liquid"));
@@ -171,24 +175,31 @@ TEST_F(Cli, ResumedRunMatchesAnUninterruptedOneBitForBit)
     Json scene = smallScene();
     scene["settings"]["frame_range"] = {1, 4};
     // An emitter and a moving solid exercise every piece of state that must survive.
-    scene["emitters"] = Json::parse(R"([{ "geometry": { "box": { "min": [0.2, 0.2, 0.1], "max": [0.26, 0.26, 0.2] } },
+    scene["emitters"] = Json::parse(
+        R"([{ "geometry": { "box": { "min": [0.2, 0.2, 0.1], "max": [0.26, 0.26, 0.2] } },
                                           "velocity": [0, -0.5, 0], "start": 0, "end": 1 }])");
     const std::string path = write(scene);
     const fs::path a = mDir / "a", b = mDir / "b";
     ASSERT_EQ(run("run " + path + " --out " + a.string() + " -q").code, 0);
     ASSERT_EQ(run("run " + path + " --out " + b.string() + " -q --frames 1-2").code, 0);
     fs::remove(b / "liquid_points.0003.vdb");
-    const Result resumed = run("run " + path + " --out " + b.string() + " -q --resume " +
-                               (b / "checkpoint.0002.h5").string());
+    const Result resumed = run("run " + path + " --out " + b.string() + " -q --resume "
+                               + (b / "checkpoint.0002.h5").string());
     ASSERT_EQ(resumed.code, 0) << resumed.err;
 
     const std::string fingerprint = vdbio::readScene(path).simulationFingerprint();
-    const sph::SolverState sa = vdbio::readCheckpoint((a / "checkpoint.0004.h5").string(), fingerprint);
-    const sph::SolverState sb = vdbio::readCheckpoint((b / "checkpoint.0004.h5").string(), fingerprint);
+    const sph::SolverState sa =
+        vdbio::readCheckpoint((a / "checkpoint.0004.h5").string(), fingerprint);
+    const sph::SolverState sb =
+        vdbio::readCheckpoint((b / "checkpoint.0004.h5").string(), fingerprint);
     ASSERT_EQ(sa.particles.size(), sb.particles.size());
     const std::size_t n = sa.particles.size();
-    EXPECT_EQ(std::memcmp(sa.particles.positions().data(), sb.particles.positions().data(), n * sizeof(sph::Vec3)), 0);
-    EXPECT_EQ(std::memcmp(sa.particles.velocities().data(), sb.particles.velocities().data(), n * sizeof(sph::Vec3)), 0);
+    EXPECT_EQ(std::memcmp(sa.particles.positions().data(), sb.particles.positions().data(),
+                          n * sizeof(sph::Vec3)),
+              0);
+    EXPECT_EQ(std::memcmp(sa.particles.velocities().data(), sb.particles.velocities().data(),
+                          n * sizeof(sph::Vec3)),
+              0);
     EXPECT_EQ(sa.particles.ids(), sb.particles.ids());
     EXPECT_EQ(sa.reals, sb.reals);
     EXPECT_EQ(sa.integers, sb.integers);
@@ -202,9 +213,11 @@ TEST_F(Cli, ResumedRunMatchesAnUninterruptedOneBitForBit)
 TEST_F(Cli, CheckpointFromOtherSettingsIsRefused)
 {
     const std::string path = write(smallScene());
-    ASSERT_EQ(run("run " + path + " --out " + (mDir / "out").string() + " -q --frames 1-2").code, 0);
-    const std::string line = errorLine("run " + path + " -D settings.stiffness=5000 --out " + (mDir / "out").string() +
-                                       " --resume " + (mDir / "out" / "checkpoint.0002.h5").string());
+    ASSERT_EQ(run("run " + path + " --out " + (mDir / "out").string() + " -q --frames 1-2").code,
+              0);
+    const std::string line =
+        errorLine("run " + path + " -D settings.stiffness=5000 --out " + (mDir / "out").string()
+                  + " --resume " + (mDir / "out" / "checkpoint.0002.h5").string());
     EXPECT_CONTAINS(line, "checkpoint.0002.h5' was written with different settings");
     EXPECT_CONTAINS(line, "stiffness");
     EXPECT_CONTAINS(line, "2000");
@@ -214,37 +227,48 @@ TEST_F(Cli, CheckpointFromOtherSettingsIsRefused)
 TEST_F(Cli, BadInputGetsOneClearLine)
 {
     const std::string out = " --out " + (mDir / "out").string();
-    EXPECT_CONTAINS(errorLine("run " + (mDir / "nope.json").string() + out), "nope.json': cannot open the file");
+    EXPECT_CONTAINS(errorLine("run " + (mDir / "nope.json").string() + out),
+                    "nope.json': cannot open the file");
 
     const std::string good = write(smallScene());
     EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.stifness=5000"),
                     "settings.stifness: unknown key (did you mean 'stiffness'?)");
     EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.stiffness=-1"),
                     "settings.stiffness = -1: expected a number > 0");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.cfl=50"), "settings.cfl = 50: expected a number in [0.001, 10]");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.cfl=50"),
+                    "settings.cfl = 50: expected a number in [0.001, 10]");
     EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.method=gas"),
-                    "liquids: a 'gas' scene simulates gas only: liquids, emitters and heaters need method 'ghost' or 'basic'");
+                    "liquids: a 'gas' scene simulates gas only: liquids, emitters and heaters need "
+                    "method 'ghost' or 'basic'");
     EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.gas.kappa=2"),
                     "settings.gas: gas settings need method 'gas' or heaters (boiling)");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D 'liquids[0].geometry={\"file\":\"none.vdb\",\"grid\":\"x\"}'"),
+    EXPECT_CONTAINS(errorLine("run " + good + out
+                              + " -D 'liquids[0].geometry={\"file\":\"none.vdb\",\"grid\":\"x\"}'"),
                     "none.vdb' does not exist");
     // Liquid entirely inside the tank wall: no particles.
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D liquids[0].geometry.box.min=[-0.04,0.05,0.05]" +
-                              " -D liquids[0].geometry.box.max=[-0.01,0.1,0.1]"),
+    EXPECT_CONTAINS(errorLine("run " + good + out
+                              + " -D liquids[0].geometry.box.min=[-0.04,0.05,0.05]"
+                              + " -D liquids[0].geometry.box.max=[-0.01,0.1,0.1]"),
                     "liquid 'water' (box) gives no particles at spacing 0.015 m");
     // Unwritable output folder: a file where the folder should be.
     std::ofstream(mDir / "afile") << "x";
     EXPECT_CONTAINS(errorLine("run " + good + " --out " + (mDir / "afile").string()),
-                    "output folder '" + (mDir / "afile").string() + "': exists and is not a folder");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 5-2"), "--frames '5-2': expected 1 <= first <= last");
+                    "output folder '" + (mDir / "afile").string()
+                        + "': exists and is not a folder");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 5-2"),
+                    "--frames '5-2': expected 1 <= first <= last");
     // Frame numbers that do not fit: refused, not wrapped into "nothing to do" with exit 0.
     EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 1-3000000000"),
-                    "--frames '1-3000000000': expected A-B (e.g. 1-48) or a last frame, whole numbers up to 9999999");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 1-2x"), "--frames '1-2x': expected A-B");
+                    "--frames '1-3000000000': expected A-B (e.g. 1-48) or a last frame, whole "
+                    "numbers up to 9999999");
+    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 1-2x"),
+                    "--frames '1-2x': expected A-B");
     EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.frame_range=[1,3000000000]"),
-                    "settings.frame_range = [1,3000000000]: expected [first, last] with 1 <= first <= last <= 9999999");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.frame_range=[1,99999999999999999999]"),
-                    "settings.frame_range = [1,1e+20]: expected [first, last]");
+                    "settings.frame_range = [1,3000000000]: expected [first, last] with 1 <= first "
+                    "<= last <= 9999999");
+    EXPECT_CONTAINS(
+        errorLine("run " + good + out + " -D settings.frame_range=[1,99999999999999999999]"),
+        "settings.frame_range = [1,1e+20]: expected [first, last]");
     // Nothing was written by any of the failed runs.
     EXPECT_FALSE(fs::exists(mDir / "out") && !fs::is_empty(mDir / "out"));
 }
@@ -255,8 +279,10 @@ TEST_F(Cli, FixedStepBeyondTheStabilityLimitIsWarnedAboutBeforeTheFirstStep)
     const std::string out = " --out " + (mDir / "out").string() + " -q --frames 1-1";
     // 1 fps and one substep: dt = 1 s against a limit of a few ms (spacing 0.015 m, sound
     // speed 3.7 m/s): the warning names both numbers and the substeps that would do.
-    const Result bad = run("run " + path + out + " -D settings.frame_rate=1 -D settings.substeps=1");
-    EXPECT_CONTAINS(bad.err, "ghostfx: warning: scene '" + path + "': the fixed step 1 s (frame_rate 1, substeps 1) is ");
+    const Result bad =
+        run("run " + path + out + " -D settings.frame_rate=1 -D settings.substeps=1");
+    EXPECT_CONTAINS(bad.err, "ghostfx: warning: scene '" + path
+                                 + "': the fixed step 1 s (frame_rate 1, substeps 1) is ");
     EXPECT_CONTAINS(bad.err, "x the stability limit 0.00");
     EXPECT_CONTAINS(bad.err, "use substeps >= ");
     // The scene's own 10 substeps at 30 fps (dt 3.3 ms) are within it: no warning.
@@ -279,8 +305,8 @@ TEST_F(Cli, CtrlCFinishesTheFrameWritesACheckpointAndExitsNonZero)
     ASSERT_EQ(posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
     // Wait for the first frame, then interrupt.
     const auto start = std::chrono::steady_clock::now();
-    while (!fs::exists(fs::path(out) / "liquid.0001.vdb") &&
-           std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
+    while (!fs::exists(fs::path(out) / "liquid.0001.vdb")
+           && std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
     ::kill(pid, SIGINT);
@@ -292,7 +318,8 @@ TEST_F(Cli, CtrlCFinishesTheFrameWritesACheckpointAndExitsNonZero)
     int last = 0;
     for (const auto& e : fs::directory_iterator(out)) {
         const std::string name = e.path().filename().string();
-        if (name.rfind("checkpoint.", 0) == 0) last = std::max(last, vdbio::readCheckpointHeader(e.path().string()).frame);
+        if (name.rfind("checkpoint.", 0) == 0)
+            last = std::max(last, vdbio::readCheckpointHeader(e.path().string()).frame);
     }
     ASSERT_GE(last, 1);
     EXPECT_LT(last, 400);
@@ -314,17 +341,21 @@ TEST_F(Cli, OnlyWhatTheSceneRequiresIsModelledAndWritten)
     EXPECT_EQ(solver->count(sph::ParticleKind::GhostSolid), 0u);
     EXPECT_EQ(solver->count(sph::ParticleKind::Boundary), 0u);
     for (const std::string& c : solver->particles().vectorChannelNames()) {
-        EXPECT_EQ(c.find("solid"), std::string::npos) << "channel " << c << " in a scene without solids";
+        EXPECT_EQ(c.find("solid"), std::string::npos)
+            << "channel " << c << " in a scene without solids";
     }
     for (const std::string& c : solver->particles().scalarChannelNames()) {
-        EXPECT_EQ(c.find("solid"), std::string::npos) << "channel " << c << " in a scene without solids";
+        EXPECT_EQ(c.find("solid"), std::string::npos)
+            << "channel " << c << " in a scene without solids";
     }
-    const double bytes = double(solver->particles().memoryBytes()) / double(solver->particles().size());
+    const double bytes =
+        double(solver->particles().memoryBytes()) / double(solver->particles().size());
     std::printf("[measured] %.1f bytes per particle without solids\n", bytes);
 
     // Basic SPH: no ghost air at all.
     // (Basic SPH's Lennard-Jones walls need the CFL-limited step: it blows up at 10 fixed substeps.)
-    const vdbio::Scene basic = vdbio::readScene(write(smallScene()), {"settings.method=basic", "settings.substeps=0"});
+    const vdbio::Scene basic =
+        vdbio::readScene(write(smallScene()), {"settings.method=basic", "settings.substeps=0"});
     auto b = cmd::makeLiquidSolver(basic, cmd::liquidSettings(basic));
     b->advanceFrame();
     EXPECT_EQ(b->count(sph::ParticleKind::GhostAir), 0u);
@@ -334,8 +365,11 @@ TEST_F(Cli, OnlyWhatTheSceneRequiresIsModelledAndWritten)
 
     // Only the grids asked for are made and written; points off means no points file.
     const std::string path = write(smallScene());
-    ASSERT_EQ(run("run " + path + " --out " + (mDir / "out").string() +
-                  " -q --frames 1-1 -D 'outputs.volume.grids=[\"density\"]' -D outputs.points=false").code, 0);
+    ASSERT_EQ(
+        run("run " + path + " --out " + (mDir / "out").string()
+            + " -q --frames 1-1 -D 'outputs.volume.grids=[\"density\"]' -D outputs.points=false")
+            .code,
+        0);
     openvdb::io::File volume((mDir / "out" / "liquid.0001.vdb").string());
     volume.open();
     std::vector<std::string> names;
@@ -349,8 +383,11 @@ TEST_F(Cli, InfoPreviewAndSceneFromRoleTaggedVdb)
 {
     const std::string path = write(smallScene());
     const fs::path out = mDir / "out";
-    ASSERT_EQ(run("run " + path + " --out " + out.string() + " -q --frames 1-1 -D outputs.preview.width=160" +
-                  " -D outputs.preview.height=90").code, 0);
+    ASSERT_EQ(run("run " + path + " --out " + out.string()
+                  + " -q --frames 1-1 -D outputs.preview.width=160"
+                  + " -D outputs.preview.height=90")
+                  .code,
+              0);
     EXPECT_TRUE(fs::exists(out / "preview.0001.exr"));
     const Result info = run("info " + (out / "liquid.0001.vdb").string());
     EXPECT_EQ(info.code, 0) << info.err;
@@ -359,8 +396,10 @@ TEST_F(Cli, InfoPreviewAndSceneFromRoleTaggedVdb)
     EXPECT_CONTAINS(text, "density");
     EXPECT_EQ(run("info " + (out / "checkpoint.0001.h5").string()).code, 0);
     EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "schema_version");
-    EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o " + (mDir / "p.exr").string() +
-                  " --width 64 --height 48").code, 0);
+    EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o "
+                  + (mDir / "p.exr").string() + " --width 64 --height 48")
+                  .code,
+              0);
     EXPECT_TRUE(fs::exists(mDir / "p.exr"));
 }
 
@@ -408,22 +447,27 @@ TEST_F(Cli, GasPlumeRunsToDensityAndTemperatureVolumes)
     EXPECT_GT(pointCount(out / "gas_points.0003.vdb"), 0u);
 
     // The gas run resumes like the liquid one.
-    const Result resumed = run("run " + path + " --out " + (mDir / "b").string() + " -q --frames 1-3 --resume " +
-                               (out / "checkpoint.0002.h5").string());
+    const Result resumed =
+        run("run " + path + " --out " + (mDir / "b").string() + " -q --frames 1-3 --resume "
+            + (out / "checkpoint.0002.h5").string());
     ASSERT_EQ(resumed.code, 0) << resumed.err;
     const std::string fingerprint = vdbio::readScene(path).simulationFingerprint();
-    const sph::SolverState sa = vdbio::readCheckpoint((out / "checkpoint.0003.h5").string(), fingerprint);
-    const sph::SolverState sb = vdbio::readCheckpoint((mDir / "b" / "checkpoint.0003.h5").string(), fingerprint);
+    const sph::SolverState sa =
+        vdbio::readCheckpoint((out / "checkpoint.0003.h5").string(), fingerprint);
+    const sph::SolverState sb =
+        vdbio::readCheckpoint((mDir / "b" / "checkpoint.0003.h5").string(), fingerprint);
     ASSERT_EQ(sa.particles.size(), sb.particles.size());
     EXPECT_EQ(std::memcmp(sa.particles.positions().data(), sb.particles.positions().data(),
-                          sa.particles.size() * sizeof(sph::Vec3)), 0);
+                          sa.particles.size() * sizeof(sph::Vec3)),
+              0);
 
     // The ambient-air baseline needs the box it fills with air.
     Json noBox = plumeScene();
     noBox.erase("domain");
     noBox["settings"]["gas"]["variant"] = "ambient";
     EXPECT_CONTAINS(errorLine("run " + write(noBox, "nobox.json") + " --out " + out.string()),
-                    "settings.gas.variant = \"ambient\": the ambient-air baseline fills a box with air: expected domain.kill_box");
+                    "settings.gas.variant = \"ambient\": the ambient-air baseline fills a box with "
+                    "air: expected domain.kill_box");
 }
 
 TEST_F(Cli, AttractorRunsAndACheckpointWithoutItIsRefused)
@@ -434,20 +478,25 @@ TEST_F(Cli, AttractorRunsAndACheckpointWithoutItIsRefused)
     const std::string path = write(plumeScene(), "plume.json");
     const fs::path out = mDir / "out";
     ASSERT_EQ(run("run " + path + " --out " + out.string() + " -q --frames 1-2").code, 0);
-    const std::string field =
-        " -D 'force_fields=[{\"name\":\"magic\",\"attractor\":{\"position\":[0.3,0.6,0],\"strength\":2}}]'";
-    const std::string line = errorLine("run " + path + field + " --out " + (mDir / "b").string() +
-                                       " --resume " + (out / "checkpoint.0002.h5").string());
-    EXPECT_CONTAINS(line, "checkpoint.0002.h5' was written with different settings: /force_fields is missing "
-                          "there, [{\"attractor\":{\"position\":[0.3,0.6,0],\"strength\":2},\"name\":\"magic\"}] "
-                          "in this scene");
+    const std::string field = " -D "
+                              "'force_fields=[{\"name\":\"magic\",\"attractor\":{\"position\":[0.3,"
+                              "0.6,0],\"strength\":2}}]'";
+    const std::string line = errorLine("run " + path + field + " --out " + (mDir / "b").string()
+                                       + " --resume " + (out / "checkpoint.0002.h5").string());
+    EXPECT_CONTAINS(
+        line,
+        "checkpoint.0002.h5' was written with different settings: /force_fields is missing "
+        "there, [{\"attractor\":{\"position\":[0.3,0.6,0],\"strength\":2},\"name\":\"magic\"}] "
+        "in this scene");
     // The scene with the attractor runs, and says so.
-    const Result r = run("run " + path + field + " --out " + (mDir / "c").string() + " --progress log --frames 1-2");
+    const Result r = run("run " + path + field + " --out " + (mDir / "c").string()
+                         + " --progress log --frames 1-2");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_CONTAINS(r.err, "gas + 1 attractor, spacing 0.04 m");
     // And a liquid scene refuses it.
-    EXPECT_CONTAINS(errorLine("run " + write(smallScene()) + field + " --out " + (mDir / "d").string()),
-                    "force_fields: attractors act on gas; this scene has no gas");
+    EXPECT_CONTAINS(
+        errorLine("run " + write(smallScene()) + field + " --out " + (mDir / "d").string()),
+        "force_fields: attractors act on gas; this scene has no gas");
 }
 
 TEST_F(Cli, BoilingPanRunsLiquidAndVapour)
@@ -463,7 +512,8 @@ TEST_F(Cli, BoilingPanRunsLiquidAndVapour)
         "domain": { "kill_box": { "min": [-0.1, -0.1, -0.1], "max": [0.3, 1.0, 0.3] } }
     })");
     const fs::path out = mDir / "out";
-    const Result r = run("run " + write(scene, "pan.json") + " --out " + out.string() + " --progress log");
+    const Result r =
+        run("run " + write(scene, "pan.json") + " --out " + out.string() + " --progress log");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_CONTAINS(r.err, "boiling scenes write no checkpoints yet");
     EXPECT_TRUE(fs::exists(out / "liquid.0002.vdb"));
@@ -480,7 +530,8 @@ TEST_F(Cli, AnimatedSolidsFollowKeysAndFileSequences)
 {
     // A ball solid from a per-frame file sequence: frame 1 at x = 0.1, frame 2 at x = 0.2.
     for (int f = 1; f <= 2; ++f) {
-        auto ball = sph::makeSphereLevelSet(sph::Vec3(0.1f * float(f), 0.2f, 0.15f), 0.04f, 0.0075f);
+        auto ball =
+            sph::makeSphereLevelSet(sph::Vec3(0.1f * float(f), 0.2f, 0.15f), 0.04f, 0.0075f);
         ball->setName("ball");
         char name[64];
         std::snprintf(name, sizeof(name), "ball.%04d.vdb", f);
@@ -491,7 +542,8 @@ TEST_F(Cli, AnimatedSolidsFollowKeysAndFileSequences)
     openvdb::io::File((mDir / "ball.vdb").string()).write(openvdb::GridPtrVec{first});
     Json scene = smallScene();
     scene["settings"]["frame_range"] = {1, 2};
-    scene["solids"].push_back(Json::parse(R"({ "name": "ball", "geometry": { "file": "ball.vdb", "grid": "ball" },
+    scene["solids"].push_back(
+        Json::parse(R"({ "name": "ball", "geometry": { "file": "ball.vdb", "grid": "ball" },
                                               "sequence": { "file": "ball.$F4.vdb", "grid": "ball" } })"));
     // A paddle keyed to slide 0.05 m in x over the first frame.
     scene["solids"].push_back(Json::parse(R"({ "name": "paddle",
@@ -499,13 +551,15 @@ TEST_F(Cli, AnimatedSolidsFollowKeysAndFileSequences)
         "motion": { "keys": [ { "time": 0, "translate": [0, 0, 0] }, { "time": 0.0333333333, "translate": [-0.05, 0, 0] } ] } })"));
     const std::string path = write(scene);
     const fs::path out = mDir / "out";
-    const Result r = run("run " + path + " --out " + out.string() + " -q -D outputs.checkpoint.every=1");
+    const Result r =
+        run("run " + path + " --out " + out.string() + " -q -D outputs.checkpoint.every=1");
     ASSERT_EQ(r.code, 0) << r.err;
 
     // Ghosts of solid 1 (the ball) sit around its frame-2 centre; those of solid 2 (the paddle)
     // moved with it by -0.05 m.
     const std::string fingerprint = vdbio::readScene(path).simulationFingerprint();
-    const sph::SolverState state = vdbio::readCheckpoint((out / "checkpoint.0002.h5").string(), fingerprint);
+    const sph::SolverState state =
+        vdbio::readCheckpoint((out / "checkpoint.0002.h5").string(), fingerprint);
     const auto& index = state.particles.scalarChannel("solid_index");
     double ballX = 0, paddleMinX = 1e9;
     std::size_t ballCount = 0;
@@ -520,8 +574,9 @@ TEST_F(Cli, AnimatedSolidsFollowKeysAndFileSequences)
     }
     ASSERT_GT(ballCount, 0u);
     ballX /= double(ballCount);
-    std::printf("[measured] ball ghosts centred at x = %.4f m (file of frame 2: 0.2), paddle min x = %.4f m\n", ballX,
-                paddleMinX);
+    std::printf("[measured] ball ghosts centred at x = %.4f m (file of frame 2: 0.2), paddle min x "
+                "= %.4f m\n",
+                ballX, paddleMinX);
     // The ghost layer is sampled symmetrically around the ball: its mean is the centre to a
     // fraction of a spacing (0.015 m).
     EXPECT_NEAR(ballX, 0.2, 0.005);
@@ -530,5 +585,6 @@ TEST_F(Cli, AnimatedSolidsFollowKeysAndFileSequences)
 
     // A missing frame of the sequence is a clear error naming the file.
     const std::string line = errorLine("run " + path + " --out " + out.string() + " --frames 1-3");
-    EXPECT_CONTAINS(line, "solids[1].sequence: file '" + (mDir / "ball.0003.vdb").string() + "' does not exist");
+    EXPECT_CONTAINS(line, "solids[1].sequence: file '" + (mDir / "ball.0003.vdb").string()
+                              + "' does not exist");
 }

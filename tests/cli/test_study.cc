@@ -42,8 +42,10 @@ std::vector<std::map<std::string, std::string>> readCsv(const fs::path& p)
         bool quoted = false;
         for (char c : l) {
             if (c == '"') quoted = !quoted;
-            else if (c == ',' && !quoted) { f.push_back(cur); cur.clear(); }
-            else cur += c;
+            else if (c == ',' && !quoted) {
+                f.push_back(cur);
+                cur.clear();
+            } else cur += c;
         }
         f.push_back(cur);
         return f;
@@ -69,8 +71,9 @@ class Study : public ::testing::Test
 protected:
     void SetUp() override
     {
-        mDir = fs::temp_directory_path() /
-               ("ghostfx_study_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        mDir = fs::temp_directory_path()
+               / ("ghostfx_study_"
+                  + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(mDir);
         fs::create_directories(mDir);
         // A drop of water in free fall, no solid anywhere: its centre of mass must follow
@@ -145,7 +148,8 @@ TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
         EXPECT_EQ(row.at("precision"), sizeof(ghostfx::sph::Real) == 8 ? "double" : "float");
         // Cost: 4 frames at 30 fps; wall time per simulated second = wall / (4/30).
         EXPECT_NEAR(num(row, "sim_s"), 4.0 / 30.0, 1e-6);
-        EXPECT_NEAR(num(row, "wall_per_sim_second"), num(row, "wall_s") / num(row, "sim_s"), 1e-3 * num(row, "wall_per_sim_second"));
+        EXPECT_NEAR(num(row, "wall_per_sim_second"), num(row, "wall_s") / num(row, "sim_s"),
+                    1e-3 * num(row, "wall_per_sim_second"));
         EXPECT_EQ(num(row, "steps"), 4 * std::stod(row.at("settings.substeps")));
         EXPECT_GT(num(row, "peak_rss_mb"), 1.0);
         EXPECT_GT(num(row, "count_liquid"), 50);
@@ -158,7 +162,8 @@ TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
         const double T = 4.0 / 30.0, dt = T / num(row, "steps");
         const double expected = 9.81 * T * dt / 2 / 0.02;
         const double tolerance = row.at("settings.method") == "basic" ? 0.01 * expected : 0.06;
-        EXPECT_NEAR(num(row, "free_fall_com_error_spacings"), expected, tolerance) << row.at("settings.method");
+        EXPECT_NEAR(num(row, "free_fall_com_error_spacings"), expected, tolerance)
+            << row.at("settings.method");
         // No particle is added or removed.
         EXPECT_EQ(num(row, "mass_drift"), 0.0);
         EXPECT_GE(num(row, "density_error_max"), num(row, "density_error_mean"));
@@ -175,7 +180,8 @@ TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
     for (const auto& row : order) {
         EXPECT_EQ(num(row, "1/settings.substeps_coarse"), 0.2);
         EXPECT_EQ(num(row, "1/settings.substeps_fine"), 0.05);
-        if (row.at("group") == "settings.method=basic") EXPECT_NEAR(num(row, "observed_order"), 1.0, 0.01);
+        if (row.at("group") == "settings.method=basic")
+            EXPECT_NEAR(num(row, "observed_order"), 1.0, 0.01);
         else EXPECT_GT(num(row, "observed_order"), 0.2);
     }
     // The plot is a PNG with its signature.
@@ -196,7 +202,8 @@ TEST_F(Study, TracesAreComparedWithTheReferenceAndOrderIsReported)
 {
     Json s = baseStudy();
     // The drop's lowest point, tracked downwards, against a reference with finer steps.
-    s["metrics"] = Json::array({Json{{"metric", "surge_front"}, {"direction", {0, -1, 0}}, {"percentile", 100}}});
+    s["metrics"] = Json::array(
+        {Json{{"metric", "surge_front"}, {"direction", {0, -1, 0}}, {"percentile", 100}}});
     s["sweep"]["settings.spacing"] = {0.03, 0.02};
     s["reference"]["settings.spacing"] = 0.015;
     const Result r = run("study " + writeStudy(s).string() + " --threads 1");
@@ -211,14 +218,17 @@ TEST_F(Study, TracesAreComparedWithTheReferenceAndOrderIsReported)
         const double e = num(rows[k], "surge_front_error_m");
         EXPECT_TRUE(std::isfinite(e));
         EXPECT_LT(e, 2 * 0.03);
-        EXPECT_NEAR(num(rows[k], "surge_front_error"), e / (0.5 * 9.81 * std::pow(4.0 / 30.0, 2)), 0.2 * num(rows[k], "surge_front_error") + 1e-9);
+        EXPECT_NEAR(num(rows[k], "surge_front_error"), e / (0.5 * 9.81 * std::pow(4.0 / 30.0, 2)),
+                    0.2 * num(rows[k], "surge_front_error") + 1e-9);
     }
     const auto order = readCsv(mDir / "out" / "convergence.csv");
     ASSERT_EQ(order.size(), 1u);
     EXPECT_EQ(num(order[0], "settings.spacing_coarse"), 0.03);
     EXPECT_EQ(num(order[0], "settings.spacing_fine"), 0.02);
     EXPECT_NEAR(num(order[0], "observed_order"),
-                std::log(num(rows[1], "surge_front_error") / num(rows[2], "surge_front_error")) / std::log(1.5), 1e-3);
+                std::log(num(rows[1], "surge_front_error") / num(rows[2], "surge_front_error"))
+                    / std::log(1.5),
+                1e-3);
 }
 
 TEST_F(Study, BlownUpCaseIsRecordedAndTheStudyGoesOn)
@@ -245,22 +255,28 @@ TEST_F(Study, BadStudyFilesGetOneClearLine)
     {
         Json s = baseStudy();
         s["metrics"] = {"free_fal"};
-        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file + "': metrics[0] = \"free_fal\": unknown metric "
-                                "(expected one of density_error, volume_drift, hydrostatic_pressure, free_fall, "
-                                "cube_shape, surge_front, plume_rise)\n");
+        EXPECT_EQ(
+            errorLine(s),
+            "ghostfx: error: study '" + file
+                + "': metrics[0] = \"free_fal\": unknown metric "
+                  "(expected one of density_error, volume_drift, hydrostatic_pressure, free_fall, "
+                  "cube_shape, surge_front, plume_rise)\n");
     }
     {
         Json s = baseStudy();
         s["sweep"]["settings.spacng"] = {0.02};
-        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file + "': case 'settings.spacng=0.02': scene '" +
-                                    (mDir / "drop.json").string() +
-                                    "': settings.spacng: unknown key (did you mean 'spacing'?)\n");
+        EXPECT_EQ(errorLine(s),
+                  "ghostfx: error: study '" + file + "': case 'settings.spacng=0.02': scene '"
+                      + (mDir / "drop.json").string()
+                      + "': settings.spacng: unknown key (did you mean 'spacing'?)\n");
     }
     {
         Json s = baseStudy();
         s["sweep"]["settings.spacing"] = Json::array();
-        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file +
-                                    "': sweep: 'settings.spacing' = []: expected a non-empty array of values\n");
+        EXPECT_EQ(
+            errorLine(s),
+            "ghostfx: error: study '" + file
+                + "': sweep: 'settings.spacing' = []: expected a non-empty array of values\n");
     }
     {
         Json s = baseStudy();
@@ -272,23 +288,29 @@ TEST_F(Study, BadStudyFilesGetOneClearLine)
         Json s = baseStudy();
         s["plot"]["error"] = "hydrostatic_pressure_error";
         const std::string e = errorLine(s);
-        EXPECT_NE(e.find("plot.error = \"hydrostatic_pressure_error\": not a column of these metrics"), std::string::npos) << e;
+        EXPECT_NE(
+            e.find("plot.error = \"hydrostatic_pressure_error\": not a column of these metrics"),
+            std::string::npos)
+            << e;
     }
     {
         Json s = baseStudy();
         s["metrics"] = Json::array({Json{{"metric", "surge_front"}, {"percentil", 90}}});
         const std::string e = errorLine(s);
-        EXPECT_NE(e.find("metrics[0].percentil: unknown option of this metric"), std::string::npos) << e;
+        EXPECT_NE(e.find("metrics[0].percentil: unknown option of this metric"), std::string::npos)
+            << e;
     }
     {
         Json s = baseStudy();
         s["scene"] = "missing.json";
-        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file + "': case '': scene '" +
-                                    (mDir / "missing.json").string() + "': cannot open the file\n");
+        EXPECT_EQ(errorLine(s), "ghostfx: error: study '" + file + "': case '': scene '"
+                                    + (mDir / "missing.json").string()
+                                    + "': cannot open the file\n");
     }
     EXPECT_EQ(errorLine(Json::parse(R"({"ghostfx_study": 1, "scene": "drop.json"})")),
-              "ghostfx: error: study '" + file + "': metrics = null: expected a non-empty array of metric names "
-              "(docs/study.md)\n");
+              "ghostfx: error: study '" + file
+                  + "': metrics = null: expected a non-empty array of metric names "
+                    "(docs/study.md)\n");
 }
 
 TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
@@ -326,5 +348,6 @@ TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
     // Mean |rho / rho0 - 1| below the bottom's 10 %.
     EXPECT_LT(num(rows[0], "density_error_mean"), 0.1);
     // Single particles scatter more than the layer means: the noise bounds the profile error.
-    EXPECT_GE(num(rows[0], "hydrostatic_pressure_noise"), num(rows[0], "hydrostatic_pressure_error"));
+    EXPECT_GE(num(rows[0], "hydrostatic_pressure_noise"),
+              num(rows[0], "hydrostatic_pressure_error"));
 }

@@ -38,7 +38,8 @@ inline bool contains(const std::string& text, const std::string& part)
 /// An empty folder of the system's temporary directory for one test ("ghostfx_test_<name>").
 inline std::filesystem::path freshDir(const std::string& name)
 {
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("ghostfx_test_" + name);
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("ghostfx_test_" + name);
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;

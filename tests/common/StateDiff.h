@@ -20,8 +20,8 @@ using sph::Vec3;
 template <typename T>
 inline bool sameBytes(const std::vector<T>& a, const std::vector<T>& b)
 {
-    return a.size() == b.size() &&
-           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+    return a.size() == b.size()
+           && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 /// "" if two states are identical bit for bit (every channel, default, id, scalar), else what

@@ -28,8 +28,8 @@ using namespace ghostfx::gas;
 
 namespace {
 
-constexpr Real S = Real(0.02);     // particle spacing (m); support radius 2 S
-constexpr Real HALF = Real(0.1);   // half edge of the test blocks (m): 10 spacings across
+constexpr Real S = Real(0.02);   // particle spacing (m); support radius 2 S
+constexpr Real HALF = Real(0.1); // half edge of the test blocks (m): 10 spacings across
 constexpr Real TAMB = Real(293.15);
 
 double seconds(std::chrono::steady_clock::time_point t0)
@@ -63,8 +63,8 @@ Real depthInBlock(const Vec3& x)
 
 struct Spread
 {
-    double rms = 0;      ///< RMS distance of gas particles from their centroid (m)
-    double nn = 0;       ///< mean nearest-neighbour distance (m), capped at 3 S
+    double rms = 0; ///< RMS distance of gas particles from their centroid (m)
+    double nn = 0;  ///< mean nearest-neighbour distance (m), capped at 3 S
     Vec3d centroid{0.0};
 };
 
@@ -131,9 +131,15 @@ TEST(GasDensity, VirtualParticleCorrectionShrinksTheSurfaceShortfall)
         const Real d = depthInBlock(p.positions()[i]);
         const double nh = double(normal[i].length() * R);
         if (d < Real(0.25) * S) {
-            outerBar += rhoBar[i]; outer += p.densities()[i]; outerN += nh; ++nOuter;
+            outerBar += rhoBar[i];
+            outer += p.densities()[i];
+            outerN += nh;
+            ++nOuter;
         } else if (d > R) {
-            innerBar += rhoBar[i]; inner += p.densities()[i]; innerN += nh; ++nInner;
+            innerBar += rhoBar[i];
+            inner += p.densities()[i];
+            innerN += nh;
+            ++nInner;
             innerAbove += nh > solver.settings().normalThreshold;
         }
     }
@@ -141,9 +147,10 @@ TEST(GasDensity, VirtualParticleCorrectionShrinksTheSurfaceShortfall)
     std::printf("[measured] density correction: %zu particles, outer layer %.0f: rho_bar/rho0 = "
                 "%.3f, corrected %.3f (shortfall %.1f%% -> %.1f%%); interior %.0f: rho_bar/rho0 = "
                 "%.3f, corrected %.3f; |n|h outer %.2f, interior %.2f (%.0f%% of interior above "
-                "C_N = %.2f)\n", p.size(), nOuter, outerBar / nOuter / rho0, outer / nOuter / rho0,
-                100 * shortBar, 100 * shortCorr, nInner, innerBar / nInner / rho0,
-                inner / nInner / rho0, outerN / nOuter, innerN / nInner, 100 * innerAbove / nInner,
+                "C_N = %.2f)\n",
+                p.size(), nOuter, outerBar / nOuter / rho0, outer / nOuter / rho0, 100 * shortBar,
+                100 * shortCorr, nInner, innerBar / nInner / rho0, inner / nInner / rho0,
+                outerN / nOuter, innerN / nInner, 100 * innerAbove / nInner,
                 double(solver.settings().normalThreshold));
     ASSERT_GT(nOuter, 100);
     ASSERT_GT(nInner, 20);
@@ -194,7 +201,8 @@ TEST(GasBlock, CompensatedBlockHoldsTogetherUncorrectedExpands)
             std::printf("[measured] block %s, %s: RMS radius x%.3f after 1 s, x%.3f after 2 s; "
                         "mean nearest neighbour %.4f -> %.4f m; %zu particles, %.2f s\n",
                         pressured ? "at 1.25 rho0" : "at rho0", methodName(method), half,
-                        s1.rms / s0.rms, s0.nn, s1.nn, solver.count(ParticleKind::Gas), seconds(t0));
+                        s1.rms / s0.rms, s0.nn, s1.nn, solver.count(ParticleKind::Gas),
+                        seconds(t0));
         }
     }
     std::printf("[measured] block at 1.25 rho0: uncorrected / fast RMS growth = %.2f\n",
@@ -214,8 +222,7 @@ TEST(GasBlock, CompensatedBlockHoldsTogetherUncorrectedExpands)
 
 TEST(GasTemperature, HotBlobRisesColdStaysAndDiffusionConservesHeat)
 {
-    const LevelSet blob =
-        makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.08), S / 2), "blob");
+    const LevelSet blob = makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.08), S / 2), "blob");
     constexpr int FRAMES = 30; // 1 s
     double rise[2] = {};
     for (int hot = 0; hot < 2; ++hot) {
@@ -255,7 +262,9 @@ TEST(GasTemperature, HotBlobRisesColdStaysAndDiffusionConservesHeat)
     auto spreadT = [&] {
         double sum = 0, sum2 = 0, n = 0;
         for (std::size_t i = 0; i < T.size(); ++i) {
-            sum += T[i]; sum2 += double(T[i]) * T[i]; ++n;
+            sum += T[i];
+            sum2 += double(T[i]) * T[i];
+            ++n;
         }
         return std::sqrt(std::max(0.0, sum2 / n - sqr(sum / n)));
     };
@@ -264,8 +273,8 @@ TEST(GasTemperature, HotBlobRisesColdStaysAndDiffusionConservesHeat)
     for (int f = 0; f < FRAMES; ++f) solver.advanceFrame();
     const double q1 = heat(solver), sd1 = spreadT();
     std::printf("[measured] diffusion only: heat %.6e -> %.6e kg K (relative change %.2e), "
-                "temperature std %.1f -> %.1f K, %zu particles\n", q0, q1, (q1 - q0) / q0, sd0, sd1,
-                solver.count(ParticleKind::Gas));
+                "temperature std %.1f -> %.1f K, %zu particles\n",
+                q0, q1, (q1 - q0) / q0, sd0, sd1, solver.count(ParticleKind::Gas));
     // Eq. 15 is antisymmetric in i, j, so heat changes only by float rounding of T += dt dT/dt
     // (T ~ 400 K, float epsilon 6e-8, 120 steps): bound 1e-4 relative.
     EXPECT_LT(std::abs(q1 - q0) / q0, 1e-4);
@@ -326,8 +335,8 @@ TEST(GasPlume, AmbientBaselineAndFastSolverRiseAlikeWithFarFewerParticles)
         visible[k] = double(heights.size());
         simulated[k] = double(peak);
         std::printf("[measured] plume %s: top %.3f m above the source after 0.8 s, %zu visible, "
-                    "%zu simulated particles (+%zu boundary), %.2f s wall\n", methodName(method),
-                    top[k], heights.size(), solver.count(ParticleKind::Gas),
+                    "%zu simulated particles (+%zu boundary), %.2f s wall\n",
+                    methodName(method), top[k], heights.size(), solver.count(ParticleKind::Gas),
                     solver.count(ParticleKind::Boundary), cost[k]);
     }
     std::printf("[measured] plume: fast / ambient top = %.2f, ambient / fast simulated particles = "
@@ -367,9 +376,9 @@ TEST(GasExtremes, KappaOverEightOrdersNeverGivesSilentNaN)
             }
             if (error.empty()) {
                 for (std::size_t i = 0; i < solver.particles().size(); ++i) {
-                    finite = finite && isFinite(solver.particles().positions()[i]) &&
-                             isFinite(solver.particles().velocities()[i]) &&
-                             std::isfinite(solver.particles().densities()[i]);
+                    finite = finite && isFinite(solver.particles().positions()[i])
+                             && isFinite(solver.particles().velocities()[i])
+                             && std::isfinite(solver.particles().densities()[i]);
                 }
                 EXPECT_TRUE(finite) << "silent NaN at kappa " << kappa;
             } else {
@@ -430,8 +439,9 @@ struct ResumeScene
     LevelSet floor, nozzle;
 
     ResumeScene()
-        : floor(makeLevelSet(makeBoxLevelSet(Vec3(-0.15f, -0.06f, -0.15f), Vec3(0.15f, -0.02f, 0.15f),
-                                             S / 2), "floor"))
+        : floor(makeLevelSet(
+            makeBoxLevelSet(Vec3(-0.15f, -0.06f, -0.15f), Vec3(0.15f, -0.02f, 0.15f), S / 2),
+            "floor"))
         , nozzle(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.04), S / 2), "nozzle"))
     {
         settings = settingsFor(Method::Fast);
@@ -544,7 +554,6 @@ TEST(GasSettingsTest, ValidationNamesTheSettingValueAndRange)
     EXPECT_THROW(methodFromName("ghost"), ValueError);
 }
 
-
 // Attractor force field ([RYY15] Fig. 7; formula in GasSettings.h) ------------------------------
 
 namespace {
@@ -606,8 +615,11 @@ TEST(GasAttractor, FormulaIsContinuousFiniteAtTheCentreAndFallsOff)
         s.validate();
         FAIL() << "radius 0 must be refused";
     } catch (const ValueError& e) {
-        EXPECT_NE(std::string(e.what()).find("gas setting attractors[0].radius = 0: expected a finite "
-                                             "value > 0 (m)"), std::string::npos) << e.what();
+        EXPECT_NE(
+            std::string(e.what()).find("gas setting attractors[0].radius = 0: expected a finite "
+                                       "value > 0 (m)"),
+            std::string::npos)
+            << e.what();
     }
     EXPECT_EQ(falloffFromName("constant"), Falloff::Constant);
     EXPECT_THROW(falloffFromName("cubic"), ValueError);
@@ -639,7 +651,8 @@ TEST(GasAttractor, CloudAcceleratesTowardsThePointAsThePerParticleFalloffSays)
         core += (x[i] - straddle.position).length() < straddle.radius;
     }
     std::printf("[measured] attractor per particle: %zu particles (%zu in the core), worst |a - "
-                "formula| = %.2e m/s^2\n", x.size(), core, worst);
+                "formula| = %.2e m/s^2\n",
+                x.size(), core, worst);
     EXPECT_GT(core, 20u);
     EXPECT_LT(core, x.size() - 20);
     EXPECT_LT(worst, 1e-4);
@@ -664,8 +677,8 @@ TEST(GasAttractor, CloudAcceleratesTowardsThePointAsThePerParticleFalloffSays)
         const double expected = 20.0 * sqr(0.1 / d);
         pull[k] = com[0] - ownMean[0];
         std::printf("[measured] ball at d = %.1f m: centre-of-mass acceleration (%.4f, %.4f, %.4f) "
-                    "m/s^2, of which own forces (%.4f, %.4f, %.4f); shell theorem %.4f\n", d, com[0],
-                    com[1], com[2], ownMean[0], ownMean[1], ownMean[2], expected);
+                    "m/s^2, of which own forces (%.4f, %.4f, %.4f); shell theorem %.4f\n",
+                    d, com[0], com[1], com[2], ownMean[0], ownMean[1], ownMean[2], expected);
         EXPECT_NEAR(pull[k], expected, 0.03 * expected);
         EXPECT_NEAR(com[0], expected, 0.03 * expected + ownMean.length());
         EXPECT_LT((com - ownMean).length() - std::abs(pull[k]), 0.03 * expected);
@@ -682,7 +695,8 @@ TEST(GasAttractor, CloudAcceleratesTowardsThePointAsThePerParticleFalloffSays)
     const Vec3d com = mean(firstStepAcceleration(cloud, {wide}, dt, nullptr));
     const double expected = 4.0 * (0.05 - mean(x)[0]) / 0.25;
     std::printf("[measured] ball inside the core: centre-of-mass acceleration %.5f m/s^2 (own "
-                "forces %.5f), expected %.5f\n", com[0], ownMean[0], expected);
+                "forces %.5f), expected %.5f\n",
+                com[0], ownMean[0], expected);
     EXPECT_NEAR(com[0] - ownMean[0], expected, 1e-3 * expected);
 }
 
@@ -698,12 +712,14 @@ TEST(GasAttractor, PullsAPuffToThePointAndHoldsItThere)
     a.radius = Real(0.15);
     s.attractors = {a};
     GasSolver solver(s);
-    solver.addGas(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.06), S / 2), "puff"), Vec3(0), TAMB);
+    solver.addGas(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.06), S / 2), "puff"), Vec3(0),
+                  TAMB);
     for (int f = 0; f < 60; ++f) solver.advanceFrame(); // 2 s
     const Spread spread = measureSpread(solver.particles());
     std::printf("[measured] puff after 2 s: centroid (%.3f, %.3f, %.3f) m, RMS radius %.3f m, "
-                "%zu particles\n", spread.centroid[0], spread.centroid[1], spread.centroid[2],
-                spread.rms, solver.count(ParticleKind::Gas));
+                "%zu particles\n",
+                spread.centroid[0], spread.centroid[1], spread.centroid[2], spread.rms,
+                solver.count(ParticleKind::Gas));
     // Free motion in the field would reach the point at about t = 0.5 s; after 2 s the centroid
     // is within a core radius of it.
     EXPECT_LT((spread.centroid - Vec3d(a.position)).length(), a.radius);
@@ -725,7 +741,8 @@ TEST(GasAmbient, AirFillsAroundASolidWithANarrowBand)
     const double boxVolume = cube(0.6 - 0.04) - cube(0.2);
     const double expected = boxVolume / cube(0.04);
     std::printf("[measured] ambient air around a narrow-band cube: %zu particles, %.0f lattice "
-                "cells of the free volume\n", solver.ambientCount(), expected);
+                "cells of the free volume\n",
+                solver.ambientCount(), expected);
     // Poisson-disk sampling at radius 0.92 s packs about 0.7 - 1 particle per s^3.
     EXPECT_GT(double(solver.ambientCount()), 0.5 * expected);
     // None inside the cube or in its band.

@@ -30,7 +30,6 @@ constexpr Real DT = Real(1) / Real(1200); ///< [SB12] k = 2000 Pa needs about 1/
 constexpr Real A = Real(0.04);            ///< pan half width (m)
 constexpr Real DEPTH = Real(0.04);        ///< water depth (m)
 
-
 /// Open-top pan: walls 4 h thick around the inside [-a, a] x [0, top] x [-a, a].
 LevelSet panLevelSet(Real a, Real top)
 {
@@ -74,11 +73,13 @@ struct Scene
     std::unique_ptr<gas::PhaseTransition> coupler;
 
     Scene(const gas::PhaseSettings& phase, const gas::GasSettings& gasSettings)
-        : liquid(liquidSettings()), side(liquid), vapour(gasSettings)
+        : liquid(liquidSettings())
+        , side(liquid)
+        , vapour(gasSettings)
     {
         liquid.addSolid(panLevelSet(A, Real(0.1)));
-        liquid.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(-A, 0, -A), Vec3(A, DEPTH, A), H / 2),
-                                      "water"));
+        liquid.addLiquid(
+            makeLevelSet(makeBoxLevelSet(Vec3(-A, 0, -A), Vec3(A, DEPTH, A), H / 2), "water"));
         coupler = std::make_unique<gas::PhaseTransition>(vapour, side, phase);
     }
 
@@ -97,8 +98,8 @@ bool allGasFinite(const gas::GasSolver& g)
 {
     const ParticleSet& p = g.particles();
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (!isFinite(p.positions()[i]) || !isFinite(p.velocities()[i]) ||
-            !std::isfinite(p.densities()[i])) {
+        if (!isFinite(p.positions()[i]) || !isFinite(p.velocities()[i])
+            || !std::isfinite(p.densities()[i])) {
             return false;
         }
     }
@@ -116,7 +117,7 @@ TEST(PhaseTransition, BoilingPanMakesVapourConservesMassAndReachesBoilingPoint)
     phase.latentHeat = Real(40);             // smaller L/c_p (water: 540 K) for the same reason
     phase.heatingTime = Real(0.05);
     phase.heaterBand = Real(1.5) * H;
-    phase.evaporationRate = Real(0);         // boiling only
+    phase.evaporationRate = Real(0); // boiling only
     Scene scene(phase, vapourSettings());
     scene.coupler->addHeater(plateLevelSet(A), Real(393.15));
 
@@ -139,17 +140,21 @@ TEST(PhaseTransition, BoilingPanMakesVapourConservesMassAndReachesBoilingPoint)
     double maxNearT = 0, sumFarT = 0, nFar = 0;
     for (std::size_t i = 0; i < p.size(); ++i) {
         if (p.kinds()[i] != ParticleKind::Liquid) continue;
-        if (plate.phi(p.positions()[i]) < phase.heaterBand) maxNearT = std::max(maxNearT, double(T[i]));
-        else { sumFarT += T[i]; nFar += 1; }
+        if (plate.phi(p.positions()[i]) < phase.heaterBand)
+            maxNearT = std::max(maxNearT, double(T[i]));
+        else {
+            sumFarT += T[i];
+            nFar += 1;
+        }
     }
     const double relMass = std::abs(end.total() - start.total()) / start.total();
     std::printf("[measured] boiling: liquid %zu -> %zu particles, boiled %zu, vapour particles "
                 "%zu at 0.15 s, %zu at 0.3 s, vapour mass %.4e kg (%.2f %% of water), mass "
                 "budget drift %.2e relative (liquid %.6e + gas %.6e kg), max T near plate "
                 "%.3f K, mean T elsewhere %.2f K, coarse boundary %zu particles\n",
-                liquid0, scene.liquidCount(), scene.coupler->boiledCount(), vapourEarly,
-                vapourLate, end.gas, 100 * end.gas / start.total(), relMass, end.liquid, end.gas,
-                maxNearT, nFar > 0 ? sumFarT / nFar : 0.0, scene.coupler->boundaryCount());
+                liquid0, scene.liquidCount(), scene.coupler->boiledCount(), vapourEarly, vapourLate,
+                end.gas, 100 * end.gas / start.total(), relMass, end.liquid, end.gas, maxNearT,
+                nFar > 0 ? sumFarT / nFar : 0.0, scene.coupler->boundaryCount());
 
     EXPECT_GT(scene.coupler->boiledCount(), 0u);
     EXPECT_GT(vapourEarly, 0u);
@@ -173,11 +178,11 @@ namespace {
 
 struct EvaporationRun
 {
-    double vapourMass = 0;   ///< kg handed to the gas
-    double rate = 0;         ///< kg/s over the measured window
-    double predicted = 0;    ///< kg/s from the surface count at the start of the window
-    double liquidLoss = 0;   ///< fraction of the water's mass lost
-    double drift = 0;        ///< relative mass budget drift
+    double vapourMass = 0; ///< kg handed to the gas
+    double rate = 0;       ///< kg/s over the measured window
+    double predicted = 0;  ///< kg/s from the surface count at the start of the window
+    double liquidLoss = 0; ///< fraction of the water's mass lost
+    double drift = 0;      ///< relative mass budget drift
     std::size_t splits = 0, merges = 0, vapourParticles = 0;
 };
 
@@ -215,8 +220,8 @@ TEST(PhaseTransition, EvaporationRateIsProportionalToTheParameter)
                 "%zu vapour particles, liquid lost %.3f %%, drift %.1e); rate 10 /s -> %.3e kg/s "
                 "(%zu splits, %zu merges, liquid lost %.3f %%, drift %.1e); ratio %.3f\n",
                 slow.rate, slow.splits, slow.merges, slow.vapourParticles, 100 * slow.liquidLoss,
-                slow.drift, fast.rate, fast.splits, fast.merges, 100 * fast.liquidLoss,
-                fast.drift, ratio);
+                slow.drift, fast.rate, fast.splits, fast.merges, 100 * fast.liquidLoss, fast.drift,
+                ratio);
     EXPECT_GT(slow.splits, 0u);
     // Deterministic accumulators: each surface particle splits floor(rate f t) times, so doubling
     // the rate doubles the splits up to one split per surface particle of quantisation and the
@@ -252,8 +257,9 @@ TEST(PhaseTransition, ViolentBoilingAtDensityRatio1000StaysFiniteOrFailsClearly)
             const ParticleSet& g = scene.vapour.particles();
             for (std::size_t i = 0; i < g.size(); ++i) {
                 if (g.kinds()[i] == ParticleKind::Gas) {
-                    maxRatio = std::max(maxRatio, double(g.densities()[i]) /
-                                                      double(scene.vapour.settings().restDensity));
+                    maxRatio =
+                        std::max(maxRatio, double(g.densities()[i])
+                                               / double(scene.vapour.settings().restDensity));
                 }
             }
         }
@@ -262,8 +268,8 @@ TEST(PhaseTransition, ViolentBoilingAtDensityRatio1000StaysFiniteOrFailsClearly)
     }
     const double drift = std::abs(scene.coupler->massBudget().total() - m0) / m0;
     std::printf("[measured] violent boiling 1000:1: %d steps, boiled %zu of the liquid, %zu "
-                "vapour particles, max gas rho / rho0 %.1f, mass drift %.1e, %s\n", done,
-                scene.coupler->boiledCount(), scene.vapour.visibleGasCount(), maxRatio, drift,
+                "vapour particles, max gas rho / rho0 %.1f, mass drift %.1e, %s\n",
+                done, scene.coupler->boiledCount(), scene.vapour.visibleGasCount(), maxRatio, drift,
                 error.empty() ? "no error" : error.c_str());
     if (!error.empty()) {
         // A blow-up must say where and what to change.

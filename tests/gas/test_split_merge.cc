@@ -79,8 +79,8 @@ TEST(SplitQuadrature, RefinementStudy)
     for (SplitKernel kernel : {SplitKernel::Poly6, SplitKernel::CubicSpline}) {
         for (double d : {0.0, 0.12, 0.3, 0.4 * std::sqrt(2.0), 0.9}) {
             const double ref = overlapIntegral(kernel, d, 1.0, 0.9, Quadrature{16, 4});
-            std::printf("[measured] %s overlap d=%.3f ref=%.15f |rule-ref|/ref:", splitKernelName(kernel),
-                        d, ref);
+            std::printf("[measured] %s overlap d=%.3f ref=%.15f |rule-ref|/ref:",
+                        splitKernelName(kernel), d, ref);
             double defaultErr = 0.0;
             for (int nodes : {2, 3, 4, 6, 8}) {
                 const double v = overlapIntegral(kernel, d, 1.0, 0.9, Quadrature{nodes, 2});
@@ -120,15 +120,15 @@ TEST(SplitQuadrature, RadialReductionMatchesCartesianSum)
                     const double z = -hy + (k + 0.5) * dy;
                     const double ra = std::sqrt(x * x + y * y + z * z);
                     const double rb = std::sqrt((x - d) * (x - d) + y * y + z * z);
-                    s += unitKernel(SplitKernel::Poly6, ra / r1) / (r1 * r1 * r1) *
-                         unitKernel(SplitKernel::Poly6, rb / r2) / (r2 * r2 * r2);
+                    s += unitKernel(SplitKernel::Poly6, ra / r1) / (r1 * r1 * r1)
+                         * unitKernel(SplitKernel::Poly6, rb / r2) / (r2 * r2 * r2);
                 }
             }
         }
         s *= dx * dy * dy;
         const double err = std::abs(s - exact) / exact;
-        std::printf("[measured] Cartesian midpoint N=%d: %.8f vs radial %.8f, rel diff %.2e\n", N, s,
-                    exact, err);
+        std::printf("[measured] Cartesian midpoint N=%d: %.8f vs radial %.8f, rel diff %.2e\n", N,
+                    s, exact, err);
         if (N == 96) {
             EXPECT_LT(err, 1e-7);
             EXPECT_LT(err, prevErr); // converging towards the radial value
@@ -142,7 +142,8 @@ TEST(SplitQuadrature, RadialReductionMatchesCartesianSum)
 
 TEST(SplitPatterns, MassRatiosSumToOne)
 {
-    for (const SplitPattern* p : {&icosahedronPattern(), &cubePattern(), &defaultResplitPattern()}) {
+    for (const SplitPattern* p :
+         {&icosahedronPattern(), &cubePattern(), &defaultResplitPattern()}) {
         EXPECT_NEAR(sum(p->lambda), 1.0, 1e-14) << p->name; // renormalised: one double sum
         EXPECT_EQ(p->lambda.size(), p->childCount());
     }
@@ -195,7 +196,8 @@ TEST(SplitPatterns, IcosahedronRatiosEqualBySymmetry)
     double maxDev = 0.0;
     for (double l : p.lambda) maxDev = std::max(maxDev, std::abs(l - 1.0 / 12.0));
     std::printf("[measured] icosahedron (0.3, 0.9): lambda = 1/12 +- %.1e, relative Eq. 18 error "
-                "%.3e\n", maxDev, p.relativeError);
+                "%.3e\n",
+                maxDev, p.relativeError);
     EXPECT_LT(maxDev, 1e-12);
     for (const auto& o : p.offsets) EXPECT_NEAR(o.length(), 1.0, 1e-15);
 }
@@ -224,8 +226,9 @@ TEST(SplitPatterns, CubeCentreRatioVersusPaper)
     const SplitPattern spline =
         optimisePattern("cube+centre", patternOffsets(PatternShape::CubeCentre), 0.4, 0.9,
                         SplitKernel::CubicSpline);
-    std::printf("[measured] cube+centre (0.4, 0.9) cubic spline optimum: centre %.5f, corners %.5f\n",
-                spline.lambda[8], spline.lambda[0]);
+    std::printf(
+        "[measured] cube+centre (0.4, 0.9) cubic spline optimum: centre %.5f, corners %.5f\n",
+        spline.lambda[8], spline.lambda[0]);
     EXPECT_NEAR(spline.lambda[8], 0.632, 1e-3);
 
     // Reverse the process (Sec. 4.1): the alpha at which the optimal centre ratio is 0.992.
@@ -237,7 +240,8 @@ TEST(SplitPatterns, CubeCentreRatioVersusPaper)
     }
     const SplitPattern at = optimisePattern("c", offsets, 0.4, lo);
     std::printf("[measured] optimal centre ratio 0.992 needs alpha = %.5f at epsilon 0.4 "
-                "(corners %.5f)\n", lo, at.lambda[0]);
+                "(corners %.5f)\n",
+                lo, at.lambda[0]);
     EXPECT_NEAR(at.lambda[0], 0.001, 1e-5); // then the corners get the paper's 0.001 too
     EXPECT_GT(lo, 0.99);
 }
@@ -247,7 +251,8 @@ TEST(SplitPatterns, CacheIsSharedAcrossThreads)
     const SplitPattern* seen[4] = {};
     std::vector<std::thread> threads;
     for (int t = 0; t < 4; ++t) {
-        threads.emplace_back([&seen, t] { seen[t] = &cachedPattern(PatternShape::Cube, 0.35, 0.8); });
+        threads.emplace_back(
+            [&seen, t] { seen[t] = &cachedPattern(PatternShape::Cube, 0.35, 0.8); });
     }
     for (auto& th : threads) th.join();
     for (int t = 1; t < 4; ++t) EXPECT_EQ(seen[t], seen[0]);
@@ -318,7 +323,8 @@ ParticleSet makeSet(std::size_t n, unsigned seed)
 
 TEST(SplitParticles, ConservesMassMomentumAndCentreOfMass)
 {
-    for (const SplitPattern* pattern : {&icosahedronPattern(), &cubePattern(), &paperCubePattern()}) {
+    for (const SplitPattern* pattern :
+         {&icosahedronPattern(), &cubePattern(), &paperCubePattern()}) {
         ParticleSet p = makeSet(6, 7);
         const Totals before = totals(p);
         const Index i = 2;
@@ -351,8 +357,9 @@ TEST(SplitParticles, ConservesMassMomentumAndCentreOfMass)
         }
         const double comErr = (dMoment / dm - xN).length();
         std::printf("[measured] split by %s: |dM|/M = %.1e, |dP|/|P| = %.1e, centre of mass moved "
-                    "%.1e m (h = %.3f m)\n", pattern->name.c_str(), massErr / before.mass,
-                    momErr / before.momentum.length(), comErr, hN);
+                    "%.1e m (h = %.3f m)\n",
+                    pattern->name.c_str(), massErr / before.mass, momErr / before.momentum.length(),
+                    comErr, hN);
         EXPECT_LE(std::abs(dm - mN), REAL_EPS * mN);
         EXPECT_LE(massErr, 2 * REAL_EPS * mN + 1e-15 * before.mass);
         EXPECT_LE((vN * dm - vN * mN).length(), REAL_EPS * mN * vN.length());
@@ -468,7 +475,7 @@ TEST(MergeParticles, DecentrationPicksTheSphericalNeighbourhood)
     sph::NeighborGrid grid(Real(0.05));
     grid.build(p.positions());
     MergeSettings s;
-    s.maxMerged = 7; // the candidate and its six neighbours
+    s.maxMerged = 7;        // the candidate and its six neighbours
     s.maxMergesPerCall = 1; // "the particle with the smallest mass decentration is merged"
     const auto plan = planMerges(p, grid, s);
     ASSERT_EQ(plan.size(), 1u);
@@ -481,7 +488,8 @@ TEST(MergeParticles, DecentrationPicksTheSphericalNeighbourhood)
     ASSERT_EQ(both.size(), 2u);
     EXPECT_EQ(both[1].candidate, 7u);
     std::printf("[measured] decentration: octahedron group eta = %.2e, line group eta = %.2e "
-                "(kg^3 m^6)\n", both[0].eta, both[1].eta);
+                "(kg^3 m^6)\n",
+                both[0].eta, both[1].eta);
     EXPECT_LT(both[0].eta, 1e-6 * both[1].eta);
 }
 
@@ -521,14 +529,16 @@ TEST(MergeParticles, ConservesMassMomentumAndCentreOfMass)
             const MergeResult r = mergeParticles(p, grid, ms);
             const Totals after = totals(p);
             const double massErr = std::abs(after.mass - before.mass) / before.mass;
-            const double momErr = (after.momentum - before.momentum).length() /
-                                  before.momentum.length();
-            const double comShift = (after.moment / after.mass - before.moment / before.mass).length();
+            const double momErr =
+                (after.momentum - before.momentum).length() / before.momentum.length();
+            const double comShift =
+                (after.moment / after.mass - before.moment / before.mass).length();
             const double thermalErr = std::abs(after.thermal - before.thermal) / before.thermal;
             std::printf("[measured] merge (resplit %d, %s): %zu groups, %zu -> %zu particles, "
                         "|dM|/M %.1e, |dP|/|P| %.1e, thermal %.1e, centre of mass moved %.2e m\n",
-                        int(resplit), placement == MergePlacement::CentreOfMass ? "com" : "candidate",
-                        r.merges, n0, p.size(), massErr, momErr, thermalErr, comShift);
+                        int(resplit),
+                        placement == MergePlacement::CentreOfMass ? "com" : "candidate", r.merges,
+                        n0, p.size(), massErr, momErr, thermalErr, comShift);
             EXPECT_GT(r.merges, 3u);
             EXPECT_EQ(p.size(), n0 - r.removed + r.added);
             // Each group: one Real rounding per new mass (plus velocity and channel roundings);
@@ -620,14 +630,15 @@ TEST(MergeParticles, SplitMergeResplitCycle)
     const SplitPattern& rp = defaultResplitPattern();
     std::size_t fresh = 0;
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] != ParticleKind::Liquid || p.scalarChannel("splits")[i] != Real(0)) continue;
+        if (p.kinds()[i] != ParticleKind::Liquid || p.scalarChannel("splits")[i] != Real(0))
+            continue;
         ++fresh;
         EXPECT_NEAR(p.scalarChannel("h")[i], 0.729 * h0, 8 * REAL_EPS * h0);
     }
     EXPECT_EQ(fresh, 12 * r.merges);
     std::printf("[measured] default re-split pattern: %s, epsilon %.4f, alpha %.4f, lambda %.5f, "
-                "relative Eq. 18 error %.3e\n", rp.name.c_str(), rp.epsilon, rp.alpha, rp.lambda[0],
-                rp.relativeError);
+                "relative Eq. 18 error %.3e\n",
+                rp.name.c_str(), rp.epsilon, rp.alpha, rp.lambda[0], rp.relativeError);
 
     // The next evaporation split of a fresh daughter starts its count again (Fig. 3 cycle).
     Index freshIndex = sph::INVALID_INDEX;

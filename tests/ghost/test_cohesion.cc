@@ -26,12 +26,14 @@ openvdb::FloatGrid::Ptr invertedCup()
 {
     const double a = 0.06, wall = 0.04;
     auto sdf = [&](const openvdb::Vec3d& x) {
-        const double outside = boxSignedDistance(x, {-a - wall, -0.1, -a - wall},
-                                                 {a + wall, wall, a + wall});
+        const double outside =
+            boxSignedDistance(x, {-a - wall, -0.1, -a - wall}, {a + wall, wall, a + wall});
         return std::max(outside, -boxSignedDistance(x, {-a, -1.0, -a}, {a, 0.0, a}));
     };
-    return levelSetFromSdf(sdf, Aabb{Vec3(Real(-a - wall), Real(-0.1), Real(-a - wall)),
-                                     Vec3(Real(a + wall), Real(wall), Real(a + wall))}, H / 2);
+    return levelSetFromSdf(sdf,
+                           Aabb{Vec3(Real(-a - wall), Real(-0.1), Real(-a - wall)),
+                                Vec3(Real(a + wall), Real(wall), Real(a + wall))},
+                           H / 2);
 }
 
 /// Drop (m) of the liquid's top layer (the highest 10 % of its particles) after 0.1 s.
@@ -51,8 +53,8 @@ double hangingDrop(Method method)
     solver.addSolid(makeLevelSet(invertedCup(), "cup"));
     // A 4 cm slab filling the top of the cup: hydrostatic tension at the top -rho0 g d =
     // -390 Pa, well within what the Tait equation holds (down to -k = -2000 Pa).
-    solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.06f, -0.04f, -0.06f),
-                                                  Vec3(0.06f, 0, 0.06f), H / 2), "slab"));
+    solver.addLiquid(makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.06f, -0.04f, -0.06f), Vec3(0.06f, 0, 0.06f), H / 2), "slab"));
     auto topLayer = [&] {
         std::vector<double> y;
         for (std::size_t i = 0; i < solver.particles().size(); ++i) {
@@ -69,9 +71,10 @@ double hangingDrop(Method method)
     const double start = topLayer();
     for (int f = 0; f < 3; ++f) solver.advanceFrame(); // 0.1 s at 30 frames/s
     const double drop = start - topLayer();
-    std::printf("[measured] %s: top layer dropped %.4f m in %.2f s (free fall: %.4f m), %llu steps\n",
-                methodName(method), drop, solver.time(), 0.5 * 9.81 * 0.1 * 0.1,
-                static_cast<unsigned long long>(solver.stepCount()));
+    std::printf(
+        "[measured] %s: top layer dropped %.4f m in %.2f s (free fall: %.4f m), %llu steps\n",
+        methodName(method), drop, solver.time(), 0.5 * 9.81 * 0.1 * 0.1,
+        static_cast<unsigned long long>(solver.stepCount()));
     return drop;
 }
 

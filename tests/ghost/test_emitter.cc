@@ -30,9 +30,10 @@ TEST(Emitter, EmitsCrossSectionTimesSpeedWithoutOverlap)
     s.killBox = Aabb{Vec3(-0.2f, -0.12f, -0.2f), Vec3(0.2f, 0.2f, 0.2f)};
     GhostSolver solver(s);
     const Real half = 3 * H;
-    solver.addEmitter(makeLevelSet(makeBoxLevelSet(Vec3(-half, 0, -half), Vec3(half, 3 * H, half),
-                                                   H / 2), "nozzle"),
-                      Vec3(0, -1, 0));
+    solver.addEmitter(
+        makeLevelSet(makeBoxLevelSet(Vec3(-half, 0, -half), Vec3(half, 3 * H, half), H / 2),
+                     "nozzle"),
+        Vec3(0, -1, 0));
     const Real dt = Real(1) / 1200;
     solver.step(dt);
     const std::size_t initial = solver.count(ParticleKind::Liquid);
@@ -65,9 +66,9 @@ TEST(Emitter, EmitsCrossSectionTimesSpeedWithoutOverlap)
     const double expected = double(2 * half) * double(2 * half) * 1.0 * steps * double(dt);
     const double r = double(PoissonSettings::SB12_RADIUS_FACTOR * H);
     std::printf("[measured] emitter: %g particles in %.3f s = %.3e m^3, expected %.3e m^3 "
-                "(%.1f %%); closest liquid pair %.3f r; killed %zu\n", emitted, steps * double(dt),
-                volume, expected, 100 * (volume - expected) / expected, minSpacing / r,
-                solver.killedCount());
+                "(%.1f %%); closest liquid pair %.3f r; killed %zu\n",
+                emitted, steps * double(dt), volume, expected, 100 * (volume - expected) / expected,
+                minSpacing / r, solver.killedCount());
     // Volume per particle m / rho0 holds for liquid at rest density; the sampler fills the
     // nozzle at its usual packing, and the stream sheds the nozzle's boundary layer. Measured
     // +4 % to +12 % as the air treatment changed; bound 15 %.
@@ -109,7 +110,8 @@ TEST(Emitter, LaterEmitterInAnEmptySceneWaitsForItsStart)
     s.seed = 4;
     GhostSolver solver(s);
     const Real half = 3 * H;
-    const LevelSet nozzle = makeLevelSet(makeBoxLevelSet(Vec3(-half, 0, -half), Vec3(half, 3 * H, half), H / 2), "tap");
+    const LevelSet nozzle =
+        makeLevelSet(makeBoxLevelSet(Vec3(-half, 0, -half), Vec3(half, 3 * H, half), H / 2), "tap");
     solver.addEmitter(nozzle, Vec3(0, -1, 0), 0.05);
     const Real dt = Real(1) / 1200;
     std::size_t stepsWithoutLiquid = 0;
@@ -118,8 +120,9 @@ TEST(Emitter, LaterEmitterInAnEmptySceneWaitsForItsStart)
         if (solver.count(ParticleKind::Liquid) == 0) ++stepsWithoutLiquid;
     }
     std::printf("[measured] late emitter: %zu steps without liquid (0.05 s at dt 1/1200 s = 60), "
-                "%zu liquid at t = 0.1 s, particle mass %.3e kg\n", stepsWithoutLiquid,
-                solver.count(ParticleKind::Liquid), double(solver.particleMass()));
+                "%zu liquid at t = 0.1 s, particle mass %.3e kg\n",
+                stepsWithoutLiquid, solver.count(ParticleKind::Liquid),
+                double(solver.particleMass()));
     // Exactly the steps before t = 0.05 s (one more for the round-off of summed steps).
     EXPECT_GE(stepsWithoutLiquid, 59u);
     EXPECT_LE(stepsWithoutLiquid, 61u);
@@ -146,18 +149,24 @@ TEST(SolidCollision, ParticleThatTunnelsPastTheBandGoesBackAndNoneStaysInside)
     s.spacing = H;
     s.seed = 5;
     GhostSolver solver(s);
-    const LevelSet floor = makeLevelSet(makeBoxLevelSet(Vec3(-0.1f, -0.5f, -0.1f), Vec3(0.1f, 0, 0.1f), H / 2), "block");
+    const LevelSet floor = makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.1f, -0.5f, -0.1f), Vec3(0.1f, 0, 0.1f), H / 2), "block");
     solver.addSolid(floor);
-    solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.03f, 0.1f, -0.03f), Vec3(0.03f, 0.16f, 0.03f), H / 2), "drop"),
-                     Vec3(0, -40, 0));
+    solver.addLiquid(
+        makeLevelSet(makeBoxLevelSet(Vec3(-0.03f, 0.1f, -0.03f), Vec3(0.03f, 0.16f, 0.03f), H / 2),
+                     "drop"),
+        Vec3(0, -40, 0));
     solver.step(Real(0.01));
     const ParticleSet& p = solver.particles();
     double deepest = 0;
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] == ParticleKind::Liquid) deepest = std::min(deepest, double(floor.phi(p.positions()[i])));
+        if (p.kinds()[i] == ParticleKind::Liquid)
+            deepest = std::min(deepest, double(floor.phi(p.positions()[i])));
     }
-    std::printf("[measured] tunnelling drop: %llu of %zu particles put back, deepest liquid %.2e m\n",
-                (unsigned long long)solver.restoredFromSolidsCount(), solver.count(ParticleKind::Liquid), deepest);
+    std::printf(
+        "[measured] tunnelling drop: %llu of %zu particles put back, deepest liquid %.2e m\n",
+        (unsigned long long)solver.restoredFromSolidsCount(), solver.count(ParticleKind::Liquid),
+        deepest);
     EXPECT_GT(solver.restoredFromSolidsCount(), 0u);
     EXPECT_GE(deepest, -1e-3 * double(H));
 }

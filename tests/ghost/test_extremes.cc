@@ -91,16 +91,16 @@ TEST(Extremes, StiffnessEpsilonAndTimeStepSweepNeverGivesSilentNaN)
                     // the floor, whatever k: with fixed steps some Basic runs stop with the error
                     // (the CFL-adaptive stepper also limits dt by the largest acceleration).
                     if (method == Method::Ghost && cfl <= Real(0.4)) {
-                        EXPECT_FALSE(o.blewUp) << methodName(method) << " k " << k << " eps "
-                                               << eps << " cfl " << cfl << ": " << o.message;
+                        EXPECT_FALSE(o.blewUp) << methodName(method) << " k " << k << " eps " << eps
+                                               << " cfl " << cfl << ": " << o.message;
                     }
                 }
             }
         }
     }
     std::printf("[measured] extremes: %d runs, %d stopped with the blow-up error (%d of them "
-                "Basic SPH inside the acoustic CFL limit), the rest stayed finite\n", runs,
-                blowUps, basicInsideCfl);
+                "Basic SPH inside the acoustic CFL limit), the rest stayed finite\n",
+                runs, blowUps, basicInsideCfl);
     // Far past the limit (cfl 6) the stiff runs do blow up: the detector must have fired.
     EXPECT_GT(blowUps, 0);
 }
@@ -115,8 +115,8 @@ TEST(Extremes, CflAdaptiveSteppingRunsAStiffLiquid)
     s.substeps = 0;
     s.cflNumber = Real(0.4);
     GhostSolver solver(s);
-    solver.addSolid(makeLevelSet(makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f),
-                                                 Vec3(0.08f, -0.05f, 0.08f), H / 2), "floor"));
+    solver.addSolid(makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f), Vec3(0.08f, -0.05f, 0.08f), H / 2), "floor"));
     solver.addLiquid(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.025), H / 2), "drop"));
     solver.advanceFrame();
     EXPECT_NEAR(solver.time(), 1.0 / 30.0, 1e-12);

@@ -76,7 +76,8 @@ TEST(GhostSolver, FreeFallCentreOfMassFollowsGravity)
         const double expected = 9.81 * dt * dt * steps * (steps + 1) / 2.0; // 0.197 m
         const Vec3d drop = start - liquidCentre(solver.particles());
         std::printf("[measured] %s free fall: drop %.5f m, expected %.5f m (%.3f %%), "
-                    "sideways %.2e m\n", methodName(method), drop.y(), expected,
+                    "sideways %.2e m\n",
+                    methodName(method), drop.y(), expected,
                     100.0 * (drop.y() - expected) / expected, std::hypot(drop.x(), drop.z()));
         const bool ghost = method == Method::Ghost;
         EXPECT_NEAR(drop.y(), expected, (ghost ? 0.02 : 1e-4) * expected) << methodName(method);
@@ -90,8 +91,8 @@ TEST(GhostSolver, LiquidMassIsConservedExactlyWithSolids)
     // air layer is resampled and particles are projected out of the solid.
     GhostSettings s = baseSettings();
     GhostSolver solver(s);
-    solver.addSolid(makeLevelSet(makeBoxLevelSet(Vec3(-0.1f, -0.2f, -0.1f), Vec3(0.1f, -0.05f, 0.1f),
-                                                 H / 2), "floor"));
+    solver.addSolid(makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.1f, -0.2f, -0.1f), Vec3(0.1f, -0.05f, 0.1f), H / 2), "floor"));
     solver.addLiquid(ball(Vec3(0, 0, 0), Real(0.035)));
     solver.step(Real(1) / 1200);
     const std::size_t count = solver.count(ParticleKind::Liquid);
@@ -108,8 +109,8 @@ TEST(GhostSolver, OneAndTwoThreadsGiveIdenticalParticles)
     auto run = [](int threads) {
         parallel::ThreadLimit limit(threads);
         GhostSolver solver(baseSettings());
-        solver.addSolid(makeLevelSet(makeBoxLevelSet(Vec3(-0.1f, -0.2f, -0.1f),
-                                                     Vec3(0.1f, -0.05f, 0.1f), H / 2), "floor"));
+        solver.addSolid(makeLevelSet(
+            makeBoxLevelSet(Vec3(-0.1f, -0.2f, -0.1f), Vec3(0.1f, -0.05f, 0.1f), H / 2), "floor"));
         solver.addLiquid(ball(Vec3(0), Real(0.035)));
         for (int k = 0; k < 40; ++k) solver.step(Real(1) / 1200);
         return solver.particles();
@@ -135,8 +136,9 @@ TEST(GhostSolver, BlowUpStopsWithAClearError)
     } catch (const NumericalError& e) {
         const std::string what = e.what();
         EXPECT_NE(what.find("blew up at frame 0, step "), std::string::npos) << what;
-        EXPECT_TRUE(what.find("maxSpeed") != std::string::npos ||
-                    what.find("non-finite") != std::string::npos) << what;
+        EXPECT_TRUE(what.find("maxSpeed") != std::string::npos
+                    || what.find("non-finite") != std::string::npos)
+            << what;
     }
 }
 

@@ -18,19 +18,19 @@ using namespace ghostfx::ghost;
 
 namespace {
 
-constexpr Real H = Real(0.01);         // particle spacing (m)
-constexpr Real HALF = Real(0.06);      // half edge of the cube (m): 12 h across
+constexpr Real H = Real(0.01);    // particle spacing (m)
+constexpr Real HALF = Real(0.06); // half edge of the cube (m): 12 h across
 constexpr int STEPS = 300;
 constexpr Real DT = Real(1) / Real(1200); // acoustic CFL c dt / h = 0.31 at k = 2000
 
 struct CubeState
 {
-    double volume;        ///< SPH volume sum m / rho over liquid (m^3)
-    double gyration;      ///< radius of gyration about the centre of mass (m)
-    double innerDensity;  ///< mean density of particles in the inner half of the cube (kg/m^3)
-    double outerDensity;  ///< mean density of the outer layer (kg/m^3)
-    double innerSpacing;  ///< mean nearest-neighbour distance, inner half (m)
-    double outerSpacing;  ///< mean nearest-neighbour distance, outer layer (m)
+    double volume;       ///< SPH volume sum m / rho over liquid (m^3)
+    double gyration;     ///< radius of gyration about the centre of mass (m)
+    double innerDensity; ///< mean density of particles in the inner half of the cube (kg/m^3)
+    double outerDensity; ///< mean density of the outer layer (kg/m^3)
+    double innerSpacing; ///< mean nearest-neighbour distance, inner half (m)
+    double outerSpacing; ///< mean nearest-neighbour distance, outer layer (m)
 };
 
 CubeState measure(const ParticleSet& p)
@@ -60,8 +60,15 @@ CubeState measure(const ParticleSet& p)
         });
         // Box "norm" relative to the initial half edge: < 0.5 inner half, > 0.8 outer layer.
         const double q = std::max({std::abs(d.x()), std::abs(d.y()), std::abs(d.z())}) / HALF;
-        if (q < 0.5) { s.innerDensity += rho[i]; s.innerSpacing += nn; nIn += 1; }
-        else if (q > 0.8 && q < 1.05) { s.outerDensity += rho[i]; s.outerSpacing += nn; nOut += 1; }
+        if (q < 0.5) {
+            s.innerDensity += rho[i];
+            s.innerSpacing += nn;
+            nIn += 1;
+        } else if (q > 0.8 && q < 1.05) {
+            s.outerDensity += rho[i];
+            s.outerSpacing += nn;
+            nOut += 1;
+        }
     }
     s.gyration = std::sqrt(rg / double(x.size()));
     s.innerDensity /= nIn;
@@ -94,9 +101,9 @@ CubeRun runCube(Method method)
                 "density inner/outer %.1f / %.1f, spacing inner/outer %.3f / %.3f h "
                 "(start %.3f / %.3f h)\n",
                 methodName(method), 1.0, run.end.volume / run.start.volume, 1.0,
-                run.end.gyration / run.start.gyration, run.end.innerDensity,
-                run.end.outerDensity, run.end.innerSpacing / H, run.end.outerSpacing / H,
-                run.start.innerSpacing / H, run.start.outerSpacing / H);
+                run.end.gyration / run.start.gyration, run.end.innerDensity, run.end.outerDensity,
+                run.end.innerSpacing / H, run.end.outerSpacing / H, run.start.innerSpacing / H,
+                run.start.outerSpacing / H);
     return run;
 }
 
@@ -187,11 +194,13 @@ TEST(ZeroGravityCube, DISABLED_DefaultGhostAirKeepsTheCubeTogetherForTwoSeconds)
     double lateSpeed = 0; // largest liquid speed over the second second (m/s)
     for (int s = 1; s < ZG_STEPS; ++s) {
         solver.step(ZG_DT);
-        if (s >= ZG_STEPS / 2) lateSpeed = std::max(lateSpeed, measureShape(solver.particles()).maxSpeed);
+        if (s >= ZG_STEPS / 2)
+            lateSpeed = std::max(lateSpeed, measureShape(solver.particles()).maxSpeed);
     }
     const Shape end = measureShape(solver.particles());
     std::printf("[measured] zero-g cube, 2 s: gyration %+.2f %%, max speed over 1-2 s %.3f m/s, "
-                "%zu air\n", 100.0 * (end.gyration / start.gyration - 1.0), lateSpeed,
+                "%zu air\n",
+                100.0 * (end.gyration / start.gyration - 1.0), lateSpeed,
                 solver.count(ParticleKind::GhostAir));
 
     // Measured (seed 1, h = 0.025, CFL-adaptive CLI run of the same scene and this fixed step):

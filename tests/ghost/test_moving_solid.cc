@@ -31,13 +31,14 @@ TEST(MovingSolid, PaddlePushesLiquidAndLeavesNoneInside)
     const double omega = 2.0, speed = 0.5;
     auto motion = [=](double t) {
         RigidTransform xf;
-        xf.rotation = openvdb::math::rotation<openvdb::math::Mat3<Real>>(
-            openvdb::math::Y_AXIS, Real(omega * t));
+        xf.rotation = openvdb::math::rotation<openvdb::math::Mat3<Real>>(openvdb::math::Y_AXIS,
+                                                                         Real(omega * t));
         xf.translation = Vec3(Real(-0.08 + speed * t), 0, 0);
         return xf;
     };
     solver.addMovingSolid(paddle, motion);
-    solver.addLiquid(makeLevelSet(makeSphereLevelSet(Vec3(0.02f, 0, 0), Real(0.05), H / 2), "drop"));
+    solver.addLiquid(
+        makeLevelSet(makeSphereLevelSet(Vec3(0.02f, 0, 0), Real(0.05), H / 2), "drop"));
 
     const Real dt = Real(1) / 1200;
     for (int k = 0; k < 120; ++k) solver.step(dt); // 0.1 s: the paddle advances 5 cm
@@ -64,12 +65,12 @@ TEST(MovingSolid, PaddlePushesLiquidAndLeavesNoneInside)
         }
     }
     std::printf("[measured] moving solid: ghost placement error %.2e m, velocity error %.2e m/s, "
-                "deepest liquid %.2e m, liquid x-momentum %.4f kg m/s\n", worstGhost,
-                worstVelocity, deepest, momentumX);
-    EXPECT_LT(worstGhost, 1e-5);     // float round-off of the transform (positions ~0.1 m)
-    EXPECT_LT(worstVelocity, 1e-3);  // central difference of 1e-4 s on a 2 rad/s rotation
+                "deepest liquid %.2e m, liquid x-momentum %.4f kg m/s\n",
+                worstGhost, worstVelocity, deepest, momentumX);
+    EXPECT_LT(worstGhost, 1e-5);           // float round-off of the transform (positions ~0.1 m)
+    EXPECT_LT(worstVelocity, 1e-3);        // central difference of 1e-4 s on a 2 rad/s rotation
     EXPECT_GE(deepest, -0.01 * double(H)); // collision projection tolerance
-    EXPECT_GT(momentumX, 0.0);       // the paddle pushed the liquid to the right
+    EXPECT_GT(momentumX, 0.0);             // the paddle pushed the liquid to the right
 }
 
 TEST(MovingSolid, PerFrameShapeReplacesTheGhosts)
@@ -80,12 +81,12 @@ TEST(MovingSolid, PerFrameShapeReplacesTheGhosts)
     s.spacing = H;
     GhostSolver solver(s);
     auto floorAt = [](Real top) {
-        return makeLevelSet(makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f), Vec3(0.08f, top, 0.08f),
-                                            H / 2), "floor");
+        return makeLevelSet(
+            makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f), Vec3(0.08f, top, 0.08f), H / 2), "floor");
     };
     solver.addSolid(floorAt(Real(-0.05)));
-    solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.05f, -0.05f, -0.05f),
-                                                  Vec3(0.05f, 0.0f, 0.05f), H / 2), "pool"));
+    solver.addLiquid(makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.05f, -0.05f, -0.05f), Vec3(0.05f, 0.0f, 0.05f), H / 2), "pool"));
     solver.advanceFrame();
     const std::size_t liquid = solver.count(ParticleKind::Liquid);
     const LevelSet raised = floorAt(Real(-0.04));

@@ -33,12 +33,14 @@ struct Scene
     LevelSet floor, liquid, nozzle;
 
     explicit Scene(Method method, int substeps)
-        : floor(makeLevelSet(makeBoxLevelSet(Vec3(-0.1f, -0.05f, -0.05f), Vec3(0.1f, 0.0f, 0.05f),
-                                             H / 2), "floor"))
-        , liquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.05f, 0.0f, -0.03f), Vec3(0.05f, 0.05f, 0.03f),
-                                              H / 2), "liquid"))
-        , nozzle(makeLevelSet(makeBoxLevelSet(Vec3(-0.02f, 0.08f, -0.02f),
-                                              Vec3(0.02f, 0.1f, 0.02f), H / 2), "nozzle"))
+        : floor(makeLevelSet(
+            makeBoxLevelSet(Vec3(-0.1f, -0.05f, -0.05f), Vec3(0.1f, 0.0f, 0.05f), H / 2), "floor"))
+        , liquid(makeLevelSet(
+              makeBoxLevelSet(Vec3(-0.05f, 0.0f, -0.03f), Vec3(0.05f, 0.05f, 0.03f), H / 2),
+              "liquid"))
+        , nozzle(makeLevelSet(
+              makeBoxLevelSet(Vec3(-0.02f, 0.08f, -0.02f), Vec3(0.02f, 0.1f, 0.02f), H / 2),
+              "nozzle"))
     {
         settings.method = method;
         settings.spacing = H;
@@ -87,12 +89,13 @@ TEST(Resume, GhostInMemoryContinuationIsBitIdentical)
     while (resumed.frame() < frames) resumed.advanceFrame();
 
     const std::string difference = firstDifference(whole.saveState(), resumed.saveState());
-    std::printf("[measured] ghost resume in memory: %zu particles (%zu liquid, %zu air, %zu solid), "
-                "%llu steps, emitted %zu, killed %zu, first difference: '%s'\n",
-                whole.particles().size(), whole.count(ParticleKind::Liquid),
-                whole.count(ParticleKind::GhostAir), whole.count(ParticleKind::GhostSolid),
-                static_cast<unsigned long long>(whole.stepCount()), whole.emittedCount(),
-                whole.killedCount(), difference.c_str());
+    std::printf(
+        "[measured] ghost resume in memory: %zu particles (%zu liquid, %zu air, %zu solid), "
+        "%llu steps, emitted %zu, killed %zu, first difference: '%s'\n",
+        whole.particles().size(), whole.count(ParticleKind::Liquid),
+        whole.count(ParticleKind::GhostAir), whole.count(ParticleKind::GhostSolid),
+        static_cast<unsigned long long>(whole.stepCount()), whole.emittedCount(),
+        whole.killedCount(), difference.c_str());
     // Exact: the same operations on the same bits, in the same order (STYLE.md rule 6).
     EXPECT_EQ(difference, "");
     EXPECT_EQ(whole.time(), resumed.time());
@@ -134,8 +137,8 @@ TEST(Resume, RestoreContract)
     for (const char* key : {"time", "particle_mass", "lennard_jones", "max_acceleration"}) {
         EXPECT_EQ(saved.reals.count(key), 1u) << key;
     }
-    for (const char* key : {"step", "frame", "initialized", "emitted", "killed", "solids",
-                            "emitters"}) {
+    for (const char* key :
+         {"step", "frame", "initialized", "emitted", "killed", "solids", "emitters"}) {
         EXPECT_EQ(saved.integers.count(key), 1u) << key;
     }
 
@@ -148,7 +151,9 @@ TEST(Resume, RestoreContract)
         FAIL() << "restoring a ghost state into a basic solver must throw";
     } catch (const ValueError& e) {
         EXPECT_NE(std::string(e.what()).find("saved by the 'ghost' solver, this solver runs "
-                                             "'basic'"), std::string::npos) << e.what();
+                                             "'basic'"),
+                  std::string::npos)
+            << e.what();
     }
 
     // Liquid after a restore.
@@ -159,7 +164,8 @@ TEST(Resume, RestoreContract)
         FAIL() << "addLiquid after restoreState must throw";
     } catch (const ValueError& e) {
         EXPECT_NE(std::string(e.what()).find("cannot add liquid after restoreState()"),
-                  std::string::npos) << e.what();
+                  std::string::npos)
+            << e.what();
     }
     EXPECT_THROW(resumed.addLiquidParticles({Vec3(0)}), ValueError);
 
@@ -169,7 +175,8 @@ TEST(Resume, RestoreContract)
         FAIL() << "stepping without the restored solids must throw";
     } catch (const ValueError& e) {
         EXPECT_NE(std::string(e.what()).find("the restored state has 1 solids but 0 were added"),
-                  std::string::npos) << e.what();
+                  std::string::npos)
+            << e.what();
     }
 
     // Restore into a solver that already has inputs, or twice.
@@ -243,13 +250,15 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     // Bytes per particle of the particle storage: built-in channels 2 Vec3 + 3 Real + kind + id,
     // plus the named ones.
     const double builtIn = 2 * sizeof(Vec3) + 3 * sizeof(Real) + 1 + sizeof(ParticleId);
-    auto perParticle = [](const ParticleSet& s) { return double(s.memoryBytes()) / double(s.size()); };
+    auto perParticle = [](const ParticleSet& s) {
+        return double(s.memoryBytes()) / double(s.size());
+    };
     const double ghostSize = builtIn + sizeof(Vec3) + 2 * sizeof(Real);
     const double staticSolidSize = builtIn + sizeof(Vec3) + sizeof(Real);
     std::printf("[measured] bytes per particle: ghost liquid-only %.1f (size-based %.0f), static "
                 "solid particles %.1f (%.0f), basic liquid-only %.1f (%.0f)\n",
-                perParticle(liquidOnly.particles()), ghostSize, perParticle(solids), staticSolidSize,
-                perParticle(bare.particles()), builtIn + sizeof(Vec3));
+                perParticle(liquidOnly.particles()), ghostSize, perParticle(solids),
+                staticSolidSize, perParticle(bare.particles()), builtIn + sizeof(Vec3));
     // memoryBytes counts capacity: at least the size-based bytes, and at most twice that
     // (vectors grow by doubling), plus the scratch of a sort that may be a little larger.
     EXPECT_GE(perParticle(liquidOnly.particles()), ghostSize);

@@ -26,7 +26,8 @@ TEST(ShearFlow, AirResamplingJumpIsOfTheSizeOfTheSphError)
     GhostSolver solver(s);
     solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.06f), Vec3(0.06f), H / 2), "cube"));
     auto& v = solver.particles().velocities();
-    for (std::size_t i = 0; i < v.size(); ++i) v[i] = Vec3(0, solver.particles().positions()[i][0], 0);
+    for (std::size_t i = 0; i < v.size(); ++i)
+        v[i] = Vec3(0, solver.particles().positions()[i][0], 0);
 
     const Real dt = Real(1) / 1200;
     const int steps = 33;
@@ -55,31 +56,39 @@ TEST(ShearFlow, AirResamplingJumpIsOfTheSizeOfTheSphError)
     }
     // Steps 3 .. 32 as in Fig. 9. Step n's position update comes from solver step n - 1, whose
     // air was resampled when (n - 1) % 10 == 0: the jump shows in Delta E at those n.
-    double meanE = 0, countE = 0, maxE = 0, maxJumpResample = 0, meanJumpResample = 0, nResample = 0;
+    double meanE = 0, countE = 0, maxE = 0, maxJumpResample = 0, meanJumpResample = 0,
+           nResample = 0;
     double meanJumpOther = 0, nOther = 0;
     for (std::size_t n = 3; n + 1 < history.size(); ++n) {
         double sumE = 0, sumDE = 0, maxDE = 0, count = 0;
         for (const auto& [id, a] : accel[n]) {
             const double E = a.length();
             const double dE = (a - accel[n - 1].at(id)).length();
-            sumE += E; sumDE += dE; maxDE = std::max(maxDE, dE); count += 1;
+            sumE += E;
+            sumDE += dE;
+            maxDE = std::max(maxDE, dE);
+            count += 1;
             maxE = std::max(maxE, E);
         }
         const bool resampled = (n - 1) % std::size_t(s.airResampleSteps) == 0;
         if (resampled) {
-            meanJumpResample += sumDE / count; maxJumpResample = std::max(maxJumpResample, maxDE);
+            meanJumpResample += sumDE / count;
+            maxJumpResample = std::max(maxJumpResample, maxDE);
             nResample += 1;
         } else {
-            meanE += sumE / count; countE += 1;
-            meanJumpOther += sumDE / count; nOther += 1;
+            meanE += sumE / count;
+            countE += 1;
+            meanJumpOther += sumDE / count;
+            nOther += 1;
         }
     }
     meanE /= countE;
     meanJumpResample /= nResample;
     meanJumpOther /= nOther;
     std::printf("[measured] shear: mean E %.4f m/s^2 (max %.4f), mean Delta E at resampling %.4f "
-                "(max %.4f), elsewhere %.4f; ratio jump / E = %.3f\n", meanE, maxE,
-                meanJumpResample, maxJumpResample, meanJumpOther, meanJumpResample / meanE);
+                "(max %.4f), elsewhere %.4f; ratio jump / E = %.3f\n",
+                meanE, maxE, meanJumpResample, maxJumpResample, meanJumpOther,
+                meanJumpResample / meanE);
     ASSERT_GT(nResample, 1);
     // [SB12] Fig. 9: the resampling jump is "of the same magnitude as the SPH acceleration
     // error E". Bound: mean Delta E at resampling steps at most 2 x mean E, and the largest

@@ -52,7 +52,11 @@ HydrostaticFit fitPressureSlope(const ParticleSet& p, Real a)
         if (std::abs(x[0]) > a - 2 * H || std::abs(x[2]) > a - 2 * H) continue;
         if (x[1] < 2 * H || x[1] > top - 2 * H) continue;
         const double y = x[1], pressure = p.pressures()[i];
-        sy += y; sp += pressure; syy += y * y; syp += y * pressure; n += 1;
+        sy += y;
+        sp += pressure;
+        syy += y * y;
+        syp += y * pressure;
+        n += 1;
         rhoSum += p.densities()[i];
     }
     fit.slope = (n * syp - sy * sp) / (n * syy - sy * sy);
@@ -73,7 +77,8 @@ TEST(HydrostaticTank, PressureGrowsAsRhoGDepthAndNoParticleEntersTheWalls)
     GhostSolver solver(s);
     const LevelSet tank = makeLevelSet(tankGrid(a, Real(0.2)), "tank");
     solver.addSolid(tank);
-    solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(-a, 0, -a), Vec3(a, depth, a), H / 2), "water"));
+    solver.addLiquid(
+        makeLevelSet(makeBoxLevelSet(Vec3(-a, 0, -a), Vec3(a, depth, a), H / 2), "water"));
     // [SB12] defaults: k = 2000 Pa (sound speed 3.7 m/s), 20 substeps at 30 fps would be
     // dt = 1/600 s; half that keeps the acoustic CFL number at 0.31.
     const Real dt = Real(1) / Real(1200);
@@ -103,7 +108,8 @@ TEST(HydrostaticTank, PressureGrowsAsRhoGDepthAndNoParticleEntersTheWalls)
     }
     double maxSpeed = 0;
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] == ParticleKind::Liquid) maxSpeed = std::max(maxSpeed, double(p.velocities()[i].length()));
+        if (p.kinds()[i] == ParticleKind::Liquid)
+            maxSpeed = std::max(maxSpeed, double(p.velocities()[i].length()));
     }
     const double slope = slopeSum / snapshots;
     // Hydrostatics: dp/dy = -rho g. With the paper's soft k = 2000 Pa the column compresses
@@ -113,9 +119,10 @@ TEST(HydrostaticTank, PressureGrowsAsRhoGDepthAndNoParticleEntersTheWalls)
     const double expected = -rhoMean * 9.81;
     std::printf("[measured] tank: mean dp/dy %.1f Pa/m over %d snapshots vs -rho g %.1f (%.2f %%; "
                 "-rho0 g %.1f), mean rho %.1f, %.0f particles per fit, deepest liquid inside wall "
-                "%.2e m, max speed %.3f m/s, top %.4f m\n", slope, snapshots, expected,
-                100 * (slope - expected) / expected, -double(s.restDensity) * 9.81, rhoMean,
-                fitted / snapshots, worstInside, maxSpeed, top);
+                "%.2e m, max speed %.3f m/s, top %.4f m\n",
+                slope, snapshots, expected, 100 * (slope - expected) / expected,
+                -double(s.restDensity) * 9.81, rhoMean, fitted / snapshots, worstInside, maxSpeed,
+                top);
     // SPH pressure noise over 0.1 m of height: bound 5 %.
     EXPECT_NEAR(slope / expected, 1.0, 0.05);
     // Collision projection keeps every particle out (at every snapshot): tolerance 1e-3 voxel of projection.

@@ -80,7 +80,8 @@ public:
 };
 
 template <typename Case>
-class KernelTest : public ::testing::Test {};
+class KernelTest : public ::testing::Test
+{};
 
 using KernelCases = ::testing::Types<CubicSB12, CubicOther, Poly6, Spiky, Viscosity>;
 TYPED_TEST_SUITE(KernelTest, KernelCases, CaseNames);
@@ -135,11 +136,11 @@ double maxAbsDwdr(const Kernel& kernel, double rMin, double rMax)
 // ---------------------------------------------------------------------------------------------
 
 /// 5-point Gauss-Legendre nodes and weights on [-1, 1].
-constexpr std::array<double, 5> GL_NODES = {
-    -0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
-constexpr std::array<double, 5> GL_WEIGHTS = {
-    0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-    0.2369268850561891};
+constexpr std::array<double, 5> GL_NODES = {-0.9061798459386640, -0.5384693101056831, 0.0,
+                                            0.5384693101056831, 0.9061798459386640};
+constexpr std::array<double, 5> GL_WEIGHTS = {0.2369268850561891, 0.4786286704993665,
+                                              0.5688888888888889, 0.4786286704993665,
+                                              0.2369268850561891};
 
 /// Integral over the ball of radius R of W(|x|), i.e. int_0^R 4 pi r^2 W(r) dr, by composite
 /// 5-point Gauss-Legendre on `intervals` equal sub-intervals, in double.
@@ -219,8 +220,8 @@ TYPED_TEST(KernelTest, GradientMatchesFiniteDifferences)
         for (int a = 0; a < 3; ++a) {
             Vec3 e(0);
             e[a] = d;
-            const double fd = (double(kernel.W(x + e)) - double(kernel.W(x - e))) /
-                              (double((x + e)[a]) - double((x - e)[a]));
+            const double fd = (double(kernel.W(x + e)) - double(kernel.W(x - e)))
+                              / (double((x + e)[a]) - double((x - e)[a]));
             worst = std::max(worst, std::abs(fd - double(g[a])) / scale);
         }
     });
@@ -300,11 +301,12 @@ TEST(CubicSplineKernel, VanishesExactlyAtTheSupportForEverySupportRadius)
         const Real R = Real(0.0005) * Real(i);
         const CubicSplineKernel kernel(R);
         const Real below = std::nextafter(R, Real(0));
-        if (kernel.W(R) != Real(0) || kernel.dWdr(R) != Real(0) || kernel.W(below) < Real(0) ||
-            kernel.dWdr(below) > Real(0)) {
+        if (kernel.W(R) != Real(0) || kernel.dWdr(R) != Real(0) || kernel.W(below) < Real(0)
+            || kernel.dWdr(below) > Real(0)) {
             if (++failures <= 5) {
-                ADD_FAILURE() << "R = " << R << ": W(R) = " << kernel.W(R) << ", dW/dr(R) = "
-                              << kernel.dWdr(R) << ", W(R - ulp) = " << kernel.W(below);
+                ADD_FAILURE() << "R = " << R << ": W(R) = " << kernel.W(R)
+                              << ", dW/dr(R) = " << kernel.dWdr(R)
+                              << ", W(R - ulp) = " << kernel.W(below);
             }
         }
     }
@@ -332,8 +334,8 @@ void checkLaplacian(const Kernel& kernel, double rMinFraction)
         for (int a = 0; a < 3; ++a) {
             Vec3 e(0);
             e[a] = d;
-            div += (double(kernel.gradW(x + e)[a]) - double(kernel.gradW(x - e)[a])) /
-                   (double((x + e)[a]) - double((x - e)[a]));
+            div += (double(kernel.gradW(x + e)[a]) - double(kernel.gradW(x - e)[a]))
+                   / (double((x + e)[a]) - double((x - e)[a]));
         }
         worst = std::max(worst, std::abs(div - double(kernel.laplacianW(x.length()))) / scale);
     });
@@ -385,9 +387,9 @@ TYPED_TEST(KernelTest, RejectsNonPositiveOrNonFiniteSupport)
 {
     using Kernel = typename TypeParam::Kernel;
     const std::string name = std::is_same_v<Kernel, CubicSplineKernel> ? "cubic spline kernel"
-                             : std::is_same_v<Kernel, Poly6Kernel>    ? "poly6 kernel"
-                             : std::is_same_v<Kernel, SpikyKernel>    ? "spiky kernel"
-                                                                      : "viscosity kernel";
+                             : std::is_same_v<Kernel, Poly6Kernel>     ? "poly6 kernel"
+                             : std::is_same_v<Kernel, SpikyKernel>     ? "spiky kernel"
+                                                                       : "viscosity kernel";
     checkRejectsSupport<Kernel>(Real(0), name, "0 m");
     checkRejectsSupport<Kernel>(Real(-0.1), name, "-0.1 m");
     checkRejectsSupport<Kernel>(std::numeric_limits<Real>::quiet_NaN(), name, "nan m");
@@ -414,9 +416,11 @@ TEST(KernelFunctions, PerPairSupportFormsAgreeWithTheKernelObjects)
         const ViscosityKernel viscosity(R);
         for (int k = 0; k <= 40; ++k) {
             const Real r = R * Real(k) / Real(40);
-            EXPECT_NEAR(poly6W(r, R), poly6.W(r), 1e-5 * poly6.W(Real(0))) << "R " << R << " r " << r;
+            EXPECT_NEAR(poly6W(r, R), poly6.W(r), 1e-5 * poly6.W(Real(0)))
+                << "R " << R << " r " << r;
             EXPECT_NEAR(spikySlope(r, R), -spiky.dWdr(r), 1e-5 * -spiky.dWdr(Real(0)));
-            EXPECT_NEAR(viscosityLaplacian(r, R), viscosity.laplacianW(r), 1e-5 * viscosity.laplacianW(Real(0)));
+            EXPECT_NEAR(viscosityLaplacian(r, R), viscosity.laplacianW(r),
+                        1e-5 * viscosity.laplacianW(Real(0)));
             if (k > 0 && k < 40) {
                 const Vec3 xij(r * Real(0.6), r * Real(0.8), 0);
                 const Vec3 a = spikyGrad(xij, r, R), b = spiky.gradW(xij, r);

@@ -18,9 +18,9 @@
 ///          for the gradient stencil, plus sqrt(3) voxels to the interpolation cell's corners)
 ///          lies inside the band where values are exact.
 #include <ghostfx/sph/Exceptions.h>
-#include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/RigidMotion.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -144,17 +144,18 @@ void expectInsideMatchesSphere(const LevelSet& ls, const Sphere& s)
     }
     EXPECT_GT(in, 50);
     EXPECT_GT(out, 50);
-    EXPECT_TRUE(ls.inside(toVec3(s.center)));                            // deep inside
+    EXPECT_TRUE(ls.inside(toVec3(s.center))); // deep inside
     EXPECT_TRUE(ls.inside(toVec3(s.center + Vec3d(0, 0.5 * s.radius, 0))));
     EXPECT_FALSE(ls.inside(toVec3(s.center + Vec3d(0, 0, 10.0 * s.radius)))); // far outside
-    EXPECT_FALSE(ls.inside(toVec3(s.center + Vec3d(1e4 * s.radius, 0, 0)))); // beyond the grid
+    EXPECT_FALSE(ls.inside(toVec3(s.center + Vec3d(1e4 * s.radius, 0, 0))));  // beyond the grid
     EXPECT_FALSE(ls.inBand(toVec3(s.center)));
 }
 
 LevelSet sphereLevelSet(const Sphere& s, double voxel, double halfWidth = HALF_WIDTH)
 {
-    return makeLevelSet(makeSphereLevelSet(toVec3(s.center), Real(s.radius), Real(voxel),
-                                           Real(halfWidth)), "sphere");
+    return makeLevelSet(
+        makeSphereLevelSet(toVec3(s.center), Real(s.radius), Real(voxel), Real(halfWidth)),
+        "sphere");
 }
 
 TEST(LevelSet, SpherePhiAndGradientMatchAnalyticDistance)
@@ -182,8 +183,8 @@ TEST(LevelSet, TranslatedTransformGivesTranslatedAnswers)
 {
     const Sphere s{Vec3d(0), 0.5};
     const double h = 0.02;
-    openvdb::FloatGrid::Ptr grid = makeSphereLevelSet(Vec3(0), Real(s.radius), Real(h),
-                                                      Real(HALF_WIDTH));
+    openvdb::FloatGrid::Ptr grid =
+        makeSphereLevelSet(Vec3(0), Real(s.radius), Real(h), Real(HALF_WIDTH));
     const Vec3d t(0.1234, -5.3, 2.71); // not a whole number of voxels
     openvdb::FloatGrid::Ptr moved = grid->deepCopy();
     openvdb::math::Transform::Ptr xform = grid->transform().copy();
@@ -203,8 +204,8 @@ TEST(LevelSet, TranslatedTransformGivesTranslatedAnswers)
     const double eps = std::numeric_limits<Real>::epsilon();
     for (const Vec3& x : pointsNearSphere(s, h, SAMPLE_BAND, 500, 23)) {
         const Vec3 xt = x + toVec3(t);
-        const double tol = 2.0 * std::sqrt(3.0) * eps * (toVec3d(x).length() + t.length()) +
-                           STORAGE_ERROR * h;
+        const double tol =
+            2.0 * std::sqrt(3.0) * eps * (toVec3d(x).length() + t.length()) + STORAGE_ERROR * h;
         EXPECT_NEAR(double(shifted.phi(xt)), double(base.phi(x)), tol);
         EXPECT_LT(angleDegrees(toVec3d(shifted.normal(xt)), toVec3d(base.normal(x))), 0.1);
         EXPECT_EQ(shifted.inside(xt), base.inside(x));
@@ -284,9 +285,9 @@ TEST(LevelSet, ProjectToSurfaceFailsQuicklyBeyondTheBand)
     const double h = 0.02;
     const LevelSet ls = sphereLevelSet(s, h);
     // Outside beyond the band (8 voxels, band 5), far outside, deep inside, and beyond the grid.
-    for (const Vec3d& x : {s.center + Vec3d(0, s.radius + 8 * h, 0),
-                           s.center + Vec3d(3.0, -2.0, 1.0), s.center,
-                           s.center + Vec3d(0, 0, 0.3 * s.radius), Vec3d(1e5, 0, 0)}) {
+    for (const Vec3d& x :
+         {s.center + Vec3d(0, s.radius + 8 * h, 0), s.center + Vec3d(3.0, -2.0, 1.0), s.center,
+          s.center + Vec3d(0, 0, 0.3 * s.radius), Vec3d(1e5, 0, 0)}) {
         const SurfaceProjection p = ls.projectToSurface(toVec3(x), Real(-1), 1000);
         EXPECT_FALSE(p.converged) << "from " << x;
         EXPECT_EQ(p.iterations, 0) << "from " << x << ": walked in a made-up direction";
@@ -309,8 +310,8 @@ TEST(LevelSet, SphereSurfaceCellsAreTheCellsTheSurfaceCrosses)
     // the corner values, < 1e-4 h).
     double worst = 0.0;
     for (const auto& c : cells) {
-        const Vec3 centre = ls.indexToWorld(Vec3(Real(c[0] + 0.5), Real(c[1] + 0.5),
-                                                 Real(c[2] + 0.5)));
+        const Vec3 centre =
+            ls.indexToWorld(Vec3(Real(c[0] + 0.5), Real(c[1] + 0.5), Real(c[2] + 0.5)));
         worst = std::max(worst, std::abs(s.sdf(toVec3d(centre))));
     }
     EXPECT_LE(worst, (std::sqrt(3.0) / 2.0 + STORAGE_ERROR) * h);
@@ -362,8 +363,8 @@ TEST(LevelSet, BoxFacesAreExactAndInsideHoldsBeyondTheBand)
 {
     const Vec3d lo(-0.5, -0.3, -0.4), hi(0.6, 0.5, 0.45);
     const double h = 0.025;
-    const LevelSet ls = makeLevelSet(makeBoxLevelSet(toVec3(lo), toVec3(hi), Real(h),
-                                                     Real(HALF_WIDTH)), "box");
+    const LevelSet ls =
+        makeLevelSet(makeBoxLevelSet(toVec3(lo), toVec3(hi), Real(h), Real(HALF_WIDTH)), "box");
     // Points near the middle of each face, at least band + 2 voxels from every edge: there the
     // distance is linear (no curvature, no crease) across every sample the query touches, so
     // trilinear interpolation and central differences are exact up to float storage.
@@ -403,8 +404,8 @@ TEST(LevelSet, TorusPhiMatchesAnalyticDistance)
 {
     const Vec3d c(0.05, 0.1, -0.2);
     const double R = 0.5, r = 0.15, h = 0.0125;
-    const LevelSet ls = makeLevelSet(makeTorusLevelSet(toVec3(c), Real(R), Real(r), Real(h),
-                                                       Real(HALF_WIDTH)), "torus");
+    const LevelSet ls = makeLevelSet(
+        makeTorusLevelSet(toVec3(c), Real(R), Real(r), Real(h), Real(HALF_WIDTH)), "torus");
     auto sdf = [&](const Vec3d& x) {
         const Vec3d d = x - c;
         return std::hypot(std::hypot(d.x(), d.z()) - R, d.y()) - r;
@@ -412,8 +413,7 @@ TEST(LevelSet, TorusPhiMatchesAnalyticDistance)
     // Curvatures of the level sets: 1/d around the tube (d = distance to the core circle) and
     // at most 1/(R - d) around the axis; worst over the samples touched, d in r +/- reach.
     const double reach = (SAMPLE_BAND + std::sqrt(3.0)) * h;
-    const double E = h * h / 8.0 * (1.0 / (r - reach) + 1.0 / (R - r - reach)) +
-                     STORAGE_ERROR * h;
+    const double E = h * h / 8.0 * (1.0 / (r - reach) + 1.0 / (R - r - reach)) + STORAGE_ERROR * h;
     std::mt19937 rng(41);
     std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI),
         off(-SAMPLE_BAND * h, SAMPLE_BAND * h);
@@ -421,8 +421,8 @@ TEST(LevelSet, TorusPhiMatchesAnalyticDistance)
     for (int k = 0; k < 2000; ++k) {
         const double theta = angle(rng), psi = angle(rng), rho = r + off(rng);
         const Vec3d ring(std::cos(theta), 0.0, std::sin(theta));
-        const Vec3 x = toVec3(c + (R + rho * std::cos(psi)) * ring +
-                              Vec3d(0.0, rho * std::sin(psi), 0.0));
+        const Vec3 x =
+            toVec3(c + (R + rho * std::cos(psi)) * ring + Vec3d(0.0, rho * std::sin(psi), 0.0));
         worst = std::max(worst, std::abs(double(ls.phi(x)) - sdf(toVec3d(x))));
     }
     EXPECT_LT(worst, E) << "bound " << E / h << " voxel";
@@ -445,8 +445,7 @@ TEST(LevelSet, LevelSetFromSdfRejectsBadArguments)
     EXPECT_THROW(levelSetFromSdf(sdf, Aabb(), Real(0.1)), ghostfx::ValueError);
     EXPECT_THROW(makeSphereLevelSet(Vec3(0), Real(-1), Real(0.1)), ghostfx::ValueError);
     EXPECT_THROW(makeBoxLevelSet(Vec3(1), Vec3(0), Real(0.1)), ghostfx::ValueError);
-    EXPECT_THROW(makeTorusLevelSet(Vec3(0), Real(0.1), Real(0.2), Real(0.01)),
-                 ghostfx::ValueError);
+    EXPECT_THROW(makeTorusLevelSet(Vec3(0), Real(0.1), Real(0.2), Real(0.01)), ghostfx::ValueError);
 }
 
 TEST(LevelSet, QueriesFromManyThreadsAgreeWithSerialQueries)
@@ -456,8 +455,8 @@ TEST(LevelSet, QueriesFromManyThreadsAgreeWithSerialQueries)
     const std::vector<Vec3> xs = pointsNearSphere(s, 0.02, 4.0, 20000, 51);
     std::vector<Real> serial(xs.size()), threaded(xs.size());
     for (std::size_t i = 0; i < xs.size(); ++i) serial[i] = ls.phi(xs[i]);
-    ghostfx::parallel::forEach(0, xs.size(), [&](std::size_t i) { threaded[i] = ls.phi(xs[i]); },
-                               64);
+    ghostfx::parallel::forEach(
+        0, xs.size(), [&](std::size_t i) { threaded[i] = ls.phi(xs[i]); }, 64);
     EXPECT_EQ(threaded, serial);
 }
 
@@ -547,7 +546,7 @@ TEST(LevelSetGrid, AcceptsValidGridAndUsesItsNameByDefault)
     EXPECT_NO_THROW(validateLevelSetGrid(*grid, "collider"));
     const LevelSet ls = makeLevelSet(grid);
     EXPECT_EQ(ls.name(), "collider");
-    EXPECT_EQ(gridOf(ls), grid); // shared, not copied
+    EXPECT_EQ(gridOf(ls), grid);            // shared, not copied
     EXPECT_NEAR(ls.bandWidth(), 0.3, 1e-6); // default half width: 3 voxels
     // The default name also appears in errors.
     grid->setGridClass(openvdb::GRID_FOG_VOLUME);
@@ -562,8 +561,9 @@ TEST(RigidMotion, ConstantVelocityIsExactFarFromTheOrigin)
     // difference of single-precision placements lost 0.5 % at t = 10 s and 4 % at t = 100 s
     // (issue 15); the rates of the motion are exact to rounding (bound 1e-6 relative).
     const Vec3 v(3, 0, -1);
-    const MovingLevelSet body{makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.1), Real(0.02)), "ball"),
-                              constantVelocity(v)};
+    const MovingLevelSet body{
+        makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.1), Real(0.02)), "ball"),
+        constantVelocity(v)};
     for (double t : {0.0, 10.0, 100.0, 1000.0}) {
         const Vec3 u = body.velocity(Vec3(Real(0.05), 0, 0), t);
         EXPECT_NEAR((u - v).length() / v.length(), 0.0, 1e-6) << "t = " << t;
@@ -572,10 +572,10 @@ TEST(RigidMotion, ConstantVelocityIsExactFarFromTheOrigin)
     }
     // A motion without rates still gets its velocity by the central difference.
     const MovingLevelSet lambda{body.shape, [](double t) {
-        RigidTransform xf;
-        xf.translation = Vec3(Real(2 * t), 0, 0);
-        return xf;
-    }};
+                                    RigidTransform xf;
+                                    xf.translation = Vec3(Real(2 * t), 0, 0);
+                                    return xf;
+                                }};
     EXPECT_NEAR(double(lambda.velocity(Vec3(0), 1.0)[0]), 2.0, 1e-3);
 }
 
@@ -583,12 +583,14 @@ TEST(SolidCollision, ProjectsRestoresOrReportsStuck)
 {
     // A 2 m cube (solid) whose level set has a narrow band of 3 voxels of 1 cm.
     const Real voxel = Real(0.01);
-    const MovingLevelSet cube{makeLevelSet(makeBoxLevelSet(Vec3(-1), Vec3(1), voxel), "cube"), constantVelocity(Vec3(0))};
+    const MovingLevelSet cube{makeLevelSet(makeBoxLevelSet(Vec3(-1), Vec3(1), voxel), "cube"),
+                              constantVelocity(Vec3(0))};
     const RigidTransform xf = cube.at(0);
     const Real band = cube.shape.bandWidth();
     // Just inside the top face, moving down: to the face, downward velocity removed.
     Vec3 x(Real(0.2), Real(1) - Real(0.5) * band, Real(0.1)), v(1, -2, 0);
-    EXPECT_EQ(collideWithSolid(cube, xf, 0, x + Vec3(0, Real(0.01), 0), x, v), Collision::Projected);
+    EXPECT_EQ(collideWithSolid(cube, xf, 0, x + Vec3(0, Real(0.01), 0), x, v),
+              Collision::Projected);
     EXPECT_NEAR(double(x[1]), 1.0, 1e-3 * double(voxel));
     EXPECT_EQ(v, Vec3(1, 0, 0));
     // 0.5 m deep (far beyond the band, where phi is clamped), having started above the face:

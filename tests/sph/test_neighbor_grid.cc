@@ -44,8 +44,7 @@ std::vector<Vec3> uniformPoints(std::size_t n, const Vec3& lo, const Vec3& hi, u
 
 /// `clusters` Gaussian blobs of `perCluster` points, standard deviation `sigma` (m), centres
 /// uniform in [-1, 1]^3 m.
-std::vector<Vec3> clusteredPoints(int clusters, std::size_t perCluster, double sigma,
-                                  unsigned seed)
+std::vector<Vec3> clusteredPoints(int clusters, std::size_t perCluster, double sigma, unsigned seed)
 {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -83,7 +82,10 @@ Index bruteNearest(const std::vector<Vec3>& xs, const Vec3& x, Real maxRadius, P
     Real best2 = maxRadius * maxRadius;
     for (std::size_t j = 0; j < xs.size(); ++j) {
         const Real r2 = (x - xs[j]).lengthSqr();
-        if (r2 < best2 && pred(Index(j))) { best2 = r2; best = Index(j); }
+        if (r2 < best2 && pred(Index(j))) {
+            best2 = r2;
+            best = Index(j);
+        }
     }
     *distance = best == INVALID_INDEX ? Real(-1) : std::sqrt(best2);
     return best;
@@ -197,7 +199,8 @@ TEST(NeighborGrid, BucketCountForSmallAndEmptySets)
     grid.forEachInRadius(Vec3(0), Real(10), [&](Index, const Vec3&, Real) { ++calls; });
     EXPECT_EQ(calls, 0);
     Real distance = 0;
-    EXPECT_EQ(grid.nearest(Vec3(0), Real(5), [](Index) { return true; }, &distance),
+    EXPECT_EQ(grid.nearest(
+                  Vec3(0), Real(5), [](Index) { return true; }, &distance),
               INVALID_INDEX);
     EXPECT_LT(distance, Real(0));
     grid.build(uniformPoints(33, Vec3(0), Vec3(1), 4));
@@ -222,8 +225,8 @@ TEST(NeighborGrid, ForEachInRadiusMatchesBruteForceForSmallAndLargeRadii)
     grid.build(xs);
     // Query points are not particles, and some lie outside the cloud.
     const std::vector<Vec3> queries = uniformPoints(300, Vec3(-0.3f), Vec3(0.3f), 8);
-    for (Real radius : {Real(0.3) * cellSize, cellSize, Real(1.7) * cellSize,
-                        Real(2.5) * cellSize}) {
+    for (Real radius :
+         {Real(0.3) * cellSize, cellSize, Real(1.7) * cellSize, Real(2.5) * cellSize}) {
         std::size_t mismatches = 0, found = 0;
         for (const Vec3& x : queries) {
             std::vector<Index> got;
@@ -257,13 +260,13 @@ TEST(NeighborGrid, NearestMatchesBruteForce)
     std::mt19937 rng(10);
     std::normal_distribution<double> offset(0.0, 0.05);
     for (std::size_t q = 0; q < queries.size(); q += 2) {
-        queries[q] = xs[rng() % xs.size()] +
-                     Vec3(Real(offset(rng)), Real(offset(rng)), Real(offset(rng)));
+        queries[q] =
+            xs[rng() % xs.size()] + Vec3(Real(offset(rng)), Real(offset(rng)), Real(offset(rng)));
     }
     const auto any = [](Index) { return true; };
     std::size_t foundCount = 0, noneCount = 0;
-    for (Real maxRadius : {Real(0.5) * cellSize, cellSize, Real(3) * cellSize,
-                           Real(10) * cellSize}) {
+    for (Real maxRadius :
+         {Real(0.5) * cellSize, cellSize, Real(3) * cellSize, Real(10) * cellSize}) {
         for (const Vec3& x : queries) {
             Real d = 0, dBrute = 0;
             const Index j = grid.nearest(x, maxRadius, any, &d);
@@ -466,13 +469,16 @@ TEST(NeighborGrid, HugeRadiiAndFarQueryPointsMatchBruteForceWithoutScanningEmpty
     for (const Vec3& x : queries) {
         for (const Real radius : radii) {
             std::vector<Index> found;
-            grid.forEachInRadius(x, radius, [&](Index j, const Vec3&, Real) { found.push_back(j); });
+            grid.forEachInRadius(x, radius,
+                                 [&](Index j, const Vec3&, Real) { found.push_back(j); });
             std::sort(found.begin(), found.end());
             EXPECT_EQ(found, bruteInRadius(xs, x, radius)) << "radius " << radius;
 
             Real d = 0, dBrute = 0;
-            const Index j = grid.nearest(x, radius, [](Index) { return true; }, &d);
-            const Index jBrute = bruteNearest(xs, x, radius, [](Index) { return true; }, &dBrute);
+            const Index j = grid.nearest(
+                x, radius, [](Index) { return true; }, &d);
+            const Index jBrute = bruteNearest(
+                xs, x, radius, [](Index) { return true; }, &dBrute);
             EXPECT_EQ(j, jBrute) << "radius " << radius;
             EXPECT_EQ(d, dBrute) << "radius " << radius;
         }

@@ -61,12 +61,14 @@ void expectListsMatchBruteForce(const std::vector<Vec3>& targets, const std::vec
     NeighborGrid grid(cellSize);
     grid.build(targets);
     NeighborLists lists;
-    lists.build(grid, queries.data(), queries.size(), radius, wanted.empty() ? nullptr : wanted.data());
+    lists.build(grid, queries.data(), queries.size(), radius,
+                wanted.empty() ? nullptr : wanted.data());
     ASSERT_EQ(lists.size(), queries.size());
     std::size_t pairs = 0;
     for (std::size_t q = 0; q < queries.size(); ++q) {
         const bool want = wanted.empty() || wanted[q];
-        const std::vector<Index> expected = want ? bruteForce(queries[q], targets, radius) : std::vector<Index>{};
+        const std::vector<Index> expected =
+            want ? bruteForce(queries[q], targets, radius) : std::vector<Index>{};
         ASSERT_EQ(sorted(lists[q]), expected) << "query " << q;
         pairs += expected.size();
     }
@@ -106,11 +108,14 @@ TEST(NeighborLists, SortedSetAgainstItselfHoldsEachParticleAndIsTheSameOnBothSea
     NeighborLists::setWideSimd(false);
     b.build(grid, x.data(), x.size(), Real(0.03));
     NeighborLists::setWideSimd(true);
-    std::printf("[measured] %zu pairs, wide SIMD path %s\n", a.pairCount(), wide ? "available" : "absent");
+    std::printf("[measured] %zu pairs, wide SIMD path %s\n", a.pairCount(),
+                wide ? "available" : "absent");
     for (std::size_t i = 0; i < x.size(); ++i) {
-        ASSERT_EQ(std::vector<Index>(a[i].begin(), a[i].end()), std::vector<Index>(b[i].begin(), b[i].end()))
+        ASSERT_EQ(std::vector<Index>(a[i].begin(), a[i].end()),
+                  std::vector<Index>(b[i].begin(), b[i].end()))
             << "particle " << i;
-        ASSERT_TRUE(std::find(a[i].begin(), a[i].end(), Index(i)) != a[i].end()) << "particle " << i;
+        ASSERT_TRUE(std::find(a[i].begin(), a[i].end(), Index(i)) != a[i].end())
+            << "particle " << i;
         ASSERT_EQ(sorted(a[i]), bruteForce(x[i], x, Real(0.03))) << "particle " << i;
     }
 }
@@ -127,7 +132,8 @@ TEST(NeighborLists, IdenticalForOneThreadAndAllThreads)
     parallel::setSerial(false);
     for (std::size_t i = 0; i < xs.size(); ++i) {
         ASSERT_EQ(std::vector<Index>(all[i].begin(), all[i].end()),
-                  std::vector<Index>(one[i].begin(), one[i].end())) << "query " << i;
+                  std::vector<Index>(one[i].begin(), one[i].end()))
+            << "query " << i;
     }
 }
 
@@ -148,7 +154,8 @@ TEST(PairBatch, SumsEqualPlainSumsOverLongLists)
     std::vector<Index> list(xs.size());
     for (std::size_t k = 0; k < list.size(); ++k) list[k] = Index(k);
     std::vector<Vec3> values(xs.size());
-    for (std::size_t k = 0; k < values.size(); ++k) values[k] = Vec3(Real(k), Real(0.5) * Real(k), -Real(k));
+    for (std::size_t k = 0; k < values.size(); ++k)
+        values[k] = Vec3(Real(k), Real(0.5) * Real(k), -Real(k));
     const Vec3 xi(Real(0.05)), vi(1, 2, 3);
     const CubicSplineKernel kernel(Real(0.2));
     double w = 0;
@@ -228,8 +235,8 @@ TEST(LevelSet, PushOutsideLeavesEdgesAndCornersOfABox)
     // Where Newton projection with the trilinear gradient oscillates (at the box's edges and
     // corners the gradient jumps between cells), pushOutside still ends just outside.
     const Real h = Real(0.01);
-    const LevelSet box = makeLevelSet(makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f),
-                                                      Vec3(0.08f, -0.04f, 0.08f), h / 2), "box");
+    const LevelSet box = makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.08f, -0.1f, -0.08f), Vec3(0.08f, -0.04f, 0.08f), h / 2), "box");
     const Vec3 points[] = {Vec3(-0.0793571f, -0.0408085f, -0.0113048f), // an edge (seen in a run)
                            Vec3(0.0797f, -0.0403f, 0.0796f),            // a corner
                            Vec3(0, -0.0405f, 0)};                       // a face

@@ -118,7 +118,10 @@ TEST(ParallelSum, EmptyRangeIsZeroAndCallsNothing)
 {
     SerialGuard guard(false);
     int calls = 0;
-    auto fn = [&calls](std::size_t) { ++calls; return 1.0; };
+    auto fn = [&calls](std::size_t) {
+        ++calls;
+        return 1.0;
+    };
     EXPECT_EQ(bits(parallel::sum(5, 5, fn)), bits(0.0));
     EXPECT_EQ(bits(parallel::sum(7, 3, fn)), bits(0.0)); // end < begin: empty, not huge
     EXPECT_EQ(calls, 0);
@@ -131,14 +134,15 @@ void checkVisitsOnce(std::size_t begin, std::size_t end, std::size_t grain)
     const std::size_t pad = 3;
     std::vector<std::atomic<int>> visits(end + pad);
     for (auto& c : visits) c.store(0);
-    parallel::forEach(begin, end, [&](std::size_t i) { visits[i].fetch_add(1); }, grain);
+    parallel::forEach(
+        begin, end, [&](std::size_t i) { visits[i].fetch_add(1); }, grain);
     std::size_t wrong = 0;
     for (std::size_t i = 0; i < visits.size(); ++i) {
         const int expected = (i >= begin && i < end) ? 1 : 0;
         if (visits[i].load() != expected && ++wrong <= 3) {
             ADD_FAILURE() << "index " << i << " visited " << visits[i].load() << " times, expected "
-                          << expected << " (range [" << begin << ", " << end << "), grain "
-                          << grain << ")";
+                          << expected << " (range [" << begin << ", " << end << "), grain " << grain
+                          << ")";
         }
     }
     EXPECT_EQ(wrong, 0u);
@@ -163,8 +167,10 @@ TEST(ParallelForEach, EmptyRangesCallNothing)
     SerialGuard guard(false);
     std::atomic<int> calls{0};
     parallel::forEach(0, 0, [&](std::size_t) { ++calls; });
-    parallel::forEach(10, 10, [&](std::size_t) { ++calls; }, 1);
-    parallel::forEach(10, 2, [&](std::size_t) { ++calls; }, 1); // end < begin
+    parallel::forEach(
+        10, 10, [&](std::size_t) { ++calls; }, 1);
+    parallel::forEach(
+        10, 2, [&](std::size_t) { ++calls; }, 1); // end < begin
     parallel::forRange(4, 4, [&](std::size_t, std::size_t) { ++calls; });
     EXPECT_EQ(calls.load(), 0);
 }
@@ -176,10 +182,13 @@ TEST(ParallelForRange, ChunksAreDisjointCoverTheRangeAndRespectTheGrain)
         const std::size_t begin = 7, end = 10007;
         std::mutex mutex;
         std::vector<std::pair<std::size_t, std::size_t>> chunks;
-        parallel::forRange(begin, end, [&](std::size_t b, std::size_t e) {
-            std::lock_guard<std::mutex> lock(mutex);
-            chunks.emplace_back(b, e);
-        }, grain);
+        parallel::forRange(
+            begin, end,
+            [&](std::size_t b, std::size_t e) {
+                std::lock_guard<std::mutex> lock(mutex);
+                chunks.emplace_back(b, e);
+            },
+            grain);
         std::sort(chunks.begin(), chunks.end());
         ASSERT_FALSE(chunks.empty());
         EXPECT_EQ(chunks.front().first, begin);
@@ -201,12 +210,15 @@ TEST(ParallelForRange, TinyRangeRunsOnceOnTheCallingThread)
     for (std::size_t size : {std::size_t(1), std::size_t(100), std::size_t(256)}) {
         int calls = 0;
         std::thread::id where;
-        parallel::forRange(1000, 1000 + size, [&](std::size_t b, std::size_t e) {
-            ++calls;
-            where = std::this_thread::get_id();
-            EXPECT_EQ(b, 1000u);
-            EXPECT_EQ(e, 1000u + size);
-        }, 256);
+        parallel::forRange(
+            1000, 1000 + size,
+            [&](std::size_t b, std::size_t e) {
+                ++calls;
+                where = std::this_thread::get_id();
+                EXPECT_EQ(b, 1000u);
+                EXPECT_EQ(e, 1000u + size);
+            },
+            256);
         EXPECT_EQ(calls, 1) << "size " << size;
         EXPECT_EQ(where, std::this_thread::get_id());
     }
@@ -222,7 +234,8 @@ TEST(ParallelForRange, ZeroGrainIsTreatedAsOne)
     std::vector<double> v = orderSensitiveValues(5000);
     double forward = 0.0;
     for (double x : v) forward += x;
-    EXPECT_EQ(bits(parallel::sum(0, v.size(), [&v](std::size_t i) { return v[i]; }, 0)),
+    EXPECT_EQ(bits(parallel::sum(
+                  0, v.size(), [&v](std::size_t i) { return v[i]; }, 0)),
               bits(forward)); // block 0 means block 1: the left-to-right sum
 }
 
@@ -234,19 +247,25 @@ TEST(ParallelSerial, SwitchRunsEverythingInOrderOnTheCallingThread)
     std::vector<std::size_t> seen; // no lock: serial means one thread
     bool otherThread = false;
     const auto caller = std::this_thread::get_id();
-    parallel::forEach(0, 50000, [&](std::size_t i) {
-        seen.push_back(i);
-        if (std::this_thread::get_id() != caller) otherThread = true;
-    }, 16);
+    parallel::forEach(
+        0, 50000,
+        [&](std::size_t i) {
+            seen.push_back(i);
+            if (std::this_thread::get_id() != caller) otherThread = true;
+        },
+        16);
     EXPECT_FALSE(otherThread);
     ASSERT_EQ(seen.size(), 50000u);
     for (std::size_t i = 0; i < seen.size(); ++i) ASSERT_EQ(seen[i], i);
     int calls = 0;
-    parallel::forRange(0, 50000, [&](std::size_t b, std::size_t e) {
-        ++calls;
-        EXPECT_EQ(b, 0u);
-        EXPECT_EQ(e, 50000u);
-    }, 16);
+    parallel::forRange(
+        0, 50000,
+        [&](std::size_t b, std::size_t e) {
+            ++calls;
+            EXPECT_EQ(b, 0u);
+            EXPECT_EQ(e, 50000u);
+        },
+        16);
     EXPECT_EQ(calls, 1);
     parallel::setSerial(false);
     EXPECT_FALSE(parallel::isSerial());
@@ -263,9 +282,12 @@ TEST(ParallelThreadLimit, CapsThreadsWhileAliveAndRestoresAfter)
         // With one thread allowed TBB runs every chunk on the calling thread.
         std::atomic<bool> otherThread{false};
         const auto caller = std::this_thread::get_id();
-        parallel::forEach(0, 100000, [&](std::size_t) {
-            if (std::this_thread::get_id() != caller) otherThread = true;
-        }, 64);
+        parallel::forEach(
+            0, 100000,
+            [&](std::size_t) {
+                if (std::this_thread::get_id() != caller) otherThread = true;
+            },
+            64);
         EXPECT_FALSE(otherThread.load());
     }
     EXPECT_EQ(parallel::maxThreads(), all);

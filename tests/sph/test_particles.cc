@@ -79,13 +79,12 @@ void expectRowsMatchIds(const ParticleSet& set)
     ASSERT_EQ(set.vectorChannel("vorticity").size(), n);
     for (std::size_t k = 0; k < n; ++k) {
         const ParticleId id = set.ids()[k];
-        const bool ok = set.positions()[k] == positionOf(id) &&
-                        set.velocities()[k] == velocityOf(id) &&
-                        set.kinds()[k] == kindOf(id) && set.masses()[k] == massOf(kindOf(id)) &&
-                        set.densities()[k] == densityOf(id) &&
-                        set.pressures()[k] == pressureOf(id) &&
-                        set.scalarChannel("temperature")[k] == temperatureOf(id) &&
-                        set.vectorChannel("vorticity")[k] == vorticityOf(id);
+        const bool ok =
+            set.positions()[k] == positionOf(id) && set.velocities()[k] == velocityOf(id)
+            && set.kinds()[k] == kindOf(id) && set.masses()[k] == massOf(kindOf(id))
+            && set.densities()[k] == densityOf(id) && set.pressures()[k] == pressureOf(id)
+            && set.scalarChannel("temperature")[k] == temperatureOf(id)
+            && set.vectorChannel("vorticity")[k] == vorticityOf(id);
         ASSERT_TRUE(ok) << "row " << k << " (id " << id << ") has channels of another particle";
     }
 }

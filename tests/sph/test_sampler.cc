@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numeric>
 
@@ -22,9 +22,9 @@ using namespace ghostfx::sph;
 
 namespace {
 
-constexpr Real SPACING = Real(0.01);         // h (m)
-constexpr Real VOXEL = Real(0.5) * SPACING;  // level-set voxel (m)
-constexpr Real REST_DENSITY = Real(1000);    // rho0 (kg/m^3)
+constexpr Real SPACING = Real(0.01);        // h (m)
+constexpr Real VOXEL = Real(0.5) * SPACING; // level-set voxel (m)
+constexpr Real REST_DENSITY = Real(1000);   // rho0 (kg/m^3)
 
 /// A shape: its analytic signed distance (exact, not band-limited) and its level set.
 struct Shape
@@ -76,9 +76,12 @@ Shape twoSpheres()
         return std::min(double((x - c0).length() - r0), double((x - c1).length() - r1));
     };
     Aabb b{Vec3(-0.15, -0.05, -0.05), Vec3(0.135, 0.05, 0.05)};
-    return {"two_spheres", sdf, levelSetFromSdf([&](const openvdb::Vec3d& x) {
-                return sdf(Vec3(Real(x[0]), Real(x[1]), Real(x[2]))); }, b, VOXEL), b,
-            4.0 / 3.0 * M_PI * (std::pow(double(r0), 3) + std::pow(double(r1), 3))};
+    return {
+        "two_spheres", sdf,
+        levelSetFromSdf(
+            [&](const openvdb::Vec3d& x) { return sdf(Vec3(Real(x[0]), Real(x[1]), Real(x[2]))); },
+            b, VOXEL),
+        b, 4.0 / 3.0 * M_PI * (std::pow(double(r0), 3) + std::pow(double(r1), 3))};
 }
 
 /// Distance from every sample to its nearest other sample (m).
@@ -131,7 +134,8 @@ Shape shapeByName(const std::string& name)
     return twoSpheres();
 }
 
-class SamplerShapes : public ::testing::TestWithParam<std::string> {};
+class SamplerShapes : public ::testing::TestWithParam<std::string>
+{};
 
 } // namespace
 
@@ -183,14 +187,16 @@ TEST_P(SamplerShapes, PoissonDiskBoundaryFitAndCoverage)
         if (shape.sdf(x) >= 0) continue;
         ++tested;
         Real dist = -1;
-        const Index j = grid.nearest(x, Real(4) * r, [](Index) { return true; }, &dist);
+        const Index j = grid.nearest(
+            x, Real(4) * r, [](Index) { return true; }, &dist);
         ASSERT_NE(j, INVALID_INDEX) << "no sample within 4r of an interior point of " << shape.name;
         worstHole = std::max(worstHole, double(dist));
     }
     EXPECT_LT(worstHole, 1.5 * r) << shape.name;
     std::printf("[measured] %s: %zu samples (%zu surface), min distance %.4f r, worst surface "
-                "|phi| %.4f voxel, largest empty ball %.3f r\n", shape.name.c_str(), s.size(),
-                s.surfaceCount(), double(minDist / r), worstSurface / VOXEL, worstHole / r);
+                "|phi| %.4f voxel, largest empty ball %.3f r\n",
+                shape.name.c_str(), s.size(), s.surfaceCount(), double(minDist / r),
+                worstSurface / VOXEL, worstHole / r);
 
     // 4. Sample count matches the volume: interior number density after relaxation measured
     //    at 0.74-0.77 / h^3 (see the mass-scaling test); surface samples add a shell. Allow
@@ -202,7 +208,9 @@ TEST_P(SamplerShapes, PoissonDiskBoundaryFitAndCoverage)
 
 INSTANTIATE_TEST_SUITE_P(Shapes, SamplerShapes,
                          ::testing::Values("Sphere", "Box", "Torus", "TwoSpheres"),
-                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                             return info.param;
+                         });
 
 TEST(Sampler, FindsBothDisjointComponentsInProportionToVolume)
 {
@@ -237,7 +245,8 @@ TEST(Sampler, RelaxationSpreadsSamplesAndEvensDensity)
     // Algorithm 2 only accepts moves that increase a sample's nearest distance. Measured:
     // mean nearest distance 1.07 r -> 1.19 r. Assert at least a 5 % gain.
     std::printf("[measured] mean nearest distance %.3f r -> %.3f r\n", nnBefore / r, nnAfter / r);
-    EXPECT_GT(nnAfter, 1.05 * nnBefore) << "before " << nnBefore / r << " r, after " << nnAfter / r << " r";
+    EXPECT_GT(nnAfter, 1.05 * nnBefore)
+        << "before " << nnBefore / r << " r, after " << nnAfter / r << " r";
 
     // Interior SPH density spread (M4 kernel, support 3h, unit mass, particles deeper than
     // the support): measured 6.2 % -> 2.9 %. Assert the spread falls by at least 30 %.
@@ -245,14 +254,15 @@ TEST(Sampler, RelaxationSpreadsSamplesAndEvensDensity)
     auto spread = [&](const SampleSet& set) {
         NeighborGrid grid(kernel.supportRadius());
         grid.build(set.positions);
-        const std::vector<Real> rho = densitySum(set.positions,
-            std::vector<Real>(set.size(), Real(1)), grid, kernel);
+        const std::vector<Real> rho =
+            densitySum(set.positions, std::vector<Real>(set.size(), Real(1)), grid, kernel);
         return relativeSpread(rho, interiorMask(set.positions, shape, kernel.supportRadius()));
     };
     const double spreadBefore = spread(before), spreadAfter = spread(s);
     std::printf("[measured] interior density spread %.2f %% -> %.2f %%\n", 100 * spreadBefore,
                 100 * spreadAfter);
-    EXPECT_LT(spreadAfter, 0.7 * spreadBefore) << "before " << spreadBefore << ", after " << spreadAfter;
+    EXPECT_LT(spreadAfter, 0.7 * spreadBefore)
+        << "before " << spreadBefore << ", after " << spreadAfter;
 }
 
 TEST(Sampler, MassScalingGivesRestDensityOnAverage)
@@ -267,10 +277,14 @@ TEST(Sampler, MassScalingGivesRestDensityOnAverage)
 
     NeighborGrid grid(kernel.supportRadius());
     grid.build(s.positions);
-    const std::vector<Real> rho = densitySum(s.positions, std::vector<Real>(s.size(), m), grid, kernel);
+    const std::vector<Real> rho =
+        densitySum(s.positions, std::vector<Real>(s.size(), m), grid, kernel);
     double sum = 0, n = 0;
     for (std::size_t i = 0; i < s.size(); ++i) {
-        if (interior[i]) { sum += rho[i]; n += 1; }
+        if (interior[i]) {
+            sum += rho[i];
+            n += 1;
+        }
     }
     ASSERT_GT(n, 100);
     // Exact up to float summation error: ~60 terms of relative error 6e-8 each per density,
@@ -309,8 +323,8 @@ TEST(Sampler, BandLimitedSamplingForSolids)
         EXPECT_GT(deepest, 0.85 * depth) << "half width " << halfWidth;
         // The band volume 4/3 pi (R^3 - (R - depth)^3) holds about 0.75 samples per h^3 plus
         // the surface shell: expect 0.6 to 1.5 per h^3.
-        const double bandVolume = 4.0 / 3.0 * M_PI *
-            (std::pow(double(radius), 3) - std::pow(double(radius - depth), 3));
+        const double bandVolume =
+            4.0 / 3.0 * M_PI * (std::pow(double(radius), 3) - std::pow(double(radius - depth), 3));
         const double perVolume = double(s.size()) * std::pow(double(SPACING), 3) / bandVolume;
         EXPECT_GT(perVolume, 0.6) << "half width " << halfWidth;
         EXPECT_LT(perVolume, 1.5) << "half width " << halfWidth;
@@ -392,8 +406,8 @@ TEST(Sampler, SeededSamplingGrowsAnAirLayer)
         ASSERT_TRUE(inLayer(air[k])) << "air sample " << k << " outside the layer";
     }
     // Layer volume times the interior packing (0.75 / h^3), within a factor 0.6 - 1.3.
-    const double layerVolume = 4.0 / 3.0 * M_PI *
-        (std::pow(0.05 + double(layer), 3) - std::pow(0.05, 3));
+    const double layerVolume =
+        4.0 / 3.0 * M_PI * (std::pow(0.05 + double(layer), 3) - std::pow(0.05, 3));
     const double perVolume = double(air.size()) * std::pow(double(SPACING), 3) / layerVolume;
     std::printf("[measured] air layer: %zu samples, %.3f per h^3\n", air.size(), perVolume);
     EXPECT_GT(perVolume, 0.45);
@@ -434,18 +448,23 @@ TEST(Sampler, TiledInteriorKeepsThePoissonRadiusTheFitAndTheDensity)
     const double minDist = *std::min_element(nn.begin(), nn.end());
     double worstSurface = 0;
     for (std::size_t i = 0; i < b.size(); ++i) {
-        if (b.onSurface[i]) worstSurface = std::max(worstSurface, std::abs(shape.sdf(b.positions[i])));
+        if (b.onSurface[i])
+            worstSurface = std::max(worstSurface, std::abs(shape.sdf(b.positions[i])));
     }
     const CubicSplineKernel kernel = CubicSplineKernel::fromSpacing(SPACING);
     auto interiorDensity = [&](const SampleSet& s, double& spread) {
         NeighborGrid grid(kernel.supportRadius());
         grid.build(s.positions);
-        const std::vector<Real> rho = densitySum(s.positions, std::vector<Real>(s.size(), Real(1)), grid, kernel);
+        const std::vector<Real> rho =
+            densitySum(s.positions, std::vector<Real>(s.size(), Real(1)), grid, kernel);
         const auto interior = interiorMask(s.positions, shape, kernel.supportRadius());
         spread = relativeSpread(rho, interior);
         double sum = 0, n = 0;
         for (std::size_t i = 0; i < s.size(); ++i) {
-            if (interior[i]) { sum += rho[i]; n += 1; }
+            if (interior[i]) {
+                sum += rho[i];
+                n += 1;
+            }
         }
         return sum / n;
     };
@@ -453,11 +472,12 @@ TEST(Sampler, TiledInteriorKeepsThePoissonRadiusTheFitAndTheDensity)
     const double rhoA = interiorDensity(a, spreadA), rhoB = interiorDensity(b, spreadB);
     std::printf("[measured] tiled interior: %zu samples (full pipeline %zu), min distance %.4f r, "
                 "worst surface |phi| %.4f voxel, interior density %+.2f %% of the full pipeline's, "
-                "spread %.2f %% (full %.2f %%)\n", b.size(), a.size(), minDist / r,
-                worstSurface / VOXEL, 100 * (rhoB / rhoA - 1), 100 * spreadB, 100 * spreadA);
+                "spread %.2f %% (full %.2f %%)\n",
+                b.size(), a.size(), minDist / r, worstSurface / VOXEL, 100 * (rhoB / rhoA - 1),
+                100 * spreadB, 100 * spreadA);
     EXPECT_GE(minDist, r * Real(1 - 1e-5));
-    EXPECT_LT(worstSurface, 0.08 * VOXEL);          // the bound of PoissonDiskBoundaryFitAndCoverage
-    EXPECT_NEAR(rhoB / rhoA, 1.0, 0.02);            // one tile's packing: about 1 % off, bound 2 %
-    EXPECT_LT(spreadB, 0.045);                      // MassScalingGivesRestDensityOnAverage's bound
+    EXPECT_LT(worstSurface, 0.08 * VOXEL); // the bound of PoissonDiskBoundaryFitAndCoverage
+    EXPECT_NEAR(rhoB / rhoA, 1.0, 0.02);   // one tile's packing: about 1 % off, bound 2 %
+    EXPECT_LT(spreadB, 0.045);             // MassScalingGivesRestDensityOnAverage's bound
     EXPECT_NEAR(double(b.size()) / double(a.size()), 1.0, 0.03);
 }

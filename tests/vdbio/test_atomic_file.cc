@@ -66,7 +66,8 @@ TEST(AtomicFile, UnwritableFolderIsAClearError)
         vdbio::ensureWritableDirectory(file.string());
         FAIL() << "expected IoError";
     } catch (const IoError& e) {
-        EXPECT_NE(std::string(e.what()).find("exists and is not a folder"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("exists and is not a folder"), std::string::npos)
+            << e.what();
     }
     vdbio::ensureWritableDirectory((dir / "a" / "b").string());
     EXPECT_TRUE(fs::is_directory(dir / "a" / "b"));

@@ -38,8 +38,8 @@ constexpr Real H = Real(0.01);
 
 fs::path freshDir(const std::string& name)
 {
-    const fs::path dir = fs::temp_directory_path() /
-                         ("ghostfx_ckpt_test_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir = fs::temp_directory_path()
+                         / ("ghostfx_ckpt_test_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
@@ -180,7 +180,8 @@ TEST(Checkpoint, RefusesOtherSchemaAndPrecision)
     const std::string precision = messageOf([&] { readCheckpoint(path, SETTINGS); });
     std::printf("[measured] precision refusal: %s\n", precision.c_str());
     EXPECT_NE(precision.find("checkpoint '" + path + "': written by a build with Real = " + other),
-              std::string::npos) << precision;
+              std::string::npos)
+        << precision;
     fs::remove_all(dir);
 }
 
@@ -194,8 +195,9 @@ TEST(Checkpoint, RefusesDifferentSettingsNamingTheKeyAndBothValues)
     here.replace(here.find("2000"), 4, "5000");
     const std::string changed = messageOf([&] { readCheckpoint(path, here); });
     std::printf("[measured] settings refusal: %s\n", changed.c_str());
-    EXPECT_EQ(changed, "checkpoint '" + path + "' was written with different settings: "
-                       "/settings/stiffness is 2000 there, 5000 in this scene");
+    EXPECT_EQ(changed, "checkpoint '" + path
+                           + "' was written with different settings: "
+                             "/settings/stiffness is 2000 there, 5000 in this scene");
     EXPECT_THROW(readCheckpoint(path, here), SceneError);
 
     // A key only one side has, and a difference inside an array.
@@ -208,7 +210,8 @@ TEST(Checkpoint, RefusesDifferentSettingsNamingTheKeyAndBothValues)
     EXPECT_EQ(firstSettingsDifference(R"({"a/b": 1})", R"({"a/b": 2})"),
               "/a~1b is 1 there, 2 in this scene");
     // The same values written differently are the same settings.
-    EXPECT_EQ(firstSettingsDifference(R"({"k": 2000, "s": 0.5})", R"({"s": 0.50, "k": 2000.0})"), "");
+    EXPECT_EQ(firstSettingsDifference(R"({"k": 2000, "s": 0.5})", R"({"s": 0.50, "k": 2000.0})"),
+              "");
     EXPECT_NO_THROW(readCheckpoint(path, std::string(SETTINGS) + "  \n"));
     EXPECT_THROW(readCheckpoint(path, "{not json"), ValueError);
     fs::remove_all(dir);
@@ -227,8 +230,9 @@ TEST(Checkpoint, RefusesMissingNonHdf5AndForeignFiles)
     std::ofstream(text) << "this is not an HDF5 file\n";
     const std::string textMessage = messageOf([&] { readCheckpoint(text, SETTINGS); });
     std::printf("[measured] non-HDF5 file: %s\n", textMessage.c_str());
-    EXPECT_EQ(textMessage, "checkpoint '" + text + "': not an HDF5 file, so not a ghostfx "
-                           "checkpoint");
+    EXPECT_EQ(textMessage, "checkpoint '" + text
+                               + "': not an HDF5 file, so not a ghostfx "
+                                 "checkpoint");
     EXPECT_THROW(readCheckpoint(text, SETTINGS), IoError);
 
     // An HDF5 file that is not a checkpoint: a statistics file.
@@ -239,15 +243,16 @@ TEST(Checkpoint, RefusesMissingNonHdf5AndForeignFiles)
     const std::string foreign = messageOf([&] { readCheckpoint(stats, SETTINGS); });
     std::printf("[measured] foreign HDF5 file: %s\n", foreign.c_str());
     EXPECT_NE(foreign.find("checkpoint '" + stats + "': not a ghostfx checkpoint"),
-              std::string::npos) << foreign;
+              std::string::npos)
+        << foreign;
     EXPECT_THROW(readCheckpoint(stats, SETTINGS), IoError);
 
     // Writing into a folder that does not exist fails with the file's name.
     const std::string nowhere = (dir / "no" / "such" / "c.h5").string();
     const std::string writeMessage =
         messageOf([&] { writeCheckpoint(nowhere, awkwardState(), SETTINGS, 0); });
-    EXPECT_NE(writeMessage.find("checkpoint '" + nowhere + "': cannot write it"),
-              std::string::npos) << writeMessage;
+    EXPECT_NE(writeMessage.find("checkpoint '" + nowhere + "': cannot write it"), std::string::npos)
+        << writeMessage;
     fs::remove_all(dir);
 }
 
@@ -266,12 +271,14 @@ struct ResumeScene
     Vec3 floorVelocity{0};
 
     ResumeScene(Method method, int substeps, const Vec3& floorVelocity_)
-        : floor(makeLevelSet(makeBoxLevelSet(Vec3(-0.1f, -0.05f, -0.05f), Vec3(0.1f, 0.0f, 0.05f),
-                                             H / 2), "floor"))
-        , liquid(makeLevelSet(makeBoxLevelSet(Vec3(-0.05f, 0.0f, -0.03f), Vec3(0.05f, 0.05f, 0.03f),
-                                              H / 2), "liquid"))
-        , nozzle(makeLevelSet(makeBoxLevelSet(Vec3(-0.02f, 0.08f, -0.02f),
-                                              Vec3(0.02f, 0.1f, 0.02f), H / 2), "nozzle"))
+        : floor(makeLevelSet(
+            makeBoxLevelSet(Vec3(-0.1f, -0.05f, -0.05f), Vec3(0.1f, 0.0f, 0.05f), H / 2), "floor"))
+        , liquid(makeLevelSet(
+              makeBoxLevelSet(Vec3(-0.05f, 0.0f, -0.03f), Vec3(0.05f, 0.05f, 0.03f), H / 2),
+              "liquid"))
+        , nozzle(makeLevelSet(
+              makeBoxLevelSet(Vec3(-0.02f, 0.08f, -0.02f), Vec3(0.02f, 0.1f, 0.02f), H / 2),
+              "nozzle"))
     {
         floorVelocity = floorVelocity_;
         settings.method = method;
@@ -292,8 +299,8 @@ struct ResumeScene
     std::string settingsJson() const
     {
         std::ostringstream os;
-        os << R"({"settings": {"method": ")" << methodName(settings.method)
-           << R"(", "substeps": )" << settings.substeps << R"(, "seed": )" << settings.seed << "}}";
+        os << R"({"settings": {"method": ")" << methodName(settings.method) << R"(", "substeps": )"
+           << settings.substeps << R"(, "seed": )" << settings.seed << "}}";
         return os.str();
     }
 };
@@ -333,14 +340,15 @@ void checkResume(const ResumeScene& scene, int frames, int split, const std::str
 
     const SolverState a = whole.saveState(), b = resumed.saveState();
     const std::string difference = firstDifference(a, b);
-    std::printf("[measured] %s resume: %d frames vs %d + checkpoint (%zu bytes) + %d: %zu particles "
-                "(%zu liquid, %zu ghost air, %zu ghost solid, %zu boundary), %llu steps, "
-                "emitted %zu, killed %zu; first difference '%s'; %.1f s\n", tag.c_str(), frames,
-                split, std::size_t(fs::file_size(path)), frames - split, a.particles.size(),
-                whole.count(ParticleKind::Liquid), whole.count(ParticleKind::GhostAir),
-                whole.count(ParticleKind::GhostSolid), whole.count(ParticleKind::Boundary),
-                static_cast<unsigned long long>(whole.stepCount()), whole.emittedCount(),
-                whole.killedCount(), difference.c_str(), seconds);
+    std::printf(
+        "[measured] %s resume: %d frames vs %d + checkpoint (%zu bytes) + %d: %zu particles "
+        "(%zu liquid, %zu ghost air, %zu ghost solid, %zu boundary), %llu steps, "
+        "emitted %zu, killed %zu; first difference '%s'; %.1f s\n",
+        tag.c_str(), frames, split, std::size_t(fs::file_size(path)), frames - split,
+        a.particles.size(), whole.count(ParticleKind::Liquid), whole.count(ParticleKind::GhostAir),
+        whole.count(ParticleKind::GhostSolid), whole.count(ParticleKind::Boundary),
+        static_cast<unsigned long long>(whole.stepCount()), whole.emittedCount(),
+        whole.killedCount(), difference.c_str(), seconds);
     // Exact: the resumed solver performs the same operations on the same bits (STYLE.md rule 6:
     // results do not depend on thread timing), so any difference is state the checkpoint lost.
     EXPECT_EQ(difference, "");
@@ -395,9 +403,13 @@ std::vector<std::string> lines(const std::string& path)
 
 StatsRow row(std::int64_t step, double time)
 {
-    return StatsRow{{{"frame", double(step / 4)}, {"step", double(step)}, {"time", time},
-                     {"dt", 0.1}, {"count_liquid", 1000.0 + double(step)},
-                     {"max_speed", 1.0 / 3.0}, {"bytes_per_particle", 84}}};
+    return StatsRow{{{"frame", double(step / 4)},
+                     {"step", double(step)},
+                     {"time", time},
+                     {"dt", 0.1},
+                     {"count_liquid", 1000.0 + double(step)},
+                     {"max_speed", 1.0 / 3.0},
+                     {"bytes_per_particle", 84}}};
 }
 
 } // namespace
@@ -414,8 +426,8 @@ TEST(Stats, AppendFlushAndReadBack)
     EXPECT_EQ(writer.rows(), 6u);
 
     const StatsTable table = readStats(h5);
-    const std::vector<std::string> columns{"frame", "step", "time", "dt", "count_liquid",
-                                           "max_speed", "bytes_per_particle"};
+    const std::vector<std::string> columns{
+        "frame", "step", "time", "dt", "count_liquid", "max_speed", "bytes_per_particle"};
     EXPECT_EQ(table.columns, columns);
     ASSERT_EQ(table.rows.size(), 6u);
     EXPECT_EQ(table.rows[2][2], 0.1 * 3); // doubles stored as doubles: exact

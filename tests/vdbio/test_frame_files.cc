@@ -35,13 +35,13 @@ using namespace ghostfx::sph;
 
 namespace {
 
-constexpr double SPACING = 0.02;              // h (m)
-constexpr double VOXEL = 0.5 * SPACING;       // dx = h / 2 (m)
-constexpr double SUPPORT = 3.0 * SPACING;     // R = 3 h ([SB12] Sec. 3) (m)
-constexpr double REST_DENSITY = 1000.0;       // rho0 (kg/m^3)
-constexpr double SPHERE_RADIUS = 6 * SPACING; // liquid sphere (m)
+constexpr double SPACING = 0.02;                       // h (m)
+constexpr double VOXEL = 0.5 * SPACING;                // dx = h / 2 (m)
+constexpr double SUPPORT = 3.0 * SPACING;              // R = 3 h ([SB12] Sec. 3) (m)
+constexpr double REST_DENSITY = 1000.0;                // rho0 (kg/m^3)
+constexpr double SPHERE_RADIUS = 6 * SPACING;          // liquid sphere (m)
 const Vec3 VELOCITY(Real(0.3), Real(-1.2), Real(0.5)); // uniform liquid velocity (m/s)
-constexpr Real TEMPERATURE = Real(353.15);              // uniform liquid temperature (K)
+constexpr Real TEMPERATURE = Real(353.15);             // uniform liquid temperature (K)
 
 fs::path freshDir(const std::string& name)
 {
@@ -56,7 +56,7 @@ struct Scene
 {
     ParticleSet particles;
     std::size_t liquidCount = 0;
-    double liquidMass = 0;    // kg
+    double liquidMass = 0;      // kg
     double outermostRadius = 0; // max |x| over the liquid (m)
 };
 
@@ -66,16 +66,16 @@ const Scene& scene()
         Scene sc;
         const SampleSet samples =
             PoissonDiskSampler(PoissonSettings::forSpacing(Real(SPACING)))
-                .sampleVolume(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(SPHERE_RADIUS),
-                                                              Real(VOXEL))));
+                .sampleVolume(
+                    makeLevelSet(makeSphereLevelSet(Vec3(0), Real(SPHERE_RADIUS), Real(VOXEL))));
         // [SB12] Sec. 4.6 mass, measured on the particles with a full neighbourhood (deeper
         // than R): in a sphere this small the surface layer holds most particles.
         std::vector<std::uint8_t> interior(samples.size());
         for (std::size_t i = 0; i < samples.size(); ++i) {
             interior[i] = samples.positions[i].length() < Real(SPHERE_RADIUS - SUPPORT);
         }
-        const Real mass = massForRestDensity(
-            samples.positions, CubicSplineKernel(Real(SUPPORT)), Real(REST_DENSITY), interior);
+        const Real mass = massForRestDensity(samples.positions, CubicSplineKernel(Real(SUPPORT)),
+                                             Real(REST_DENSITY), interior);
         sc.particles.addBatch(samples.positions, mass, ParticleKind::Liquid);
         // Ghost air: lattice points in the shell [R + h, R + 3 h], moving the other way.
         std::vector<Vec3> air;
@@ -135,7 +135,8 @@ openvdb::GridPtrVecPtr readGrids(const std::string& path, openvdb::MetaMap::Ptr*
 
 openvdb::GridBase::Ptr findGrid(const openvdb::GridPtrVec& grids, const std::string& name)
 {
-    for (const auto& g : grids) if (g->getName() == name) return g;
+    for (const auto& g : grids)
+        if (g->getName() == name) return g;
     return nullptr;
 }
 
@@ -243,8 +244,9 @@ TEST(FrameFiles, DensityOfOneParticleConservesMass)
         }
     }
     std::printf("[measured] one particle, 16 offsets: max |grid mass - m| / m = %.3g without "
-                "cutoff, %.3g with cutoff 1e-4\n", worstQuadrature, worstWithCutoff);
-    EXPECT_LT(worstQuadrature, 1e-4);                // lattice quadrature only
+                "cutoff, %.3g with cutoff 1e-4\n",
+                worstQuadrature, worstWithCutoff);
+    EXPECT_LT(worstQuadrature, 1e-4);                 // lattice quadrature only
     EXPECT_LT(worstWithCutoff, 6.1e-4 + 1e-4 + 1e-4); // analytic tail + quadrature + margin
 }
 
@@ -265,7 +267,8 @@ TEST(FrameFiles, DensityGridMassAndSparsity)
     const double mass = densityMass(*density, REST_DENSITY);
     const double relError = std::abs(mass - sc.liquidMass) / sc.liquidMass;
     std::printf("[measured] %zu liquid particles, mass %.6g kg, density grid mass %.6g kg, "
-                "relative error %.3g\n", sc.liquidCount, sc.liquidMass, mass, relError);
+                "relative error %.3g\n",
+                sc.liquidCount, sc.liquidMass, mass, relError);
     EXPECT_LT(relError, 6.1e-4 + 1e-4 + 1e-4); // DensityOfOneParticleConservesMass bound
 
     // Sparsity: every voxel inside the liquid (deeper than one spacing below the outermost
@@ -373,14 +376,18 @@ TEST(FrameFiles, VelocityGridReproducesAUniformField)
 /// Distance of the zero crossing from a sphere of radius `radius` about the origin: on every
 /// voxel edge where phi changes sign, the crossing point found by linear interpolation. Mean,
 /// min, max and rms about the mean (m).
-struct CrossingStats { double mean = 0, lo = 1e9, hi = -1e9, rms = 0; std::size_t count = 0; };
+struct CrossingStats
+{
+    double mean = 0, lo = 1e9, hi = -1e9, rms = 0;
+    std::size_t count = 0;
+};
 CrossingStats zeroCrossingAboutSphere(const openvdb::FloatGrid& surface, double radius)
 {
     CrossingStats st;
     double sum = 0, sum2 = 0;
     const auto acc = surface.getConstAccessor();
-    const openvdb::Coord steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                     {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const openvdb::Coord steps[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     for (auto it = surface.cbeginValueOn(); it; ++it) {
         const double a = *it;
         if (a >= 0) continue;
@@ -432,8 +439,8 @@ TEST(FrameFiles, SurfaceZeroCrossingLiesNearTheOutermostParticles)
         openvdb::gridPtrCast<openvdb::FloatGrid>(vdbio::makeVolumeGrids(sc.particles, raw)[0]);
     const CrossingStats rawSt = zeroCrossingAboutSphere(*rawSurface, sc.outermostRadius);
     std::printf("[measured] raw union of spheres: mean %+.3f h, rms about mean %.4f h, range "
-                "[%+.3f h, %+.3f h]\n", rawSt.mean / SPACING, rawSt.rms / SPACING,
-                rawSt.lo / SPACING, rawSt.hi / SPACING);
+                "[%+.3f h, %+.3f h]\n",
+                rawSt.mean / SPACING, rawSt.rms / SPACING, rawSt.lo / SPACING, rawSt.hi / SPACING);
     EXPECT_LT(st.rms, 0.5 * rawSt.rms); // the smoothing at least halves the roughness
     EXPECT_LT(st.rms, 0.05 * SPACING);  // and leaves bumps far below a spacing
 
@@ -534,8 +541,8 @@ TEST(FrameFiles, PointsRoundTrip)
             const std::size_t i = found->second;
             const openvdb::Vec3d x = xform.indexToWorld(idx.getCoord().asVec3d() + P.get(*idx));
             const Vec3& x0 = sc.particles.positions()[i];
-            maxPositionError = std::max(
-                maxPositionError, (x - openvdb::Vec3d(x0[0], x0[1], x0[2])).length());
+            maxPositionError =
+                std::max(maxPositionError, (x - openvdb::Vec3d(x0[0], x0[1], x0[2])).length());
             mismatches += v.get(*idx) != openvdb::Vec3f(sc.particles.velocities()[i]);
             mismatches +=
                 normal.get(*idx) != openvdb::Vec3f(sc.particles.vectorChannel("normal")[i]);
@@ -548,8 +555,8 @@ TEST(FrameFiles, PointsRoundTrip)
         }
     }
     std::printf("[measured] points: %zu written of %zu (%zu liquid), voxel %.4g m, %.2f points "
-                "per voxel, max position error %.3g m = %.3g voxel\n", count,
-                sc.particles.size(), sc.liquidCount, dx, double(count) / double(voxels),
+                "per voxel, max position error %.3g m = %.3g voxel\n",
+                count, sc.particles.size(), sc.liquidCount, dx, double(count) / double(voxels),
                 maxPositionError, maxPositionError / dx);
     EXPECT_EQ(count, sc.liquidCount); // ghost air left out
     EXPECT_EQ(mismatches, 0u);        // float channels are stored uncompressed: bit-exact
@@ -674,20 +681,20 @@ TEST(FrameFiles, ErrorsNameTheOptionAndTheValue)
 
     vdbio::PointsOptions po;
     po.channels = {"v", "vorticity"};
-    const std::string points = messageOf([&] {
-        vdbio::writePointsFile((freshDir("errors") / "p.vdb").string(), sc.particles, po);
-    });
+    const std::string points = messageOf(
+        [&] { vdbio::writePointsFile((freshDir("errors") / "p.vdb").string(), sc.particles, po); });
     EXPECT_NE(points.find("channel 'vorticity' not found: available: v, id, density, pressure, "
                           "mass, kind, temperature, normal"),
-              std::string::npos) << points;
+              std::string::npos)
+        << points;
 
     // A folder that does not exist: IoError naming the file.
     const std::string missing = "/nonexistent_ghostfx_dir/frame.vdb";
     openvdb::FloatGrid::Ptr named = openvdb::FloatGrid::create();
     named->setName("density");
     const std::string io = messageOf([&] { vdbio::writeVolumeFile(missing, {named}); });
-    EXPECT_EQ(io, "volume output '" + missing +
-                      "': folder '/nonexistent_ghostfx_dir' does not exist or is not a folder");
+    EXPECT_EQ(io, "volume output '" + missing
+                      + "': folder '/nonexistent_ghostfx_dir' does not exist or is not a folder");
     EXPECT_THROW(vdbio::writeVolumeFile(missing, {named}), IoError);
     EXPECT_THROW(vdbio::writePointsFile(missing, sc.particles, vdbio::PointsOptions()), IoError);
 

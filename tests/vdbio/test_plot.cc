@@ -209,13 +209,13 @@ TEST(Plot, BadSpecsAreRejectedAndLeaveTheExistingFileIntact)
 
     PlotSpec empty = twoSeries();
     empty.points.clear();
-    EXPECT_TRUE(contains(errorOf<ValueError>([&] { vdbio::writePlotPng(path, empty); }),
-                         "no points"));
+    EXPECT_TRUE(
+        contains(errorOf<ValueError>([&] { vdbio::writePlotPng(path, empty); }), "no points"));
 
     PlotSpec tiny = twoSeries();
     tiny.width = 10;
-    EXPECT_TRUE(contains(errorOf<ValueError>([&] { vdbio::writePlotPng(path, tiny); }),
-                         "width = 10"));
+    EXPECT_TRUE(
+        contains(errorOf<ValueError>([&] { vdbio::writePlotPng(path, tiny); }), "width = 10"));
 
     PlotSpec notFinite = twoSeries();
     notFinite.points[1].y = std::numeric_limits<double>::infinity();
@@ -226,8 +226,8 @@ TEST(Plot, BadSpecsAreRejectedAndLeaveTheExistingFileIntact)
     PlotSpec unlabelled = twoSeries();
     unlabelled.points[3].label.clear();
     unlabelled.points[3].x = 0.0;
-    EXPECT_TRUE(contains(errorOf<ValueError>([&] { vdbio::writePlotPng(path, unlabelled); }),
-                         "point #3"));
+    EXPECT_TRUE(
+        contains(errorOf<ValueError>([&] { vdbio::writePlotPng(path, unlabelled); }), "point #3"));
 
     EXPECT_TRUE(contains(errorOf<ValueError>([&] {
                              vdbio::writePlotPng((dir / "study.jpg").string(), twoSeries());

@@ -52,18 +52,18 @@ std::string boxObj(const Vec3d& lo, const Vec3d& hi, bool withTop = true)
 {
     std::string obj = "# box\n";
     for (int i = 0; i < 8; ++i) {
-        obj += "v " + std::to_string((i & 1) ? hi.x() : lo.x()) + " " +
-               std::to_string((i & 2) ? hi.y() : lo.y()) + " " +
-               std::to_string((i & 4) ? hi.z() : lo.z()) + "\n";
+        obj += "v " + std::to_string((i & 1) ? hi.x() : lo.x()) + " "
+               + std::to_string((i & 2) ? hi.y() : lo.y()) + " "
+               + std::to_string((i & 4) ? hi.z() : lo.z()) + "\n";
     }
     obj += "vn -1 0 0\nvn 1 0 0\nvn 0 -1 0\nvn 0 1 0\nvn 0 0 -1\nvn 0 0 1\n";
     // Vertex numbers (1-based) of each face, counter-clockwise seen from outside.
-    obj += "f 1//1 5//1 7//1 3//1\n";   // -x
-    obj += "f 2//2 4//2 8//2 6//2\n";   // +x
-    obj += "f 1//3 2//3 6//3 5//3\n";   // -y
-    if (withTop) obj += "f 3//4 7//4 8//4 4//4\n";   // +y
-    obj += "f 1//5 3//5 4//5 2//5\n";   // -z
-    obj += "f 5//6 6//6 8//6 7//6\n";   // +z
+    obj += "f 1//1 5//1 7//1 3//1\n";              // -x
+    obj += "f 2//2 4//2 8//2 6//2\n";              // +x
+    obj += "f 1//3 2//3 6//3 5//3\n";              // -y
+    if (withTop) obj += "f 3//4 7//4 8//4 4//4\n"; // +y
+    obj += "f 1//5 3//5 4//5 2//5\n";              // -z
+    obj += "f 5//6 6//6 8//6 7//6\n";              // +z
     return obj;
 }
 
@@ -74,9 +74,9 @@ std::string boxPly(const Vec3d& lo, const Vec3d& hi)
                       "property float y\nproperty float z\nelement face 6\n"
                       "property list uchar int vertex_indices\nend_header\n";
     for (int i = 0; i < 8; ++i) {
-        ply += std::to_string((i & 1) ? hi.x() : lo.x()) + " " +
-               std::to_string((i & 2) ? hi.y() : lo.y()) + " " +
-               std::to_string((i & 4) ? hi.z() : lo.z()) + "\n";
+        ply += std::to_string((i & 1) ? hi.x() : lo.x()) + " "
+               + std::to_string((i & 2) ? hi.y() : lo.y()) + " "
+               + std::to_string((i & 4) ? hi.z() : lo.z()) + "\n";
     }
     ply += "4 0 4 6 2\n4 1 3 7 5\n4 0 1 5 4\n4 2 6 7 3\n4 0 2 3 1\n4 4 5 7 6\n";
     return ply;
@@ -136,12 +136,12 @@ TEST(MeshToSdf, ClosedObjBoxMatchesTheAnalyticDistance)
 
     vdbio::MeshToSdfOptions options;
     options.voxelSize = 0.02;
-    options.halfWidth = 16;   // wider than the 12.5-voxel half edge: the band reaches the centre
+    options.halfWidth = 16; // wider than the 12.5-voxel half edge: the band reaches the centre
     vdbio::MeshStats stats;
     const openvdb::FloatGrid::Ptr grid =
         vdbio::meshToLevelSet((dir / "box.obj").string(), options, &stats);
 
-    EXPECT_EQ(stats.vertices, 8u);  // 24 OBJ vertices (one normal per face) welded to 8
+    EXPECT_EQ(stats.vertices, 8u); // 24 OBJ vertices (one normal per face) welded to 8
     EXPECT_EQ(stats.triangles, 12u);
     EXPECT_EQ(stats.boundaryEdges, 0u);
     EXPECT_EQ(stats.nonManifoldEdges, 0u);
@@ -177,7 +177,7 @@ TEST(MeshToSdf, AsciiPlyWithScaleAndRoleIsWrittenToAVdb)
     const std::string vdbPath = (dir / "tank.vdb").string();
     vdbio::convertMeshFile((dir / "box.ply").string(), vdbPath, options, &stats);
     EXPECT_EQ(stats.vertices, 8u);
-    EXPECT_EQ(stats.triangles, 12u);   // 6 quads triangulated
+    EXPECT_EQ(stats.triangles, 12u); // 6 quads triangulated
     EXPECT_EQ(stats.boundaryEdges, 0u);
     const Vec3d wlo = lo * 0.5, whi = hi * 0.5;
     // Bounds come from float vertices: float rounding only (~1e-7 relative).
@@ -196,11 +196,11 @@ TEST(MeshToSdf, AsciiPlyWithScaleAndRoleIsWrittenToAVdb)
     const double faceError = maxFaceErrorVoxels(*grid, wlo, whi);
     std::printf("[measured] PLY box (scale 0.5): max face error %.2e voxels, %llu active voxels\n",
                 faceError, static_cast<unsigned long long>(grid->activeVoxelCount()));
-    EXPECT_LT(faceError, FACE_TOLERANCE_VOXELS);   // see FACE_TOLERANCE_VOXELS
+    EXPECT_LT(faceError, FACE_TOLERANCE_VOXELS); // see FACE_TOLERANCE_VOXELS
     // Beyond the 3-voxel band the inside reads -background, the outside +background.
     const float background = grid->background();
-    EXPECT_EQ(grid->tree().getValue(grid->transform().worldToIndexCellCentered(
-                  0.5 * (wlo + whi))), -background);
+    EXPECT_EQ(grid->tree().getValue(grid->transform().worldToIndexCellCentered(0.5 * (wlo + whi))),
+              -background);
     EXPECT_EQ(grid->tree().getValue(grid->transform().worldToIndexCellCentered(whi + Vec3d(0.1))),
               background);
 }
@@ -315,7 +315,7 @@ TEST(Preview, FogSphereIsVisibleButNotBlackOnATransparentBackground)
 {
     const fs::path dir = freshDir("preview_fog");
     openvdb::FloatGrid::Ptr fog = sphereLevelSet();
-    openvdb::tools::sdfToFogVolume(*fog);   // density 1 inside, 0 outside, ramp across the band
+    openvdb::tools::sdfToFogVolume(*fog); // density 1 inside, 0 outside, ramp across the band
     fog->setName("density");
 
     vdbio::PreviewOptions options;
@@ -372,11 +372,13 @@ TEST(Preview, PngMatchesTheExrThroughTheSrgbCurve)
     for (std::size_t i = 0; i < exr.rgba.size(); ++i) {
         const float linear = std::clamp(exr.rgba[i], 0.0f, 1.0f);
         const float expected = (i % 4 == 3) ? linear
-                               : linear <= 0.0031308f ? 12.92f * linear
-                                                      : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+                               : linear <= 0.0031308f
+                                   ? 12.92f * linear
+                                   : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
         worst = std::max(worst, std::abs(png.rgba[i] - expected));
     }
-    std::printf("[measured] PNG vs sRGB(EXR): worst difference %.4f (8-bit step %.4f)\n", worst, 1 / 255.0);
+    std::printf("[measured] PNG vs sRGB(EXR): worst difference %.4f (8-bit step %.4f)\n", worst,
+                1 / 255.0);
     EXPECT_LE(worst, 1.5f / 255.0f);
 }
 
@@ -399,7 +401,7 @@ TEST(Preview, LevelSetSphereIsOpaqueAndShaded)
     std::printf("[measured] level-set sphere: centre pixel rgba = (%.3f, %.3f, %.3f, %.3f), "
                 "alpha centroid (%.2f, %.2f) px, %.2f s\n",
                 c[0], c[1], c[2], c[3], centroid.x(), centroid.y(), summary.seconds);
-    EXPECT_EQ(c[3], 1.0f);   // a surface hit is opaque
+    EXPECT_EQ(c[3], 1.0f); // a surface hit is opaque
     // The centre of the sphere faces the camera; the key light is 33 degrees off the view
     // direction (Preview.cc: toCamera + 0.5 up - 0.4 right), so Lambert gives cos = 0.84 and,
     // with ambient 0.2, a shade of 0.2 + 0.8 * 0.84 = 0.87 of the albedo (0.75, 0.8, 0.88).
@@ -409,7 +411,7 @@ TEST(Preview, LevelSetSphereIsOpaqueAndShaded)
         EXPECT_LE(c[k], 0.9f);
     }
     expectTransparentCorners(image);
-    EXPECT_NEAR(centroid.x(), IMAGE_W / 2.0, 1.0);   // as for the fog sphere
+    EXPECT_NEAR(centroid.x(), IMAGE_W / 2.0, 1.0); // as for the fog sphere
     EXPECT_NEAR(centroid.y(), IMAGE_H / 2.0, 1.0);
 }
 
@@ -439,8 +441,9 @@ TEST(Preview, FromFilePicksAGridAndErrorsNameFileAndGrid)
 
     options.grid = "vel";
     e = errorOf<GridError>([&] { vdbio::renderPreviewFromFile(vdb, options, exr); });
-    EXPECT_EQ(e, "grid 'vel' in '" + vdb + "' has value type vec3s: preview renders float "
-                 "grids (fog volumes or level sets)");
+    EXPECT_EQ(e, "grid 'vel' in '" + vdb
+                     + "' has value type vec3s: preview renders float "
+                       "grids (fog volumes or level sets)");
 
     options.grid = "";
     const std::string missing = (dir / "missing.vdb").string();
@@ -449,8 +452,8 @@ TEST(Preview, FromFilePicksAGridAndErrorsNameFileAndGrid)
 
     const std::string noFolder = (dir / "no" / "such" / "folder.exr").string();
     e = errorOf<IoError>([&] { vdbio::renderPreviewFromFile(vdb, options, noFolder); });
-    EXPECT_EQ(e, "preview image '" + noFolder + "': folder '" + (dir / "no" / "such").string() +
-                     "' does not exist");
+    EXPECT_EQ(e, "preview image '" + noFolder + "': folder '" + (dir / "no" / "such").string()
+                     + "' does not exist");
 
     options.width = 0;
     e = errorOf<ValueError>([&] { vdbio::renderPreviewFromFile(vdb, options, exr); });
@@ -496,9 +499,9 @@ TEST(Info, DescribesTheGridsAndPointsOfAVdbFile)
     const std::string pointsText = vdbio::describeFile(pointsVdb);
     std::printf("[measured] ghostfx info on a particles .vdb:\n%s", pointsText.c_str());
     // P is 12 bytes (vec3s), v 12 (vec3s), id 8 (int64), density and pressure 4 each (float).
-    for (const char* part : {"grid 'particles'", "points:          100",
-                             "P              vec3s (codec null, 12 bytes)", "id ",
-                             "bytes per point: 40 in attributes"}) {
+    for (const char* part :
+         {"grid 'particles'", "points:          100", "P              vec3s (codec null, 12 bytes)",
+          "id ", "bytes per point: 40 in attributes"}) {
         EXPECT_TRUE(contains(pointsText, part)) << "missing: " << part;
     }
 
@@ -556,11 +559,10 @@ TEST(Info, DescribesGroupsDatasetsAndAttributesOfAnHdf5File)
     }
     const std::string text = vdbio::describeFile(h5);
     std::printf("[measured] ghostfx info on an .h5:\n%s", text.c_str());
-    for (const char* part : {"@schema_version = 1 (int32)", "@time = 0.25 (float64)",
-                             "@format = \"ghostfx test\"",
-                             "@columns = [\"frame\", \"time\", \"dt\"]", "/particles/  (group)",
-                             "@count_liquid = 10 (int64)",
-                             "/particles/position  (dataset float32 [10 x 3]"}) {
+    for (const char* part :
+         {"@schema_version = 1 (int32)", "@time = 0.25 (float64)", "@format = \"ghostfx test\"",
+          "@columns = [\"frame\", \"time\", \"dt\"]", "/particles/  (group)",
+          "@count_liquid = 10 (int64)", "/particles/position  (dataset float32 [10 x 3]"}) {
         EXPECT_TRUE(contains(text, part)) << "missing: " << part;
     }
     const std::string fake = (dir / "fake.h5").string();

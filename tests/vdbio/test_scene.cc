@@ -26,8 +26,9 @@ class SceneTest : public ::testing::Test
 protected:
     void SetUp() override
     {
-        mDir = fs::temp_directory_path() /
-               ("ghostfx_scene_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        mDir = fs::temp_directory_path()
+               / ("ghostfx_scene_"
+                  + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(mDir);
         fs::create_directories(mDir);
         auto sphere = sph::makeSphereLevelSet(sph::Vec3(0.5f, 0.5f, 0.5f), 0.2f, 0.01f);
@@ -75,7 +76,7 @@ protected:
     fs::path mDir;
 };
 
-#define EXPECT_CONTAINS(text, part) \
+#define EXPECT_CONTAINS(text, part)                                                                \
     EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
 } // namespace
@@ -116,7 +117,9 @@ TEST_F(SceneTest, UnknownKeysNameThePathAndTheClosestKey)
 
     s = baseScene();
     s["outputs"]["volume"] = {{"grids", {"surface", "densty"}}};
-    EXPECT_CONTAINS(errorOf(s), "grid 'densty' is not one of surface, density, vel, temperature (did you mean 'density'?)");
+    EXPECT_CONTAINS(
+        errorOf(s),
+        "grid 'densty' is not one of surface, density, vel, temperature (did you mean 'density'?)");
 
     s = baseScene();
     s["outputs"]["points"] = {{"chanels", {"v"}}};
@@ -137,12 +140,14 @@ TEST_F(SceneTest, WrongTypesAndRangesNameTheValue)
     EXPECT_CONTAINS(errorOf(s), "settings.spacing = -0.01: expected a number > 0");
     s = baseScene();
     s["settings"]["method"] = "gost";
-    EXPECT_CONTAINS(errorOf(s), "settings.method = \"gost\": expected one of 'ghost', 'basic', 'gas' (did you mean 'ghost'?)");
+    EXPECT_CONTAINS(errorOf(s), "settings.method = \"gost\": expected one of 'ghost', 'basic', "
+                                "'gas' (did you mean 'ghost'?)");
     s = baseScene();
     s["settings"]["frame_range"] = {5, 2};
     EXPECT_CONTAINS(errorOf(s), "settings.frame_range = [5,2]: expected [first, last]");
     s["settings"]["frame_range"] = {1, 3000000000.0};
-    EXPECT_CONTAINS(errorOf(s), "settings.frame_range = [1,3000000000.0]: expected [first, last] with 1 <= first <= last <= 9999999");
+    EXPECT_CONTAINS(errorOf(s), "settings.frame_range = [1,3000000000.0]: expected [first, last] "
+                                "with 1 <= first <= last <= 9999999");
     s = baseScene();
     s["liquids"][0]["velocity"] = {1, 2};
     EXPECT_CONTAINS(errorOf(s), "liquids[0].velocity = [1,2]: expected an array of 3 numbers");
@@ -158,7 +163,8 @@ TEST_F(SceneTest, GridErrorsNameFileGridAndProblem)
 {
     Json s = baseScene();
     s["liquids"][0]["geometry"]["file"] = "nope.vdb";
-    EXPECT_CONTAINS(errorOf(s), "liquids[0].geometry: file '" + (mDir / "nope.vdb").string() + "' does not exist");
+    EXPECT_CONTAINS(errorOf(s), "liquids[0].geometry: file '" + (mDir / "nope.vdb").string()
+                                    + "' does not exist");
 
     s = baseScene();
     s["liquids"][0]["geometry"]["grid"] = "water";
@@ -175,8 +181,8 @@ TEST_F(SceneTest, GridErrorsNameFileGridAndProblem)
     // Non-uniform voxels.
     auto stretched = sph::makeSphereLevelSet(sph::Vec3(0.5f), 0.2f, 0.01f);
     stretched->setName("stretched");
-    stretched->setTransform(openvdb::math::Transform::createLinearTransform(
-        openvdb::math::Mat4d(0.01, 0., 0., 0., 0., 0.02, 0., 0., 0., 0., 0.01, 0., 0., 0., 0., 1.)));
+    stretched->setTransform(openvdb::math::Transform::createLinearTransform(openvdb::math::Mat4d(
+        0.01, 0., 0., 0., 0., 0.02, 0., 0., 0., 0., 0.01, 0., 0., 0., 0., 1.)));
     // NaN inside.
     auto nan = sph::makeSphereLevelSet(sph::Vec3(0.5f), 0.2f, 0.01f);
     nan->setName("nan");
@@ -195,10 +201,12 @@ TEST_F(SceneTest, GridErrorsNameFileGridAndProblem)
         return errorOf(t);
     };
     EXPECT_CONTAINS(withGrid("fog"), "class is 'fog volume', expected 'level set'");
-    EXPECT_CONTAINS(withGrid("vel"), "grid 'vel' in '" + (mDir / "bad.vdb").string() + "' holds vec3s values, expected a float level set");
+    EXPECT_CONTAINS(withGrid("vel"), "grid 'vel' in '" + (mDir / "bad.vdb").string()
+                                         + "' holds vec3s values, expected a float level set");
     EXPECT_CONTAINS(withGrid("stretched"), "stretched");
     EXPECT_CONTAINS(withGrid("stretched"), "uniform");
-    EXPECT_CONTAINS(withGrid("nan"), "grid 'nan': value nan at (0.5, 0.7, 0.5) m, expected finite signed distances");
+    EXPECT_CONTAINS(withGrid("nan"),
+                    "grid 'nan': value nan at (0.5, 0.7, 0.5) m, expected finite signed distances");
     EXPECT_CONTAINS(withGrid("empty"), "empty");
 
     // Not a .vdb at all.
@@ -212,10 +220,15 @@ TEST_F(SceneTest, SceneWithoutLiquidIsRefused)
 {
     Json s = baseScene();
     s.erase("liquids");
-    EXPECT_CONTAINS(errorOf(s), "liquids: the scene has no liquid: expected at least one liquid body or emitter");
+    EXPECT_CONTAINS(
+        errorOf(s),
+        "liquids: the scene has no liquid: expected at least one liquid body or emitter");
     s = baseScene();
-    s["gas_sources"] = Json::parse(R"([{ "geometry": { "sphere": { "center": [0.5, 0.1, 0.5], "radius": 0.05 } } }])");
-    EXPECT_CONTAINS(errorOf(s), "gas_sources: gas sources need settings.method 'gas' (or heaters, for boiling)");
+    s["gas_sources"] = Json::parse(
+        R"([{ "geometry": { "sphere": { "center": [0.5, 0.1, 0.5], "radius": 0.05 } } }])");
+    EXPECT_CONTAINS(
+        errorOf(s),
+        "gas_sources: gas sources need settings.method 'gas' (or heaters, for boiling)");
     s["settings"]["method"] = "gas";
     EXPECT_CONTAINS(errorOf(s), "liquids: a 'gas' scene simulates gas only");
     s.erase("liquids");
@@ -240,8 +253,9 @@ TEST_F(SceneTest, SceneWithoutLiquidIsRefused)
 TEST_F(SceneTest, OverridesSetAnyKey)
 {
     const std::string path = write(baseScene());
-    const vdbio::Scene scene = vdbio::readScene(path, {"settings.spacing=0.05", "solids[0].velocity=[1,0,0]",
-                                                       "outputs.preview.grid=surface", "settings.method=basic"});
+    const vdbio::Scene scene =
+        vdbio::readScene(path, {"settings.spacing=0.05", "solids[0].velocity=[1,0,0]",
+                                "outputs.preview.grid=surface", "settings.method=basic"});
     EXPECT_DOUBLE_EQ(scene.spacing, 0.05);
     EXPECT_EQ(scene.solids[0].velocity, sph::Vec3d(1, 0, 0));
     EXPECT_EQ(scene.outputs.previewGrid, "surface");
@@ -255,7 +269,8 @@ TEST_F(SceneTest, OverridesSetAnyKey)
         }
         return std::string("no error");
     };
-    EXPECT_CONTAINS(errorFor("solids[3].velocity=[0,0,0]"), "-D solids[3].velocity: solids has no element [3] (1 elements)");
+    EXPECT_CONTAINS(errorFor("solids[3].velocity=[0,0,0]"),
+                    "-D solids[3].velocity: solids has no element [3] (1 elements)");
     // (A misspelt solver setting such as settings.stifness is reported by the solver's reader:
     // tests/cli checks it through `ghostfx run`.)
     EXPECT_CONTAINS(errorFor("nonsense"), "expected path=value");
@@ -267,8 +282,9 @@ TEST_F(SceneTest, FingerprintIgnoresOutputsAndFrameRange)
 {
     const std::string path = write(baseScene());
     const std::string a = vdbio::readScene(path).simulationFingerprint();
-    EXPECT_EQ(a, vdbio::readScene(path, {"outputs.directory=elsewhere", "settings.frame_range=[1,100]"})
-                     .simulationFingerprint());
+    EXPECT_EQ(
+        a, vdbio::readScene(path, {"outputs.directory=elsewhere", "settings.frame_range=[1,100]"})
+               .simulationFingerprint());
     EXPECT_NE(a, vdbio::readScene(path, {"settings.stiffness=5000"}).simulationFingerprint());
 }
 
@@ -284,7 +300,8 @@ TEST_F(SceneTest, RoleTaggedVdbIsASceneWithDefaults)
     untagged->setName("reference");
     writeGrids("roles.vdb", {water, floor, untagged});
 
-    const vdbio::Scene scene = vdbio::readScene((mDir / "roles.vdb").string(), {"settings.frame_range=[1,2]"});
+    const vdbio::Scene scene =
+        vdbio::readScene((mDir / "roles.vdb").string(), {"settings.frame_range=[1,2]"});
     ASSERT_EQ(scene.liquids.size(), 1u);
     ASSERT_EQ(scene.solids.size(), 1u);
     EXPECT_EQ(scene.liquids[0].name, "water");
@@ -299,7 +316,9 @@ TEST_F(SceneTest, RoleTaggedVdbIsASceneWithDefaults)
         vdbio::readScene((mDir / "badrole.vdb").string());
         ADD_FAILURE();
     } catch (const SceneError& e) {
-        EXPECT_CONTAINS(e.what(), "grid 'reference' has ghostfx_role 'lava': expected solid, liquid, emitter or source");
+        EXPECT_CONTAINS(
+            e.what(),
+            "grid 'reference' has ghostfx_role 'lava': expected solid, liquid, emitter or source");
     }
 }
 
@@ -315,17 +334,21 @@ TEST_F(SceneTest, SpacingTooFineForOpenVdbOrForMemoryIsRefusedBeforeSampling)
     s = baseScene();
     s["settings"]["spacing"] = 0.002;
     s.erase("solids");
-    s["liquids"][0]["geometry"] = Json::parse(R"({ "sphere": { "center": [0, 0, 0], "radius": 10 } })");
+    s["liquids"][0]["geometry"] =
+        Json::parse(R"({ "sphere": { "center": [0, 0, 0], "radius": 10 } })");
     const std::string e = errorOf(s);
-    EXPECT_CONTAINS(e, "liquids[0].geometry.sphere: at spacing 0.002 m this shape needs about 5.23599e+11 particles");
+    EXPECT_CONTAINS(e, "liquids[0].geometry.sphere: at spacing 0.002 m this shape needs about "
+                       "5.23599e+11 particles");
     EXPECT_CONTAINS(e, "expected a spacing of at least");
     // A solid only gets a band of ghosts under its surface: a 10 x 1 x 10 m floor slab at 1 cm
     // holds 1e8 particles' volume (35 GB) but its band 2 spacings deep holds 4.8e6; accepted.
     s = baseScene();
     s["settings"]["spacing"] = 0.01;
-    s["solids"][0]["geometry"] = Json::parse(R"({ "box": { "min": [-5, -1, -5], "max": [5, 0, 5] } })");
+    s["solids"][0]["geometry"] =
+        Json::parse(R"({ "box": { "min": [-5, -1, -5], "max": [5, 0, 5] } })");
     s["solids"][0]["geometry"]["voxel_size"] = 0.5; // a coarse grid keeps the test fast
-    s["liquids"][0]["geometry"] = Json::parse(R"({ "box": { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] } })");
+    s["liquids"][0]["geometry"] =
+        Json::parse(R"({ "box": { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] } })");
     EXPECT_NO_THROW(vdbio::readScene(write(s)));
 }
 
@@ -336,21 +359,26 @@ TEST_F(SceneTest, DeformingSolidIsRefusedWhereOnlyTheLiquidWouldApplyIt)
         "solids": [ { "name": "paddle", "geometry": { "sphere": { "center": [0, 0, 0], "radius": 0.1 } },
                       "sequence": { "file": "paddle.$F4.vdb", "grid": "paddle" } } ],
         "gas_sources": [ { "geometry": { "sphere": { "center": [0.5, 0.5, 0.5], "radius": 0.1 } } } ] })");
-    EXPECT_CONTAINS(errorOf(s), "solids[0].sequence: solid 'paddle' deforms per frame, which only a liquid scene "
-                                "supports; a gas scene takes static or rigidly moving solids");
+    EXPECT_CONTAINS(
+        errorOf(s),
+        "solids[0].sequence: solid 'paddle' deforms per frame, which only a liquid scene "
+        "supports; a gas scene takes static or rigidly moving solids");
     // A boiling scene: the liquid would follow the sequence while its vapour kept the first shape.
     Json b = baseScene();
     b["solids"][0]["sequence"] = {{"file", "tank.$F4.vdb"}, {"grid", "tank"}};
-    b["heaters"] = Json::array({Json::parse(R"({ "geometry": { "box": { "min": [0.1, 0, 0.1], "max": [0.9, 0.05, 0.9] } },
+    b["heaters"] = Json::array(
+        {Json::parse(R"({ "geometry": { "box": { "min": [0.1, 0, 0.1], "max": [0.9, 0.05, 0.9] } },
                                                  "temperature": 400 })")});
-    EXPECT_CONTAINS(errorOf(b), "solids[0].sequence: solid 'tank' deforms per frame, which only a liquid scene "
-                                "supports; a boiling scene");
+    EXPECT_CONTAINS(errorOf(b),
+                    "solids[0].sequence: solid 'tank' deforms per frame, which only a liquid scene "
+                    "supports; a boiling scene");
 }
 
 TEST(KeyedMotion, InterpolatesAndHolds)
 {
     vdbio::KeyedMotion m;
-    m.keys = {{0.0, sph::Vec3d(0), sph::Vec3d(0)}, {1.0, sph::Vec3d(2, 0, 0), sph::Vec3d(0, 90, 0)}};
+    m.keys = {{0.0, sph::Vec3d(0), sph::Vec3d(0)},
+              {1.0, sph::Vec3d(2, 0, 0), sph::Vec3d(0, 90, 0)}};
     EXPECT_EQ(m.at(-1).translate, sph::Vec3d(0));
     EXPECT_EQ(m.at(0.5).translate, sph::Vec3d(1, 0, 0));
     EXPECT_DOUBLE_EQ(m.at(0.5).rotateDegrees[1], 45.0);
@@ -365,20 +393,25 @@ TEST(KeyedMotion, InterpolatesAndHolds)
 TEST(KeyedMotion, RatesAreTheDerivativesOfTheKeys)
 {
     vdbio::KeyedMotion m;
-    m.keys = {{0.0, sph::Vec3d(0), sph::Vec3d(0)}, {2.0, sph::Vec3d(4, 0, -2), sph::Vec3d(30, 90, -60)}};
+    m.keys = {{0.0, sph::Vec3d(0), sph::Vec3d(0)},
+              {2.0, sph::Vec3d(4, 0, -2), sph::Vec3d(30, 90, -60)}};
     const vdbio::RigidKey rate = m.rate(0.7);
     EXPECT_EQ(rate.translate, sph::Vec3d(2, 0, -1));
     EXPECT_EQ(rate.rotateDegrees, sph::Vec3d(15, 45, -30));
-    EXPECT_EQ(m.rate(-1).translate, sph::Vec3d(0)); // held before the first key
+    EXPECT_EQ(m.rate(-1).translate, sph::Vec3d(0));      // held before the first key
     EXPECT_EQ(m.rate(2.5).rotateDegrees, sph::Vec3d(0)); // and after the last
     // dR/dt against a central difference of the rotation in double precision (step 1e-6 s:
     // truncation error ~1e-12 relative; the analytic form must agree to 1e-8).
     const double t = 0.7, dt = 1e-6;
-    const openvdb::math::Mat3d analytic = vdbio::KeyedMotion::rotationRate(m.at(t).rotateDegrees, rate.rotateDegrees);
-    const openvdb::math::Mat3d numeric = (vdbio::KeyedMotion::rotation(m.at(t + dt).rotateDegrees) -
-                                          vdbio::KeyedMotion::rotation(m.at(t - dt).rotateDegrees)) * (0.5 / dt);
+    const openvdb::math::Mat3d analytic =
+        vdbio::KeyedMotion::rotationRate(m.at(t).rotateDegrees, rate.rotateDegrees);
+    const openvdb::math::Mat3d numeric =
+        (vdbio::KeyedMotion::rotation(m.at(t + dt).rotateDegrees)
+         - vdbio::KeyedMotion::rotation(m.at(t - dt).rotateDegrees))
+        * (0.5 / dt);
     for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) EXPECT_NEAR(analytic(i, j), numeric(i, j), 1e-8) << i << "," << j;
+        for (int j = 0; j < 3; ++j)
+            EXPECT_NEAR(analytic(i, j), numeric(i, j), 1e-8) << i << "," << j;
     }
 }
 
@@ -419,7 +452,8 @@ TEST_F(SceneTest, ForceFieldsReadStrictlyAndBelongToTheFingerprint)
     Json s = baseScene();
     s.erase("liquids");
     s["settings"]["method"] = "gas";
-    s["gas_sources"] = Json::parse(R"([{ "geometry": { "sphere": { "center": [0.5, 0.1, 0.5], "radius": 0.05 } } }])");
+    s["gas_sources"] = Json::parse(
+        R"([{ "geometry": { "sphere": { "center": [0.5, 0.1, 0.5], "radius": 0.05 } } }])");
     s["force_fields"] = Json::parse(R"([
         { "name": "magic", "attractor": { "position": [0.5, 0.8, 0.5], "strength": 3, "radius": 0.2 } },
         { "attractor": { "position": [0, 1, 0], "strength": -1.5, "falloff": "constant" } } ])");
@@ -430,9 +464,9 @@ TEST_F(SceneTest, ForceFieldsReadStrictlyAndBelongToTheFingerprint)
     EXPECT_DOUBLE_EQ(scene.forceFields[0].attractor.strength, 3.0);
     EXPECT_DOUBLE_EQ(scene.forceFields[0].attractor.radius, 0.2);
     EXPECT_EQ(scene.forceFields[0].attractor.falloff, "inverse_square");
-    EXPECT_EQ(scene.forceFields[1].name, "force_fields[1]");            // default name: the path
-    EXPECT_DOUBLE_EQ(scene.forceFields[1].attractor.radius, 0.1);       // default radius (m)
-    EXPECT_DOUBLE_EQ(scene.forceFields[1].attractor.strength, -1.5);    // negative: repels
+    EXPECT_EQ(scene.forceFields[1].name, "force_fields[1]");         // default name: the path
+    EXPECT_DOUBLE_EQ(scene.forceFields[1].attractor.radius, 0.1);    // default radius (m)
+    EXPECT_DOUBLE_EQ(scene.forceFields[1].attractor.strength, -1.5); // negative: repels
     EXPECT_EQ(scene.forceFields[1].attractor.falloff, "constant");
 
     // Bad input: one line naming the key path, the value and what was expected.
@@ -441,41 +475,53 @@ TEST_F(SceneTest, ForceFieldsReadStrictlyAndBelongToTheFingerprint)
                     "scene.json': force_fields[0].attractor.radius = -0.1: expected a number > 0");
     EXPECT_CONTAINS(bad("force_fields[0].attractor.strength=\"big\""),
                     "scene.json': force_fields[0].attractor.strength = \"big\": expected a number");
-    EXPECT_CONTAINS(bad("force_fields[0].attractor.position=[1,2]"),
-                    "scene.json': force_fields[0].attractor.position = [1,2]: expected an array of 3 numbers");
+    EXPECT_CONTAINS(
+        bad("force_fields[0].attractor.position=[1,2]"),
+        "scene.json': force_fields[0].attractor.position = [1,2]: expected an array of 3 numbers");
     EXPECT_CONTAINS(bad("force_fields[0].attractor.falloff=cubic"),
                     "scene.json': force_fields[0].attractor.falloff = \"cubic\": expected one of "
                     "'inverse_square', 'constant'");
-    EXPECT_CONTAINS(bad("force_fields[0].attractor.strenght=2"),
-                    "scene.json': force_fields[0].attractor.strenght: unknown key (did you mean 'strength'?)");
+    EXPECT_CONTAINS(
+        bad("force_fields[0].attractor.strenght=2"),
+        "scene.json': force_fields[0].attractor.strenght: unknown key (did you mean 'strength'?)");
     Json t = s;
     t["force_fields"][0]["attractor"].erase("strength");
-    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields[0].attractor.strength: missing; expected a number");
+    EXPECT_CONTAINS(errorOf(t),
+                    "scene.json': force_fields[0].attractor.strength: missing; expected a number");
     t = s;
     t["force_fields"][0]["atractor"] = t["force_fields"][0]["attractor"];
     t["force_fields"][0].erase("attractor");
-    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields[0].atractor: unknown key (did you mean 'attractor'?)");
+    EXPECT_CONTAINS(
+        errorOf(t),
+        "scene.json': force_fields[0].atractor: unknown key (did you mean 'attractor'?)");
     t = s;
     t["force_fields"][0].erase("attractor");
-    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields[0].attractor: missing; expected a field kind: "
-                                "'attractor'");
+    EXPECT_CONTAINS(errorOf(t),
+                    "scene.json': force_fields[0].attractor: missing; expected a field kind: "
+                    "'attractor'");
     t = s;
     t["force_field"] = t["force_fields"];
     t.erase("force_fields");
-    EXPECT_CONTAINS(errorOf(t), "scene.json': force_field: unknown key (did you mean 'force_fields'?)");
+    EXPECT_CONTAINS(errorOf(t),
+                    "scene.json': force_field: unknown key (did you mean 'force_fields'?)");
     // A liquid-only scene has nothing for an attractor to act on.
     t = baseScene();
     t["force_fields"] = s["force_fields"];
-    EXPECT_CONTAINS(errorOf(t), "scene.json': force_fields: attractors act on gas; this scene has no gas");
+    EXPECT_CONTAINS(errorOf(t),
+                    "scene.json': force_fields: attractors act on gas; this scene has no gas");
 
     // Part of the simulation fingerprint: a checkpoint of the scene without the field (or with
     // another strength) is refused for the scene with it.
     const std::string path = write(s, "gas.json");
     Json plain = s;
     plain.erase("force_fields");
-    const std::string without = vdbio::readScene(write(plain, "plain.json")).simulationFingerprint();
+    const std::string without =
+        vdbio::readScene(write(plain, "plain.json")).simulationFingerprint();
     const std::string with = vdbio::readScene(path).simulationFingerprint();
     EXPECT_NE(without, with);
-    EXPECT_NE(with, vdbio::readScene(path, {"force_fields[0].attractor.strength=4"}).simulationFingerprint());
-    EXPECT_EQ(with, vdbio::readScene(path, {"outputs.directory=elsewhere"}).simulationFingerprint());
+    EXPECT_NE(
+        with,
+        vdbio::readScene(path, {"force_fields[0].attractor.strength=4"}).simulationFingerprint());
+    EXPECT_EQ(with,
+              vdbio::readScene(path, {"outputs.directory=elsewhere"}).simulationFingerprint());
 }

@@ -23,9 +23,9 @@ void writeAtomically(const std::string& path, const std::function<void(const std
     // Unique per process and call, in the target's folder so the rename never crosses devices.
     static std::atomic<unsigned> counter{0};
     const fs::path target(path);
-    const fs::path tmp = target.parent_path() /
-        ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-         std::to_string(counter++));
+    const fs::path tmp = target.parent_path()
+                         / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid())
+                            + "_" + std::to_string(counter++));
     try {
         write(tmp.string());
     } catch (...) {

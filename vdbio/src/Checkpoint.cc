@@ -80,8 +80,8 @@ void writeDataset(H5::Group& group, const std::string& name, const H5::PredType&
     if (rows > 0) set.write(data, type); // nothing to write for an empty set
 }
 
-void writeState(const std::string& file, const SolverState& state,
-                const std::string& settingsJson, int frame)
+void writeState(const std::string& file, const SolverState& state, const std::string& settingsJson,
+                int frame)
 {
     const ParticleSet& p = state.particles;
     const std::size_t n = p.size();
@@ -216,9 +216,9 @@ struct Reader
         const bool ok = columns == 1 ? (rank == 1 && dims[0] == rows)
                                      : (rank == 2 && dims[0] == rows && dims[1] == columns);
         if (!ok) {
-            fail(msg("dataset '", full, "' has shape ", rank == 2 ? msg(dims[0], " x ", dims[1])
-                                                                  : msg(dims[0]),
-                     ", expected ", columns == 1 ? msg(rows) : msg(rows, " x ", columns)));
+            fail(msg("dataset '", full, "' has shape ",
+                     rank == 2 ? msg(dims[0], " x ", dims[1]) : msg(dims[0]), ", expected ",
+                     columns == 1 ? msg(rows) : msg(rows, " x ", columns)));
         }
         if (rows > 0) set.read(data, type);
     }
@@ -239,7 +239,8 @@ Reader openCheckpoint(const std::string& path)
         throw IoError(msg("checkpoint '", path, "': cannot read it (", detailOf(e), ")"));
     }
     if (!hdf5) {
-        throw IoError(msg("checkpoint '", path, "': not an HDF5 file, so not a ghostfx checkpoint"));
+        throw IoError(
+            msg("checkpoint '", path, "': not an HDF5 file, so not a ghostfx checkpoint"));
     }
     Reader reader{path, H5::H5File()};
     try {
@@ -337,8 +338,8 @@ bool firstDifference(const nlohmann::json& there, const nlohmann::json& here,
             if (firstDifference(there[i], here[i], msg(path, "/", i), out)) return true;
         }
         if (there.size() != here.size()) {
-            out = msg(where, " has ", there.size(), " items there, ", here.size(),
-                      " in this scene");
+            out =
+                msg(where, " has ", there.size(), " items there, ", here.size(), " in this scene");
             return true;
         }
         return false;
@@ -413,13 +414,17 @@ SolverState readCheckpoint(const std::string& path, const std::string& expectedS
             try {
                 here = nlohmann::json::parse(expectedSettingsJson);
             } catch (const nlohmann::json::exception& e) {
-                throw ValueError(msg("readCheckpoint('", path, "'): the expected settings are "
-                                     "not valid JSON: ", e.what()));
+                throw ValueError(msg("readCheckpoint('", path,
+                                     "'): the expected settings are "
+                                     "not valid JSON: ",
+                                     e.what()));
             }
             std::string difference;
             if (firstDifference(there, here, "", difference)) {
-                throw SceneError(msg("checkpoint '", path, "' was written with different "
-                                     "settings: ", difference));
+                throw SceneError(msg("checkpoint '", path,
+                                     "' was written with different "
+                                     "settings: ",
+                                     difference));
             }
         }
 

@@ -12,7 +12,8 @@
 namespace ghostfx {
 namespace vdbio {
 
-sph::LevelSet fogRegionToLevelSet(const openvdb::FloatGrid& fog, float threshold, const std::string& name)
+sph::LevelSet fogRegionToLevelSet(const openvdb::FloatGrid& fog, float threshold,
+                                  const std::string& name)
 {
     // Active voxels of the mask: the fog's voxels denser than the threshold.
     openvdb::MaskGrid mask(false);
@@ -32,12 +33,13 @@ sph::LevelSet fogRegionToLevelSet(const openvdb::FloatGrid& fog, float threshold
         }
     }
     if (inside == 0) {
-        throw GridError(msg("grid '", name, "': no voxel of the fog volume exceeds the threshold ", threshold,
-                            ", so the region is empty"));
+        throw GridError(msg("grid '", name, "': no voxel of the fog volume exceeds the threshold ",
+                            threshold, ", so the region is empty"));
     }
     // One closing step fills pinholes; one smoothing pass takes the voxel staircase off.
-    openvdb::FloatGrid::Ptr sdf = openvdb::tools::topologyToLevelSet(mask, /*halfWidth=*/3, /*closing=*/1,
-                                                                   /*dilation=*/0, /*smoothing=*/1);
+    openvdb::FloatGrid::Ptr sdf =
+        openvdb::tools::topologyToLevelSet(mask, /*halfWidth=*/3, /*closing=*/1,
+                                           /*dilation=*/0, /*smoothing=*/1);
     sdf->setName(name);
     return sph::makeLevelSet(sdf, name);
 }

@@ -13,7 +13,8 @@ namespace vdbio {
 
 /// The region where `fog` exceeds `threshold`, as a narrow-band level set (3 voxels, the fog's
 /// transform). Throws GridError if the region is empty.
-sph::LevelSet fogRegionToLevelSet(const openvdb::FloatGrid& fog, float threshold, const std::string& name);
+sph::LevelSet fogRegionToLevelSet(const openvdb::FloatGrid& fog, float threshold,
+                                  const std::string& name);
 
 } // namespace vdbio
 } // namespace ghostfx

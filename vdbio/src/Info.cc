@@ -69,12 +69,12 @@ void describeMetadata(std::ostream& os, const openvdb::MetaMap& meta, const std:
 {
     for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it) {
         const std::string& key = it->first;
-        if (skipBuiltIn && (key == openvdb::GridBase::META_GRID_NAME ||
-                            key == openvdb::GridBase::META_GRID_CLASS || isStatisticsKey(key))) {
+        if (skipBuiltIn
+            && (key == openvdb::GridBase::META_GRID_NAME
+                || key == openvdb::GridBase::META_GRID_CLASS || isStatisticsKey(key))) {
             continue;
         }
-        os << indent << key << " (" << it->second->typeName() << "): " << it->second->str()
-           << "\n";
+        os << indent << key << " (" << it->second->typeName() << "): " << it->second->str() << "\n";
     }
 }
 
@@ -101,8 +101,7 @@ void describePoints(std::ostream& os, const openvdb::points::PointDataGrid& grid
     os << "  points:          " << count << "\n";
     auto leaf = grid.tree().cbeginLeaf();
     if (!leaf) return;
-    const openvdb::points::AttributeSet::Descriptor& descriptor =
-        leaf->attributeSet().descriptor();
+    const openvdb::points::AttributeSet::Descriptor& descriptor = leaf->attributeSet().descriptor();
     // Attributes in their storage order, each with its value type, codec and stored bytes.
     std::vector<std::pair<std::size_t, std::string>> byPosition;
     for (const auto& entry : descriptor.map()) byPosition.emplace_back(entry.second, entry.first);
@@ -125,7 +124,7 @@ void describePoints(std::ostream& os, const openvdb::points::PointDataGrid& grid
     }
     os << "  bytes per point: " << bytesPerPoint << " in attributes";
     if (count > 0) {
-        std::ostringstream perPoint;   // own stream: keeps `os` at its default precision
+        std::ostringstream perPoint; // own stream: keeps `os` at its default precision
         perPoint << std::fixed << std::setprecision(1) << double(grid.memUsage()) / double(count);
         os << ", " << perPoint.str() << " in memory with the tree";
     }
@@ -205,13 +204,18 @@ std::string typeName(hid_t type)
     switch (H5Tget_class(type)) {
     case H5T_INTEGER:
         return msg(H5Tget_sign(type) == H5T_SGN_NONE ? "uint" : "int", 8 * size);
-    case H5T_FLOAT: return msg("float", 8 * size);
+    case H5T_FLOAT:
+        return msg("float", 8 * size);
     case H5T_STRING:
         return H5Tis_variable_str(type) > 0 ? std::string("string") : msg("string[", size, "]");
-    case H5T_BITFIELD: return msg("bitfield", 8 * size);
-    case H5T_OPAQUE: return msg("opaque[", size, "]");
-    case H5T_REFERENCE: return "reference";
-    case H5T_ENUM: return msg("enum (", size, " bytes)");
+    case H5T_BITFIELD:
+        return msg("bitfield", 8 * size);
+    case H5T_OPAQUE:
+        return msg("opaque[", size, "]");
+    case H5T_REFERENCE:
+        return "reference";
+    case H5T_ENUM:
+        return msg("enum (", size, " bytes)");
     case H5T_VLEN: {
         const hid_t base = H5Tget_super(type);
         const std::string name = msg("variable-length of ", typeName(base));
@@ -235,14 +239,15 @@ std::string typeName(hid_t type)
         for (int i = 0; i < n; ++i) {
             char* memberName = H5Tget_member_name(type, unsigned(i));
             const hid_t memberType = H5Tget_member_type(type, unsigned(i));
-            members += msg(i ? ", " : "", memberName ? memberName : "?", ": ",
-                           typeName(memberType));
+            members +=
+                msg(i ? ", " : "", memberName ? memberName : "?", ": ", typeName(memberType));
             H5Tclose(memberType);
             H5free_memory(memberName);
         }
         return "compound {" + members + "}";
     }
-    default: return msg("type of ", size, " bytes");
+    default:
+        return msg("type of ", size, " bytes");
     }
 }
 
@@ -385,8 +390,8 @@ void describeGroup(std::ostream& os, const H5::Group& group, const std::string& 
             const H5::DataSet dataset = group.openDataSet(name);
             const H5::DataType type = dataset.getDataType();
             os << indent << childPath << "  (dataset " << typeName(type.getId()) << " "
-               << shapeOf(dataset.getSpace()) << ", "
-               << sizeText(double(dataset.getStorageSize())) << " stored)\n";
+               << shapeOf(dataset.getSpace()) << ", " << sizeText(double(dataset.getStorageSize()))
+               << " stored)\n";
             describeAttributes(os, dataset, indent + "  ");
         } else if (kind == H5O_TYPE_NAMED_DATATYPE) {
             os << indent << childPath << "  (named type)\n";
@@ -425,8 +430,8 @@ std::string describeFile(const std::string& path)
     const std::string ext = extensionOf(path);
     if (ext == ".vdb") return describeVdb(path);
     if (ext == ".h5" || ext == ".hdf5") return describeH5(path);
-    throw IoError(msg("'", path, "': unknown kind of file '", ext,
-                      "': expected .vdb, .h5 or .hdf5"));
+    throw IoError(
+        msg("'", path, "': unknown kind of file '", ext, "': expected .vdb, .h5 or .hdf5"));
 }
 
 } // namespace vdbio

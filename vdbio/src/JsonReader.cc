@@ -57,8 +57,8 @@ bool convert(const Json& v, std::int64_t& out)
 bool convert(const Json& v, int& out)
 {
     std::int64_t wide = 0;
-    if (!convert(v, wide) || wide < std::numeric_limits<int>::min() ||
-        wide > std::numeric_limits<int>::max()) {
+    if (!convert(v, wide) || wide < std::numeric_limits<int>::min()
+        || wide > std::numeric_limits<int>::max()) {
         return false;
     }
     out = int(wide);
@@ -123,8 +123,8 @@ std::size_t editDistance(const std::string& a, const std::string& b)
         row[0] = i;
         for (std::size_t j = 1; j <= b.size(); ++j) {
             const std::size_t above = row[j];
-            const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                              std::tolower(static_cast<unsigned char>(b[j - 1]));
+            const bool same = std::tolower(static_cast<unsigned char>(a[i - 1]))
+                              == std::tolower(static_cast<unsigned char>(b[j - 1]));
             row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
             diagonal = above;
         }
@@ -151,18 +151,22 @@ std::string closestKey(const std::string& key, const std::vector<std::string>& c
 }
 
 JsonObject::JsonObject()
-    : mDocument(std::make_shared<const Json>(Json::object())), mValue(mDocument.get())
-{
-}
+    : mDocument(std::make_shared<const Json>(Json::object()))
+    , mValue(mDocument.get())
+{}
 
 JsonObject::JsonObject(std::shared_ptr<const Json> document, const Json* value, std::string path,
                        std::string source, std::string kind)
-    : mDocument(std::move(document)), mValue(value), mPath(std::move(path)), mSource(std::move(source)),
-      mKind(std::move(kind))
+    : mDocument(std::move(document))
+    , mValue(value)
+    , mPath(std::move(path))
+    , mSource(std::move(source))
+    , mKind(std::move(kind))
 {
     if (!mValue || !mValue->is_object()) {
         throw SceneError(msg(mKind, " '", mSource, "': ", mPath.empty() ? "the document" : mPath,
-                             " = ", mValue ? shortDump(*mValue) : "null", ": expected an object { ... }"));
+                             " = ", mValue ? shortDump(*mValue) : "null",
+                             ": expected an object { ... }"));
     }
 }
 
@@ -193,8 +197,8 @@ void JsonObject::fail(const std::string& key, const std::string& what) const
 void JsonObject::failValue(const std::string& key, const std::string& what) const
 {
     const Json* v = raw(key);
-    throw SceneError(msg(mKind, " '", mSource, "': ", pathOf(key), " = ", v ? shortDump(*v) : "null",
-                         ": ", what));
+    throw SceneError(msg(mKind, " '", mSource, "': ", pathOf(key), " = ",
+                         v ? shortDump(*v) : "null", ": ", what));
 }
 
 template <typename T>
@@ -225,7 +229,8 @@ template std::int64_t JsonObject::get(const std::string&, const std::int64_t&) c
 template std::uint64_t JsonObject::get(const std::string&, const std::uint64_t&) const;
 template bool JsonObject::get(const std::string&, const bool&) const;
 template std::string JsonObject::get(const std::string&, const std::string&) const;
-template std::array<double, 3> JsonObject::get(const std::string&, const std::array<double, 3>&) const;
+template std::array<double, 3> JsonObject::get(const std::string&,
+                                               const std::array<double, 3>&) const;
 template std::vector<double> JsonObject::get(const std::string&, const std::vector<double>&) const;
 template std::vector<std::string> JsonObject::get(const std::string&,
                                                   const std::vector<std::string>&) const;
@@ -268,7 +273,8 @@ std::string JsonObject::choice(const std::string& key, const std::string& fallba
     std::string list;
     for (const std::string& c : choices) list += (list.empty() ? "'" : ", '") + c + "'";
     const std::string near = closestKey(v, choices);
-    failValue(key, "expected one of " + list + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
+    failValue(key,
+              "expected one of " + list + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
 }
 
 JsonObject JsonObject::object(const std::string& key) const
@@ -318,7 +324,8 @@ void applyOverride(Json& document, const std::string& assignment)
 {
     const std::size_t eq = assignment.find('=');
     if (eq == std::string::npos || eq == 0) {
-        throw SceneError(msg("-D '", assignment, "': expected path=value, e.g. settings.stiffness=5000"));
+        throw SceneError(
+            msg("-D '", assignment, "': expected path=value, e.g. settings.stiffness=5000"));
     }
     const std::string path = assignment.substr(0, eq);
     const std::string text = assignment.substr(eq + 1);
@@ -342,8 +349,8 @@ void applyOverride(Json& document, const std::string& assignment)
             const std::size_t index = std::stoul(digits);
             if (!node->is_array() || index >= node->size()) {
                 throw SceneError(msg("-D ", path, ": ", walked.empty() ? "the document" : walked,
-                                     " has no element [", index, "] (", node->is_array() ? node->size() : 0,
-                                     " elements)"));
+                                     " has no element [", index, "] (",
+                                     node->is_array() ? node->size() : 0, " elements)"));
             }
             node = &(*node)[index];
             walked += path.substr(i, close - i + 1);

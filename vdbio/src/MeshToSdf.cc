@@ -36,7 +36,7 @@ constexpr double MAX_VOXELS_ACROSS = 100000.0;
 
 struct TriangleMesh
 {
-    std::vector<openvdb::Vec3s> points;     ///< world positions (m), welded
+    std::vector<openvdb::Vec3s> points; ///< world positions (m), welded
     std::vector<openvdb::Vec3I> triangles;
 };
 
@@ -46,7 +46,7 @@ struct PositionHash
 {
     std::size_t operator()(const std::array<std::uint32_t, 3>& key) const
     {
-        std::uint64_t h = 1469598103934665603ull;       // FNV-1a over the three words
+        std::uint64_t h = 1469598103934665603ull; // FNV-1a over the three words
         for (std::uint32_t word : key) h = (h ^ word) * 1099511628211ull;
         return std::size_t(h);
     }
@@ -56,7 +56,7 @@ std::array<std::uint32_t, 3> positionKey(const openvdb::Vec3s& p)
 {
     std::array<std::uint32_t, 3> key;
     for (int i = 0; i < 3; ++i) {
-        const float c = p[i] + 0.0f;                    // -0 -> +0
+        const float c = p[i] + 0.0f; // -0 -> +0
         std::memcpy(&key[std::size_t(i)], &c, sizeof(float));
     }
     return key;
@@ -75,9 +75,9 @@ TriangleMesh readTriangles(const std::string& meshPath, double scale)
     Assimp::Importer importer;
     // Points and lines are kept (dropping them all makes Assimp fail with "No meshes
     // remaining") and skipped below: only triangles bound a volume.
-    const aiScene* scene = importer.ReadFile(
-        meshPath, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                      aiProcess_PreTransformVertices | aiProcess_SortByPType);
+    const aiScene* scene =
+        importer.ReadFile(meshPath, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices
+                                        | aiProcess_PreTransformVertices | aiProcess_SortByPType);
     if (!scene) {
         throw IoError(msg("mesh file '", meshPath, "': cannot read it as a mesh (",
                           importer.GetErrorString(), ")"));
@@ -168,8 +168,8 @@ void MeshToSdfOptions::validate() const
     }
 }
 
-openvdb::FloatGrid::Ptr meshToLevelSet(const std::string& meshPath,
-                                       const MeshToSdfOptions& options, MeshStats* stats)
+openvdb::FloatGrid::Ptr meshToLevelSet(const std::string& meshPath, const MeshToSdfOptions& options,
+                                       MeshStats* stats)
 {
     options.validate();
     const TriangleMesh mesh = readTriangles(meshPath, options.scale);

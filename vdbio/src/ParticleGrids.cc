@@ -43,7 +43,7 @@ namespace {
 using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 using VecLeaf = openvdb::Vec3STree::LeafNodeType;
 
-constexpr int LEAF_DIM = int(FloatLeaf::DIM);          // 8 voxels per leaf edge
+constexpr int LEAF_DIM = int(FloatLeaf::DIM);           // 8 voxels per leaf edge
 constexpr int LEAF_VOXELS = int(FloatLeaf::NUM_VALUES); // 512
 /// Particles per block when listing candidate leaves: large enough to amortise the local sort,
 /// small enough that a block's leaves stay few (particles are visited in cell order).
@@ -52,10 +52,10 @@ constexpr std::size_t LEAF_KEY_BLOCK = 4096;
 /// The selected particles, copied into dense arrays (only what the asked grids need).
 struct Selected
 {
-    std::vector<sph::Vec3> x;                ///< positions (m)
-    std::vector<sph::Real> m;                ///< masses (kg)
-    std::vector<sph::Vec3> v;                ///< velocities (m/s), if "vel" is asked
-    std::vector<std::vector<sph::Real>> a;   ///< scalar channels, in the order asked
+    std::vector<sph::Vec3> x;              ///< positions (m)
+    std::vector<sph::Real> m;              ///< masses (kg)
+    std::vector<sph::Vec3> v;              ///< velocities (m/s), if "vel" is asked
+    std::vector<std::vector<sph::Real>> a; ///< scalar channels, in the order asked
 };
 
 /// Voxel index range [lo, hi] on one axis whose centres i * dx lie within `reach` of `x`.
@@ -75,32 +75,35 @@ std::vector<openvdb::Coord> candidateLeaves(const Selected& sel, const sph::Neig
     std::vector<std::vector<openvdb::Coord>> perBlock(nBlocks);
     const double invDx = 1.0 / dx;
     const int mask = ~(LEAF_DIM - 1);
-    parallel::forEach(0, nBlocks, [&](std::size_t b) {
-        std::vector<openvdb::Coord>& keys = perBlock[b];
-        const std::size_t end = std::min(n, (b + 1) * LEAF_KEY_BLOCK);
-        for (std::size_t k = b * LEAF_KEY_BLOCK; k < end; ++k) {
-            const sph::Vec3& x = sel.x[order[k]];
-            int lo[3], hi[3];
-            for (int d = 0; d < 3; ++d) {
-                voxelRange(double(x[d]), R, invDx, lo[d], hi[d]);
-                lo[d] &= mask;
-                hi[d] &= mask;
-            }
-            for (int i = lo[0]; i <= hi[0]; i += LEAF_DIM) {
-                for (int j = lo[1]; j <= hi[1]; j += LEAF_DIM) {
-                    for (int l = lo[2]; l <= hi[2]; l += LEAF_DIM) {
-                        keys.emplace_back(i, j, l);
+    parallel::forEach(
+        0, nBlocks,
+        [&](std::size_t b) {
+            std::vector<openvdb::Coord>& keys = perBlock[b];
+            const std::size_t end = std::min(n, (b + 1) * LEAF_KEY_BLOCK);
+            for (std::size_t k = b * LEAF_KEY_BLOCK; k < end; ++k) {
+                const sph::Vec3& x = sel.x[order[k]];
+                int lo[3], hi[3];
+                for (int d = 0; d < 3; ++d) {
+                    voxelRange(double(x[d]), R, invDx, lo[d], hi[d]);
+                    lo[d] &= mask;
+                    hi[d] &= mask;
+                }
+                for (int i = lo[0]; i <= hi[0]; i += LEAF_DIM) {
+                    for (int j = lo[1]; j <= hi[1]; j += LEAF_DIM) {
+                        for (int l = lo[2]; l <= hi[2]; l += LEAF_DIM) {
+                            keys.emplace_back(i, j, l);
+                        }
                     }
                 }
+                if (keys.size() > 4 * LEAF_KEY_BLOCK) { // keep the block's list short
+                    std::sort(keys.begin(), keys.end());
+                    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+                }
             }
-            if (keys.size() > 4 * LEAF_KEY_BLOCK) { // keep the block's list short
-                std::sort(keys.begin(), keys.end());
-                keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-            }
-        }
-        std::sort(keys.begin(), keys.end());
-        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-    }, 1);
+            std::sort(keys.begin(), keys.end());
+            keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+        },
+        1);
     std::vector<openvdb::Coord> leaves;
     for (const auto& keys : perBlock) leaves.insert(leaves.end(), keys.begin(), keys.end());
     std::sort(leaves.begin(), leaves.end());
@@ -139,9 +142,9 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     density->setName("density");
     density->setGridClass(openvdb::GRID_FOG_VOLUME);
     density->insertMeta("rest_density", openvdb::FloatMetadata(float(rho0)));
-    density->insertMeta("units", openvdb::StringMetadata(
-        "rho/rho0 (dimensionless); kg/m^3 = value * rest_density; "
-        "mass (kg) = rest_density * sum(values) * voxel_size^3"));
+    density->insertMeta(
+        "units", openvdb::StringMetadata("rho/rho0 (dimensionless); kg/m^3 = value * rest_density; "
+                                         "mass (kg) = rest_density * sum(values) * voxel_size^3"));
     openvdb::Vec3SGrid::Ptr vel = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
     vel->setName("vel");
     vel->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
@@ -151,8 +154,10 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
         openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.0f);
         g->setName(name);
         g->setGridClass(openvdb::GRID_FOG_VOLUME);
-        g->insertMeta("normalisation", openvdb::StringMetadata(
-            "Shepard: sum m a W / sum m W over the particles within the kernel support"));
+        g->insertMeta(
+            "normalisation",
+            openvdb::StringMetadata(
+                "Shepard: sum m a W / sum m W over the particles within the kernel support"));
         channels.push_back(g);
     }
     for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(density.get()),
@@ -176,16 +181,20 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     for (std::size_t c = 0; c < nChannels; ++c) {
         const std::string& name = options.scalarChannels[c];
         source[c] = name == "pressure" && !particles.hasScalarChannel(name)
-                        ? &particles.pressures() : &particles.scalarChannel(name);
+                        ? &particles.pressures()
+                        : &particles.scalarChannel(name);
         sel.a[c].resize(n);
     }
-    parallel::forEach(0, n, [&](std::size_t k) {
-        const sph::Index i = selection[k];
-        sel.x[k] = particles.positions()[i];
-        sel.m[k] = particles.masses()[i];
-        if (wantVel) sel.v[k] = particles.velocities()[i];
-        for (std::size_t c = 0; c < nChannels; ++c) sel.a[c][k] = (*source[c])[i];
-    }, 4096);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t k) {
+            const sph::Index i = selection[k];
+            sel.x[k] = particles.positions()[i];
+            sel.m[k] = particles.masses()[i];
+            if (wantVel) sel.v[k] = particles.velocities()[i];
+            for (std::size_t c = 0; c < nChannels; ++c) sel.a[c][k] = (*source[c])[i];
+        },
+        4096);
 
     openvdb::GridPtrVec out;
     auto collect = [&]() {
@@ -212,85 +221,91 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     const double leafHalfDiagonal = 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx;
     const sph::Real searchRadius = sph::Real(R + leafHalfDiagonal);
 
-    parallel::forEach(0, leaves.size(), [&](std::size_t L) {
-        const openvdb::Coord origin = leaves[L];
-        // Per-leaf accumulators, in double: sums of a hundred-odd terms in a fixed order.
-        std::vector<double> rho(LEAF_VOXELS, 0.0);
-        std::vector<openvdb::Vec3d> mv(wantVel ? LEAF_VOXELS : 0, openvdb::Vec3d(0.0));
-        std::vector<double> ma(nChannels * LEAF_VOXELS, 0.0);
+    parallel::forEach(
+        0, leaves.size(),
+        [&](std::size_t L) {
+            const openvdb::Coord origin = leaves[L];
+            // Per-leaf accumulators, in double: sums of a hundred-odd terms in a fixed order.
+            std::vector<double> rho(LEAF_VOXELS, 0.0);
+            std::vector<openvdb::Vec3d> mv(wantVel ? LEAF_VOXELS : 0, openvdb::Vec3d(0.0));
+            std::vector<double> ma(nChannels * LEAF_VOXELS, 0.0);
 
-        const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
-        grid.forEachInRadius(centre, searchRadius, [&](sph::Index j, const sph::Vec3&, sph::Real) {
-            const double xj[3] = {double(sel.x[j][0]), double(sel.x[j][1]), double(sel.x[j][2])};
-            int lo[3], hi[3];
-            for (int d = 0; d < 3; ++d) {
-                voxelRange(xj[d], R, invDx, lo[d], hi[d]);
-                lo[d] = std::max(lo[d] - origin[d], 0);
-                hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
-                if (lo[d] > hi[d]) return; // support box misses this leaf
-            }
-            const double mj = double(sel.m[j]);
-            for (int a = lo[0]; a <= hi[0]; ++a) {
-                const double dxa = (origin.x() + a) * dx - xj[0];
-                const double ra2 = dxa * dxa;
-                for (int b = lo[1]; b <= hi[1]; ++b) {
-                    const double dyb = (origin.y() + b) * dx - xj[1];
-                    const double rab2 = ra2 + dyb * dyb;
-                    const double rem = R2 - rab2;
-                    if (rem <= 0.0) continue;
-                    // z range of this row inside the support sphere.
-                    int clo, chi;
-                    voxelRange(xj[2], std::sqrt(rem), invDx, clo, chi);
-                    clo = std::max(clo - origin.z(), lo[2]);
-                    chi = std::min(chi - origin.z(), hi[2]);
-                    for (int c = clo; c <= chi; ++c) {
-                        const double dzc = (origin.z() + c) * dx - xj[2];
-                        const double r = std::sqrt(rab2 + dzc * dzc);
-                        const double w = mj * double(kernel.W(sph::Real(r)));
-                        if (w == 0.0) continue;
-                        const int voxel = (a << 6) | (b << 3) | c; // LeafNode::coordToOffset
-                        rho[voxel] += w;
-                        if (wantVel) {
-                            mv[voxel] += w * openvdb::Vec3d(sel.v[j][0], sel.v[j][1],
-                                                            sel.v[j][2]);
-                        }
-                        for (std::size_t ch = 0; ch < nChannels; ++ch) {
-                            ma[ch * LEAF_VOXELS + voxel] += w * double(sel.a[ch][j]);
+            const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
+                                   sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
+                                   sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
+            grid.forEachInRadius(
+                centre, searchRadius, [&](sph::Index j, const sph::Vec3&, sph::Real) {
+                    const double xj[3] = {double(sel.x[j][0]), double(sel.x[j][1]),
+                                          double(sel.x[j][2])};
+                    int lo[3], hi[3];
+                    for (int d = 0; d < 3; ++d) {
+                        voxelRange(xj[d], R, invDx, lo[d], hi[d]);
+                        lo[d] = std::max(lo[d] - origin[d], 0);
+                        hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
+                        if (lo[d] > hi[d]) return; // support box misses this leaf
+                    }
+                    const double mj = double(sel.m[j]);
+                    for (int a = lo[0]; a <= hi[0]; ++a) {
+                        const double dxa = (origin.x() + a) * dx - xj[0];
+                        const double ra2 = dxa * dxa;
+                        for (int b = lo[1]; b <= hi[1]; ++b) {
+                            const double dyb = (origin.y() + b) * dx - xj[1];
+                            const double rab2 = ra2 + dyb * dyb;
+                            const double rem = R2 - rab2;
+                            if (rem <= 0.0) continue;
+                            // z range of this row inside the support sphere.
+                            int clo, chi;
+                            voxelRange(xj[2], std::sqrt(rem), invDx, clo, chi);
+                            clo = std::max(clo - origin.z(), lo[2]);
+                            chi = std::min(chi - origin.z(), hi[2]);
+                            for (int c = clo; c <= chi; ++c) {
+                                const double dzc = (origin.z() + c) * dx - xj[2];
+                                const double r = std::sqrt(rab2 + dzc * dzc);
+                                const double w = mj * double(kernel.W(sph::Real(r)));
+                                if (w == 0.0) continue;
+                                const int voxel =
+                                    (a << 6) | (b << 3) | c; // LeafNode::coordToOffset
+                                rho[voxel] += w;
+                                if (wantVel) {
+                                    mv[voxel] +=
+                                        w * openvdb::Vec3d(sel.v[j][0], sel.v[j][1], sel.v[j][2]);
+                                }
+                                for (std::size_t ch = 0; ch < nChannels; ++ch) {
+                                    ma[ch * LEAF_VOXELS + voxel] += w * double(sel.a[ch][j]);
+                                }
+                            }
                         }
                     }
-                }
-            }
-        });
+                });
 
-        // Keep the voxels whose density reaches the cutoff; normalise.
-        LeafOutput& res = results[L];
-        bool any = false;
-        for (int voxel = 0; voxel < LEAF_VOXELS; ++voxel) {
-            const double ratio = rho[voxel] / rho0;
-            if (!(ratio > 0.0) || ratio < cutoff) continue;
-            if (!any) {
-                any = true;
-                res.density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                if (wantVel) {
-                    res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
+            // Keep the voxels whose density reaches the cutoff; normalise.
+            LeafOutput& res = results[L];
+            bool any = false;
+            for (int voxel = 0; voxel < LEAF_VOXELS; ++voxel) {
+                const double ratio = rho[voxel] / rho0;
+                if (!(ratio > 0.0) || ratio < cutoff) continue;
+                if (!any) {
+                    any = true;
+                    res.density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                    if (wantVel) {
+                        res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                    }
+                    res.channels.resize(nChannels);
+                    for (auto& leaf : res.channels) {
+                        leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                    }
                 }
-                res.channels.resize(nChannels);
-                for (auto& leaf : res.channels) {
-                    leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                const openvdb::Index offset = openvdb::Index(voxel);
+                res.density->setValueOn(offset, float(ratio));
+                const double invRho = 1.0 / rho[voxel];
+                if (wantVel) res.vel->setValueOn(offset, openvdb::Vec3s(mv[voxel] * invRho));
+                for (std::size_t ch = 0; ch < nChannels; ++ch) {
+                    res.channels[ch]->setValueOn(offset,
+                                                 float(ma[ch * LEAF_VOXELS + voxel] * invRho));
                 }
             }
-            const openvdb::Index offset = openvdb::Index(voxel);
-            res.density->setValueOn(offset, float(ratio));
-            const double invRho = 1.0 / rho[voxel];
-            if (wantVel) res.vel->setValueOn(offset, openvdb::Vec3s(mv[voxel] * invRho));
-            for (std::size_t ch = 0; ch < nChannels; ++ch) {
-                res.channels[ch]->setValueOn(offset,
-                                             float(ma[ch * LEAF_VOXELS + voxel] * invRho));
-            }
-        }
-    }, 1);
+        },
+        1);
 
     // Attach the leaves in leaf order (serial: tree insertion is not thread-safe).
     for (LeafOutput& res : results) {

@@ -33,7 +33,7 @@ constexpr Rgb AXES{70, 70, 70};
 constexpr Rgb GRID{230, 230, 230};
 constexpr Rgb FRONT{25, 25, 25};
 constexpr Rgb LEGEND_EDGE{180, 180, 180};
-constexpr Rgb PALETTE[] = {{78, 121, 167}, {242, 142, 43}, {225, 87, 89},  {118, 183, 178},
+constexpr Rgb PALETTE[] = {{78, 121, 167}, {242, 142, 43}, {225, 87, 89},   {118, 183, 178},
                            {89, 161, 79},  {237, 201, 72}, {176, 122, 161}, {156, 117, 95}};
 constexpr std::size_t PALETTE_SIZE = sizeof(PALETTE) / sizeof(PALETTE[0]);
 // Marker outlines are the fill colour darkened to this fraction, so light hues (yellow) still
@@ -207,9 +207,10 @@ class Canvas
 {
 public:
     Canvas(int width, int height)
-        : mWidth(width), mHeight(height), mPixels(std::size_t(width) * std::size_t(height), WHITE)
-    {
-    }
+        : mWidth(width)
+        , mHeight(height)
+        , mPixels(std::size_t(width) * std::size_t(height), WHITE)
+    {}
 
     /// Blend `c` over the pixel with coverage `alpha` in [0, 1] (1 sets it exactly).
     void blend(int x, int y, const Rgb& c, double alpha)
@@ -449,9 +450,9 @@ std::vector<Tick> linearTicks(const Axis& axis, int scale, Extent extent)
             if (axis.log && !(value > 0.0)) continue;
             ticks.push_back({value, true, linearLabel(value, step)});
         }
-        const double spacing = ticks.size() > 1 ? std::abs(axis.pixelOf(ticks[1].value) -
-                                                           axis.pixelOf(ticks[0].value))
-                                                 : axis.length();
+        const double spacing =
+            ticks.size() > 1 ? std::abs(axis.pixelOf(ticks[1].value) - axis.pixelOf(ticks[0].value))
+                             : axis.length();
         if (spacing >= MIN_TICK_SPACING * scale && labelsFit(axis, ticks, scale, extent)) break;
     }
     return ticks;
@@ -494,15 +495,14 @@ std::vector<Tick> logTicks(const Axis& axis, int scale, Extent extent)
         return ticks;
     }
     // Under two decades: label 1, 2 and 5 x 10^k, else every 1..9 x 10^k, if two or more fit.
-    for (const std::vector<int>& labelled : {std::vector<int>{1, 2, 5},
-                                             std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 9}}) {
+    for (const std::vector<int>& labelled :
+         {std::vector<int>{1, 2, 5}, std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 9}}) {
         ticks.clear();
         int count = 0;
         for (int e = first; e <= last; ++e) {
             for (int m = 1; m <= 9; ++m) {
                 if (!inRange(e + std::log10(double(m)))) continue;
-                const bool label =
-                    std::find(labelled.begin(), labelled.end(), m) != labelled.end();
+                const bool label = std::find(labelled.begin(), labelled.end(), m) != labelled.end();
                 ticks.push_back({m * std::pow(10.0, e), label, label ? logLabel(m, e) : ""});
                 count += label ? 1 : 0;
             }
@@ -531,8 +531,8 @@ void checkValue(double value, bool log, const char* axisName, const std::string&
                 const std::string& what)
 {
     if (!std::isfinite(value)) {
-        throw ValueError(msg(where, ": ", what, " has ", axisName, " = ", value,
-                             ": expected a finite value"));
+        throw ValueError(
+            msg(where, ": ", what, " has ", axisName, " = ", value, ": expected a finite value"));
     }
     if (log && !(value > 0.0)) {
         throw ValueError(msg(where, ": ", what, " has ", axisName, " = ", value,
@@ -547,8 +547,8 @@ void checkSpec(const PlotSpec& spec, const std::string& where)
                              "..", PlotSpec::MAX_SIDE, " pixels"));
     }
     if (spec.height < PlotSpec::MIN_HEIGHT || spec.height > PlotSpec::MAX_SIDE) {
-        throw ValueError(msg(where, ": height = ", spec.height, ": expected ",
-                             PlotSpec::MIN_HEIGHT, "..", PlotSpec::MAX_SIDE, " pixels"));
+        throw ValueError(msg(where, ": height = ", spec.height, ": expected ", PlotSpec::MIN_HEIGHT,
+                             "..", PlotSpec::MAX_SIDE, " pixels"));
     }
     if (spec.points.empty()) throw ValueError(msg(where, ": no points to plot"));
     for (std::size_t i = 0; i < spec.points.size(); ++i) {
@@ -562,12 +562,12 @@ void checkSpec(const PlotSpec& spec, const std::string& where)
 /// the legend.
 struct Layout
 {
-    int scale = 1;              ///< text scale of titles, labels and the legend
-    int smallScale = 1;         ///< text scale of point labels
-    int pad = 6;                ///< outer margin and spacing unit (pixels)
-    int tickLength = 3;         ///< major tick length (pixels), minor ticks 2/3 of it
-    double markerRadius = 3.5;  ///< marker radius (pixels)
-    Box plot;                   ///< the axes box (its outline pixels)
+    int scale = 1;             ///< text scale of titles, labels and the legend
+    int smallScale = 1;        ///< text scale of point labels
+    int pad = 6;               ///< outer margin and spacing unit (pixels)
+    int tickLength = 3;        ///< major tick length (pixels), minor ticks 2/3 of it
+    double markerRadius = 3.5; ///< marker radius (pixels)
+    Box plot;                  ///< the axes box (its outline pixels)
     Axis x, y;
     std::vector<std::string> series;        ///< series names in order of first appearance
     std::vector<std::size_t> seriesOfPoint; ///< index into `series` for each point
@@ -621,8 +621,8 @@ Layout makeLayout(const PlotSpec& spec)
 
     // Vertical layout: title, box, tick labels, x label.
     L.plot.top = L.pad + (spec.title.empty() ? textHeight / 2 : lineHeight + 2 * L.pad);
-    L.plot.bottom = spec.height - 1 - L.pad - (spec.xLabel.empty() ? 0 : lineHeight + L.pad) -
-                    lineHeight - 2 * s - L.tickLength;
+    L.plot.bottom = spec.height - 1 - L.pad - (spec.xLabel.empty() ? 0 : lineHeight + L.pad)
+                    - lineHeight - 2 * s - L.tickLength;
     const double clearance = L.markerRadius + 4.0 * s;
 
     const auto dataRange = [&](bool log, bool isX) {
@@ -646,8 +646,8 @@ Layout makeLayout(const PlotSpec& spec)
     for (const Tick& t : L.y.ticks) yLabelWidth = std::max(yLabelWidth, textWidth(t.label, s));
 
     // Absurdly long tick labels are cut on the left rather than squeezing the plot away.
-    L.plot.left = std::min(spec.width / 3, L.pad + (spec.yLabel.empty() ? 0 : lineHeight + L.pad) +
-                                                yLabelWidth + 2 * s + L.tickLength);
+    L.plot.left = std::min(spec.width / 3, L.pad + (spec.yLabel.empty() ? 0 : lineHeight + L.pad)
+                                               + yLabelWidth + 2 * s + L.tickLength);
     // Right of the box: the legend, else room for half of the last x tick label.
     L.plot.right = spec.width - 1 - (legendRows > 0 ? legendWidth + 2 * L.pad : 3 * L.pad);
     // Never let a long legend squeeze the plot below half the image.
@@ -657,8 +657,8 @@ Layout makeLayout(const PlotSpec& spec)
     L.x.pixelHi = L.plot.right;
     const auto [xlo, xhi] = dataRange(spec.logX, true);
     padRange(L.x, xlo, xhi, L.x.length(), std::max(clearance, AXIS_MARGIN_FRACTION * L.x.length()));
-    L.x.ticks = makeTicks(L.x, s,
-                          [&](const std::string& label) { return double(textWidth(label, s)); });
+    L.x.ticks =
+        makeTicks(L.x, s, [&](const std::string& label) { return double(textWidth(label, s)); });
 
     if (legendRows > 0) {
         L.legend.left = L.plot.right + L.pad;
@@ -772,8 +772,8 @@ Canvas render(const PlotSpec& spec, const Layout& L)
         const int length = t.major ? L.tickLength : (2 * L.tickLength) / 3;
         canvas.fillRect(px, box.bottom + 1, px, box.bottom + length, AXES);
         if (!t.label.empty()) {
-            canvas.text(px - textWidth(t.label, s) / 2, box.bottom + L.tickLength + 2 * s,
-                        t.label, s, TEXT);
+            canvas.text(px - textWidth(t.label, s) / 2, box.bottom + L.tickLength + 2 * s, t.label,
+                        s, TEXT);
         }
     }
     for (const Tick& t : L.y.ticks) {
@@ -793,8 +793,7 @@ Canvas render(const PlotSpec& spec, const Layout& L)
                     box.bottom + L.tickLength + 2 * s + lineHeight + L.pad, spec.xLabel, s, TEXT);
     }
     if (!spec.yLabel.empty()) {
-        canvas.text(L.pad, boxMiddleY + textWidth(spec.yLabel, s) / 2, spec.yLabel, s, TEXT,
-                    true);
+        canvas.text(L.pad, boxMiddleY + textWidth(spec.yLabel, s) / 2, spec.yLabel, s, TEXT, true);
     }
     // Title, centred over the box and kept on the image, drawn twice one pixel apart (bold).
     if (!spec.title.empty()) {

@@ -22,15 +22,18 @@ const unsigned char SIGNATURE[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}
 
 void putU32(std::vector<unsigned char>& out, std::uint32_t v)
 {
-    for (int shift = 24; shift >= 0; shift -= 8) out.push_back((unsigned char)((v >> shift) & 0xff));
+    for (int shift = 24; shift >= 0; shift -= 8)
+        out.push_back((unsigned char)((v >> shift) & 0xff));
 }
 
 std::uint32_t getU32(const unsigned char* p)
 {
-    return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
+    return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8)
+           | p[3];
 }
 
-void chunk(std::vector<unsigned char>& out, const char type[4], const std::vector<unsigned char>& data)
+void chunk(std::vector<unsigned char>& out, const char type[4],
+           const std::vector<unsigned char>& data)
 {
     putU32(out, std::uint32_t(data.size()));
     const std::size_t start = out.size();
@@ -53,8 +56,8 @@ unsigned char toSrgb8(float linear)
 void writePng(const std::string& path, int width, int height, const std::vector<float>& rgba)
 {
     if (width < 1 || height < 1 || rgba.size() != std::size_t(width) * std::size_t(height) * 4) {
-        throw ValueError(msg("PNG '", path, "': ", width, " x ", height, " image with ", rgba.size(),
-                             " values: expected width x height x 4"));
+        throw ValueError(msg("PNG '", path, "': ", width, " x ", height, " image with ",
+                             rgba.size(), " values: expected width x height x 4"));
     }
     // Scanlines, each led by filter type 0 (none).
     std::vector<unsigned char> raw;
@@ -93,7 +96,8 @@ void writePng(const std::string& path, int width, int height, const std::vector<
 std::vector<std::uint8_t> readPngRgba8(const std::string& path, int& width, int& height)
 {
     std::ifstream in(path, std::ios::binary);
-    const std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in),
+                                           std::istreambuf_iterator<char>()};
     if (bytes.size() < 8 || std::memcmp(bytes.data(), SIGNATURE, 8) != 0) {
         throw IoError(msg("PNG '", path, "': not a PNG file"));
     }
@@ -113,14 +117,16 @@ std::vector<std::uint8_t> readPngRgba8(const std::string& path, int& width, int&
     }
     std::vector<unsigned char> raw(std::size_t(height) * (std::size_t(width) * 4 + 1));
     uLongf rawSize = uLongf(raw.size());
-    if (width < 1 || uncompress(raw.data(), &rawSize, packed.data(), uLong(packed.size())) != Z_OK) {
+    if (width < 1
+        || uncompress(raw.data(), &rawSize, packed.data(), uLong(packed.size())) != Z_OK) {
         throw IoError(msg("PNG '", path, "': cannot decode"));
     }
     std::vector<std::uint8_t> rgba;
     rgba.reserve(std::size_t(width) * std::size_t(height) * 4);
     for (int y = 0; y < height; ++y) {
         const unsigned char* row = &raw[std::size_t(y) * (std::size_t(width) * 4 + 1)];
-        if (row[0] != 0) throw IoError(msg("PNG '", path, "': filter type ", int(row[0]), " not supported"));
+        if (row[0] != 0)
+            throw IoError(msg("PNG '", path, "': filter type ", int(row[0]), " not supported"));
         rgba.insert(rgba.end(), row + 1, row + 1 + std::size_t(width) * 4);
     }
     return rgba;

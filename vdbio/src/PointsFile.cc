@@ -33,9 +33,9 @@ using openvdb::tools::PointIndexGrid;
 using openvdb::tools::PointIndexTree;
 
 /// Particle kinds known to this build, in value order (ParticleKind values are stored in files).
-constexpr sph::ParticleKind ALL_KINDS[] = {
-    sph::ParticleKind::Liquid, sph::ParticleKind::GhostAir, sph::ParticleKind::GhostSolid,
-    sph::ParticleKind::Gas, sph::ParticleKind::Boundary};
+constexpr sph::ParticleKind ALL_KINDS[] = {sph::ParticleKind::Liquid, sph::ParticleKind::GhostAir,
+                                           sph::ParticleKind::GhostSolid, sph::ParticleKind::Gas,
+                                           sph::ParticleKind::Boundary};
 
 const char* const BUILTIN_CHANNELS[] = {"v", "id", "density", "pressure", "mass", "kind"};
 
@@ -56,9 +56,8 @@ template <typename T, typename S>
 std::vector<T> gatherSelected(const std::vector<S>& src, const std::vector<sph::Index>& selection)
 {
     std::vector<T> out(selection.size());
-    parallel::forEach(0, selection.size(), [&](std::size_t k) {
-        out[k] = T(src[selection[k]]);
-    }, 4096);
+    parallel::forEach(
+        0, selection.size(), [&](std::size_t k) { out[k] = T(src[selection[k]]); }, 4096);
     return out;
 }
 
@@ -66,10 +65,13 @@ std::vector<openvdb::Vec3s> gatherSelected3(const std::vector<sph::Vec3>& src,
                                             const std::vector<sph::Index>& selection)
 {
     std::vector<openvdb::Vec3s> out(selection.size());
-    parallel::forEach(0, selection.size(), [&](std::size_t k) {
-        const sph::Vec3& a = src[selection[k]];
-        out[k] = openvdb::Vec3s(float(a[0]), float(a[1]), float(a[2]));
-    }, 4096);
+    parallel::forEach(
+        0, selection.size(),
+        [&](std::size_t k) {
+            const sph::Vec3& a = src[selection[k]];
+            out[k] = openvdb::Vec3s(float(a[0]), float(a[1]), float(a[2]));
+        },
+        4096);
     return out;
 }
 
@@ -87,8 +89,8 @@ std::string kindNamesList()
 void PointsOptions::validate() const
 {
     if (!(std::isfinite(voxelSize) && voxelSize >= 0.0)) {
-        throw ValueError(msg("points output: voxel size = ", voxelSize,
-                             " m: expected > 0, or 0 for automatic"));
+        throw ValueError(
+            msg("points output: voxel size = ", voxelSize, " m: expected > 0, or 0 for automatic"));
     }
     std::set<std::string> seen;
     for (const std::string& name : channels) {
@@ -126,16 +128,19 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
 
     // Positions in double, so the world-to-voxel conversion adds no rounding of its own.
     std::vector<openvdb::Vec3d> positions(selection.size());
-    parallel::forEach(0, selection.size(), [&](std::size_t k) {
-        const sph::Vec3& x = particles.positions()[selection[k]];
-        positions[k] = openvdb::Vec3d(x[0], x[1], x[2]);
-    }, 4096);
+    parallel::forEach(
+        0, selection.size(),
+        [&](std::size_t k) {
+            const sph::Vec3& x = particles.positions()[selection[k]];
+            positions[k] = openvdb::Vec3d(x[0], x[1], x[2]);
+        },
+        4096);
     const openvdb::points::PointAttributeVector<openvdb::Vec3d> positionArray(positions);
 
     double voxelSize = options.voxelSize;
     if (voxelSize == 0.0) {
-        voxelSize = double(openvdb::points::computeVoxelSize(
-            positionArray, PointsOptions::AUTO_POINTS_PER_VOXEL));
+        voxelSize = double(
+            openvdb::points::computeVoxelSize(positionArray, PointsOptions::AUTO_POINTS_PER_VOXEL));
     }
     const openvdb::math::Transform::Ptr xform =
         openvdb::math::Transform::createLinearTransform(voxelSize);
@@ -183,8 +188,8 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
     grid->insertMeta("kind_names", openvdb::StringMetadata(kindNamesList()));
     grid->insertMeta("point_count", openvdb::Int64Metadata(std::int64_t(selection.size())));
     std::string written;
-    for (sph::ParticleKind k : options.kinds) written += (written.empty() ? "" : ",") +
-                                                        std::string(sph::kindName(k));
+    for (sph::ParticleKind k : options.kinds)
+        written += (written.empty() ? "" : ",") + std::string(sph::kindName(k));
     grid->insertMeta("kinds_written", openvdb::StringMetadata(written));
 
     writeAtomically(path, [&](const std::string& tmp) {

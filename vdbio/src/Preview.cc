@@ -63,7 +63,7 @@ double radians(double degrees) { return degrees * openvdb::math::pi<double>() / 
 struct CameraSetup
 {
     Vec3R eye, target, up;
-    Vec3R toLight;              ///< unit vector from the scene towards the key light
+    Vec3R toLight; ///< unit vector from the scene towards the key light
     double nearPlane = 1e-3, farPlane = 1e30;
 };
 
@@ -122,9 +122,10 @@ class KeyLightShader : public openvdb::tools::BaseShader
 {
 public:
     KeyLightShader(const Vec3R& toLight, const Film::RGBA& albedo, float ambient)
-        : mToLight(toLight), mAlbedo(albedo), mAmbient(ambient)
-    {
-    }
+        : mToLight(toLight)
+        , mAlbedo(albedo)
+        , mAmbient(ambient)
+    {}
     Film::RGBA operator()(const Vec3R&, const Vec3R& normal, const Vec3R& rayDir) const override
     {
         Vec3R n = normal;
@@ -249,11 +250,12 @@ void checkOutputFolder(const std::string& exrPath)
     const fs::path folder = fs::path(exrPath).parent_path();
     std::error_code ec;
     if (!folder.empty() && !fs::is_directory(folder, ec)) {
-        throw IoError(msg("preview image '", exrPath, "': folder '", folder.string(),
-                          "' does not exist"));
+        throw IoError(
+            msg("preview image '", exrPath, "': folder '", folder.string(), "' does not exist"));
     }
     if (fs::is_directory(exrPath, ec)) {
-        throw IoError(msg("preview image '", exrPath, "' is a folder, expected an .exr or .png file"));
+        throw IoError(
+            msg("preview image '", exrPath, "' is a folder, expected an .exr or .png file"));
     }
 }
 
@@ -269,8 +271,8 @@ PreviewSummary render(const openvdb::GridBase& grid, const PreviewOptions& optio
     const openvdb::GridClass gridClass = grid.getGridClass();
     const bool isLevelSet = gridClass == openvdb::GRID_LEVEL_SET;
     // A float grid of unknown class with a zero background reads as a density.
-    const bool isFog = gridClass == openvdb::GRID_FOG_VOLUME ||
-        (gridClass == openvdb::GRID_UNKNOWN && floatGrid->background() == 0.0f);
+    const bool isFog = gridClass == openvdb::GRID_FOG_VOLUME
+                       || (gridClass == openvdb::GRID_UNKNOWN && floatGrid->background() == 0.0f);
     if (!isLevelSet && !isFog) {
         throw GridError(msg(where, " is of class '",
                             openvdb::GridBase::gridClassToString(gridClass), "' with background ",
@@ -301,8 +303,7 @@ PreviewSummary render(const openvdb::GridBase& grid, const PreviewOptions& optio
     } catch (const openvdb::Exception& e) {
         throw GridError(msg(where, ": cannot be rendered (", e.what(), ")"));
     }
-    summary.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     writeExr(film, exrPath);
     return summary;
@@ -320,12 +321,12 @@ std::string listNames(const openvdb::GridPtrVec& grids)
 void PreviewOptions::validate() const
 {
     if (width < 1 || width > MAX_IMAGE_SIDE) {
-        throw ValueError(msg("preview width = ", width, ": expected 1 to ", MAX_IMAGE_SIDE,
-                             " pixels"));
+        throw ValueError(
+            msg("preview width = ", width, ": expected 1 to ", MAX_IMAGE_SIDE, " pixels"));
     }
     if (height < 1 || height > MAX_IMAGE_SIDE) {
-        throw ValueError(msg("preview height = ", height, ": expected 1 to ", MAX_IMAGE_SIDE,
-                             " pixels"));
+        throw ValueError(
+            msg("preview height = ", height, ": expected 1 to ", MAX_IMAGE_SIDE, " pixels"));
     }
     if (!std::isfinite(azimuth)) {
         throw ValueError(msg("preview azimuth = ", azimuth, ": expected a finite angle (degrees)"));
@@ -378,8 +379,8 @@ PreviewSummary renderPreviewFromFile(const std::string& vdbPath, const PreviewOp
         const bool found = std::any_of(headers->begin(), headers->end(),
                                        [&](const auto& g) { return g->getName() == name; });
         if (!found) {
-            throw GridError(msg("grid '", name, "' not found in '", vdbPath, "' (grids: ",
-                                listNames(*headers), ")"));
+            throw GridError(msg("grid '", name, "' not found in '", vdbPath,
+                                "' (grids: ", listNames(*headers), ")"));
         }
     }
 
@@ -410,8 +411,8 @@ RgbaImage readExrImage(const std::string& exrPath)
         image.height = window.max.y - window.min.y + 1;
         std::vector<Imf::Rgba> pixels(std::size_t(image.width) * std::size_t(image.height));
         // The frame buffer is addressed by data-window coordinates: shift its origin.
-        file.setFrameBuffer(pixels.data() - window.min.x -
-                                std::ptrdiff_t(window.min.y) * image.width,
+        file.setFrameBuffer(pixels.data() - window.min.x
+                                - std::ptrdiff_t(window.min.y) * image.width,
                             1, std::size_t(image.width));
         file.readPixels(window.min.y, window.max.y);
         image.rgba.reserve(4 * pixels.size());

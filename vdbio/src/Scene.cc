@@ -109,7 +109,8 @@ openvdb::math::Mat3d KeyedMotion::rotation(const Vec3d& degrees)
 namespace {
 
 /// Read one float grid from a .vdb file, with errors naming the file, the grid and `context`.
-openvdb::FloatGrid::Ptr loadFloatGrid(const std::string& file, const std::string& grid, const std::string& context)
+openvdb::FloatGrid::Ptr loadFloatGrid(const std::string& file, const std::string& grid,
+                                      const std::string& context)
 {
     std::error_code ec;
     if (!fs::exists(file, ec)) {
@@ -119,34 +120,38 @@ openvdb::FloatGrid::Ptr loadFloatGrid(const std::string& file, const std::string
     try {
         vdb.open(/*delayLoad=*/false);
     } catch (const openvdb::Exception& e) {
-        throw IoError(msg(context, ": file '", file, "' is not a readable .vdb file (", e.what(), ")"));
+        throw IoError(
+            msg(context, ": file '", file, "' is not a readable .vdb file (", e.what(), ")"));
     }
     if (!vdb.hasGrid(grid)) {
         std::string names;
-        for (auto it = vdb.beginName(); it != vdb.endName(); ++it) names += (names.empty() ? "'" : ", '") + *it + "'";
+        for (auto it = vdb.beginName(); it != vdb.endName(); ++it)
+            names += (names.empty() ? "'" : ", '") + *it + "'";
         vdb.close();
-        throw GridError(msg(context, ": file '", file, "' has no grid '", grid, "' (grids: ",
-                            names.empty() ? "none" : names, ")"));
+        throw GridError(msg(context, ": file '", file, "' has no grid '", grid,
+                            "' (grids: ", names.empty() ? "none" : names, ")"));
     }
     openvdb::GridBase::Ptr base;
     try {
         base = vdb.readGrid(grid);
     } catch (const openvdb::Exception& e) {
         vdb.close();
-        throw IoError(msg(context, ": grid '", grid, "' in '", file, "' cannot be read (", e.what(), ")"));
+        throw IoError(
+            msg(context, ": grid '", grid, "' in '", file, "' cannot be read (", e.what(), ")"));
     }
     vdb.close();
     auto floatGrid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
     if (!floatGrid) {
-        throw GridError(msg(context, ": grid '", grid, "' in '", file, "' holds ", base->valueType(),
-                            " values, expected a float level set"));
+        throw GridError(msg(context, ": grid '", grid, "' in '", file, "' holds ",
+                            base->valueType(), " values, expected a float level set"));
     }
     return floatGrid;
 }
 
 } // namespace
 
-sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid, const std::string& context)
+sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid,
+                           const std::string& context)
 {
     openvdb::FloatGrid::Ptr floatGrid = loadFloatGrid(file, grid, context);
     try {
@@ -193,13 +198,16 @@ void checkParticleBudget(const JsonObject& g, double spacing, Sampled sampled, c
     } else {
         const auto lo = shape.get<std::array<double, 3>>("min", {0, 0, 0});
         const auto hi = shape.get<std::array<double, 3>>("max", {0, 0, 0});
-        const double a = std::abs(hi[0] - lo[0]), b = std::abs(hi[1] - lo[1]), c = std::abs(hi[2] - lo[2]);
+        const double a = std::abs(hi[0] - lo[0]), b = std::abs(hi[1] - lo[1]),
+                     c = std::abs(hi[2] - lo[2]);
         volume = a * b * c;
         area = 2 * (a * b + b * c + c * a);
         if (std::string(kind) == "container") {
             const double w = shape.get<double>("wall", 3 * spacing);
             volume = (a + 2 * w) * (b + 2 * w) * (c + 2 * w) - volume;
-            area += 2 * ((a + 2 * w) * (b + 2 * w) + (b + 2 * w) * (c + 2 * w) + (c + 2 * w) * (a + 2 * w));
+            area += 2
+                    * ((a + 2 * w) * (b + 2 * w) + (b + 2 * w) * (c + 2 * w)
+                       + (c + 2 * w) * (a + 2 * w));
         }
     }
     if (sampled == Sampled::Band) volume = std::min(volume, area * 2 * spacing);
@@ -207,9 +215,12 @@ void checkParticleBudget(const JsonObject& g, double spacing, Sampled sampled, c
     const double bytes = particles * BYTES_PER_PARTICLE, memory = physicalMemory();
     if (memory > 0 && bytes > memory) {
         const double fits = spacing * std::cbrt(bytes / memory);
-        g.fail(kind, msg("at spacing ", spacing, " m this shape needs about ", particles, " particles (",
-                         bytes / double(1ULL << 30), " GiB at ", BYTES_PER_PARTICLE, " bytes each), more than this "
-                         "machine's ", memory / double(1ULL << 30), " GiB: expected a spacing of at least ", fits, " m"));
+        g.fail(kind, msg("at spacing ", spacing, " m this shape needs about ", particles,
+                         " particles (", bytes / double(1ULL << 30), " GiB at ", BYTES_PER_PARTICLE,
+                         " bytes each), more than this "
+                         "machine's ",
+                         memory / double(1ULL << 30), " GiB: expected a spacing of at least ", fits,
+                         " m"));
     }
 }
 
@@ -248,7 +259,8 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
     }
     const double voxel = g.positive("voxel_size", defaultVoxel);
     if (voxel < MIN_SPACING / 2) {
-        g.failValue("voxel_size", msg("expected at least ", MIN_SPACING / 2, " m (OpenVDB's smallest usable voxel)"));
+        g.failValue("voxel_size", msg("expected at least ", MIN_SPACING / 2,
+                                      " m (OpenVDB's smallest usable voxel)"));
     }
     checkParticleBudget(g, scene.spacing, sampled, sphere ? "sphere" : box ? "box" : "container");
     openvdb::FloatGrid::Ptr grid;
@@ -257,7 +269,8 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
         const Vec3d c = vec(s.require<std::array<double, 3>>("center"));
         const double r = s.positive("radius", 0);
         s.finish();
-        if (r < 2 * voxel) s.failValue("radius", msg("expected at least 2 voxels (", 2 * voxel, " m)"));
+        if (r < 2 * voxel)
+            s.failValue("radius", msg("expected at least 2 voxels (", 2 * voxel, " m)"));
         grid = sph::makeSphereLevelSet(sph::Vec3(c), sph::Real(r), sph::Real(voxel));
         description = msg("sphere r = ", r, " m");
     } else {
@@ -266,7 +279,8 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
         const Vec3d hi = vec(b.require<std::array<double, 3>>("max"));
         for (int a = 0; a < 3; ++a) {
             if (!(hi[a] - lo[a] >= 2 * voxel)) {
-                b.failValue("max", msg("expected max > min + 2 voxels on every axis (axis ", a, ")"));
+                b.failValue("max",
+                            msg("expected max > min + 2 voxels on every axis (axis ", a, ")"));
             }
         }
         if (box) {
@@ -327,56 +341,80 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         read(s);
         s.finish();
     };
-    section("points", [&](const JsonObject& s) {
-        out.pointsFile = s.get<std::string>("file", out.pointsFile);
-        out.pointChannels = s.get<std::vector<std::string>>("channels", out.pointChannels);
-        out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
-    }, [&] { out.pointsFile.clear(); });
-    section("volume", [&](const JsonObject& s) {
-        out.volumeFile = s.get<std::string>("file", out.volumeFile);
-        out.volumeGrids = s.get<std::vector<std::string>>("grids", out.volumeGrids);
-        for (const std::string& g : out.volumeGrids) {
-            if (g != "surface" && g != "density" && g != "vel" && g != "temperature") {
-                const std::string near = closestKey(g, {"surface", "density", "vel", "temperature"});
-                s.failValue("grids", msg("grid '", g, "' is not one of surface, density, vel, temperature",
-                                         near.empty() ? "" : " (did you mean '" + near + "'?)"));
+    section(
+        "points",
+        [&](const JsonObject& s) {
+            out.pointsFile = s.get<std::string>("file", out.pointsFile);
+            out.pointChannels = s.get<std::vector<std::string>>("channels", out.pointChannels);
+            out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
+        },
+        [&] { out.pointsFile.clear(); });
+    section(
+        "volume",
+        [&](const JsonObject& s) {
+            out.volumeFile = s.get<std::string>("file", out.volumeFile);
+            out.volumeGrids = s.get<std::vector<std::string>>("grids", out.volumeGrids);
+            for (const std::string& g : out.volumeGrids) {
+                if (g != "surface" && g != "density" && g != "vel" && g != "temperature") {
+                    const std::string near =
+                        closestKey(g, {"surface", "density", "vel", "temperature"});
+                    s.failValue("grids",
+                                msg("grid '", g,
+                                    "' is not one of surface, density, vel, temperature",
+                                    near.empty() ? "" : " (did you mean '" + near + "'?)"));
+                }
             }
-        }
-        out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
-    }, [&] { out.volumeFile.clear(); });
-    section("gas_points", [&](const JsonObject& s) {
-        out.gasPointsFile = s.get<std::string>("file", out.gasPointsFile);
-        out.gasPointChannels = s.get<std::vector<std::string>>("channels", out.gasPointChannels);
-    }, [&] { out.gasPointsFile.clear(); });
-    section("gas_volume", [&](const JsonObject& s) {
-        out.gasVolumeFile = s.get<std::string>("file", out.gasVolumeFile);
-        out.gasVolumeGrids = s.get<std::vector<std::string>>("grids", out.gasVolumeGrids);
-        for (const std::string& g : out.gasVolumeGrids) {
-            if (g != "density" && g != "vel" && g != "temperature") {
-                const std::string near = closestKey(g, {"density", "vel", "temperature"});
-                s.failValue("grids", msg("grid '", g, "' is not one of density, vel, temperature",
-                                         near.empty() ? "" : " (did you mean '" + near + "'?)"));
+            out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
+        },
+        [&] { out.volumeFile.clear(); });
+    section(
+        "gas_points",
+        [&](const JsonObject& s) {
+            out.gasPointsFile = s.get<std::string>("file", out.gasPointsFile);
+            out.gasPointChannels =
+                s.get<std::vector<std::string>>("channels", out.gasPointChannels);
+        },
+        [&] { out.gasPointsFile.clear(); });
+    section(
+        "gas_volume",
+        [&](const JsonObject& s) {
+            out.gasVolumeFile = s.get<std::string>("file", out.gasVolumeFile);
+            out.gasVolumeGrids = s.get<std::vector<std::string>>("grids", out.gasVolumeGrids);
+            for (const std::string& g : out.gasVolumeGrids) {
+                if (g != "density" && g != "vel" && g != "temperature") {
+                    const std::string near = closestKey(g, {"density", "vel", "temperature"});
+                    s.failValue("grids",
+                                msg("grid '", g, "' is not one of density, vel, temperature",
+                                    near.empty() ? "" : " (did you mean '" + near + "'?)"));
+                }
             }
-        }
-        out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
-    }, [&] { out.gasVolumeFile.clear(); });
+            out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
+        },
+        [&] { out.gasVolumeFile.clear(); });
     out.previewFile.clear();
-    section("preview", [&](const JsonObject& s) {
-        out.previewFile = s.get<std::string>("file", "preview.$F4.exr");
-        out.previewGrid = s.get<std::string>("grid", out.previewGrid);
-        out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
-        out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
-    }, [&] { out.previewFile.clear(); });
+    section(
+        "preview",
+        [&](const JsonObject& s) {
+            out.previewFile = s.get<std::string>("file", "preview.$F4.exr");
+            out.previewGrid = s.get<std::string>("grid", out.previewGrid);
+            out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
+            out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
+        },
+        [&] { out.previewFile.clear(); });
     if (!out.previewFile.empty() && out.volumeFile.empty() && out.gasVolumeFile.empty()) {
         o.fail("preview", "a preview renders a grid of the volume output, which is off");
     }
-    section("checkpoint", [&](const JsonObject& s) {
-        out.checkpointFile = s.get<std::string>("file", out.checkpointFile);
-        out.checkpointEvery = int(s.inRange("every", out.checkpointEvery, 0, 1e6));
-    }, [&] { out.checkpointFile.clear(); });
-    section("stats", [&](const JsonObject& s) {
-        out.statsFile = s.get<std::string>("file", out.statsFile);
-    }, [&] { out.statsFile.clear(); });
+    section(
+        "checkpoint",
+        [&](const JsonObject& s) {
+            out.checkpointFile = s.get<std::string>("file", out.checkpointFile);
+            out.checkpointEvery = int(s.inRange("every", out.checkpointEvery, 0, 1e6));
+        },
+        [&] { out.checkpointFile.clear(); });
+    section(
+        "stats",
+        [&](const JsonObject& s) { out.statsFile = s.get<std::string>("file", out.statsFile); },
+        [&] { out.statsFile.clear(); });
     o.finish();
 }
 
@@ -409,16 +447,18 @@ Json documentFromRoles(const std::string& path)
         else if (r == "emitter") doc["emitters"].push_back(entry);
         else if (r == "source") doc["gas_sources"].push_back(entry);
         else {
-            throw SceneError(msg("scene '", path, "': grid '", grid->getName(), "' has ", ROLE_METADATA,
-                                 " '", r, "': expected solid, liquid, emitter or source"));
+            throw SceneError(msg("scene '", path, "': grid '", grid->getName(), "' has ",
+                                 ROLE_METADATA, " '", r,
+                                 "': expected solid, liquid, emitter or source"));
         }
         const double dx = grid->voxelSize()[0];
         if (dx > 0 && (finest == 0 || dx < finest)) finest = dx;
     }
     if (!doc.contains("liquids") && !doc.contains("emitters") && !doc.contains("gas_sources")) {
-        throw SceneError(msg("scene '", path, "': no grid has ", ROLE_METADATA,
-                             " 'liquid', 'emitter' or 'source' (a .vdb scene needs grids tagged with roles;"
-                             " 'ghostfx mesh2sdf --role' writes them)"));
+        throw SceneError(
+            msg("scene '", path, "': no grid has ", ROLE_METADATA,
+                " 'liquid', 'emitter' or 'source' (a .vdb scene needs grids tagged with roles;"
+                " 'ghostfx mesh2sdf --role' writes them)"));
     }
     doc["settings"]["spacing"] = 2 * finest;
     // Sources without liquid: a gas scene.
@@ -434,7 +474,8 @@ std::string Scene::simulationFingerprint() const
 {
     Json copy = *document;
     copy.erase("outputs");
-    if (copy.contains("settings") && copy["settings"].is_object()) copy["settings"].erase("frame_range");
+    if (copy.contains("settings") && copy["settings"].is_object())
+        copy["settings"].erase("frame_range");
     return copy.dump();
 }
 
@@ -474,7 +515,8 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
 
     scene.version = root.require<int>("ghostfx_scene");
     if (scene.version != SCENE_FORMAT_VERSION) {
-        root.failValue("ghostfx_scene", msg("this ghostfx reads scene format ", SCENE_FORMAT_VERSION));
+        root.failValue("ghostfx_scene",
+                       msg("this ghostfx reads scene format ", SCENE_FORMAT_VERSION));
     }
 
     // Shared settings; the solver-specific rest is read by the caller.
@@ -483,15 +525,17 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     scene.method = s.choice("method", "ghost", {"ghost", "basic", "gas"});
     scene.spacing = s.positive("spacing", 0.02);
     if (scene.spacing < MIN_SPACING) {
-        s.failValue("spacing", msg("expected at least ", MIN_SPACING, " m (OpenVDB refuses transforms with voxels "
-                                   "below about 1.5e-5 m, and grids use voxels of half the spacing)"));
+        s.failValue("spacing",
+                    msg("expected at least ", MIN_SPACING,
+                        " m (OpenVDB refuses transforms with voxels "
+                        "below about 1.5e-5 m, and grids use voxels of half the spacing)"));
     }
     scene.frameRate = s.positive("frame_rate", 30);
     const std::vector<double> range = s.get<std::vector<double>>("frame_range", {1, 24});
-    if (range.size() != 2 || !(range[0] >= 1) || !(range[1] >= range[0]) || !(range[1] <= MAX_FRAME) ||
-        range[0] != std::floor(range[0]) || range[1] != std::floor(range[1])) {
-        s.failValue("frame_range", msg("expected [first, last] with 1 <= first <= last <= ", MAX_FRAME,
-                                       ", whole numbers"));
+    if (range.size() != 2 || !(range[0] >= 1) || !(range[1] >= range[0]) || !(range[1] <= MAX_FRAME)
+        || range[0] != std::floor(range[0]) || range[1] != std::floor(range[1])) {
+        s.failValue("frame_range", msg("expected [first, last] with 1 <= first <= last <= ",
+                                       MAX_FRAME, ", whole numbers"));
     }
     scene.firstFrame = int(range[0]);
     scene.lastFrame = int(range[1]);
@@ -517,7 +561,8 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         if (auto motion = o.optionalObject("motion")) {
             solid.motion = readMotion(*motion);
-            if (solid.velocity != Vec3d(0)) o.fail("velocity", "give either 'velocity' or 'motion', not both");
+            if (solid.velocity != Vec3d(0))
+                o.fail("velocity", "give either 'velocity' or 'motion', not both");
         }
         if (auto seq = o.optionalObject("sequence")) {
             solid.sequenceFile = resolve(scene.folder, seq->require<std::string>("file"));
@@ -547,21 +592,24 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         emitter.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         emitter.start = o.nonNegative("start", 0);
         emitter.end = o.get<double>("end", std::numeric_limits<double>::infinity());
-        if (!(emitter.end > emitter.start)) o.failValue("end", msg("expected end > start (", emitter.start, " s)"));
+        if (!(emitter.end > emitter.start))
+            o.failValue("end", msg("expected end > start (", emitter.start, " s)"));
         o.finish();
         scene.emitters.push_back(std::move(emitter));
     }
     for (const JsonObject& o : root.objects("gas_sources")) {
         const std::string name = o.get<std::string>("name", o.path());
         std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume, /*allowFog=*/true);
+        sph::LevelSet shape =
+            readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume, /*allowFog=*/true);
         SceneGasSource source{name, geometry, shape};
         source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         source.temperature = o.positive("temperature", source.temperature);
         source.rate = o.nonNegative("rate", 0);
         source.start = o.nonNegative("start", 0);
         source.end = o.get<double>("end", std::numeric_limits<double>::infinity());
-        if (!(source.end > source.start)) o.failValue("end", msg("expected end > start (", source.start, " s)"));
+        if (!(source.end > source.start))
+            o.failValue("end", msg("expected end > start (", source.start, " s)"));
         if (auto motion = o.optionalObject("motion")) source.motion = readMotion(*motion);
         o.finish();
         scene.gasSources.push_back(std::move(source));
@@ -580,14 +628,16 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         field.name = o.get<std::string>("name", o.path());
         if (!o.has("attractor")) {
             o.finish(); // a misspelt kind is reported as an unknown key with the closest one
-            o.fail("attractor", "missing; expected a field kind: 'attractor' { \"position\": [x, y, z], "
-                                "\"strength\": S, \"radius\": R }");
+            o.fail("attractor",
+                   "missing; expected a field kind: 'attractor' { \"position\": [x, y, z], "
+                   "\"strength\": S, \"radius\": R }");
         }
         const JsonObject a = o.object("attractor");
         SceneAttractor& at = field.attractor;
         at.position = vec(a.require<std::array<double, 3>>("position"));
         const double strength = a.require<double>("strength");
-        if (!std::isfinite(strength)) a.failValue("strength", "expected a finite number (m/s^2; < 0 repels)");
+        if (!std::isfinite(strength))
+            a.failValue("strength", "expected a finite number (m/s^2; < 0 repels)");
         at.strength = strength;
         at.radius = a.positive("radius", at.radius);
         at.falloff = a.choice("falloff", at.falloff, {"inverse_square", "constant"});
@@ -596,7 +646,9 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         scene.forceFields.push_back(std::move(field));
     }
     if (auto phase = root.optionalObject("phase_transition")) {
-        if (scene.heaters.empty()) root.fail("phase_transition", "expected heaters: a phase transition needs at least one");
+        if (scene.heaters.empty())
+            root.fail("phase_transition",
+                      "expected heaters: a phase transition needs at least one");
         scene.phaseTransition = *phase;
     }
     if (auto outputs = root.optionalObject("outputs")) readOutputs(*outputs, scene.outputs);
@@ -608,15 +660,20 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         for (std::size_t i = 0; i < scene.solids.size(); ++i) {
             if (scene.solids[i].sequenceFile.empty()) continue;
             root.fail(msg("solids[", i, "].sequence"),
-                      msg("solid '", scene.solids[i].name, "' deforms per frame, which only a liquid scene "
-                          "supports; ", scene.method == "gas" ? "a gas" : "a boiling", " scene takes static or "
+                      msg("solid '", scene.solids[i].name,
+                          "' deforms per frame, which only a liquid scene "
+                          "supports; ",
+                          scene.method == "gas" ? "a gas" : "a boiling",
+                          " scene takes static or "
                           "rigidly moving solids ('velocity' or 'motion')"));
         }
     }
     if (scene.method == "gas") {
         if (!scene.liquids.empty() || !scene.emitters.empty() || !scene.heaters.empty()) {
-            root.fail(scene.liquids.empty() ? (scene.emitters.empty() ? "heaters" : "emitters") : "liquids",
-                      "a 'gas' scene simulates gas only: liquids, emitters and heaters need method 'ghost' or "
+            root.fail(scene.liquids.empty() ? (scene.emitters.empty() ? "heaters" : "emitters")
+                                            : "liquids",
+                      "a 'gas' scene simulates gas only: liquids, emitters and heaters need method "
+                      "'ghost' or "
                       "'basic' (with heaters, the liquid boils into gas)");
         }
         if (scene.gasSources.empty()) {
@@ -624,14 +681,17 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         }
     } else {
         if (scene.liquids.empty() && scene.emitters.empty()) {
-            root.fail("liquids", "the scene has no liquid: expected at least one liquid body or emitter");
+            root.fail("liquids",
+                      "the scene has no liquid: expected at least one liquid body or emitter");
         }
         if (!scene.gasSources.empty() && scene.heaters.empty()) {
-            root.fail("gas_sources", "gas sources need settings.method 'gas' (or heaters, for boiling)");
+            root.fail("gas_sources",
+                      "gas sources need settings.method 'gas' (or heaters, for boiling)");
         }
         if (!scene.forceFields.empty() && scene.heaters.empty()) {
-            root.fail("force_fields", "attractors act on gas; this scene has no gas (expected settings.method "
-                                      "'gas', or heaters that boil the liquid into vapour)");
+            root.fail("force_fields",
+                      "attractors act on gas; this scene has no gas (expected settings.method "
+                      "'gas', or heaters that boil the liquid into vapour)");
         }
     }
     return scene;

@@ -63,8 +63,8 @@ void writeH5(const std::string& file, const StatsTable& table)
     const hsize_t columnCount = table.columns.size();
     std::vector<const char*> names;
     for (const std::string& c : table.columns) names.push_back(c.c_str());
-    H5::Attribute columns = steps.createAttribute("columns", stringType,
-                                                  H5::DataSpace(1, &columnCount));
+    H5::Attribute columns =
+        steps.createAttribute("columns", stringType, H5::DataSpace(1, &columnCount));
     if (columnCount > 0) columns.write(stringType, names.data());
 
     const hsize_t rows = table.rows.size();
@@ -97,9 +97,9 @@ void writeCsv(const std::string& file, const StatsTable& table)
 /// Column names must be usable as HDF5 dataset names and as CSV header fields as they are.
 void checkColumnName(const std::string& name)
 {
-    if (name.empty() || name == "." ||
-        name.find_first_of("/,\"\n\r") != std::string::npos) {
-        throw ValueError(msg("statistics column '", name, "': expected a non-empty name without "
+    if (name.empty() || name == "." || name.find_first_of("/,\"\n\r") != std::string::npos) {
+        throw ValueError(msg("statistics column '", name,
+                             "': expected a non-empty name without "
                              "'/', ',', quotes or line breaks"));
     }
 }
@@ -179,9 +179,9 @@ StatsTable readStats(const std::string& h5Path)
 }
 
 StatsWriter::StatsWriter(std::string h5Path, std::string csvPath)
-    : mH5Path(std::move(h5Path)), mCsvPath(std::move(csvPath))
-{
-}
+    : mH5Path(std::move(h5Path))
+    , mCsvPath(std::move(csvPath))
+{}
 
 void StatsWriter::append(const StatsRow& row)
 {
@@ -201,10 +201,12 @@ void StatsWriter::append(const StatsRow& row)
             const std::string expected = c < columns.size() ? columns[c] : "(none)";
             const std::string got = c < row.values.size() ? row.values[c].first : "(none)";
             if (expected != got) {
-                throw ValueError(msg("statistics row ", mTable.rows.size(), ": column ", c,
-                                     " is '", got, "', expected '", expected, "' (the columns "
-                                     "are fixed by the first row: ", columns.size(),
-                                     " columns, this row has ", row.values.size(), ")"));
+                throw ValueError(msg("statistics row ", mTable.rows.size(), ": column ", c, " is '",
+                                     got, "', expected '", expected,
+                                     "' (the columns "
+                                     "are fixed by the first row: ",
+                                     columns.size(), " columns, this row has ", row.values.size(),
+                                     ")"));
             }
         }
     }

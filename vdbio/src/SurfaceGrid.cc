@@ -47,7 +47,9 @@ public:
 
     SelectedParticles(const std::vector<sph::Vec3>& x, const std::vector<sph::Index>& selection,
                       double radius)
-        : mX(x), mSelection(selection), mRadius(radius)
+        : mX(x)
+        , mSelection(selection)
+        , mRadius(radius)
     {}
 
     std::size_t size() const { return mSelection.size(); }
@@ -80,7 +82,7 @@ void trimInterior(openvdb::FloatGrid& grid, int halfWidthVoxels)
     const FloatTree& phi = grid.tree();
     MaskTree exterior(phi, false, openvdb::TopologyCopy());
     openvdb::tree::LeafManager<MaskTree> exteriorLeaves(exterior);
-    exteriorLeaves.foreach([&phi](MaskTree::LeafNodeType& leaf, std::size_t) {
+    exteriorLeaves.foreach ([&phi](MaskTree::LeafNodeType& leaf, std::size_t) {
         const FloatTree::LeafNodeType* values = phi.probeConstLeaf(leaf.origin());
         for (auto it = leaf.beginValueOn(); it; ++it) {
             if (values->getValue(it.pos()) < 0.0f) leaf.setValueOff(it.pos());
@@ -91,7 +93,7 @@ void trimInterior(openvdb::FloatGrid& grid, int halfWidthVoxels)
                                        openvdb::tools::IGNORE_TILES);
     const float inside = -grid.background();
     openvdb::tree::LeafManager<FloatTree> leaves(grid.tree());
-    leaves.foreach([&exterior, inside](FloatTree::LeafNodeType& leaf, std::size_t) {
+    leaves.foreach ([&exterior, inside](FloatTree::LeafNodeType& leaf, std::size_t) {
         const MaskTree::LeafNodeType* near = exterior.probeConstLeaf(leaf.origin());
         for (auto it = leaf.beginValueOn(); it; ++it) {
             if (*it < 0.0f && !(near && near->isValueOn(it.pos()))) {

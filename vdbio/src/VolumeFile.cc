@@ -99,12 +99,12 @@ void VolumeOptions::validate() const
     }
     if (surface) {
         if (!isPositiveFinite(particleSpacing)) {
-            throw ValueError(msg(where, "particle spacing = ", particleSpacing,
-                                 " m: expected > 0"));
+            throw ValueError(
+                msg(where, "particle spacing = ", particleSpacing, " m: expected > 0"));
         }
         if (!isPositiveFinite(surfaceRadiusSpacings)) {
-            throw ValueError(msg(where, "surface radius = ", surfaceRadiusSpacings,
-                                 " spacings: expected > 0"));
+            throw ValueError(
+                msg(where, "surface radius = ", surfaceRadiusSpacings, " spacings: expected > 0"));
         }
         const double radius = surfaceRadiusSpacings * particleSpacing;
         if (radius < voxelSize) {
@@ -120,8 +120,8 @@ void VolumeOptions::validate() const
             throw ValueError(msg(where, "surface smoothing iterations = ",
                                  surfaceSmoothingIterations, ": expected >= 0"));
         }
-        if (!std::isfinite(surfaceOffsetSpacings) ||
-            surfaceOffsetSpacings > surfaceRadiusSpacings + surfaceClosingSpacings) {
+        if (!std::isfinite(surfaceOffsetSpacings)
+            || surfaceOffsetSpacings > surfaceRadiusSpacings + surfaceClosingSpacings) {
             throw ValueError(msg(where, "surface offset = ", surfaceOffsetSpacings,
                                  " spacings: expected finite and <= radius + closing = ",
                                  surfaceRadiusSpacings + surfaceClosingSpacings));
@@ -151,8 +151,7 @@ void VolumeOptions::validate() const
 // makeVolumeGrids
 // ---------------------------------------------------------------------------------------------
 
-openvdb::GridPtrVec makeVolumeGrids(const sph::ParticleSet& particles,
-                                    const VolumeOptions& options)
+openvdb::GridPtrVec makeVolumeGrids(const sph::ParticleSet& particles, const VolumeOptions& options)
 {
     options.validate();
     for (const std::string& name : options.scalarChannels) {
@@ -187,12 +186,12 @@ void writeVolumeFile(const std::string& path, const openvdb::GridPtrVec& grids,
         if (!grid) throw ValueError(msg("volume output '", path, "': grid ", i, " is null"));
         const std::string name = grid->getName();
         if (name.empty()) {
-            throw ValueError(msg("volume output '", path, "': grid ", i, " (",
-                                 grid->type(), ") has no name"));
+            throw ValueError(
+                msg("volume output '", path, "': grid ", i, " (", grid->type(), ") has no name"));
         }
         const std::string valueType = grid->valueType();
-        if (valueType == openvdb::typeNameAsString<openvdb::PointDataIndex32>() ||
-            valueType == openvdb::typeNameAsString<openvdb::PointIndex32>()) {
+        if (valueType == openvdb::typeNameAsString<openvdb::PointDataIndex32>()
+            || valueType == openvdb::typeNameAsString<openvdb::PointIndex32>()) {
             throw ValueError(msg("volume output '", path, "': grid '", name,
                                  "' is a point grid: write it with writePointsFile (Blender "
                                  "refuses volume files that hold point grids)"));

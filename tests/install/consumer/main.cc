@@ -15,7 +15,8 @@ int main(int argc, char** argv)
     settings.spacing = 0.02f;
     settings.substeps = 5;
     ghost::GhostSolver solver(settings);
-    solver.addLiquid(sph::makeLevelSet(sph::makeSphereLevelSet(sph::Vec3(0), 0.08f, 0.01f), "ball"));
+    solver.addLiquid(
+        sph::makeLevelSet(sph::makeSphereLevelSet(sph::Vec3(0), 0.08f, 0.01f), "ball"));
     solver.advanceFrame();
     vdbio::writePointsFile(argv[1], solver.particles(), vdbio::PointsOptions());
     std::printf("consumer: %zu liquid particles after one frame, written to %s\n",

@@ -70,9 +70,9 @@ Falloff falloffFromName(const std::string& name);
 /// fluid only builds up a pressure gradient, which would leave the air still and hide it).
 struct Attractor
 {
-    Vec3 position{0};              ///< c (m)
-    Real strength = Real(1);       ///< S (m/s^2): the pull at r = R; < 0 repels
-    Real radius = Real(0.1);       ///< R (m): core radius, > 0
+    Vec3 position{0};        ///< c (m)
+    Real strength = Real(1); ///< S (m/s^2): the pull at r = R; < 0 repels
+    Real radius = Real(0.1); ///< R (m): core radius, > 0
     Falloff falloff = Falloff::InverseSquare;
 
     /// a(x) (m/s^2) at position x (m).
@@ -176,7 +176,7 @@ struct GasSettings
     /// a particle may move at most 10 spacings in one step, and not faster than 100 sound speeds.
     Real maxSpeed = Real(0);
 
-    std::uint64_t seed = 0;     ///< random seed of all sampling and of the life-strength epsilon
+    std::uint64_t seed = 0; ///< random seed of all sampling and of the life-strength epsilon
 
     /// Kernel support radius h (m): the paper's h, the default of the per-particle "h" channel.
     Real supportRadius() const { return supportFactor * spacing; }

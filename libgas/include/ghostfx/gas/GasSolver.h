@@ -62,14 +62,14 @@ using sph::ParticleSet;
 
 /// Names of the particle channels the gas solver keeps (exporters read them by name).
 namespace channel {
-constexpr const char* TEMPERATURE = "temperature";   ///< T (K), gas; boundaries: ambient
-constexpr const char* SUPPORT = "h";                 ///< kernel support radius h_i (m)
+constexpr const char* TEMPERATURE = "temperature"; ///< T (K), gas; boundaries: ambient
+constexpr const char* SUPPORT = "h";               ///< kernel support radius h_i (m)
 constexpr const char* DENSITY_UNCORRECTED = "density_uncorrected"; ///< rho_bar (kg/m^3)
-constexpr const char* NORMAL = "normal";             ///< n_i of Eq. 12 (1/m), points inwards
-constexpr const char* LIFE = "life";                 ///< life strength l_s left (s), Sec. 5
-constexpr const char* AMBIENT = "ambient";           ///< 1 for ambient air (Method::Ambient only)
-constexpr const char* VORTICITY = "vorticity";       ///< omega of Eq. 25 (1/s), if enabled
-constexpr const char* SOLID_LOCAL = "solid_x";       ///< boundary: position in its solid's frame
+constexpr const char* NORMAL = "normal";       ///< n_i of Eq. 12 (1/m), points inwards
+constexpr const char* LIFE = "life";           ///< life strength l_s left (s), Sec. 5
+constexpr const char* AMBIENT = "ambient";     ///< 1 for ambient air (Method::Ambient only)
+constexpr const char* VORTICITY = "vorticity"; ///< omega of Eq. 25 (1/s), if enabled
+constexpr const char* SOLID_LOCAL = "solid_x"; ///< boundary: position in its solid's frame
 /// Boundary: index of its solid (>= 0), EXTERNAL_BOUNDARY or DOMAIN_WALL.
 constexpr const char* SOLID_INDEX = "solid_index";
 } // namespace channel
@@ -91,8 +91,8 @@ struct GasSource
     Vec3 velocity{0};                ///< velocity of new particles (m/s)
     /// Most particles emitted (or air particles converted) per second; 0 = as many as fit.
     Real rate = Real(0);
-    double start = 0;                                         ///< active from (s)
-    double end = std::numeric_limits<double>::infinity();     ///< active until (s)
+    double start = 0;                                     ///< active from (s)
+    double end = std::numeric_limits<double>::infinity(); ///< active until (s)
     /// Placement of the source's level set at time t; empty = where the level set is.
     RigidMotion motion;
 };
@@ -160,8 +160,8 @@ public:
     /// Replace the external boundary (e.g. liquid particles of a phase-transition coupler): from
     /// the next step these particles take part in every sum like solid boundary particles,
     /// carrying `mass` (kg) in the gas sums, until the next call replaces them.
-    void setExternalBoundary(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
-                             Real mass);
+    void setExternalBoundary(const std::vector<Vec3>& positions,
+                             const std::vector<Vec3>& velocities, Real mass);
 
     /// Advance one frame: `substeps` fixed steps, or CFL-limited steps up to the frame end.
     void advanceFrame();
@@ -239,8 +239,8 @@ private:
     sph::NeighborGrid mGrid;
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Source>> mSources;
-    std::vector<Vec3> mNbar;               ///< n_bar_i with uncorrected densities (Eq. 5), per step
-    std::vector<std::uint8_t> mIsolated;   ///< no neighbour this step (Sec. 5)
+    std::vector<Vec3> mNbar;             ///< n_bar_i with uncorrected densities (Eq. 5), per step
+    std::vector<std::uint8_t> mIsolated; ///< no neighbour this step (Sec. 5)
     Real mMass = 0;
     Real mMaxAcceleration = 0;
     bool mInitialized = false;

@@ -163,11 +163,11 @@ struct PhaseSettings
 /// Wall-clock seconds per phase of PhaseTransition::step, accumulated since the last reset.
 struct PhaseTransitionTimings
 {
-    double liquid = 0;   ///< LiquidSide::step
-    double heat = 0;     ///< grid, heater, Eq. 15 diffusion, surface detection
+    double liquid = 0;     ///< LiquidSide::step
+    double heat = 0;       ///< grid, heater, Eq. 15 diffusion, surface detection
     double transition = 0; ///< boiling / evaporation splits, merges, hand-over to the gas
-    double boundary = 0; ///< coarse liquid boundary for the gas
-    double gas = 0;      ///< GasSolver::step
+    double boundary = 0;   ///< coarse liquid boundary for the gas
+    double gas = 0;        ///< GasSolver::step
     double total = 0;
     std::uint64_t steps = 0;
 };
@@ -175,9 +175,9 @@ struct PhaseTransitionTimings
 /// Mass budget (kg), summed in double in index order.
 struct MassBudget
 {
-    double liquid = 0;      ///< liquid particles of the liquid set
-    double gas = 0;         ///< gas particles of the gas solver (not ambient air)
-    double gasRemoved = 0;  ///< gas removed by the gas solver (kill box, life strength)
+    double liquid = 0;     ///< liquid particles of the liquid set
+    double gas = 0;        ///< gas particles of the gas solver (not ambient air)
+    double gasRemoved = 0; ///< gas removed by the gas solver (kill box, life strength)
     double total() const { return liquid + gas + gasRemoved; }
 };
 

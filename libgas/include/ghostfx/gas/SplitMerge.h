@@ -127,22 +127,23 @@ enum class MergeSizeRule {
 /// Settings of mergeParticles, with documented defaults ([RYY15] gives no numbers for these).
 struct MergeSettings
 {
-    int splitThreshold = 3;            ///< "splits" count that makes a particle a candidate (>= 1)
-    Real neighbourhoodFactor = Real(1);///< neighbourhood radius / h_M (Eq. 19: the smoothing radius)
-    Real maxSizeRatio = Real(2);       ///< "similar": h_j / h_M in [1 / ratio, ratio] (>= 1)
-    std::size_t maxMerged = 0;         ///< most particles in a group, M included; 0: daughters of
-                                       ///< the re-split pattern (count-neutral merge-resplit)
-    std::size_t minMerged = 0;         ///< fewest particles in a group, M included; 0: the
-                                       ///< group limit (only full groups: equal-size groups keep
-                                       ///< the raw eta of Eq. 20 comparable, and the count neutral)
+    int splitThreshold = 3; ///< "splits" count that makes a particle a candidate (>= 1)
+    Real neighbourhoodFactor =
+        Real(1);                 ///< neighbourhood radius / h_M (Eq. 19: the smoothing radius)
+    Real maxSizeRatio = Real(2); ///< "similar": h_j / h_M in [1 / ratio, ratio] (>= 1)
+    std::size_t maxMerged = 0;   ///< most particles in a group, M included; 0: daughters of
+                                 ///< the re-split pattern (count-neutral merge-resplit)
+    std::size_t minMerged = 0;   ///< fewest particles in a group, M included; 0: the
+                                 ///< group limit (only full groups: equal-size groups keep
+                                 ///< the raw eta of Eq. 20 comparable, and the count neutral)
     /// Only particles of this kind are candidates ([RYY15] merges liquid particles); empty: any.
     std::optional<ParticleKind> candidateKind = ParticleKind::Liquid;
-    std::size_t maxMergesPerCall = 0;  ///< 0: no limit
+    std::size_t maxMergesPerCall = 0; ///< 0: no limit
     MergePlacement placement = MergePlacement::CentreOfMass;
     MergeSizeRule sizeRule = MergeSizeRule::VolumeSum;
-    Real referenceMass = Real(0);      ///< mRef (kg), for ReferenceDensity (> 0 there)
-    Real referenceRadius = Real(0);    ///< hRef (m), for ReferenceDensity (> 0 there)
-    bool resplit = true;               ///< re-split M' at once (Fig. 3c)
+    Real referenceMass = Real(0);               ///< mRef (kg), for ReferenceDensity (> 0 there)
+    Real referenceRadius = Real(0);             ///< hRef (m), for ReferenceDensity (> 0 there)
+    bool resplit = true;                        ///< re-split M' at once (Fig. 3c)
     std::optional<SplitPattern> resplitPattern; ///< empty: defaultResplitPattern()
 
     /// Throws ValueError naming the field and the bad value.

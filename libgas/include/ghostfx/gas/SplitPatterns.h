@@ -56,7 +56,7 @@ using sph::Vec3d;
 /// for densities (its ref. 20, Mueller et al. 2003); the M4 cubic spline is offered for
 /// comparison with Feldman and Bonet 2007, who use a spline.
 enum class SplitKernel {
-    Poly6,      ///< w(q) = 315 / (64 pi) (1 - q^2)^3, q = r / h (support radius h)
+    Poly6, ///< w(q) = 315 / (64 pi) (1 - q^2)^3, q = r / h (support radius h)
     CubicSpline ///< Monaghan M4 with support radius h (smoothing length h / 2), as sph::CubicSplineKernel
 };
 
@@ -88,9 +88,9 @@ double overlapIntegral(SplitKernel kernel, double d, double r1, double r2,
 /// C - 2 lambda^T b + lambda^T A lambda.
 struct RefinementTerms
 {
-    double C = 0;              ///< int w^2 over the mother's kernel
-    std::vector<double> b;     ///< b_k = int w w_k, one per daughter
-    std::vector<double> A;     ///< A_kl = int w_k w_l, row-major M x M, symmetric positive definite
+    double C = 0;          ///< int w^2 over the mother's kernel
+    std::vector<double> b; ///< b_k = int w w_k, one per daughter
+    std::vector<double> A; ///< A_kl = int w_k w_l, row-major M x M, symmetric positive definite
 
     std::size_t size() const { return b.size(); }
     /// Normalised error C - 2 lambda^T b + lambda^T A lambda (dimensionless, >= 0 up to round-off).
@@ -126,15 +126,15 @@ std::vector<Vec3d> patternOffsets(PatternShape shape);
 /// A split pattern with its optimal mass ratios.
 struct SplitPattern
 {
-    std::string name;             ///< e.g. "cube+centre"
-    std::vector<Vec3d> offsets;   ///< daughter k at x_N + epsilon h_N offsets[k]; |o| = 1 or 0
-    bool hasCentre = false;       ///< whether one daughter sits at the mother's position
-    double epsilon = 0;           ///< daughter distance / mother's smoothing radius
-    double alpha = 0;             ///< daughter smoothing radius / mother's smoothing radius
+    std::string name;           ///< e.g. "cube+centre"
+    std::vector<Vec3d> offsets; ///< daughter k at x_N + epsilon h_N offsets[k]; |o| = 1 or 0
+    bool hasCentre = false;     ///< whether one daughter sits at the mother's position
+    double epsilon = 0;         ///< daughter distance / mother's smoothing radius
+    double alpha = 0;           ///< daughter smoothing radius / mother's smoothing radius
     SplitKernel kernel = SplitKernel::Poly6;
-    std::vector<double> lambda;   ///< mass ratio per daughter, sum = 1 ([RYY15] Sec. 4.1)
-    double error = 0;             ///< normalised Eq. 18 error at lambda (see RefinementTerms)
-    double relativeError = 0;     ///< error / C: squared L2 error relative to the mother's field
+    std::vector<double> lambda; ///< mass ratio per daughter, sum = 1 ([RYY15] Sec. 4.1)
+    double error = 0;           ///< normalised Eq. 18 error at lambda (see RefinementTerms)
+    double relativeError = 0;   ///< error / C: squared L2 error relative to the mother's field
 
     std::size_t childCount() const { return offsets.size(); }
     /// Index of the centre daughter, or childCount() if there is none.

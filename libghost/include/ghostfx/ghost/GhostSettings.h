@@ -37,35 +37,35 @@ struct GhostSettings
     Method method = Method::Ghost;
 
     // Discretisation ---------------------------------------------------------------------------
-    Real spacing = Real(0.01);         ///< particle spacing h (m)
-    Real supportFactor = Real(3);      ///< kernel support radius / h ([SB12] Sec. 3: 3)
+    Real spacing = Real(0.01);    ///< particle spacing h (m)
+    Real supportFactor = Real(3); ///< kernel support radius / h ([SB12] Sec. 3: 3)
 
     // Liquid -----------------------------------------------------------------------------------
-    Real restDensity = Real(1000);     ///< rho0 (kg/m^3)
-    Real stiffness = Real(2000);       ///< Tait k (Pa): p = k ((rho / rho0)^7 - 1) ([SB12]: 2000)
-    Vec3 gravity{0, Real(-9.81), 0};   ///< (m/s^2)
+    Real restDensity = Real(1000);   ///< rho0 (kg/m^3)
+    Real stiffness = Real(2000);     ///< Tait k (Pa): p = k ((rho / rho0)^7 - 1) ([SB12]: 2000)
+    Vec3 gravity{0, Real(-9.81), 0}; ///< (m/s^2)
 
     // Ghost SPH ([SB12] Sec. 4) ------------------------------------------------------------------
-    Real xsphEpsilon = Real(0.05);     ///< epsilon of Eq. 2 (XSPH on velocities)
-    Real solidEpsilon = Real(0.05);    ///< epsilon of Eq. 2 for ghost-solid neighbours
+    Real xsphEpsilon = Real(0.05);  ///< epsilon of Eq. 2 (XSPH on velocities)
+    Real solidEpsilon = Real(0.05); ///< epsilon of Eq. 2 for ghost-solid neighbours
     SolidSlip solidSlip = SolidSlip::Free;
-    int airResampleSteps = 10;         ///< resample the ghost air every N steps ([SB12]: about 10)
+    int airResampleSteps = 10; ///< resample the ghost air every N steps ([SB12]: about 10)
     /// At a resampling, air particles closer than this fraction of the Poisson radius r to the
     /// liquid are replaced; the others stay (temporal coherence). 0 keeps all in the layer;
     /// a value above the largest liquid-air distance replaces all, as in [SB12].
     Real airKeepFraction = Real(0.8);
 
     // Basic SPH ([SB12] Sec. 3) -------------------------------------------------------------------
-    Real basicXsphEpsilon = Real(0.5);         ///< XSPH on positions [Monaghan 1989]
-    Real basicViscosityAlpha = Real(0.0005);   ///< Becker and Teschner 2007 alpha
+    Real basicXsphEpsilon = Real(0.5);       ///< XSPH on positions [Monaghan 1989]
+    Real basicViscosityAlpha = Real(0.0005); ///< Becker and Teschner 2007 alpha
     /// Lennard-Jones strength D (m^2/s^2) of Monaghan 1994; 0 picks 5 |g| H at initialisation,
     /// H the height of the liquid (Monaghan's choice), or (0.1 c)^2 without gravity.
     Real lennardJonesStrength = Real(0);
 
     // Time stepping -------------------------------------------------------------------------------
-    Real frameRate = Real(30);         ///< frames per second
-    int substeps = 20;                 ///< fixed steps per frame ([SB12]: 20); 0 = CFL-adaptive
-    Real cflNumber = Real(0.4);        ///< dt <= cfl h / (c + |v|max) and forces limit, when adaptive
+    Real frameRate = Real(30);  ///< frames per second
+    int substeps = 20;          ///< fixed steps per frame ([SB12]: 20); 0 = CFL-adaptive
+    Real cflNumber = Real(0.4); ///< dt <= cfl h / (c + |v|max) and forces limit, when adaptive
     /// Blow-up bound: a particle faster than this (m/s) stops the run with a NumericalError.
     /// 0 picks 20 x the speed of sound.
     Real maxSpeed = Real(0);
@@ -73,7 +73,7 @@ struct GhostSettings
     /// Domain: liquid and air leaving this box are removed (a kill box). Empty: no limit.
     sph::Aabb killBox;
 
-    std::uint64_t seed = 0;            ///< random seed of all sampling
+    std::uint64_t seed = 0; ///< random seed of all sampling
     /// Sample the interior of liquid bodies and solids deeper than 2r from a relaxed periodic
     /// tile (PoissonSettings::tiledInterior): about twice as fast a set-up, with an interior
     /// packing up to about 1 % off the layer near the surface. Off: [SB12]'s pipeline throughout.

@@ -67,12 +67,13 @@ using sph::RigidTransform;
 /// Seconds spent in each phase of the step, accumulated since the last reset ([SB12] Sec. 5).
 struct PhaseTimings
 {
-    double neighborsAndDensity = 0; ///< sort + neighbour search + density (+ solid density extrapolation)
-    double sortAndSearch = 0;       ///< of which: the sort and the neighbour search
-    double pressureForce = 0;       ///< equation of state + pressure (and Basic viscosity/LJ) forces
-    double xsphAndBoundary = 0;     ///< ghost velocities, XSPH, positions, collisions
-    double airResampling = 0;       ///< ghost air sampling
-    double emission = 0;            ///< emitter sampling
+    double neighborsAndDensity =
+        0;                    ///< sort + neighbour search + density (+ solid density extrapolation)
+    double sortAndSearch = 0; ///< of which: the sort and the neighbour search
+    double pressureForce = 0; ///< equation of state + pressure (and Basic viscosity/LJ) forces
+    double xsphAndBoundary = 0; ///< ghost velocities, XSPH, positions, collisions
+    double airResampling = 0;   ///< ghost air sampling
+    double emission = 0;        ///< emitter sampling
     double total = 0;
     std::uint64_t steps = 0;
 };
@@ -235,14 +236,14 @@ private:
 
     GhostSettings mSettings;
     sph::CubicSplineKernel mKernel;
-    ParticleSet mParticles;              ///< liquid and ghost air
-    sph::NeighborGrid mGrid;             ///< over mParticles, rebuilt (and mParticles sorted) each step
-    sph::NeighborLists mFluidLists;      ///< this step: liquid particle -> mParticles
-    std::vector<std::uint8_t> mQueryMask;///< this step: 1 for liquid and air (fluid lists)
-    std::vector<std::uint8_t> mLiquidMask;///< this step: 1 for liquid (solid-block lists)
-    std::vector<Real> mScratch;          ///< per particle scratch of a pass
-    SolidBlock mStatic, mMoving;         ///< solid particles of static and of moving solids
-    ParticleSet mPendingSolids;          ///< restored solid particles until their solid is added
+    ParticleSet mParticles;         ///< liquid and ghost air
+    sph::NeighborGrid mGrid;        ///< over mParticles, rebuilt (and mParticles sorted) each step
+    sph::NeighborLists mFluidLists; ///< this step: liquid particle -> mParticles
+    std::vector<std::uint8_t> mQueryMask;  ///< this step: 1 for liquid and air (fluid lists)
+    std::vector<std::uint8_t> mLiquidMask; ///< this step: 1 for liquid (solid-block lists)
+    std::vector<Real> mScratch;            ///< per particle scratch of a pass
+    SolidBlock mStatic, mMoving;           ///< solid particles of static and of moving solids
+    ParticleSet mPendingSolids;            ///< restored solid particles until their solid is added
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Emitter>> mEmitters;
     std::size_t mEmitted = 0, mKilled = 0;

@@ -19,22 +19,40 @@ public:
 };
 
 /// A setting or argument is out of range or inconsistent ("settings.stiffness = -1: expected > 0").
-class ValueError : public Error { using Error::Error; };
+class ValueError : public Error
+{
+    using Error::Error;
+};
 
 /// A grid cannot be used as asked: wrong class or type, non-uniform voxels, empty, NaN values.
-class GridError : public Error { using Error::Error; };
+class GridError : public Error
+{
+    using Error::Error;
+};
 
 /// Sampling could not produce what was asked (shape without a surface, too many samples...).
-class SamplingError : public Error { using Error::Error; };
+class SamplingError : public Error
+{
+    using Error::Error;
+};
 
 /// A simulation left the range where its numbers mean anything (NaN, speed beyond a bound).
-class NumericalError : public Error { using Error::Error; };
+class NumericalError : public Error
+{
+    using Error::Error;
+};
 
 /// A file could not be read or written (thrown by vdbio only: solvers never touch files).
-class IoError : public Error { using Error::Error; };
+class IoError : public Error
+{
+    using Error::Error;
+};
 
 /// A scene file is malformed: unknown key, wrong type, missing value.
-class SceneError : public Error { using Error::Error; };
+class SceneError : public Error
+{
+    using Error::Error;
+};
 
 /// Build a message from stream-able parts: `throw ValueError(msg("spacing = ", h, ": expected > 0"))`.
 template <typename... Args>

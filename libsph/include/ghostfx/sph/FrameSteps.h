@@ -14,7 +14,8 @@ namespace sph {
 /// leaves a remainder of ~1e-11 s at the end; leftovers below a millionth of the frame are
 /// dropped rather than paid for with a whole extra step (the caller sets its clock to frameEnd).
 template <typename Time, typename StableStep, typename Step>
-void stepFrame(double frameEnd, Real frameRate, int substeps, Time&& time, StableStep&& stableStep, Step&& step)
+void stepFrame(double frameEnd, Real frameRate, int substeps, Time&& time, StableStep&& stableStep,
+               Step&& step)
 {
     if (substeps > 0) {
         const Real dt = Real(1) / (frameRate * Real(substeps));

@@ -83,7 +83,8 @@ public:
         const Real q = r * mInvS;
         const Real u = lesser(q, Real(1));
         const Real t = cutoff(q, r);
-        return mSigma * (Real(0.75) * (Real(1) - Real(2) * u * u + u * u * u) + Real(0.25) * t * t * t);
+        return mSigma
+               * (Real(0.75) * (Real(1) - Real(2) * u * u + u * u * u) + Real(0.25) * t * t * t);
     }
 
     Real dWdr(Real r) const
@@ -221,16 +222,16 @@ public:
     {
         if (r >= mSupport) return Real(0);
         const Real R = mSupport;
-        return mCoefW * (-cube(r) / (Real(2) * cube(R)) + r * r / (R * R) + R / (Real(2) * r)
-                         - Real(1));
+        return mCoefW
+               * (-cube(r) / (Real(2) * cube(R)) + r * r / (R * R) + R / (Real(2) * r) - Real(1));
     }
 
     Real dWdr(Real r) const
     {
         if (r >= mSupport) return Real(0);
         const Real R = mSupport;
-        return mCoefW * (Real(-1.5) * r * r / cube(R) + Real(2) * r / (R * R)
-                         - R / (Real(2) * r * r));
+        return mCoefW
+               * (Real(-1.5) * r * r / cube(R) + Real(2) * r / (R * R) - R / (Real(2) * r * r));
     }
 
     Vec3 gradW(const Vec3& xij, Real r) const
@@ -258,7 +259,8 @@ inline Real poly6W(Real r, Real R)
     if (r >= R) return Real(0);
     const Real invR = Real(1) / R;
     const Real invR3 = invR * invR * invR;
-    return Real(315.0 / (64.0 * 3.14159265358979323846)) * cube(R * R - r * r) * invR3 * invR3 * invR3;
+    return Real(315.0 / (64.0 * 3.14159265358979323846)) * cube(R * R - r * r) * invR3 * invR3
+           * invR3;
 }
 
 /// |dW/dr| of the spiky kernel 15 / (pi R^6) (R - r)^3: 45 / (pi R^6) (R - r)^2 (1/m^4);

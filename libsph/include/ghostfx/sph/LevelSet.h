@@ -28,9 +28,9 @@ namespace sph {
 /// Result of a closest-point projection.
 struct SurfaceProjection
 {
-    Vec3 point{0};         ///< the projected point (m); the last iterate if it did not converge
-    Real residual = 0;     ///< |phi(point)| (m)
-    int iterations = 0;    ///< Newton-like steps taken
+    Vec3 point{0};      ///< the projected point (m); the last iterate if it did not converge
+    Real residual = 0;  ///< |phi(point)| (m)
+    int iterations = 0; ///< Newton-like steps taken
     bool converged = false;
 };
 

@@ -39,7 +39,8 @@ openvdb::FloatGrid::Ptr levelSetFromSdf(const SignedDistanceFn& sdf, const Aabb&
 
 /// Exact signed distance (m) from x to the axis-aligned box [lo, hi], negative inside: the
 /// building block of composed shapes (containers as max(outer, -inner), unions as min).
-double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo, const openvdb::Vec3d& hi);
+double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo,
+                         const openvdb::Vec3d& hi);
 
 /// Sphere of `radius` (m) about `center`.
 openvdb::FloatGrid::Ptr makeSphereLevelSet(const Vec3& center, Real radius, Real voxelSize,

@@ -157,24 +157,22 @@ public:
 
     /// Nearest particle of one kind (e.g. the closest liquid particle to a ghost, [SB12] Sec. 4).
     template <typename KindT>
-    Index nearestOfKind(const Vec3& x, const std::vector<KindT>& kinds, KindT kind,
-                        Real maxRadius, Real* distance = nullptr) const
+    Index nearestOfKind(const Vec3& x, const std::vector<KindT>& kinds, KindT kind, Real maxRadius,
+                        Real* distance = nullptr) const
     {
-        return nearest(x, maxRadius, [&](Index j) { return kinds[j] == kind; }, distance);
+        return nearest(
+            x, maxRadius, [&](Index j) { return kinds[j] == kind; }, distance);
     }
 
 private:
     /// Whether a search `reach` cells wide would visit more cells than there are particles:
     /// then a plain sweep over the particles is cheaper.
-    bool sweepIsCheaper(Real reach) const
-    {
-        return cube(Real(2) * reach + Real(1)) > Real(size());
-    }
+    bool sweepIsCheaper(Real reach) const { return cube(Real(2) * reach + Real(1)) > Real(size()); }
     static constexpr std::int64_t KEY_OFFSET = std::int64_t(1) << 20;
     static std::uint64_t packKey(const Cell& c)
     {
-        return (std::uint64_t(c.i + KEY_OFFSET) << 42) | (std::uint64_t(c.j + KEY_OFFSET) << 21) |
-               std::uint64_t(c.k + KEY_OFFSET);
+        return (std::uint64_t(c.i + KEY_OFFSET) << 42) | (std::uint64_t(c.j + KEY_OFFSET) << 21)
+               | std::uint64_t(c.k + KEY_OFFSET);
     }
     static Cell unpackKey(std::uint64_t key)
     {
@@ -195,8 +193,9 @@ private:
     }
     std::uint32_t bucketOf(const Cell& c) const
     {
-        const std::uint64_t m = spreadBits(std::uint64_t(c.i)) << 2 |
-                                spreadBits(std::uint64_t(c.j)) << 1 | spreadBits(std::uint64_t(c.k));
+        const std::uint64_t m = spreadBits(std::uint64_t(c.i)) << 2
+                                | spreadBits(std::uint64_t(c.j)) << 1
+                                | spreadBits(std::uint64_t(c.k));
         return std::uint32_t(m & mTableMask);
     }
 
@@ -205,14 +204,14 @@ private:
 
     Real mCellSize, mInvCellSize;
     std::uint64_t mTableMask = 0;
-    std::vector<std::uint32_t> mBucketCell;  ///< bucket b holds cells [cell[b], cell[b+1])
-    std::vector<std::uint64_t> mCellKey;     ///< packed key of each occupied cell, sorted order
-    std::vector<std::uint32_t> mCellStart;   ///< cell k holds slots [start[k], start[k+1])
-    std::vector<Real> mX, mY, mZ;            ///< positions in sorted order (m)
-    std::vector<Index> mIndex;               ///< particle index of each sorted slot
-    std::vector<std::uint32_t> mSlotOf;      ///< sorted slot of each particle index
-    bool mIdentity = false;                  ///< mIndex[s] == s for every slot
-    std::size_t mPerCellHint = 1;            ///< see setParticlesPerCellHint
+    std::vector<std::uint32_t> mBucketCell; ///< bucket b holds cells [cell[b], cell[b+1])
+    std::vector<std::uint64_t> mCellKey;    ///< packed key of each occupied cell, sorted order
+    std::vector<std::uint32_t> mCellStart;  ///< cell k holds slots [start[k], start[k+1])
+    std::vector<Real> mX, mY, mZ;           ///< positions in sorted order (m)
+    std::vector<Index> mIndex;              ///< particle index of each sorted slot
+    std::vector<std::uint32_t> mSlotOf;     ///< sorted slot of each particle index
+    bool mIdentity = false;                 ///< mIndex[s] == s for every slot
+    std::size_t mPerCellHint = 1;           ///< see setParticlesPerCellHint
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -276,7 +275,8 @@ inline void NeighborGrid::forEachInBox(const Aabb& box, Fn&& fn) const
 {
     if (mIndex.empty() || box.empty() || !isFinite(box.min) || !isFinite(box.max)) return;
     const Cell lo = cellOf(box.min), hi = cellOf(box.max);
-    const double cells = double(hi.i - lo.i + 1) * double(hi.j - lo.j + 1) * double(hi.k - lo.k + 1);
+    const double cells =
+        double(hi.i - lo.i + 1) * double(hi.j - lo.j + 1) * double(hi.k - lo.k + 1);
     if (cells > double(cellCount())) {
         for (std::uint32_t s = 0; s < mIndex.size(); ++s) {
             const Vec3 x = sortedPosition(s);
@@ -306,7 +306,10 @@ inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, R
     auto consider = [&](Index j, const Vec3& xij, Real) {
         const Real r2 = xij.lengthSqr();
         const bool closer = r2 < best2 || (r2 == best2 && best != INVALID_INDEX && j < best);
-        if (closer && pred(j)) { best2 = r2; best = j; }
+        if (closer && pred(j)) {
+            best2 = r2;
+            best = j;
+        }
     };
     if (!mIndex.empty() && isFinite(x) && maxRadius > Real(0)) {
         const Real maxRingCells = std::ceil(maxRadius * mInvCellSize);
@@ -323,7 +326,8 @@ inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, R
                 // block.
                 for (int di = -ring; di <= ring; ++di) {
                     for (int dj = -ring; dj <= ring; ++dj) {
-                        const bool faceIJ = (di == -ring || di == ring || dj == -ring || dj == ring);
+                        const bool faceIJ =
+                            (di == -ring || di == ring || dj == -ring || dj == ring);
                         const int stepK = faceIJ || ring == 0 ? 1 : 2 * ring;
                         for (int dk = -ring; dk <= ring; dk += stepK) {
                             visitCell(Cell{c.i + di, c.j + dj, c.k + dk}, x, best2, consider);

@@ -35,12 +35,12 @@ struct PairBatch
     static constexpr int SIZE = 64; ///< pairs per batch
     static constexpr int LANES = 8; ///< interleaved partial sums
 
-    int n = 0;                 ///< pairs in this batch
-    Index j[SIZE];             ///< neighbour indices
+    int n = 0;                         ///< pairs in this batch
+    Index j[SIZE];                     ///< neighbour indices
     Real dx[SIZE], dy[SIZE], dz[SIZE]; ///< x_i - x_j (m)
-    Real r[SIZE];              ///< |x_i - x_j| (m)
-    Real f[SIZE];              ///< scratch for the caller's per-pair factor
-    Real g[SIZE];              ///< second scratch array
+    Real r[SIZE];                      ///< |x_i - x_j| (m)
+    Real f[SIZE];                      ///< scratch for the caller's per-pair factor
+    Real g[SIZE];                      ///< second scratch array
 
     /// Load up to SIZE neighbours `idx[0..count)` of the particle at xi; returns how many.
     int load(const Vec3& xi, const Vec3* x, const Index* idx, std::size_t count)

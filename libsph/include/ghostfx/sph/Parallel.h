@@ -54,18 +54,22 @@ void forRange(std::size_t begin, std::size_t end, Fn&& fn, std::size_t grain = D
         fn(begin, end);
         return;
     }
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain),
-                      [&fn](const tbb::blocked_range<std::size_t>& r) { fn(r.begin(), r.end()); },
-                      tbb::simple_partitioner());
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(begin, end, grain),
+        [&fn](const tbb::blocked_range<std::size_t>& r) { fn(r.begin(), r.end()); },
+        tbb::simple_partitioner());
 }
 
 /// Call `fn(i)` for every i in [begin, end).
 template <typename Fn>
 void forEach(std::size_t begin, std::size_t end, Fn&& fn, std::size_t grain = DEFAULT_GRAIN)
 {
-    forRange(begin, end, [&fn](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) fn(i);
-    }, grain);
+    forRange(
+        begin, end,
+        [&fn](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) fn(i);
+        },
+        grain);
 }
 
 /// Deterministic sum of `fn(i)` (converted to double) over [begin, end): blocks of `block`
@@ -78,13 +82,16 @@ double sum(std::size_t begin, std::size_t end, Fn&& fn, std::size_t block = 1024
     if (block == 0) block = 1;
     const std::size_t nBlocks = (end - begin + block - 1) / block;
     std::vector<double> partial(nBlocks, 0.0);
-    forEach(0, nBlocks, [&](std::size_t b) {
-        const std::size_t lo = begin + b * block;
-        const std::size_t hi = lo + block < end ? lo + block : end;
-        double s = 0.0;
-        for (std::size_t i = lo; i < hi; ++i) s += double(fn(i));
-        partial[b] = s;
-    }, 1);
+    forEach(
+        0, nBlocks,
+        [&](std::size_t b) {
+            const std::size_t lo = begin + b * block;
+            const std::size_t hi = lo + block < end ? lo + block : end;
+            double s = 0.0;
+            for (std::size_t i = lo; i < hi; ++i) s += double(fn(i));
+            partial[b] = s;
+        },
+        1);
     double total = 0.0;
     for (double s : partial) total += s;
     return total;

@@ -76,15 +76,15 @@ public:
     void setNextId(ParticleId next);
 
     // Built-in channels ----------------------------------------------------------------------
-    std::vector<Vec3>& positions() { return mPositions; }             ///< x (m)
+    std::vector<Vec3>& positions() { return mPositions; } ///< x (m)
     const std::vector<Vec3>& positions() const { return mPositions; }
-    std::vector<Vec3>& velocities() { return mVelocities; }           ///< v (m/s)
+    std::vector<Vec3>& velocities() { return mVelocities; } ///< v (m/s)
     const std::vector<Vec3>& velocities() const { return mVelocities; }
-    std::vector<Real>& masses() { return mMasses; }                   ///< m (kg)
+    std::vector<Real>& masses() { return mMasses; } ///< m (kg)
     const std::vector<Real>& masses() const { return mMasses; }
-    std::vector<Real>& densities() { return mDensities; }             ///< rho (kg/m^3)
+    std::vector<Real>& densities() { return mDensities; } ///< rho (kg/m^3)
     const std::vector<Real>& densities() const { return mDensities; }
-    std::vector<Real>& pressures() { return mPressures; }             ///< p (Pa)
+    std::vector<Real>& pressures() { return mPressures; } ///< p (Pa)
     const std::vector<Real>& pressures() const { return mPressures; }
     std::vector<ParticleKind>& kinds() { return mKinds; }
     const std::vector<ParticleKind>& kinds() const { return mKinds; }
@@ -126,12 +126,21 @@ public:
     std::size_t memoryBytes() const;
 
 private:
-    template <typename Fn> void forEachChannel(Fn&& fn);
+    template <typename Fn>
+    void forEachChannel(Fn&& fn);
     void growFor(std::size_t count);
     void appendDefaults(std::size_t count);
 
-    struct ScalarChannel { std::vector<Real> data; Real defaultValue; };
-    struct VectorChannel { std::vector<Vec3> data; Vec3 defaultValue; };
+    struct ScalarChannel
+    {
+        std::vector<Real> data;
+        Real defaultValue;
+    };
+    struct VectorChannel
+    {
+        std::vector<Vec3> data;
+        Vec3 defaultValue;
+    };
 
     std::vector<Vec3> mPositions, mVelocities;
     std::vector<Real> mMasses, mDensities, mPressures;

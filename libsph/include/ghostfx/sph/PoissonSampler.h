@@ -40,17 +40,17 @@ struct PoissonSettings
     /// [SB12] Sec. 4.5.2: attempts per sample for air layers and emission, where speed matters.
     static constexpr int SB12_SEEDED_ATTEMPTS = 8;
 
-    Real radius = Real(0);             ///< Poisson-disk radius r (m); no two samples closer
-    int surfaceAttempts = 30;          ///< t of Algorithm 1 (per cell and per walk step)
-    Real surfaceStep = Real(1.085);    ///< e of Algorithm 1: walk step e r
-    int volumeAttempts = 30;           ///< Bridson's t; [SB12] uses 8 for air and emission
-    int relaxAttempts = 50;            ///< t of Algorithm 2
-    int surfaceRelaxSweeps = 5;        ///< k of Algorithm 2 for the surface
-    int volumeRelaxSweeps = 30;        ///< k of Algorithm 2 for the volume
+    Real radius = Real(0);          ///< Poisson-disk radius r (m); no two samples closer
+    int surfaceAttempts = 30;       ///< t of Algorithm 1 (per cell and per walk step)
+    Real surfaceStep = Real(1.085); ///< e of Algorithm 1: walk step e r
+    int volumeAttempts = 30;        ///< Bridson's t; [SB12] uses 8 for air and emission
+    int relaxAttempts = 50;         ///< t of Algorithm 2
+    int surfaceRelaxSweeps = 5;     ///< k of Algorithm 2 for the surface
+    int volumeRelaxSweeps = 30;     ///< k of Algorithm 2 for the volume
     /// Sample only down to this depth below the surface (m): solids need one kernel radius
     /// ([SB12] Sec. 4.5). Infinity samples the whole interior.
     Real bandDepth = std::numeric_limits<Real>::infinity();
-    std::uint64_t seed = 0;            ///< random seed: same seed, same samples
+    std::uint64_t seed = 0; ///< random seed: same seed, same samples
     /// sampleVolume fills the interior deeper than 2r with copies of a periodic tile that was
     /// relaxed once ([SB12] Algorithms 1 and 2 run only between the surface and that depth):
     /// about twice as fast for large bodies, but the whole interior inherits the one tile's
@@ -71,8 +71,8 @@ struct PoissonSettings
 /// Samples and which of them lie on the surface.
 struct SampleSet
 {
-    std::vector<Vec3> positions;          ///< (m)
-    std::vector<std::uint8_t> onSurface;  ///< 1 for a surface sample, 0 for an interior one
+    std::vector<Vec3> positions;         ///< (m)
+    std::vector<std::uint8_t> onSurface; ///< 1 for a surface sample, 0 for an interior one
 
     std::size_t size() const { return positions.size(); }
     std::size_t surfaceCount() const;
@@ -119,7 +119,8 @@ public:
 private:
     SampleSet sampleVolumeTiled(const LevelSet& shape) const;
     /// Bridson growth from the samples with seeds[i] (all when empty); the rest are obstacles.
-    void growInterior(SampleSet& samples, const LevelSet& shape, const std::vector<std::uint8_t>& seeds) const;
+    void growInterior(SampleSet& samples, const LevelSet& shape,
+                      const std::vector<std::uint8_t>& seeds) const;
     /// Algorithm 2 for the samples with movable[i] (all when empty); the rest hold still.
     void relaxSome(SampleSet& samples, const LevelSet& shape, int sweeps, int pass,
                    const std::vector<std::uint8_t>& movable) const;

@@ -72,7 +72,11 @@ public:
     /// Generator state, for checkpoints.
     std::uint64_t state() const { return mState; }
     std::uint64_t increment() const { return mInc; }
-    void restore(std::uint64_t state, std::uint64_t increment) { mState = state; mInc = increment; }
+    void restore(std::uint64_t state, std::uint64_t increment)
+    {
+        mState = state;
+        mInc = increment;
+    }
 
 private:
     std::uint64_t mState = 0;

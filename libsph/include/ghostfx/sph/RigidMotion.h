@@ -70,8 +70,7 @@ struct MovingLevelSet
 };
 
 /// What collideWithSolid did with one particle.
-enum class Collision
-{
+enum class Collision {
     None,      ///< outside the solid: untouched
     Projected, ///< moved to the surface, velocity into the solid removed
     Restored,  ///< deeper than the level set's band: back where it started the step
@@ -85,8 +84,8 @@ enum class Collision
 /// `previous` (its position at the start of the step) if that is outside the solid now, moving
 /// with the solid; otherwise it is Stuck, and the caller must stop with an error (a particle
 /// inside a wall is a wrong answer, not a slow one).
-inline Collision collideWithSolid(const MovingLevelSet& solid, const RigidTransform& xf, double time,
-                                  const Vec3& previous, Vec3& x, Vec3& v)
+inline Collision collideWithSolid(const MovingLevelSet& solid, const RigidTransform& xf,
+                                  double time, const Vec3& previous, Vec3& x, Vec3& v)
 {
     const Vec3 local = xf.toLocal(x);
     if (!(solid.shape.phi(local) < Real(0))) return Collision::None;

@@ -37,8 +37,7 @@ struct SolverState
 
 private:
     template <typename T>
-    T lookup(const std::map<std::string, T>& values, const std::string& key,
-             const char* what) const
+    T lookup(const std::map<std::string, T>& values, const std::string& key, const char* what) const
     {
         const auto it = values.find(key);
         if (it == values.end()) {

@@ -22,9 +22,8 @@ std::vector<Real> densitySum(const std::vector<Vec3>& positions, const std::vect
     std::vector<Real> rho(positions.size(), Real(0));
     parallel::forEach(0, positions.size(), [&](std::size_t i) {
         Real sum = 0;
-        grid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
-            sum += masses[j] * kernel.W(r);
-        });
+        grid.forEachNeighbor(Index(i),
+                             [&](Index j, const Vec3&, Real r) { sum += masses[j] * kernel.W(r); });
         rho[i] = sum;
     });
     return rho;
@@ -34,20 +33,18 @@ std::vector<Real> densitySum(const std::vector<Vec3>& positions, const std::vect
 /// by `measure` (all when empty) equal `restDensity` (kg/m^3): m = rho0 / mean_i(sum_j W_ij).
 /// Throws ValueError when no particle is selected or the density sum is zero.
 template <typename Kernel>
-Real massForRestDensity(const std::vector<Vec3>& positions, const Kernel& kernel,
-                        Real restDensity, const std::vector<std::uint8_t>& measure = {})
+Real massForRestDensity(const std::vector<Vec3>& positions, const Kernel& kernel, Real restDensity,
+                        const std::vector<std::uint8_t>& measure = {})
 {
     NeighborGrid grid(kernel.supportRadius());
     grid.build(positions);
     const std::vector<Real> unitMass(positions.size(), Real(1));
     const std::vector<Real> rho = densitySum(positions, unitMass, grid, kernel);
     const bool all = measure.empty();
-    const double total = parallel::sum(0, rho.size(), [&](std::size_t i) {
-        return all || measure[i] ? double(rho[i]) : 0.0;
-    });
-    const double count = parallel::sum(0, rho.size(), [&](std::size_t i) {
-        return all || measure[i] ? 1.0 : 0.0;
-    });
+    const double total = parallel::sum(
+        0, rho.size(), [&](std::size_t i) { return all || measure[i] ? double(rho[i]) : 0.0; });
+    const double count =
+        parallel::sum(0, rho.size(), [&](std::size_t i) { return all || measure[i] ? 1.0 : 0.0; });
     if (!(count > 0.0) || !(total > 0.0)) {
         throw ValueError(msg("mass for rest density: no particle to measure (", count,
                              " selected of ", positions.size(), ")"));

@@ -37,13 +37,22 @@ constexpr Real PI = Real(3.14159265358979323846);
 
 /// x^2
 template <typename T>
-constexpr T sqr(T x) { return x * x; }
+constexpr T sqr(T x)
+{
+    return x * x;
+}
 /// x^3
 template <typename T>
-constexpr T cube(T x) { return x * x * x; }
+constexpr T cube(T x)
+{
+    return x * x * x;
+}
 /// Clamp x into [lo, hi].
 template <typename T>
-constexpr T clamp(T x, T lo, T hi) { return x < lo ? lo : (hi < x ? hi : x); }
+constexpr T clamp(T x, T lo, T hi)
+{
+    return x < lo ? lo : (hi < x ? hi : x);
+}
 
 /// True when every component is a finite number (no NaN, no infinity).
 template <typename T>
@@ -71,11 +80,17 @@ struct Aabb
         min = openvdb::math::minComponent(min, x);
         max = openvdb::math::maxComponent(max, x);
     }
-    void expand(const Aabb& b) { if (!b.empty()) { expand(b.min); expand(b.max); } }
+    void expand(const Aabb& b)
+    {
+        if (!b.empty()) {
+            expand(b.min);
+            expand(b.max);
+        }
+    }
     bool contains(const Vec3& x) const
     {
-        return x[0] >= min[0] && x[1] >= min[1] && x[2] >= min[2] &&
-               x[0] <= max[0] && x[1] <= max[1] && x[2] <= max[2];
+        return x[0] >= min[0] && x[1] >= min[1] && x[2] >= min[2] && x[0] <= max[0]
+               && x[1] <= max[1] && x[2] <= max[2];
     }
     Vec3 extent() const { return empty() ? Vec3(0) : max - min; }
     Vec3 center() const { return Real(0.5) * (min + max); }
@@ -83,7 +98,10 @@ struct Aabb
     Aabb padded(Real margin) const
     {
         Aabb b = *this;
-        if (!b.empty()) { b.min -= Vec3(margin); b.max += Vec3(margin); }
+        if (!b.empty()) {
+            b.min -= Vec3(margin);
+            b.max += Vec3(margin);
+        }
         return b;
     }
 };

@@ -49,9 +49,11 @@ public:
 
     /// Read a value of type T (double, int, std::int64_t, std::uint64_t, bool, std::string,
     /// std::array<double, 3>, std::vector<double>, std::vector<std::string>), or `fallback` if absent.
-    template <typename T> T get(const std::string& key, const T& fallback) const;
+    template <typename T>
+    T get(const std::string& key, const T& fallback) const;
     /// Read a value that must be present.
-    template <typename T> T require(const std::string& key) const;
+    template <typename T>
+    T require(const std::string& key) const;
 
     /// Numbers with a range check: "settings.stiffness = -1: expected > 0".
     double positive(const std::string& key, double fallback) const;

@@ -18,13 +18,13 @@ namespace vdbio {
 /// Conversion settings; validate() throws ValueError naming the field and the bad value.
 struct MeshToSdfOptions
 {
-    double voxelSize = 0;           ///< voxel edge of the level set (m), > 0 (no default)
-    double halfWidth = 3;           ///< narrow-band half width (voxels), >= 1
+    double voxelSize = 0; ///< voxel edge of the level set (m), > 0 (no default)
+    double halfWidth = 3; ///< narrow-band half width (voxels), >= 1
     std::string gridName = "surface";
     /// If non-empty, stored as string grid metadata "ghostfx_role": solid, liquid, emitter or
     /// source (the roles a scene .vdb understands, DESIGN.md "Scene files").
     std::string role;
-    double scale = 1;               ///< uniform scale applied to the mesh (mesh units -> m), > 0
+    double scale = 1; ///< uniform scale applied to the mesh (mesh units -> m), > 0
 
     void validate() const;
 };
@@ -48,8 +48,8 @@ std::string meshRoles();
 /// Read `meshPath` and convert it to a level set named `options.gridName`.
 /// Throws ValueError for bad options, IoError for a missing or unreadable file, GridError for a
 /// mesh without triangles or a conversion that yields no voxels.
-openvdb::FloatGrid::Ptr meshToLevelSet(const std::string& meshPath,
-                                       const MeshToSdfOptions& options, MeshStats* stats = nullptr);
+openvdb::FloatGrid::Ptr meshToLevelSet(const std::string& meshPath, const MeshToSdfOptions& options,
+                                       MeshStats* stats = nullptr);
 
 /// meshToLevelSet() then write the grid to `vdbPath` atomically (the file holds that one grid).
 /// Returns the grid that was written.

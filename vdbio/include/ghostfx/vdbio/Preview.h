@@ -41,9 +41,9 @@ struct PreviewOptions
 struct PreviewSummary
 {
     std::string gridName;
-    std::string gridClass;        ///< "fog volume" or "level set"
+    std::string gridClass; ///< "fog volume" or "level set"
     openvdb::Index64 activeVoxels = 0;
-    double seconds = 0;           ///< ray tracing time (s), without file I/O
+    double seconds = 0; ///< ray tracing time (s), without file I/O
 };
 
 /// Render `grid` and write `exrPath` atomically. A FloatGrid of class fog volume (or of unknown
@@ -62,7 +62,7 @@ PreviewSummary renderPreviewFromFile(const std::string& vdbPath, const PreviewOp
 struct RgbaImage
 {
     int width = 0, height = 0;
-    std::vector<float> rgba;      ///< 4 floats per pixel, row-major from the top-left pixel
+    std::vector<float> rgba; ///< 4 floats per pixel, row-major from the top-left pixel
 
     const float* pixel(int x, int y) const { return &rgba[4 * (std::size_t(y) * width + x)]; }
 };

@@ -65,7 +65,8 @@ struct KeyedMotion
     /// Rotation for column vectors, world = R * local + translate: R = Rz * Ry * Rx.
     static openvdb::math::Mat3d rotation(const sph::Vec3d& degrees);
     /// dR/dt of rotation(degrees) while the angles change at degreesPerSecond.
-    static openvdb::math::Mat3d rotationRate(const sph::Vec3d& degrees, const sph::Vec3d& degreesPerSecond);
+    static openvdb::math::Mat3d rotationRate(const sph::Vec3d& degrees,
+                                             const sph::Vec3d& degreesPerSecond);
 };
 
 /// The largest frame number a scene or `--frames` may name: frame files carry the number in
@@ -80,13 +81,16 @@ constexpr double MIN_SPACING = 4e-5;
 struct SceneSolid
 {
     SceneSolid(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+        : name(std::move(name_))
+        , geometry(std::move(geometry_))
+        , shape(std::move(shape_))
+    {}
 
     std::string name;
-    std::string geometry;        ///< where the shape came from, for messages and reports
+    std::string geometry; ///< where the shape came from, for messages and reports
     sph::LevelSet shape;
-    sph::Vec3d velocity{0};      ///< constant velocity (m/s), if no keys
-    KeyedMotion motion;          ///< keyed rigid motion (empty: constant velocity)
+    sph::Vec3d velocity{0}; ///< constant velocity (m/s), if no keys
+    KeyedMotion motion;     ///< keyed rigid motion (empty: constant velocity)
     /// Per-frame shapes (deforming solid): file pattern with $F and grid name; empty if static.
     std::string sequenceFile, sequenceGrid;
 };
@@ -94,7 +98,10 @@ struct SceneSolid
 struct SceneLiquid
 {
     SceneLiquid(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+        : name(std::move(name_))
+        , geometry(std::move(geometry_))
+        , shape(std::move(shape_))
+    {}
 
     std::string name;
     std::string geometry;
@@ -105,7 +112,10 @@ struct SceneLiquid
 struct SceneEmitter
 {
     SceneEmitter(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+        : name(std::move(name_))
+        , geometry(std::move(geometry_))
+        , shape(std::move(shape_))
+    {}
 
     std::string name;
     std::string geometry;
@@ -119,23 +129,29 @@ struct SceneEmitter
 struct SceneGasSource
 {
     SceneGasSource(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+        : name(std::move(name_))
+        , geometry(std::move(geometry_))
+        , shape(std::move(shape_))
+    {}
 
     std::string name;
     std::string geometry;
     sph::LevelSet shape;
     sph::Vec3d velocity{0};
     double temperature = 373.15;
-    double rate = 0;             ///< particles per second; 0: keep the volume full
+    double rate = 0; ///< particles per second; 0: keep the volume full
     double start = 0, end = std::numeric_limits<double>::infinity();
-    KeyedMotion motion;          ///< a moving source (the paper's steam train); empty: static
+    KeyedMotion motion; ///< a moving source (the paper's steam train); empty: static
 };
 
 /// A heater for the liquid-gas phase transition: liquid near it is heated towards `temperature`.
 struct SceneHeater
 {
     SceneHeater(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_)), geometry(std::move(geometry_)), shape(std::move(shape_)) {}
+        : name(std::move(name_))
+        , geometry(std::move(geometry_))
+        , shape(std::move(shape_))
+    {}
 
     std::string name;
     std::string geometry;
@@ -170,20 +186,20 @@ struct SceneOutputs
     // Points: a PointDataGrid "particles".
     std::string pointsFile = "liquid_points.$F4.vdb";
     std::vector<std::string> pointChannels{"v", "id", "density", "pressure"};
-    bool pointGhosts = false;         ///< also write ghost air / ghost solid particles (with "kind")
+    bool pointGhosts = false; ///< also write ghost air / ghost solid particles (with "kind")
     // Volumes.
     std::string volumeFile = "liquid.$F4.vdb";
     std::vector<std::string> volumeGrids{"surface", "density", "vel"};
-    double voxelSize = 0;             ///< 0: half the particle spacing
+    double voxelSize = 0; ///< 0: half the particle spacing
     // Gas (gas scenes and boiling): points and volumes of the gas particles.
     std::string gasPointsFile = "gas_points.$F4.vdb";
     std::vector<std::string> gasPointChannels{"v", "id", "temperature"};
     std::string gasVolumeFile = "gas.$F4.vdb";
     std::vector<std::string> gasVolumeGrids{"density", "temperature", "vel"};
-    double gasVoxelSize = 0;          ///< 0: half the gas particle spacing
+    double gasVoxelSize = 0; ///< 0: half the gas particle spacing
     // EXR preview of one grid of the volume file (the liquid's, else the gas's).
     std::string previewFile;
-    std::string previewGrid;          ///< "" : density if written, else surface
+    std::string previewGrid; ///< "" : density if written, else surface
     int previewWidth = 640, previewHeight = 360;
     // HDF5 checkpoint every N frames (0: only at the end and on interruption).
     std::string checkpointFile = "checkpoint.$F4.h5";
@@ -194,8 +210,8 @@ struct SceneOutputs
 
 struct Scene
 {
-    std::string file;    ///< the scene file as given
-    std::string folder;  ///< folder input paths are relative to
+    std::string file;   ///< the scene file as given
+    std::string folder; ///< folder input paths are relative to
     int version = SCENE_FORMAT_VERSION;
 
     /// The document after `-D` overrides.
@@ -204,12 +220,14 @@ struct Scene
     JsonObject settings;
 
     // Settings every solver shares.
-    std::string method;          ///< "ghost", "basic" (liquids), "gas" (gas only: fast, ambient or uncorrected by settings.gas.variant)
-    double spacing = 0;          ///< particle spacing h (m)
-    double frameRate = 30;       ///< frames per second
-    int firstFrame = 1, lastFrame = 24; ///< frames written; frame f is the state at t = f / frameRate
+    std::string
+        method; ///< "ghost", "basic" (liquids), "gas" (gas only: fast, ambient or uncorrected by settings.gas.variant)
+    double spacing = 0;    ///< particle spacing h (m)
+    double frameRate = 30; ///< frames per second
+    int firstFrame = 1,
+        lastFrame = 24; ///< frames written; frame f is the state at t = f / frameRate
 
-    sph::Aabb killBox;           ///< empty: none
+    sph::Aabb killBox; ///< empty: none
     std::vector<SceneSolid> solids;
     std::vector<SceneLiquid> liquids;
     std::vector<SceneEmitter> emitters;
@@ -233,7 +251,8 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
 
 /// Read and validate one level-set grid from a .vdb file; `context` names the scene key in
 /// messages ("solids[0].geometry").
-sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid, const std::string& context);
+sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid,
+                           const std::string& context);
 
 } // namespace vdbio
 } // namespace ghostfx
