@@ -19,6 +19,13 @@ cmake --install "$build" --prefix "$work/prefix" > "$work/install.log"
 # The installed program runs from the prefix without LD_LIBRARY_PATH (install RPATH), also when
 # the environment points elsewhere.
 env -u LD_LIBRARY_PATH "$work/prefix/bin/ghostfx" --version | grep -q "^ghostfx "
+# The Python module, where it was built (not under the sanitizers): importable from the prefix's
+# dist-packages, finding the libraries through its install RPATH.
+module="$(find "$work/prefix" -name '_ghostfx*.so' | head -n 1)"
+if [ -n "$module" ]; then
+    env -u LD_LIBRARY_PATH PYTHONPATH="$(dirname "$(dirname "$module")")" /usr/bin/python3 \
+        -c "import ghostfx; assert ghostfx.__version__"
+fi
 generator=()
 command -v ninja > /dev/null && generator=(-G Ninja)
 cmake -S "$here/consumer" -B "$work/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \

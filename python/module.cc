@@ -1,0 +1,248 @@
+/// @file   module.cc
+/// @brief  The `ghostfx` Python module (pybind11): scenes, simulations, particles as NumPy arrays
+///         and Poisson-disk sampling, over the same code the command line runs (vdbio::readScene,
+///         cmd::makeSimulation, sph::PoissonDiskSampler).
+/// @details Particle arrays are copies: the solvers reorder and grow their particle storage every
+///          step, so a view would dangle after the next advance_frame(). Long calls (a frame, a
+///          sampling) release the GIL. Errors of the library keep their one-line text: a bad scene
+///          raises ValueError with the message the command line prints after "ghostfx: error: ".
+#include "Simulation.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/sph/PoissonSampler.h>
+#include <ghostfx/vdbio/Scene.h>
+
+#include <openvdb/openvdb.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+using namespace ghostfx;
+
+namespace {
+
+/// `-D` assignments from a dict of dotted keys: {"settings.stiffness": 5000} ->
+/// "settings.stiffness=5000" (values as JSON, as the command line parses them).
+std::vector<std::string> assignments(const py::object& overrides)
+{
+    std::vector<std::string> out;
+    if (overrides.is_none()) return out;
+    const py::module_ json = py::module_::import("json");
+    for (const auto& item : overrides.cast<py::dict>()) {
+        const std::string key = py::str(item.first);
+        out.push_back(key + "=" + json.attr("dumps")(item.second).cast<std::string>());
+    }
+    return out;
+}
+
+/// A read scene, kept with what it was read from.
+struct PyScene
+{
+    std::shared_ptr<const vdbio::Scene> scene;
+};
+
+sph::ParticleKind kindFromName(const std::string& name)
+{
+    if (name == "liquid") return sph::ParticleKind::Liquid;
+    if (name == "air") return sph::ParticleKind::GhostAir;
+    if (name == "solid") return sph::ParticleKind::GhostSolid;
+    if (name == "gas") return sph::ParticleKind::Gas;
+    if (name == "boundary") return sph::ParticleKind::Boundary;
+    throw ValueError("particle kind '" + name +
+                          "': expected 'liquid', 'air', 'solid', 'gas' or 'boundary'");
+}
+
+/// One medium's particles of `kind`, ghosts included (a copy; see the file comment).
+sph::ParticleSet particlesOf(const cmd::Simulation& sim, sph::ParticleKind kind)
+{
+    for (const cmd::OutputMedium& m : sim.media()) {
+        const bool listed = std::find(m.kinds.begin(), m.kinds.end(), kind) != m.kinds.end()
+                            || std::find(m.ghostKinds.begin(), m.ghostKinds.end(), kind)
+                                   != m.ghostKinds.end();
+        if (!listed) continue;
+        sph::ParticleSet all = m.withGhosts ? m.withGhosts() : *m.particles;
+        std::vector<std::uint8_t> keep(all.size());
+        for (std::size_t i = 0; i < all.size(); ++i) keep[i] = all.kinds()[i] == kind;
+        return all.select(keep);
+    }
+    return sph::ParticleSet();
+}
+
+py::array_t<double> vectors(const std::vector<sph::Vec3>& v)
+{
+    py::array_t<double> a({py::ssize_t(v.size()), py::ssize_t(3)});
+    auto w = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        for (int c = 0; c < 3; ++c) w(py::ssize_t(i), c) = double(v[i][c]);
+    }
+    return a;
+}
+
+class PySimulation
+{
+public:
+    explicit PySimulation(const PyScene& scene) : mScene(scene.scene)
+    {
+        mSim = cmd::makeSimulation(*mScene);
+    }
+
+    void advanceFrame()
+    {
+        py::gil_scoped_release release;
+        mSim->beforeFrame(mSim->frame() + 1);
+        mSim->advanceFrame();
+    }
+
+    /// Advance `frames` frames (default: to the scene's last frame), calling on_frame(self)
+    /// after each; Ctrl-C (KeyboardInterrupt) is raised at the end of a frame.
+    void run(py::object frames, py::object onFrame, py::object self)
+    {
+        const int last = frames.is_none() ? mScene->lastFrame : mSim->frame() + frames.cast<int>();
+        while (mSim->frame() < last) {
+            advanceFrame();
+            if (!onFrame.is_none()) onFrame(self);
+            if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+        }
+    }
+
+    int frame() const { return mSim->frame(); }
+    double time() const { return mSim->time(); }
+    std::uint64_t steps() const { return mSim->stepCount(); }
+    std::string counts() const { return mSim->counts(); }
+
+    py::array_t<double> positions(const std::string& kind) const
+    {
+        return vectors(particlesOf(*mSim, kindFromName(kind)).positions());
+    }
+    py::array_t<double> velocities(const std::string& kind) const
+    {
+        return vectors(particlesOf(*mSim, kindFromName(kind)).velocities());
+    }
+    /// A per-particle quantity: "density", "pressure", "mass", "id" or a named channel.
+    py::array channel(const std::string& kind, const std::string& name) const
+    {
+        const sph::ParticleSet p = particlesOf(*mSim, kindFromName(kind));
+        auto scalars = [](const std::vector<sph::Real>& s) {
+            py::array_t<double> a(py::ssize_t(s.size()));
+            auto w = a.mutable_unchecked<1>();
+            for (std::size_t i = 0; i < s.size(); ++i) w(py::ssize_t(i)) = double(s[i]);
+            return py::array(a);
+        };
+        if (name == "density") return scalars(p.densities());
+        if (name == "pressure") return scalars(p.pressures());
+        if (name == "mass") return scalars(p.masses());
+        if (name == "id") {
+            py::array_t<std::int64_t> a(py::ssize_t(p.size()));
+            auto w = a.mutable_unchecked<1>();
+            for (std::size_t i = 0; i < p.size(); ++i) w(py::ssize_t(i)) = std::int64_t(p.ids()[i]);
+            return a;
+        }
+        if (p.hasScalarChannel(name)) return scalars(p.scalarChannel(name));
+        if (p.hasVectorChannel(name)) return vectors(p.vectorChannel(name));
+        throw ValueError("channel '" + name + "' of the " + kind +
+                              " particles: not found (density, pressure, mass, id, or a solver "
+                              "channel)");
+    }
+
+private:
+    std::shared_ptr<const vdbio::Scene> mScene;
+    std::unique_ptr<cmd::Simulation> mSim;
+};
+
+} // namespace
+
+PYBIND11_MODULE(_ghostfx, m)
+{
+    m.doc() = "ghostfx: Ghost SPH liquids and fast SPH gases on OpenVDB (the C++ library behind "
+              "the ghostfx command line)";
+    openvdb::initialize();
+
+    // The library's errors carry one-line messages meant for users: keep the text, map the
+    // kind to the Python exception a script expects.
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const IoError& e) {
+            PyErr_SetString(PyExc_OSError, e.what());
+        } catch (const NumericalError& e) {
+            PyErr_SetString(PyExc_ArithmeticError, e.what());
+        } catch (const Error& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        }
+    });
+
+    py::class_<PyScene>(m, "Scene", "A scene read from a JSON file (or a role-tagged .vdb)")
+        .def_property_readonly("file", [](const PyScene& s) { return s.scene->file; })
+        .def_property_readonly("method", [](const PyScene& s) { return s.scene->method; })
+        .def_property_readonly("spacing", [](const PyScene& s) { return s.scene->spacing; })
+        .def_property_readonly("frame_rate", [](const PyScene& s) { return s.scene->frameRate; })
+        .def_property_readonly("frame_range", [](const PyScene& s) {
+            return std::make_pair(s.scene->firstFrame, s.scene->lastFrame);
+        });
+
+    m.def(
+        "load_scene",
+        [](const std::string& path, py::object overrides) {
+            auto scene = std::make_shared<const vdbio::Scene>(
+                vdbio::readScene(path, assignments(overrides)));
+            // Every solver key too, as `ghostfx run` checks them before sampling anything.
+            cmd::checkSimulationSettings(*scene);
+            return PyScene{scene};
+        },
+        py::arg("path"), py::arg("overrides") = py::none(),
+        "Read a scene. `overrides` is a dict of the dotted keys of the command line's -D, e.g. "
+        "{'settings.stiffness': 5000}. A bad scene raises ValueError with the command line's "
+        "message; a file that cannot be read raises OSError.");
+
+    py::class_<PySimulation>(m, "Simulation",
+                             "The solvers a scene needs (liquid, gas or boiling), as `ghostfx run` "
+                             "builds them")
+        .def(py::init<const PyScene&>(), py::arg("scene"))
+        .def("advance_frame", &PySimulation::advanceFrame,
+             "Simulate one frame (the scene's substeps or CFL steps); releases the GIL")
+        .def(
+            "run",
+            [](py::object self, py::object frames, py::object onFrame) {
+                self.cast<PySimulation&>().run(frames, onFrame, self);
+            },
+            py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
+            "Advance `frames` frames (default: to the scene's last), calling on_frame(sim) after "
+            "each; Ctrl-C stops at the end of a frame with KeyboardInterrupt")
+        .def_property_readonly("frame", &PySimulation::frame, "frames advanced so far")
+        .def_property_readonly("time", &PySimulation::time, "simulated time (s)")
+        .def_property_readonly("steps", &PySimulation::steps, "steps taken so far")
+        .def_property_readonly("counts", &PySimulation::counts, "particle counts, as the log prints")
+        .def("positions", &PySimulation::positions, py::arg("kind") = "liquid",
+             "Positions (m) of the particles of `kind` ('liquid', 'air', 'solid', 'gas', "
+             "'boundary'), an (N, 3) float64 copy")
+        .def("velocities", &PySimulation::velocities, py::arg("kind") = "liquid",
+             "Velocities (m/s), an (N, 3) float64 copy")
+        .def("channel", &PySimulation::channel, py::arg("kind"), py::arg("name"),
+             "A per-particle quantity ('density', 'pressure', 'mass', 'id' or a solver channel), "
+             "a copy");
+
+    m.def(
+        "sample",
+        [](const std::string& file, const std::string& grid, double spacing, std::uint64_t seed) {
+            const sph::LevelSet shape = vdbio::loadLevelSet(file, grid, "sample");
+            sph::SampleSet samples;
+            {
+                py::gil_scoped_release release;
+                sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
+                settings.seed = seed;
+                samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
+            }
+            return vectors(samples.positions);
+        },
+        py::arg("file"), py::arg("grid"), py::arg("spacing"), py::arg("seed") = 1,
+        "Poisson-disk samples ([SB12] Sec. 4.5) of the level set `grid` in the .vdb `file` at "
+        "particle spacing `spacing` (m): an (N, 3) float64 array");
+
+    m.attr("__version__") = GHOSTFX_VERSION;
+}
