@@ -11,6 +11,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/PoissonSampler.h>
+#include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/Scene.h>
 
 #include <openvdb/openvdb.h>
@@ -92,6 +93,29 @@ public:
         mSim = cmd::makeSimulation(*mScene);
     }
 
+    /// A simulation continuing from a checkpoint written for the same scene settings (the
+    /// checkpoint is refused otherwise, naming the first differing key).
+    static PySimulation resume(const PyScene& scene, const std::string& path)
+    {
+        if (cmd::stateCount(*scene.scene) == 0) {
+            throw ValueError("scene '" + scene.scene->file + "': a boiling scene (with heaters) cannot "
+                             "be resumed yet");
+        }
+        const std::vector<sph::SolverState> states{
+            vdbio::readCheckpoint(path, scene.scene->simulationFingerprint())};
+        return PySimulation(scene.scene, cmd::makeSimulation(*scene.scene, &states));
+    }
+
+    /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames.
+    void saveCheckpoint(const std::string& path) const
+    {
+        if (cmd::stateCount(*mScene) == 0) {
+            throw ValueError("scene '" + mScene->file + "': boiling scenes write no checkpoints yet");
+        }
+        vdbio::writeCheckpoint(path, mSim->saveStates().front(), mScene->simulationFingerprint(),
+                               mSim->frame());
+    }
+
     void advanceFrame()
     {
         py::gil_scoped_release release;
@@ -151,6 +175,10 @@ public:
     }
 
 private:
+    PySimulation(std::shared_ptr<const vdbio::Scene> scene, std::unique_ptr<cmd::Simulation> sim)
+        : mScene(std::move(scene)), mSim(std::move(sim))
+    {}
+
     std::shared_ptr<const vdbio::Scene> mScene;
     std::unique_ptr<cmd::Simulation> mSim;
 };
@@ -214,6 +242,11 @@ PYBIND11_MODULE(_ghostfx, m)
             py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
             "Advance `frames` frames (default: to the scene's last), calling on_frame(sim) after "
             "each; Ctrl-C stops at the end of a frame with KeyboardInterrupt")
+        .def("save_checkpoint", &PySimulation::saveCheckpoint, py::arg("path"),
+             "Write the state to an HDF5 checkpoint (the format of `ghostfx run`)")
+        .def_static("resume", &PySimulation::resume, py::arg("scene"), py::arg("path"),
+                    "A simulation continuing from a checkpoint of the same scene settings; it "
+                    "continues bit for bit as the run that wrote it")
         .def_property_readonly("frame", &PySimulation::frame, "frames advanced so far")
         .def_property_readonly("time", &PySimulation::time, "simulated time (s)")
         .def_property_readonly("steps", &PySimulation::steps, "steps taken so far")
