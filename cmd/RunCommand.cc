@@ -219,6 +219,45 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
 
 } // namespace
 
+void writeFrameOutputs(const vdbio::Scene& scene, const Simulation& sim, const std::string& folder,
+                       int frame)
+{
+    const vdbio::SceneOutputs& out = scene.outputs;
+    auto inFolder = [&](const std::string& pattern) {
+        return pattern.empty()
+                   ? std::string()
+                   : (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
+    };
+    openvdb::MetaMap fileMeta;
+    fileMeta.insertMeta("ghostfx_scene", openvdb::StringMetadata(scene.file));
+    fileMeta.insertMeta("ghostfx_method", openvdb::StringMetadata(scene.method));
+    fileMeta.insertMeta("frame", openvdb::Int32Metadata(frame));
+    fileMeta.insertMeta("time", openvdb::DoubleMetadata(sim.time()));
+    openvdb::GridPtrVec previewGrids;
+    for (const OutputMedium& m : sim.media()) {
+        const bool liquid = m.liquid;
+        const openvdb::GridPtrVec grids =
+            writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile),
+                        inFolder(liquid ? out.volumeFile : out.gasVolumeFile), fileMeta);
+        if (previewGrids.empty()) previewGrids = grids;
+    }
+    if (out.previewFile.empty() || previewGrids.empty()) return;
+    vdbio::PreviewOptions pv;
+    pv.width = out.previewWidth;
+    pv.height = out.previewHeight;
+    const std::string& name = out.previewGrid;
+    openvdb::GridBase::Ptr grid;
+    for (const auto& g : previewGrids) {
+        if (name.empty() ? g->getName() == "density" : g->getName() == name) grid = g;
+    }
+    if (!grid && name.empty()) grid = previewGrids.front();
+    if (!grid) {
+        throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '", name,
+                             "': the volume output has no such grid"));
+    }
+    vdbio::renderPreview(*grid, pv, inFolder(out.previewFile));
+}
+
 int runScene(const RunOptions& o)
 {
     const auto runStart = Clock::now();
@@ -320,10 +359,6 @@ int runScene(const RunOptions& o)
         return path;
     };
 
-    openvdb::MetaMap fileMeta;
-    fileMeta.insertMeta("ghostfx_scene", openvdb::StringMetadata(scene.file));
-    fileMeta.insertMeta("ghostfx_method", openvdb::StringMetadata(scene.method));
-
     const std::uint64_t stepsAtStart = sim->stepCount();
     for (; frame <= last; ++frame) {
         const auto frameStart = Clock::now();
@@ -333,34 +368,7 @@ int runScene(const RunOptions& o)
         sim->advanceFrame();
 
         const bool write = frame >= first;
-        if (write) {
-            fileMeta.insertMeta("frame", openvdb::Int32Metadata(frame));
-            fileMeta.insertMeta("time", openvdb::DoubleMetadata(sim->time()));
-            openvdb::GridPtrVec previewGrids;
-            for (const OutputMedium& m : sim->media()) {
-                const bool liquid = m.liquid;
-                const openvdb::GridPtrVec grids = writeMedium(
-                    m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile, frame),
-                    inFolder(liquid ? out.volumeFile : out.gasVolumeFile, frame), fileMeta);
-                if (previewGrids.empty()) previewGrids = grids;
-            }
-            if (!out.previewFile.empty() && !previewGrids.empty()) {
-                vdbio::PreviewOptions pv;
-                pv.width = out.previewWidth;
-                pv.height = out.previewHeight;
-                std::string name = out.previewGrid;
-                openvdb::GridBase::Ptr grid;
-                for (const auto& g : previewGrids) {
-                    if (name.empty() ? g->getName() == "density" : g->getName() == name) grid = g;
-                }
-                if (!grid && name.empty()) grid = previewGrids.front();
-                if (!grid) {
-                    throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '", name,
-                                         "': the volume output has no such grid"));
-                }
-                vdbio::renderPreview(*grid, pv, inFolder(out.previewFile, frame));
-            }
-        }
+        if (write) writeFrameOutputs(scene, *sim, folder, frame);
         if (stats) stats->flush();
         const bool interrupted = gInterrupted.load();
         std::string checkpoint;

@@ -11,6 +11,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/PoissonSampler.h>
+#include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/Scene.h>
 
@@ -104,6 +105,16 @@ public:
         const std::vector<sph::SolverState> states{
             vdbio::readCheckpoint(path, scene.scene->simulationFingerprint())};
         return PySimulation(scene.scene, cmd::makeSimulation(*scene.scene, &states));
+    }
+
+    /// The scene's outputs of the current frame (points, volume, preview), into `folder` or
+    /// the scene's outputs.directory; the same files `ghostfx run` writes.
+    void writeFrame(py::object folder) const
+    {
+        const std::string dir = folder.is_none() ? mScene->outputs.directory : py::str(folder).cast<std::string>();
+        py::gil_scoped_release release;
+        vdbio::ensureWritableDirectory(dir);
+        cmd::writeFrameOutputs(*mScene, *mSim, dir, mSim->frame());
     }
 
     /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames.
@@ -242,6 +253,10 @@ PYBIND11_MODULE(_ghostfx, m)
             py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
             "Advance `frames` frames (default: to the scene's last), calling on_frame(sim) after "
             "each; Ctrl-C stops at the end of a frame with KeyboardInterrupt")
+        .def("write_frame", &PySimulation::writeFrame, py::arg("folder") = py::none(),
+             "Write the scene's outputs for the current frame (files named by the scene's "
+             "`outputs`, as `ghostfx run` writes them) into `folder` (default: "
+             "outputs.directory); releases the GIL")
         .def("save_checkpoint", &PySimulation::saveCheckpoint, py::arg("path"),
              "Write the state to an HDF5 checkpoint (the format of `ghostfx run`)")
         .def_static("resume", &PySimulation::resume, py::arg("scene"), py::arg("path"),

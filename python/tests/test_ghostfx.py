@@ -163,3 +163,17 @@ except KeyboardInterrupt:
     assert child.returncode == 3, out
     word, frame, at_boundary = out.split()
     assert word == "interrupted" and 1 <= int(frame) < 200 and at_boundary == "True"
+
+
+def test_write_frame_writes_the_files_the_command_line_writes(tmp_path):
+    scene = ghostfx.load_scene(DAM, {"settings.frame_range": [1, 1], "outputs.preview": False})
+    sim = ghostfx.Simulation(scene)
+    sim.advance_frame()
+    sim.write_frame(str(tmp_path))
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == ["liquid.0001.vdb", "liquid_points.0001.vdb"]
+    assert all((tmp_path / n).stat().st_size > 1000 for n in names)
+    if EXE:  # `ghostfx info` reads them: the points file holds the liquid particles
+        info = subprocess.run([EXE, "info", str(tmp_path / "liquid_points.0001.vdb")],
+                              capture_output=True, text=True, check=True).stdout
+        assert str(sim.positions("liquid").shape[0]) in info
