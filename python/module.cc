@@ -16,10 +16,13 @@
 #include <ghostfx/vdbio/Scene.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/SignedFloodFill.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -84,6 +87,63 @@ py::array_t<double> vectors(const std::vector<sph::Vec3>& v)
         for (int c = 0; c < 3; ++c) w(py::ssize_t(i), c) = double(v[i][c]);
     }
     return a;
+}
+
+/// A level set from a dense signed-distance array sdf[i, j, k] at world points
+/// origin + voxel (i, j, k) (negative inside): the narrow band of 3 voxels is kept, the
+/// inside is filled, and the grid is checked as every other level set is.
+sph::LevelSet levelSetFromArray(const py::array_t<float, py::array::c_style | py::array::forcecast>& sdf,
+                                double voxel, const std::array<double, 3>& origin, const std::string& name)
+{
+    if (sdf.ndim() != 3) {
+        throw ValueError("level set '" + name + "': expected a 3-D array of signed distances, got " +
+                         std::to_string(sdf.ndim()) + " dimensions");
+    }
+    if (!(voxel > 0) || !std::isfinite(voxel)) {
+        throw ValueError("level set '" + name + "': voxel_size = " + std::to_string(voxel) +
+                         ": expected a number > 0");
+    }
+    const float background = float(3 * voxel);
+    auto grid = openvdb::FloatGrid::create(background);
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(voxel));
+    grid->transform().postTranslate(openvdb::Vec3d(origin[0], origin[1], origin[2]));
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+    grid->setName(name);
+    auto a = sdf.unchecked<3>();
+    auto acc = grid->getAccessor();
+    for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+        for (py::ssize_t j = 0; j < a.shape(1); ++j) {
+            for (py::ssize_t k = 0; k < a.shape(2); ++k) {
+                const float v = a(i, j, k);
+                if (!std::isfinite(v)) {
+                    throw ValueError("level set '" + name + "': sdf[" + std::to_string(i) + ", " +
+                                     std::to_string(j) + ", " + std::to_string(k) +
+                                     "] is not finite");
+                }
+                if (std::abs(v) < background) acc.setValue(openvdb::Coord(int(i), int(j), int(k)), v);
+            }
+        }
+    }
+    openvdb::tools::signedFloodFill(grid->tree());
+    return sph::makeLevelSet(grid, name);
+}
+
+/// The level set's values over the index box of its active voxels: (array, origin).
+std::pair<py::array_t<float>, std::array<double, 3>> levelSetToArray(const sph::LevelSet& shape)
+{
+    const openvdb::FloatGrid::ConstPtr grid = sph::gridOf(shape);
+    const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+    const openvdb::Coord dim = box.dim();
+    py::array_t<float> out({py::ssize_t(dim.x()), py::ssize_t(dim.y()), py::ssize_t(dim.z())});
+    auto w = out.mutable_unchecked<3>();
+    auto acc = grid->getConstAccessor();
+    for (int i = 0; i < dim.x(); ++i) {
+        for (int j = 0; j < dim.y(); ++j) {
+            for (int k = 0; k < dim.z(); ++k) w(i, j, k) = acc.getValue(box.min() + openvdb::Coord(i, j, k));
+        }
+    }
+    const openvdb::Vec3d o = grid->indexToWorld(box.min());
+    return {out, {o.x(), o.y(), o.z()}};
 }
 
 class PySimulation
@@ -275,6 +335,53 @@ PYBIND11_MODULE(_ghostfx, m)
              "A per-particle quantity ('density', 'pressure', 'mass', 'id' or a solver channel), "
              "a copy");
 
+    py::class_<sph::LevelSet>(m, "LevelSet", "A narrow-band signed-distance grid (OpenVDB), negative inside")
+        .def_static("from_array", &levelSetFromArray, py::arg("sdf"), py::arg("voxel_size"),
+                    py::arg("origin") = std::array<double, 3>{0, 0, 0}, py::arg("name") = "array",
+                    "From a dense array sdf[i, j, k] of signed distances (m) at origin + voxel_size "
+                    "(i, j, k); the band within 3 voxels of the surface is kept")
+        .def_static(
+            "from_vdb",
+            [](const std::string& file, const std::string& grid) {
+                return vdbio::loadLevelSet(file, grid, "LevelSet.from_vdb");
+            },
+            py::arg("file"), py::arg("grid"), "The level-set grid `grid` of a .vdb file")
+        .def("to_array", &levelSetToArray,
+             "(values, origin): the signed distances over the box of active voxels, float32, and "
+             "the world position of values[0, 0, 0]")
+        .def(
+            "phi",
+            [](const sph::LevelSet& shape, const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+                if (points.ndim() != 2 || points.shape(1) != 3) {
+                    throw ValueError("LevelSet.phi: expected an (N, 3) array of points");
+                }
+                auto p = points.unchecked<2>();
+                py::array_t<double> out(points.shape(0));
+                auto w = out.mutable_unchecked<1>();
+                for (py::ssize_t i = 0; i < p.shape(0); ++i) {
+                    w(i) = double(shape.phi(sph::Vec3(sph::Real(p(i, 0)), sph::Real(p(i, 1)), sph::Real(p(i, 2)))));
+                }
+                return out;
+            },
+            py::arg("points"), "Signed distance (m) at each of the (N, 3) points, trilinear")
+        .def_property_readonly("voxel_size", [](const sph::LevelSet& s) { return double(s.voxelSize()); })
+        .def_property_readonly("name", &sph::LevelSet::name);
+
+    m.def(
+        "sample",
+        [](const sph::LevelSet& shape, double spacing, std::uint64_t seed) {
+            sph::SampleSet samples;
+            {
+                py::gil_scoped_release release;
+                sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
+                settings.seed = seed;
+                samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
+            }
+            return vectors(samples.positions);
+        },
+        py::arg("level_set"), py::arg("spacing"), py::arg("seed") = 1,
+        "Poisson-disk samples ([SB12] Sec. 4.5) of a LevelSet at particle spacing `spacing` (m): an "
+        "(N, 3) float64 array");
     m.def(
         "sample",
         [](const std::string& file, const std::string& grid, double spacing, std::uint64_t seed) {

@@ -8,6 +8,6 @@
 The same code as the `ghostfx` command line: scene errors raise ValueError with its message.
 Particle arrays are float64 NumPy copies (the solver reorders its storage every step).
 """
-from ._ghostfx import Scene, Simulation, load_scene, sample, __version__
+from ._ghostfx import LevelSet, Scene, Simulation, load_scene, sample, __version__
 
-__all__ = ["Scene", "Simulation", "load_scene", "sample", "__version__"]
+__all__ = ["LevelSet", "Scene", "Simulation", "load_scene", "sample", "__version__"]
