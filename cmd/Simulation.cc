@@ -75,6 +75,10 @@ public:
     {
         return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
     }
+    void setSolidMotion(std::size_t index, sph::RigidMotion motion) override
+    {
+        mSolver->setSolidMotion(index, std::move(motion));
+    }
 
     void setStepObserver(std::function<void(double)> observer) override
     {
@@ -536,6 +540,11 @@ void checkSimulationSettings(const vdbio::Scene& scene)
 }
 
 std::size_t stateCount(const vdbio::Scene& scene) { return scene.heaters.empty() ? 1 : 0; }
+
+void Simulation::setSolidMotion(std::size_t /*index*/, sph::RigidMotion /*motion*/)
+{
+    throw ValueError("changing a solid's motion during a run is supported in liquid scenes only");
+}
 
 std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
                                            const std::vector<sph::SolverState>* restored)

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
 #include <ghostfx/vdbio/Scene.h>
 #include <ghostfx/vdbio/Stats.h>
@@ -66,6 +67,9 @@ public:
     /// Solver states for a checkpoint (one per solver), and their restoration; the order is the
     /// simulation's own. `restore` is called on a simulation built from the same scene.
     virtual std::vector<sph::SolverState> saveStates() const = 0;
+    /// Replace the motion of the scene's solid `index` (in scene order) from now on; refused
+    /// for a static solid and where the scene's solver cannot (gas, boiling).
+    virtual void setSolidMotion(std::size_t index, sph::RigidMotion motion);
     /// Before simulating towards `frame`: per-frame inputs (deforming solid sequences).
     virtual void beforeFrame(int /*frame*/) {}
 };

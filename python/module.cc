@@ -6,6 +6,7 @@
 ///          step, so a view would dangle after the next advance_frame(). Long calls (a frame, a
 ///          sampling) release the GIL. Errors of the library keep their one-line text: a bad scene
 ///          raises ValueError with the message the command line prints after "ghostfx: error: ".
+#include "LiquidScene.h"
 #include "Simulation.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -177,6 +178,42 @@ public:
         cmd::writeFrameOutputs(*mScene, *mSim, dir, mSim->frame());
     }
 
+    /// From now on, solid `name` moves at `velocity` (m/s) from where it is, without turning.
+    void setSolidVelocity(const std::string& name, const std::array<double, 3>& velocity)
+    {
+        const auto& solids = mScene->solids;
+        std::size_t index = solids.size();
+        for (std::size_t i = 0; i < solids.size(); ++i) {
+            if (solids[i].name == name) index = i;
+        }
+        if (index == solids.size()) {
+            std::string known;
+            for (const auto& s : solids) known += (known.empty() ? "'" : ", '") + s.name + "'";
+            throw ValueError("solid '" + name + "': the scene has no such solid (solids: " +
+                             (known.empty() ? "none" : known) + ")");
+        }
+        if (mMotions.empty()) {
+            for (const auto& s : solids) {
+                mMotions.push_back(s.motion.keys.empty() ? sph::constantVelocity(sph::Vec3(s.velocity))
+                                                         : cmd::keyedMotion(s.motion));
+            }
+        }
+        const double t0 = mSim->time();
+        const sph::RigidTransform start = mMotions[index](t0);
+        const sph::Vec3d v(velocity[0], velocity[1], velocity[2]);
+        const sph::Vec3d p0(start.translation);
+        sph::RigidMotion motion = [start, p0, v, t0](double t) {
+            sph::RigidTransform xf = start;
+            xf.translation = sph::Vec3(p0 + v * (t - t0));
+            xf.translationRate = sph::Vec3(v);
+            xf.rotationRate = openvdb::math::Mat3<sph::Real>::zero();
+            xf.hasRates = true;
+            return xf;
+        };
+        mSim->setSolidMotion(index, motion);
+        mMotions[index] = motion;
+    }
+
     /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames.
     void saveCheckpoint(const std::string& path) const
     {
@@ -252,6 +289,7 @@ private:
 
     std::shared_ptr<const vdbio::Scene> mScene;
     std::unique_ptr<cmd::Simulation> mSim;
+    std::vector<sph::RigidMotion> mMotions; ///< each scene solid's motion as this object set it
 };
 
 } // namespace
@@ -317,6 +355,10 @@ PYBIND11_MODULE(_ghostfx, m)
              "Write the scene's outputs for the current frame (files named by the scene's "
              "`outputs`, as `ghostfx run` writes them) into `folder` (default: "
              "outputs.directory); releases the GIL")
+        .def("set_solid_velocity", &PySimulation::setSolidVelocity, py::arg("name"), py::arg("velocity"),
+             "From now on the scene's solid `name` moves at `velocity` (m/s) from where it is. It "
+             "must be a moving solid in the scene (a velocity or motion keys); not saved in "
+             "checkpoints")
         .def("save_checkpoint", &PySimulation::saveCheckpoint, py::arg("path"),
              "Write the state to an HDF5 checkpoint (the format of `ghostfx run`)")
         .def_static("resume", &PySimulation::resume, py::arg("scene"), py::arg("path"),

@@ -123,6 +123,21 @@ void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
     sampleSolid(solidIndex);
 }
 
+void GhostSolver::setSolidMotion(std::size_t solidIndex, RigidMotion motion)
+{
+    if (solidIndex >= mSolids.size()) {
+        throw ValueError(msg("setSolidMotion: solid ", solidIndex, " does not exist (",
+                             mSolids.size(), " solids)"));
+    }
+    if (!motion) throw ValueError(msg("setSolidMotion: solid ", solidIndex, ": no motion given"));
+    Solid& solid = *mSolids[solidIndex];
+    if (!solid.moving) {
+        throw ValueError(msg("solid '", solid.shape.name(), "' was added as a static solid: its motion "
+                             "cannot change (give it a velocity or motion keys to make it a moving one)"));
+    }
+    solid.motion = std::move(motion);
+}
+
 void GhostSolver::sampleSolid(std::size_t solidIndex)
 {
     const Solid& body = *mSolids[solidIndex];

@@ -104,6 +104,11 @@ public:
     /// set of a deforming solid: its ghosts are sampled anew, its motion is kept. Solids keep
     /// their index for the life of the solver.
     void setSolidShape(std::size_t solidIndex, const LevelSet& shape);
+    /// Replace the motion of moving solid `solidIndex` from now on (a script steering a paddle):
+    /// the motion should continue from the solid's current placement, or its ghosts jump. A
+    /// solid added as static is refused (its ghosts are sorted once and never re-placed).
+    /// Motions are not part of saveState(): a restored run uses what its caller adds.
+    void setSolidMotion(std::size_t solidIndex, RigidMotion motion);
     std::size_t solidCount() const { return mSolids.size(); }
 
     /// Sample a liquid body from a level set ([SB12] Sec. 4.5 - 4.6) with initial velocity
