@@ -11,7 +11,7 @@ packages=(
     libhdf5-dev libopenexr-dev python3-imath
     libgtest-dev libgmock-dev libbenchmark-dev libassimp-dev
     nlohmann-json3-dev libcli11-dev
-    python3-dev pybind11-dev python3-numpy python3-pytest
+    python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
 )
 
 missing=()
