@@ -15,6 +15,7 @@
 #include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/Scene.h>
+#include <ghostfx/vdbio/Stats.h>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/SignedFloodFill.h>
@@ -153,6 +154,7 @@ public:
     explicit PySimulation(const PyScene& scene) : mScene(scene.scene)
     {
         mSim = cmd::makeSimulation(*mScene);
+        observe();
     }
 
     /// A simulation continuing from a checkpoint written for the same scene settings (the
@@ -212,6 +214,19 @@ public:
         };
         mSim->setSolidMotion(index, motion);
         mMotions[index] = motion;
+    }
+
+    /// Statistics of every step since this object was made: column name -> float64 array.
+    py::dict statistics() const
+    {
+        py::dict out;
+        for (std::size_t c = 0; c < mStats->columns.size(); ++c) {
+            const std::vector<double>& v = mStats->values[c];
+            py::array_t<double> a(py::ssize_t(v.size()));
+            std::copy(v.begin(), v.end(), a.mutable_data());
+            out[py::str(mStats->columns[c])] = a;
+        }
+        return out;
     }
 
     /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames.
@@ -285,11 +300,37 @@ public:
 private:
     PySimulation(std::shared_ptr<const vdbio::Scene> scene, std::unique_ptr<cmd::Simulation> sim)
         : mScene(std::move(scene)), mSim(std::move(sim))
-    {}
+    {
+        observe();
+    }
+
+    /// The per-step statistics rows (the columns of `ghostfx run`'s stats file), collected by a
+    /// step observer that holds the simulation and the table, not this object (which moves).
+    struct StatsTable
+    {
+        std::vector<std::string> columns;
+        std::vector<std::vector<double>> values; ///< values[c][step]
+    };
+    void observe()
+    {
+        cmd::Simulation* sim = mSim.get();
+        std::shared_ptr<StatsTable> table = mStats;
+        mSim->setStepObserver([sim, table](double dt) {
+            const vdbio::StatsRow row = sim->statsRow(sim->frame() + 1, dt);
+            if (table->columns.empty()) {
+                for (const auto& [name, value] : row.values) table->columns.push_back(name);
+                table->values.resize(table->columns.size());
+            }
+            for (std::size_t c = 0; c < row.values.size() && c < table->values.size(); ++c) {
+                table->values[c].push_back(row.values[c].second);
+            }
+        });
+    }
 
     std::shared_ptr<const vdbio::Scene> mScene;
     std::unique_ptr<cmd::Simulation> mSim;
     std::vector<sph::RigidMotion> mMotions; ///< each scene solid's motion as this object set it
+    std::shared_ptr<StatsTable> mStats = std::make_shared<StatsTable>();
 };
 
 } // namespace
@@ -359,6 +400,9 @@ PYBIND11_MODULE(_ghostfx, m)
              "From now on the scene's solid `name` moves at `velocity` (m/s) from where it is. It "
              "must be a moving solid in the scene (a velocity or motion keys); not saved in "
              "checkpoints")
+        .def("statistics", &PySimulation::statistics,
+             "Per-step statistics since this object was made, as `ghostfx run` writes them to "
+             "stats.h5: a dict of column name -> float64 array, one entry per step")
         .def("save_checkpoint", &PySimulation::saveCheckpoint, py::arg("path"),
              "Write the state to an HDF5 checkpoint (the format of `ghostfx run`)")
         .def_static("resume", &PySimulation::resume, py::arg("scene"), py::arg("path"),

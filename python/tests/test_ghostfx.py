@@ -251,3 +251,17 @@ def test_a_script_steers_a_moving_solid(tmp_path):
         sim.set_solid_velocity("tank", (0.1, 0, 0))
     with pytest.raises(ValueError, match="no such solid"):
         sim.set_solid_velocity("lid", (0.1, 0, 0))
+
+
+def test_statistics_per_step_as_numpy_arrays():
+    sim = ghostfx.Simulation(ghostfx.load_scene(DAM, {"settings.frame_range": [1, 2]}))
+    sim.run()
+    stats = sim.statistics()
+    # One entry per step, the columns of the run command's stats file.
+    for name in ("step", "time", "dt", "count_liquid"):
+        assert name in stats, sorted(stats)
+        assert stats[name].shape == (sim.steps,)
+    # Steps are numbered in order and their dt add up to the simulated time (2 frames).
+    assert np.all(np.diff(stats["step"]) == 1)
+    assert stats["dt"].sum() == pytest.approx(2 / 30, rel=1e-6)
+    assert np.all(stats["count_liquid"] == sim.positions("liquid").shape[0])
