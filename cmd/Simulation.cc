@@ -79,6 +79,14 @@ public:
     {
         mSolver->setSolidMotion(index, std::move(motion));
     }
+    void addSolid(const sph::LevelSet& shape, const Vec3& velocity) override
+    {
+        mSolver->addSolid(shape, velocity);
+    }
+    std::size_t addLiquid(const sph::LevelSet& shape, const Vec3& velocity) override
+    {
+        return mSolver->addLiquid(shape, velocity);
+    }
 
     void setStepObserver(std::function<void(double)> observer) override
     {
@@ -544,6 +552,16 @@ std::size_t stateCount(const vdbio::Scene& scene) { return scene.heaters.empty()
 void Simulation::setSolidMotion(std::size_t /*index*/, sph::RigidMotion /*motion*/)
 {
     throw ValueError("changing a solid's motion during a run is supported in liquid scenes only");
+}
+
+void Simulation::addSolid(const sph::LevelSet& shape, const Vec3& /*velocity*/)
+{
+    throw ValueError("solid '" + shape.name() + "': adding solids from a script is supported in liquid scenes only");
+}
+
+std::size_t Simulation::addLiquid(const sph::LevelSet& shape, const Vec3& /*velocity*/)
+{
+    throw ValueError("liquid '" + shape.name() + "': adding liquid from a script is supported in liquid scenes only");
 }
 
 std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,

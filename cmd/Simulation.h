@@ -70,6 +70,10 @@ public:
     /// Replace the motion of the scene's solid `index` (in scene order) from now on; refused
     /// for a static solid and where the scene's solver cannot (gas, boiling).
     virtual void setSolidMotion(std::size_t index, sph::RigidMotion motion);
+    /// Add a solid (static for a zero velocity) or a liquid body given as a level set, beside
+    /// the scene's (scripts); returns the liquid particles added. Liquid scenes only.
+    virtual void addSolid(const sph::LevelSet& shape, const sph::Vec3& velocity);
+    virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity);
     /// Before simulating towards `frame`: per-frame inputs (deforming solid sequences).
     virtual void beforeFrame(int /*frame*/) {}
 };

@@ -216,6 +216,17 @@ public:
         mMotions[index] = motion;
     }
 
+    void addSolid(const sph::LevelSet& shape, const std::array<double, 3>& velocity)
+    {
+        py::gil_scoped_release release;
+        mSim->addSolid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]), sph::Real(velocity[2])));
+    }
+    std::size_t addLiquid(const sph::LevelSet& shape, const std::array<double, 3>& velocity)
+    {
+        py::gil_scoped_release release;
+        return mSim->addLiquid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]), sph::Real(velocity[2])));
+    }
+
     /// Statistics of every step since this object was made: column name -> float64 array.
     py::dict statistics() const
     {
@@ -400,6 +411,14 @@ PYBIND11_MODULE(_ghostfx, m)
              "From now on the scene's solid `name` moves at `velocity` (m/s) from where it is. It "
              "must be a moving solid in the scene (a velocity or motion keys); not saved in "
              "checkpoints")
+        .def("add_solid", &PySimulation::addSolid, py::arg("level_set"),
+             py::arg("velocity") = std::array<double, 3>{0, 0, 0},
+             "Add a solid beside the scene's (static at zero velocity, else moving at it); its "
+             "ghosts are sampled now. Liquid scenes")
+        .def("add_liquid", &PySimulation::addLiquid, py::arg("level_set"),
+             py::arg("velocity") = std::array<double, 3>{0, 0, 0},
+             "Sample a liquid body into the simulation before its first frame; returns the "
+             "particles added. Liquid scenes")
         .def("statistics", &PySimulation::statistics,
              "Per-step statistics since this object was made, as `ghostfx run` writes them to "
              "stats.h5: a dict of column name -> float64 array, one entry per step")
