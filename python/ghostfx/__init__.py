@@ -8,14 +8,17 @@
 The same code as the `ghostfx` command line: scene errors raise ValueError with its message.
 Particle arrays are float64 NumPy copies (the solver reorders its storage every step).
 """
+import csv as _csv
 import json as _json
 import os as _os
+import shutil as _shutil
+import subprocess as _subprocess
 import tempfile as _tempfile
 
 from ._ghostfx import LevelSet, Scene, Simulation, sample, __version__
 from ._ghostfx import load_scene as _load_scene_file
 
-__all__ = ["LevelSet", "Scene", "Simulation", "load_scene", "sample", "__version__"]
+__all__ = ["LevelSet", "Scene", "Simulation", "load_scene", "sample", "study", "__version__"]
 
 
 def load_scene(scene, overrides=None, folder=None):
@@ -34,3 +37,53 @@ def load_scene(scene, overrides=None, folder=None):
         return _load_scene_file(f.name, overrides)
     finally:
         _os.unlink(f.name)
+
+
+def _program(executable=None):
+    """The ghostfx program: given, $GHOSTFX_EXE, beside this package in a build tree
+    (build/cmd/ghostfx) or an install prefix (bin/ghostfx), or on the PATH."""
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    candidates = [executable, _os.environ.get("GHOSTFX_EXE"),
+                  _os.path.join(here, "..", "..", "cmd", "ghostfx"),
+                  _os.path.join(here, "..", "..", "..", "..", "bin", "ghostfx"),
+                  _shutil.which("ghostfx")]
+    for c in candidates:
+        if c and _os.path.isfile(c) and _os.access(c, _os.X_OK):
+            return _os.path.normpath(c)
+    raise OSError("ghostfx.study: the ghostfx program was not found (give executable=, set "
+                  "GHOSTFX_EXE, or put it on the PATH)")
+
+
+def study(path, out=None, threads=0, executable=None):
+    """Run a study (docs/study.md): every case of its sweep, the table and the plot, as
+    `ghostfx study` does (its cases run as child ghostfx processes). Returns the table as a dict
+    of column name -> list of values (numbers where the column holds numbers).
+
+    A bad study file raises ValueError with the command line's message."""
+    args = [_program(executable), "study", _os.fspath(path), "-q", "--threads", str(int(threads))]
+    if out is not None:
+        args += ["--out", _os.fspath(out)]
+    run = _subprocess.run(args, capture_output=True, text=True)
+    if run.returncode != 0:
+        line = run.stderr.strip().splitlines()[-1] if run.stderr.strip() else f"exit code {run.returncode}"
+        raise ValueError(line.removeprefix("ghostfx: error: "))
+    with open(path) as f:
+        text = f.read()
+    try:
+        spec = _json.loads(text)
+    except ValueError:  # the scene format allows // comments
+        import re
+        spec = _json.loads(re.sub(r"(^|\s)//[^\n]*", r"\1", text))
+    output = spec.get("output", {})
+    folder = _os.fspath(out) if out is not None else output.get("directory", "out")
+    table = _os.path.join(folder, output.get("table", "study.csv"))
+    with open(table, newline="") as f:
+        rows = list(_csv.DictReader(f))
+    columns = {}
+    for name in (rows[0].keys() if rows else []):
+        values = [r[name] for r in rows]
+        try:
+            columns[name] = [float(v) for v in values]
+        except ValueError:
+            columns[name] = values
+    return columns
