@@ -10,6 +10,8 @@
 #include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/Scene.h>
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointCount.h>
@@ -34,11 +36,8 @@ extern char** environ;
 
 namespace {
 
-std::string slurp(const fs::path& p)
-{
-    std::ifstream in(p);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using ghostfx::testing::slurp;
+
 
 struct Result
 {

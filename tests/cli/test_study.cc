@@ -3,6 +3,8 @@
 ///         bad study files, on a free-falling drop small enough to run many times.
 #include <ghostfx/sph/Types.h>
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -21,13 +23,8 @@ using Json = nlohmann::json;
 
 namespace {
 
-std::string slurp(const fs::path& p)
-{
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using ghostfx::testing::slurp;
+
 
 /// A CSV table as rows of column -> text.
 std::vector<std::map<std::string, std::string>> readCsv(const fs::path& p)

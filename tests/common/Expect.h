@@ -7,6 +7,9 @@
 
 #include <exception>
 #include <filesystem>
+#include <string>
+
+#include <unistd.h>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -35,11 +38,12 @@ inline bool contains(const std::string& text, const std::string& part)
     return text.find(part) != std::string::npos;
 }
 
-/// An empty folder of the system's temporary directory for one test ("ghostfx_test_<name>").
+/// An empty folder of the system's temporary directory for one test
+/// ("ghostfx_test_<name>_<pid>": test processes that ctest runs side by side never share one).
 inline std::filesystem::path freshDir(const std::string& name)
 {
-    const std::filesystem::path dir =
-        std::filesystem::temp_directory_path() / ("ghostfx_test_" + name);
+    const std::filesystem::path dir = std::filesystem::temp_directory_path()
+                                      / ("ghostfx_test_" + name + "_" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;

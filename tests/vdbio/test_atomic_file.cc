@@ -17,11 +17,8 @@ using namespace ghostfx;
 
 namespace {
 
-std::string slurp(const fs::path& p)
-{
-    std::ifstream in(p);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using ghostfx::testing::slurp;
+
 
 using ghostfx::testing::freshDir;
 

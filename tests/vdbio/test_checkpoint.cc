@@ -10,6 +10,8 @@
 
 #include "common/StateDiff.h"
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -34,16 +36,10 @@ using namespace ghostfx::vdbio;
 
 namespace {
 
+using ghostfx::testing::freshDir;
+
 constexpr Real H = Real(0.01);
 
-fs::path freshDir(const std::string& name)
-{
-    const fs::path dir = fs::temp_directory_path()
-                         / ("ghostfx_ckpt_test_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
 
 using ghostfx::testing::firstDifference;
 using ghostfx::testing::sameBytes;

@@ -20,6 +20,8 @@
 #include <openvdb/io/File.h>
 #include <openvdb/points/PointDataGrid.h>
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -35,6 +37,8 @@ using namespace ghostfx::sph;
 
 namespace {
 
+using ghostfx::testing::freshDir;
+
 constexpr double SPACING = 0.02;                       // h (m)
 constexpr double VOXEL = 0.5 * SPACING;                // dx = h / 2 (m)
 constexpr double SUPPORT = 3.0 * SPACING;              // R = 3 h ([SB12] Sec. 3) (m)
@@ -43,13 +47,6 @@ constexpr double SPHERE_RADIUS = 6 * SPACING;          // liquid sphere (m)
 const Vec3 VELOCITY(Real(0.3), Real(-1.2), Real(0.5)); // uniform liquid velocity (m/s)
 constexpr Real TEMPERATURE = Real(353.15);             // uniform liquid temperature (K)
 
-fs::path freshDir(const std::string& name)
-{
-    const fs::path dir = fs::temp_directory_path() / ("ghostfx_test_frames_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
 
 /// The test scene: a Poisson-disk liquid sphere and a ghost-air shell around it.
 struct Scene
