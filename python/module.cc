@@ -61,17 +61,17 @@ sph::ParticleKind kindFromName(const std::string& name)
     if (name == "solid") return sph::ParticleKind::GhostSolid;
     if (name == "gas") return sph::ParticleKind::Gas;
     if (name == "boundary") return sph::ParticleKind::Boundary;
-    throw ValueError("particle kind '" + name +
-                          "': expected 'liquid', 'air', 'solid', 'gas' or 'boundary'");
+    throw ValueError("particle kind '" + name
+                     + "': expected 'liquid', 'air', 'solid', 'gas' or 'boundary'");
 }
 
 /// One medium's particles of `kind`, ghosts included (a copy; see the file comment).
 sph::ParticleSet particlesOf(const cmd::Simulation& sim, sph::ParticleKind kind)
 {
     for (const cmd::OutputMedium& m : sim.media()) {
-        const bool listed = std::find(m.kinds.begin(), m.kinds.end(), kind) != m.kinds.end()
-                            || std::find(m.ghostKinds.begin(), m.ghostKinds.end(), kind)
-                                   != m.ghostKinds.end();
+        const bool listed =
+            std::find(m.kinds.begin(), m.kinds.end(), kind) != m.kinds.end()
+            || std::find(m.ghostKinds.begin(), m.ghostKinds.end(), kind) != m.ghostKinds.end();
         if (!listed) continue;
         sph::ParticleSet all = m.withGhosts ? m.withGhosts() : *m.particles;
         std::vector<std::uint8_t> keep(all.size());
@@ -94,16 +94,17 @@ py::array_t<double> vectors(const std::vector<sph::Vec3>& v)
 /// A level set from a dense signed-distance array sdf[i, j, k] at world points
 /// origin + voxel (i, j, k) (negative inside): the narrow band of 3 voxels is kept, the
 /// inside is filled, and the grid is checked as every other level set is.
-sph::LevelSet levelSetFromArray(const py::array_t<float, py::array::c_style | py::array::forcecast>& sdf,
-                                double voxel, const std::array<double, 3>& origin, const std::string& name)
+sph::LevelSet levelSetFromArray(
+    const py::array_t<float, py::array::c_style | py::array::forcecast>& sdf, double voxel,
+    const std::array<double, 3>& origin, const std::string& name)
 {
     if (sdf.ndim() != 3) {
-        throw ValueError("level set '" + name + "': expected a 3-D array of signed distances, got " +
-                         std::to_string(sdf.ndim()) + " dimensions");
+        throw ValueError("level set '" + name + "': expected a 3-D array of signed distances, got "
+                         + std::to_string(sdf.ndim()) + " dimensions");
     }
     if (!(voxel > 0) || !std::isfinite(voxel)) {
-        throw ValueError("level set '" + name + "': voxel_size = " + std::to_string(voxel) +
-                         ": expected a number > 0");
+        throw ValueError("level set '" + name + "': voxel_size = " + std::to_string(voxel)
+                         + ": expected a number > 0");
     }
     const float background = float(3 * voxel);
     auto grid = openvdb::FloatGrid::create(background);
@@ -118,11 +119,12 @@ sph::LevelSet levelSetFromArray(const py::array_t<float, py::array::c_style | py
             for (py::ssize_t k = 0; k < a.shape(2); ++k) {
                 const float v = a(i, j, k);
                 if (!std::isfinite(v)) {
-                    throw ValueError("level set '" + name + "': sdf[" + std::to_string(i) + ", " +
-                                     std::to_string(j) + ", " + std::to_string(k) +
-                                     "] is not finite");
+                    throw ValueError("level set '" + name + "': sdf[" + std::to_string(i) + ", "
+                                     + std::to_string(j) + ", " + std::to_string(k)
+                                     + "] is not finite");
                 }
-                if (std::abs(v) < background) acc.setValue(openvdb::Coord(int(i), int(j), int(k)), v);
+                if (std::abs(v) < background)
+                    acc.setValue(openvdb::Coord(int(i), int(j), int(k)), v);
             }
         }
     }
@@ -141,7 +143,8 @@ std::pair<py::array_t<float>, std::array<double, 3>> levelSetToArray(const sph::
     auto acc = grid->getConstAccessor();
     for (int i = 0; i < dim.x(); ++i) {
         for (int j = 0; j < dim.y(); ++j) {
-            for (int k = 0; k < dim.z(); ++k) w(i, j, k) = acc.getValue(box.min() + openvdb::Coord(i, j, k));
+            for (int k = 0; k < dim.z(); ++k)
+                w(i, j, k) = acc.getValue(box.min() + openvdb::Coord(i, j, k));
         }
     }
     const openvdb::Vec3d o = grid->indexToWorld(box.min());
@@ -162,8 +165,9 @@ public:
     static PySimulation resume(const PyScene& scene, const std::string& path)
     {
         if (cmd::stateCount(*scene.scene) == 0) {
-            throw ValueError("scene '" + scene.scene->file + "': a boiling scene (with heaters) cannot "
-                             "be resumed yet");
+            throw ValueError("scene '" + scene.scene->file
+                             + "': a boiling scene (with heaters) cannot "
+                               "be resumed yet");
         }
         const std::vector<sph::SolverState> states{
             vdbio::readCheckpoint(path, scene.scene->simulationFingerprint())};
@@ -174,7 +178,8 @@ public:
     /// the scene's outputs.directory; the same files `ghostfx run` writes.
     void writeFrame(py::object folder) const
     {
-        const std::string dir = folder.is_none() ? mScene->outputs.directory : py::str(folder).cast<std::string>();
+        const std::string dir =
+            folder.is_none() ? mScene->outputs.directory : py::str(folder).cast<std::string>();
         py::gil_scoped_release release;
         vdbio::ensureWritableDirectory(dir);
         cmd::writeFrameOutputs(*mScene, *mSim, dir, mSim->frame());
@@ -191,13 +196,14 @@ public:
         if (index == solids.size()) {
             std::string known;
             for (const auto& s : solids) known += (known.empty() ? "'" : ", '") + s.name + "'";
-            throw ValueError("solid '" + name + "': the scene has no such solid (solids: " +
-                             (known.empty() ? "none" : known) + ")");
+            throw ValueError("solid '" + name + "': the scene has no such solid (solids: "
+                             + (known.empty() ? "none" : known) + ")");
         }
         if (mMotions.empty()) {
             for (const auto& s : solids) {
-                mMotions.push_back(s.motion.keys.empty() ? sph::constantVelocity(sph::Vec3(s.velocity))
-                                                         : cmd::keyedMotion(s.motion));
+                mMotions.push_back(s.motion.keys.empty()
+                                       ? sph::constantVelocity(sph::Vec3(s.velocity))
+                                       : cmd::keyedMotion(s.motion));
             }
         }
         const double t0 = mSim->time();
@@ -219,12 +225,14 @@ public:
     void addSolid(const sph::LevelSet& shape, const std::array<double, 3>& velocity)
     {
         py::gil_scoped_release release;
-        mSim->addSolid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]), sph::Real(velocity[2])));
+        mSim->addSolid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]),
+                                        sph::Real(velocity[2])));
     }
     std::size_t addLiquid(const sph::LevelSet& shape, const std::array<double, 3>& velocity)
     {
         py::gil_scoped_release release;
-        return mSim->addLiquid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]), sph::Real(velocity[2])));
+        return mSim->addLiquid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]),
+                                                sph::Real(velocity[2])));
     }
 
     /// Statistics of every step since this object was made: column name -> float64 array.
@@ -244,7 +252,8 @@ public:
     void saveCheckpoint(const std::string& path) const
     {
         if (cmd::stateCount(*mScene) == 0) {
-            throw ValueError("scene '" + mScene->file + "': boiling scenes write no checkpoints yet");
+            throw ValueError("scene '" + mScene->file
+                             + "': boiling scenes write no checkpoints yet");
         }
         vdbio::writeCheckpoint(path, mSim->saveStates().front(), mScene->simulationFingerprint(),
                                mSim->frame());
@@ -303,14 +312,15 @@ public:
         }
         if (p.hasScalarChannel(name)) return scalars(p.scalarChannel(name));
         if (p.hasVectorChannel(name)) return vectors(p.vectorChannel(name));
-        throw ValueError("channel '" + name + "' of the " + kind +
-                              " particles: not found (density, pressure, mass, id, or a solver "
-                              "channel)");
+        throw ValueError("channel '" + name + "' of the " + kind
+                         + " particles: not found (density, pressure, mass, id, or a solver "
+                           "channel)");
     }
 
 private:
     PySimulation(std::shared_ptr<const vdbio::Scene> scene, std::unique_ptr<cmd::Simulation> sim)
-        : mScene(std::move(scene)), mSim(std::move(sim))
+        : mScene(std::move(scene))
+        , mSim(std::move(sim))
     {
         observe();
     }
@@ -407,7 +417,8 @@ PYBIND11_MODULE(_ghostfx, m)
              "Write the scene's outputs for the current frame (files named by the scene's "
              "`outputs`, as `ghostfx run` writes them) into `folder` (default: "
              "outputs.directory); releases the GIL")
-        .def("set_solid_velocity", &PySimulation::setSolidVelocity, py::arg("name"), py::arg("velocity"),
+        .def("set_solid_velocity", &PySimulation::setSolidVelocity, py::arg("name"),
+             py::arg("velocity"),
              "From now on the scene's solid `name` moves at `velocity` (m/s) from where it is. It "
              "must be a moving solid in the scene (a velocity or motion keys); not saved in "
              "checkpoints")
@@ -430,7 +441,8 @@ PYBIND11_MODULE(_ghostfx, m)
         .def_property_readonly("frame", &PySimulation::frame, "frames advanced so far")
         .def_property_readonly("time", &PySimulation::time, "simulated time (s)")
         .def_property_readonly("steps", &PySimulation::steps, "steps taken so far")
-        .def_property_readonly("counts", &PySimulation::counts, "particle counts, as the log prints")
+        .def_property_readonly("counts", &PySimulation::counts,
+                               "particle counts, as the log prints")
         .def("positions", &PySimulation::positions, py::arg("kind") = "liquid",
              "Positions (m) of the particles of `kind` ('liquid', 'air', 'solid', 'gas', "
              "'boundary'), an (N, 3) float64 copy")
@@ -440,11 +452,13 @@ PYBIND11_MODULE(_ghostfx, m)
              "A per-particle quantity ('density', 'pressure', 'mass', 'id' or a solver channel), "
              "a copy");
 
-    py::class_<sph::LevelSet>(m, "LevelSet", "A narrow-band signed-distance grid (OpenVDB), negative inside")
-        .def_static("from_array", &levelSetFromArray, py::arg("sdf"), py::arg("voxel_size"),
-                    py::arg("origin") = std::array<double, 3>{0, 0, 0}, py::arg("name") = "array",
-                    "From a dense array sdf[i, j, k] of signed distances (m) at origin + voxel_size "
-                    "(i, j, k); the band within 3 voxels of the surface is kept")
+    py::class_<sph::LevelSet>(m, "LevelSet",
+                              "A narrow-band signed-distance grid (OpenVDB), negative inside")
+        .def_static(
+            "from_array", &levelSetFromArray, py::arg("sdf"), py::arg("voxel_size"),
+            py::arg("origin") = std::array<double, 3>{0, 0, 0}, py::arg("name") = "array",
+            "From a dense array sdf[i, j, k] of signed distances (m) at origin + voxel_size "
+            "(i, j, k); the band within 3 voxels of the surface is kept")
         .def_static(
             "from_vdb",
             [](const std::string& file, const std::string& grid) {
@@ -456,7 +470,8 @@ PYBIND11_MODULE(_ghostfx, m)
              "the world position of values[0, 0, 0]")
         .def(
             "phi",
-            [](const sph::LevelSet& shape, const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+            [](const sph::LevelSet& shape,
+               const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
                 if (points.ndim() != 2 || points.shape(1) != 3) {
                     throw ValueError("LevelSet.phi: expected an (N, 3) array of points");
                 }
@@ -464,12 +479,14 @@ PYBIND11_MODULE(_ghostfx, m)
                 py::array_t<double> out(points.shape(0));
                 auto w = out.mutable_unchecked<1>();
                 for (py::ssize_t i = 0; i < p.shape(0); ++i) {
-                    w(i) = double(shape.phi(sph::Vec3(sph::Real(p(i, 0)), sph::Real(p(i, 1)), sph::Real(p(i, 2)))));
+                    w(i) = double(shape.phi(
+                        sph::Vec3(sph::Real(p(i, 0)), sph::Real(p(i, 1)), sph::Real(p(i, 2)))));
                 }
                 return out;
             },
             py::arg("points"), "Signed distance (m) at each of the (N, 3) points, trilinear")
-        .def_property_readonly("voxel_size", [](const sph::LevelSet& s) { return double(s.voxelSize()); })
+        .def_property_readonly("voxel_size",
+                               [](const sph::LevelSet& s) { return double(s.voxelSize()); })
         .def_property_readonly("name", &sph::LevelSet::name);
 
     m.def(
@@ -478,14 +495,16 @@ PYBIND11_MODULE(_ghostfx, m)
             sph::SampleSet samples;
             {
                 py::gil_scoped_release release;
-                sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
+                sph::PoissonSettings settings =
+                    sph::PoissonSettings::forSpacing(sph::Real(spacing));
                 settings.seed = seed;
                 samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
             }
             return vectors(samples.positions);
         },
         py::arg("level_set"), py::arg("spacing"), py::arg("seed") = 1,
-        "Poisson-disk samples ([SB12] Sec. 4.5) of a LevelSet at particle spacing `spacing` (m): an "
+        "Poisson-disk samples ([SB12] Sec. 4.5) of a LevelSet at particle spacing `spacing` (m): "
+        "an "
         "(N, 3) float64 array");
     m.def(
         "sample",
@@ -494,7 +513,8 @@ PYBIND11_MODULE(_ghostfx, m)
             sph::SampleSet samples;
             {
                 py::gil_scoped_release release;
-                sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
+                sph::PoissonSettings settings =
+                    sph::PoissonSettings::forSpacing(sph::Real(spacing));
                 settings.seed = seed;
                 samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
             }
