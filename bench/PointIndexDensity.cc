@@ -107,14 +107,14 @@ void PointIndexDensity::density(const sph::CubicSplineKernel& kernel, const Real
     parallel::forRange(
         0, impl.points.count,
         [&](std::size_t begin, std::size_t end) {
-            Iterator::ConstAccessor acc(impl.grid->constTree());
-            Iterator it;
-            for (std::size_t i = begin; i < end; ++i) {
-                Real sum = 0;
-                impl.forEachNeighbor(i, radius, query, it, acc,
-                                     [&](std::size_t j, Real r) { sum += mass[j] * kernel.W(r); });
-                rho[i] = sum;
-            }
+        Iterator::ConstAccessor acc(impl.grid->constTree());
+        Iterator it;
+        for (std::size_t i = begin; i < end; ++i) {
+            Real sum = 0;
+            impl.forEachNeighbor(i, radius, query, it, acc,
+                                 [&](std::size_t j, Real r) { sum += mass[j] * kernel.W(r); });
+            rho[i] = sum;
+        }
         },
         GRAIN);
 }
@@ -126,14 +126,14 @@ std::uint64_t PointIndexDensity::countPairs(Real radius) const
     parallel::forRange(
         0, impl.points.count,
         [&](std::size_t begin, std::size_t end) {
-            Iterator::ConstAccessor acc(impl.grid->constTree());
-            Iterator it;
-            std::uint64_t pairs = 0;
-            for (std::size_t i = begin; i < end; ++i) {
-                impl.forEachNeighbor(i, radius, PointIndexQuery::BoxThenDistance, it, acc,
-                                     [&](std::size_t, Real) { ++pairs; });
-            }
-            total.fetch_add(pairs, std::memory_order_relaxed);
+        Iterator::ConstAccessor acc(impl.grid->constTree());
+        Iterator it;
+        std::uint64_t pairs = 0;
+        for (std::size_t i = begin; i < end; ++i) {
+            impl.forEachNeighbor(i, radius, PointIndexQuery::BoxThenDistance, it, acc,
+                                 [&](std::size_t, Real) { ++pairs; });
+        }
+        total.fetch_add(pairs, std::memory_order_relaxed);
         },
         GRAIN);
     return total.load();

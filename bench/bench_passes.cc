@@ -83,9 +83,9 @@ void densityScalar(const Scene& s, std::vector<Real>& out)
     parallel::forEach(
         0, COUNT,
         [&](std::size_t i) {
-            Real sum = 0;
-            for (Index j : s.lists[i]) sum += m[j] * s.kernel.W((x[i] - x[j]).length());
-            out[i] = sum;
+        Real sum = 0;
+        for (Index j : s.lists[i]) sum += m[j] * s.kernel.W((x[i] - x[j]).length());
+        out[i] = sum;
         },
         512);
 }
@@ -97,19 +97,19 @@ void densityBatch(const Scene& s, std::vector<Real>& out)
     parallel::forRange(
         0, COUNT,
         [&](std::size_t lo, std::size_t hi) {
-            PairBatch b;
-            const CubicSplineKernel kernel = s.kernel;
-            for (std::size_t i = lo; i < hi; ++i) {
-                const NeighborLists::List list = s.lists[i];
-                Real sum = 0;
-                for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
-                    const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
-                    for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]];
-                    for (int k = 0; k < n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                    sum += b.sum(b.f);
-                }
-                out[i] = sum;
+        PairBatch b;
+        const CubicSplineKernel kernel = s.kernel;
+        for (std::size_t i = lo; i < hi; ++i) {
+            const NeighborLists::List list = s.lists[i];
+            Real sum = 0;
+            for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
+                const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
+                for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]];
+                for (int k = 0; k < n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                sum += b.sum(b.f);
             }
+            out[i] = sum;
+        }
         },
         512);
 }
@@ -121,14 +121,14 @@ void pressureScalar(const Scene& s, std::vector<Vec3>& out)
     parallel::forEach(
         0, COUNT,
         [&](std::size_t i) {
-            Vec3 a(0);
-            const Real pi = s.ratio[i];
-            for (Index j : s.lists[i]) {
-                if (j == i) continue;
-                const Vec3 xij = x[i] - x[j];
-                a -= m[j] * (pi + s.ratio[j]) * s.kernel.gradW(xij, xij.length());
-            }
-            out[i] = a;
+        Vec3 a(0);
+        const Real pi = s.ratio[i];
+        for (Index j : s.lists[i]) {
+            if (j == i) continue;
+            const Vec3 xij = x[i] - x[j];
+            a -= m[j] * (pi + s.ratio[j]) * s.kernel.gradW(xij, xij.length());
+        }
+        out[i] = a;
         },
         512);
 }
@@ -140,19 +140,19 @@ void pressureBatch(const Scene& s, std::vector<Vec3>& out)
     parallel::forRange(
         0, COUNT,
         [&](std::size_t lo, std::size_t hi) {
-            PairBatch b;
-            for (std::size_t i = lo; i < hi; ++i) {
-                const NeighborLists::List list = s.lists[i];
-                const Real pi = s.ratio[i];
-                Vec3 a(0);
-                for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
-                    const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
-                    for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]] * (pi + s.ratio[b.j[k]]);
-                    for (int k = 0; k < n; ++k) b.f[k] *= -s.kernel.gradFactor(b.r[k]);
-                    a += b.sumScaledOffsets(b.f);
-                }
-                out[i] = a;
+        PairBatch b;
+        for (std::size_t i = lo; i < hi; ++i) {
+            const NeighborLists::List list = s.lists[i];
+            const Real pi = s.ratio[i];
+            Vec3 a(0);
+            for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
+                const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
+                for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]] * (pi + s.ratio[b.j[k]]);
+                for (int k = 0; k < n; ++k) b.f[k] *= -s.kernel.gradFactor(b.r[k]);
+                a += b.sumScaledOffsets(b.f);
             }
+            out[i] = a;
+        }
         },
         512);
 }

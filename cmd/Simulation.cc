@@ -556,12 +556,14 @@ void Simulation::setSolidMotion(std::size_t /*index*/, sph::RigidMotion /*motion
 
 void Simulation::addSolid(const sph::LevelSet& shape, const Vec3& /*velocity*/)
 {
-    throw ValueError("solid '" + shape.name() + "': adding solids from a script is supported in liquid scenes only");
+    throw ValueError("solid '" + shape.name()
+                     + "': adding solids from a script is supported in liquid scenes only");
 }
 
 std::size_t Simulation::addLiquid(const sph::LevelSet& shape, const Vec3& /*velocity*/)
 {
-    throw ValueError("liquid '" + shape.name() + "': adding liquid from a script is supported in liquid scenes only");
+    throw ValueError("liquid '" + shape.name()
+                     + "': adding liquid from a script is supported in liquid scenes only");
 }
 
 std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,

@@ -388,11 +388,11 @@ PYBIND11_MODULE(_ghostfx, m)
     m.def(
         "load_scene",
         [](const std::string& path, py::object overrides) {
-            auto scene = std::make_shared<const vdbio::Scene>(
-                vdbio::readScene(path, assignments(overrides)));
-            // Every solver key too, as `ghostfx run` checks them before sampling anything.
-            cmd::checkSimulationSettings(*scene);
-            return PyScene{scene};
+        auto scene =
+            std::make_shared<const vdbio::Scene>(vdbio::readScene(path, assignments(overrides)));
+        // Every solver key too, as `ghostfx run` checks them before sampling anything.
+        cmd::checkSimulationSettings(*scene);
+        return PyScene{scene};
         },
         py::arg("path"), py::arg("overrides") = py::none(),
         "Read a scene. `overrides` is a dict of the dotted keys of the command line's -D, e.g. "
@@ -408,7 +408,7 @@ PYBIND11_MODULE(_ghostfx, m)
         .def(
             "run",
             [](py::object self, py::object frames, py::object onFrame) {
-                self.cast<PySimulation&>().run(frames, onFrame, self);
+        self.cast<PySimulation&>().run(frames, onFrame, self);
             },
             py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
             "Advance `frames` frames (default: to the scene's last), calling on_frame(sim) after "
@@ -462,7 +462,7 @@ PYBIND11_MODULE(_ghostfx, m)
         .def_static(
             "from_vdb",
             [](const std::string& file, const std::string& grid) {
-                return vdbio::loadLevelSet(file, grid, "LevelSet.from_vdb");
+        return vdbio::loadLevelSet(file, grid, "LevelSet.from_vdb");
             },
             py::arg("file"), py::arg("grid"), "The level-set grid `grid` of a .vdb file")
         .def("to_array", &levelSetToArray,
@@ -472,17 +472,17 @@ PYBIND11_MODULE(_ghostfx, m)
             "phi",
             [](const sph::LevelSet& shape,
                const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
-                if (points.ndim() != 2 || points.shape(1) != 3) {
-                    throw ValueError("LevelSet.phi: expected an (N, 3) array of points");
-                }
-                auto p = points.unchecked<2>();
-                py::array_t<double> out(points.shape(0));
-                auto w = out.mutable_unchecked<1>();
-                for (py::ssize_t i = 0; i < p.shape(0); ++i) {
-                    w(i) = double(shape.phi(
-                        sph::Vec3(sph::Real(p(i, 0)), sph::Real(p(i, 1)), sph::Real(p(i, 2)))));
-                }
-                return out;
+        if (points.ndim() != 2 || points.shape(1) != 3) {
+            throw ValueError("LevelSet.phi: expected an (N, 3) array of points");
+        }
+        auto p = points.unchecked<2>();
+        py::array_t<double> out(points.shape(0));
+        auto w = out.mutable_unchecked<1>();
+        for (py::ssize_t i = 0; i < p.shape(0); ++i) {
+            w(i) = double(
+                shape.phi(sph::Vec3(sph::Real(p(i, 0)), sph::Real(p(i, 1)), sph::Real(p(i, 2)))));
+        }
+        return out;
             },
             py::arg("points"), "Signed distance (m) at each of the (N, 3) points, trilinear")
         .def_property_readonly("voxel_size",
@@ -492,15 +492,14 @@ PYBIND11_MODULE(_ghostfx, m)
     m.def(
         "sample",
         [](const sph::LevelSet& shape, double spacing, std::uint64_t seed) {
-            sph::SampleSet samples;
-            {
-                py::gil_scoped_release release;
-                sph::PoissonSettings settings =
-                    sph::PoissonSettings::forSpacing(sph::Real(spacing));
-                settings.seed = seed;
-                samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
-            }
-            return vectors(samples.positions);
+        sph::SampleSet samples;
+        {
+            py::gil_scoped_release release;
+            sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
+            settings.seed = seed;
+            samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
+        }
+        return vectors(samples.positions);
         },
         py::arg("level_set"), py::arg("spacing"), py::arg("seed") = 1,
         "Poisson-disk samples ([SB12] Sec. 4.5) of a LevelSet at particle spacing `spacing` (m): "
@@ -509,16 +508,15 @@ PYBIND11_MODULE(_ghostfx, m)
     m.def(
         "sample",
         [](const std::string& file, const std::string& grid, double spacing, std::uint64_t seed) {
-            const sph::LevelSet shape = vdbio::loadLevelSet(file, grid, "sample");
-            sph::SampleSet samples;
-            {
-                py::gil_scoped_release release;
-                sph::PoissonSettings settings =
-                    sph::PoissonSettings::forSpacing(sph::Real(spacing));
-                settings.seed = seed;
-                samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
-            }
-            return vectors(samples.positions);
+        const sph::LevelSet shape = vdbio::loadLevelSet(file, grid, "sample");
+        sph::SampleSet samples;
+        {
+            py::gil_scoped_release release;
+            sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
+            settings.seed = seed;
+            samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
+        }
+        return vectors(samples.positions);
         },
         py::arg("file"), py::arg("grid"), py::arg("spacing"), py::arg("seed") = 1,
         "Poisson-disk samples ([SB12] Sec. 4.5) of the level set `grid` in the .vdb `file` at "

@@ -913,13 +913,13 @@ void GasSolver::checkBlowUp(Real dt) const
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
-            if (kind[i] != ParticleKind::Gas) return;
-            if (isFinite(x[i]) && isFinite(v[i]) && std::isfinite(T[i]) && std::isfinite(rho[i])
-                && v[i].lengthSqr() <= limit2 && std::abs(T[i] - Tamb) <= MAX_TEMPERATURE_EXCESS) {
-                return;
-            }
-            std::size_t expected = bad.load();
-            while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
+        if (kind[i] != ParticleKind::Gas) return;
+        if (isFinite(x[i]) && isFinite(v[i]) && std::isfinite(T[i]) && std::isfinite(rho[i])
+            && v[i].lengthSqr() <= limit2 && std::abs(T[i] - Tamb) <= MAX_TEMPERATURE_EXCESS) {
+            return;
+        }
+        std::size_t expected = bad.load();
+        while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
         },
         4096);
     const std::size_t i = bad.load();

@@ -300,25 +300,24 @@ std::vector<MergeGroup> planMerges(const ParticleSet& particles, const sph::Neig
     parallel::forEach(
         0, candidates.size(),
         [&](std::size_t c) {
-            const Index M = candidates[c];
-            const Real radius = settings.neighbourhoodFactor * h[M];
-            std::vector<std::tuple<Real, sph::ParticleId, Index>> near;
-            grid.forEachInRadius(x[M], radius, [&](Index j, const Vec3&, Real r) {
-                if (j == M || kinds[j] != kinds[M]) return;
-                const Real ratio = h[j] / h[M];
-                if (ratio > settings.maxSizeRatio || ratio * settings.maxSizeRatio < Real(1))
-                    return;
-                near.emplace_back(r, ids[j], j);
-            });
-            std::sort(near.begin(), near.end());
-            MergeGroup& g = groups[c];
-            g.candidate = M;
-            g.members.push_back(M);
-            for (const auto& t : near) {
-                if (g.members.size() >= limit) break;
-                g.members.push_back(std::get<2>(t));
-            }
-            g.eta = massDecentration(inertiaMatrix(particles, x[M], g.members));
+        const Index M = candidates[c];
+        const Real radius = settings.neighbourhoodFactor * h[M];
+        std::vector<std::tuple<Real, sph::ParticleId, Index>> near;
+        grid.forEachInRadius(x[M], radius, [&](Index j, const Vec3&, Real r) {
+            if (j == M || kinds[j] != kinds[M]) return;
+            const Real ratio = h[j] / h[M];
+            if (ratio > settings.maxSizeRatio || ratio * settings.maxSizeRatio < Real(1)) return;
+            near.emplace_back(r, ids[j], j);
+        });
+        std::sort(near.begin(), near.end());
+        MergeGroup& g = groups[c];
+        g.candidate = M;
+        g.members.push_back(M);
+        for (const auto& t : near) {
+            if (g.members.size() >= limit) break;
+            g.members.push_back(std::get<2>(t));
+        }
+        g.eta = massDecentration(inertiaMatrix(particles, x[M], g.members));
         },
         16);
 

@@ -53,37 +53,37 @@ void GhostSolver::stepBasic(Real dt)
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
-            if (kind[i] != ParticleKind::Liquid) {
-                vnew[i] = v[i];
-                return;
+        if (kind[i] != ParticleKind::Liquid) {
+            vnew[i] = v[i];
+            return;
+        }
+        const Real pi = p[i] / sqr(rho[i]);
+        Vec3 a = g;
+        for (Index j : mFluidLists[i]) {
+            if (j == i) continue;
+            const Vec3 xij = x[i] - x[j];
+            const Real r = xij.length();
+            Real term = pi + p[j] / sqr(rho[j]);
+            const Real vx = (v[i] - v[j]).dot(xij);
+            if (vx < Real(0)) {
+                const Real nu = Real(2) * alpha * s * c / (rho[i] + rho[j]);
+                term += -nu * vx / (r * r + Real(0.01) * s * s);
             }
-            const Real pi = p[i] / sqr(rho[i]);
-            Vec3 a = g;
-            for (Index j : mFluidLists[i]) {
-                if (j == i) continue;
-                const Vec3 xij = x[i] - x[j];
-                const Real r = xij.length();
-                Real term = pi + p[j] / sqr(rho[j]);
-                const Real vx = (v[i] - v[j]).dot(xij);
-                if (vx < Real(0)) {
-                    const Real nu = Real(2) * alpha * s * c / (rho[i] + rho[j]);
-                    term += -nu * vx / (r * r + Real(0.01) * s * s);
-                }
-                a -= m[j] * term * mKernel.gradW(xij, r);
+            a -= m[j] * term * mKernel.gradW(xij, r);
+        }
+        for (const SolidBlock* b : {&mStatic, &mMoving}) {
+            const Vec3* y = b->block.particles().positions().data();
+            for (Index k : b->lists[i]) {
+                const Vec3 xik = x[i] - y[k];
+                const Real r = xik.length();
+                if (!(r < r0) || !(r > Real(0))) continue;
+                const Real q = r0 / r;
+                const Real q2 = q * q, q4 = q2 * q2;
+                a += (D * (q4 * q4 * q4 - q4) / (r * r)) * xik;
             }
-            for (const SolidBlock* b : {&mStatic, &mMoving}) {
-                const Vec3* y = b->block.particles().positions().data();
-                for (Index k : b->lists[i]) {
-                    const Vec3 xik = x[i] - y[k];
-                    const Real r = xik.length();
-                    if (!(r < r0) || !(r > Real(0))) continue;
-                    const Real q = r0 / r;
-                    const Real q2 = q * q, q4 = q2 * q2;
-                    a += (D * (q4 * q4 * q4 - q4) / (r * r)) * xik;
-                }
-            }
-            vnew[i] = v[i] + dt * a;
-            accel[i] = a.length();
+        }
+        vnew[i] = v[i] + dt * a;
+        accel[i] = a.length();
         },
         512);
     mMaxAcceleration = n ? *std::max_element(accel.begin(), accel.end()) : Real(0);
@@ -97,22 +97,22 @@ void GhostSolver::stepBasic(Real dt)
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
-            xnew[i] = x[i];
-            if (kind[i] != ParticleKind::Liquid) return;
-            Vec3 dv(0);
-            for (Index j : mFluidLists[i]) {
-                if (j == i || kind[j] != ParticleKind::Liquid) continue;
-                const Real r = (x[i] - x[j]).length();
-                dv += (Real(2) * m[j] / (rho[i] + rho[j]) * mKernel.W(r)) * (vnew[j] - vnew[i]);
-            }
-            xnew[i] = x[i] + dt * (vnew[i] + eps * dv);
+        xnew[i] = x[i];
+        if (kind[i] != ParticleKind::Liquid) return;
+        Vec3 dv(0);
+        for (Index j : mFluidLists[i]) {
+            if (j == i || kind[j] != ParticleKind::Liquid) continue;
+            const Real r = (x[i] - x[j]).length();
+            dv += (Real(2) * m[j] / (rho[i] + rho[j]) * mKernel.W(r)) * (vnew[j] - vnew[i]);
+        }
+        xnew[i] = x[i] + dt * (vnew[i] + eps * dv);
         },
         512);
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
-            xw[i] = xnew[i];
-            if (kind[i] == ParticleKind::Liquid) v[i] = vnew[i];
+        xw[i] = xnew[i];
+        if (kind[i] == ParticleKind::Liquid) v[i] = vnew[i];
         },
         4096);
     mTimings.xsphAndBoundary += secondsSince(t0);

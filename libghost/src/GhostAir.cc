@@ -118,10 +118,10 @@ void GhostSolver::resampleAir(int phase)
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
-            if (!region.near(x[i], R)) return;
-            if (region.contains(x[i])) zone[i] = IN_REGION | NEAR_SEEDING | NEAR_BODY;
-            else if (region.near(x[i], Real(2) * r)) zone[i] = NEAR_SEEDING | NEAR_BODY;
-            else zone[i] = NEAR_BODY;
+        if (!region.near(x[i], R)) return;
+        if (region.contains(x[i])) zone[i] = IN_REGION | NEAR_SEEDING | NEAR_BODY;
+        else if (region.near(x[i], Real(2) * r)) zone[i] = NEAR_SEEDING | NEAR_BODY;
+        else zone[i] = NEAR_BODY;
         },
         2048);
     auto inPhase = [&](const Vec3& q) { return region.contains(q); };
@@ -137,51 +137,50 @@ void GhostSolver::resampleAir(int phase)
     parallel::forRange(
         0, n,
         [&](std::size_t lo, std::size_t hi) {
-            const CubicSplineKernel kernel = mKernel;
-            PairBatch batch;
-            for (std::size_t i = lo; i < hi; ++i) {
-                // Only the liquid within a kernel radius of the region is asked about, and only the
-                // seeding candidates need the indicator.
-                if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)) continue;
-                for (Index j : mFluidLists[i]) {
-                    if (j != i && kind[j] == ParticleKind::Liquid) {
-                        body[i] = 1;
-                        break;
-                    }
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        for (std::size_t i = lo; i < hi; ++i) {
+            // Only the liquid within a kernel radius of the region is asked about, and only the
+            // seeding candidates need the indicator.
+            if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)) continue;
+            for (Index j : mFluidLists[i]) {
+                if (j != i && kind[j] == ParticleKind::Liquid) {
+                    body[i] = 1;
+                    break;
                 }
-                if (!body[i] || !(zone[i] & NEAR_SEEDING)) continue;
-                // A particle with no air neighbour and a full neighbourhood is interior: no seed.
-                // (Full: at least 90 % of the mean neighbour count of the last step.)
-                bool air = false;
-                for (Index j : mFluidLists[i]) {
-                    if (kind[j] == ParticleKind::GhostAir) {
-                        air = true;
-                        break;
-                    }
-                }
-                const std::size_t count =
-                    mFluidLists[i].size() + mStatic.lists[i].size() + mMoving.lists[i].size();
-                if (!air && mMass > Real(0) && mMeanNeighbors > 0
-                    && double(count) >= 0.9 * mMeanNeighbors) {
-                    indicator[i] = std::numeric_limits<Real>::max();
-                    continue;
-                }
-                Real sum = 0;
-                batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k)
-                        b.f[k] = Real(kind[b.j[k]] == ParticleKind::Liquid);
-                    for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                    sum += b.sum(b.f);
-                });
-                for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                    batch.forEachBatch(x[i], block->block.particles().positions().data(),
-                                       block->lists[i], [&](PairBatch& b) {
-                                           for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
-                                           sum += b.sum(b.f);
-                                       });
-                }
-                indicator[i] = sum;
             }
+            if (!body[i] || !(zone[i] & NEAR_SEEDING)) continue;
+            // A particle with no air neighbour and a full neighbourhood is interior: no seed.
+            // (Full: at least 90 % of the mean neighbour count of the last step.)
+            bool air = false;
+            for (Index j : mFluidLists[i]) {
+                if (kind[j] == ParticleKind::GhostAir) {
+                    air = true;
+                    break;
+                }
+            }
+            const std::size_t count =
+                mFluidLists[i].size() + mStatic.lists[i].size() + mMoving.lists[i].size();
+            if (!air && mMass > Real(0) && mMeanNeighbors > 0
+                && double(count) >= 0.9 * mMeanNeighbors) {
+                indicator[i] = std::numeric_limits<Real>::max();
+                continue;
+            }
+            Real sum = 0;
+            batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = Real(kind[b.j[k]] == ParticleKind::Liquid);
+                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                sum += b.sum(b.f);
+            });
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                batch.forEachBatch(x[i], block->block.particles().positions().data(),
+                                   block->lists[i], [&](PairBatch& b) {
+                                       for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
+                                       sum += b.sum(b.f);
+                                   });
+            }
+            indicator[i] = sum;
+        }
         },
         512);
     Aabb bounds;
@@ -355,17 +354,17 @@ void GhostSolver::resampleAir(int phase)
         parallel::forEach(
             0, xs.size(),
             [&](std::size_t i) {
-                if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
-                if (i < n && !(zone[i] & IN_REGION)) return;
-                // The liquid and the living air of the step's grid, and the new air.
-                Real sigma = 0;
-                mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
-                    if (kind[j] == ParticleKind::Liquid || target[j] != Real(0))
-                        sigma += mKernel.W(rij);
-                });
-                freshGrid.forEachInRadius(
-                    xs[i], R, [&](Index, const Vec3&, Real rij) { sigma += mKernel.W(rij); });
-                target[i] = sigma > n0 ? n0 / sigma : Real(1);
+            if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
+            if (i < n && !(zone[i] & IN_REGION)) return;
+            // The liquid and the living air of the step's grid, and the new air.
+            Real sigma = 0;
+            mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
+                if (kind[j] == ParticleKind::Liquid || target[j] != Real(0))
+                    sigma += mKernel.W(rij);
+            });
+            freshGrid.forEachInRadius(
+                xs[i], R, [&](Index, const Vec3&, Real rij) { sigma += mKernel.W(rij); });
+            target[i] = sigma > n0 ? n0 / sigma : Real(1);
             },
             64);
     }

@@ -132,8 +132,10 @@ void GhostSolver::setSolidMotion(std::size_t solidIndex, RigidMotion motion)
     if (!motion) throw ValueError(msg("setSolidMotion: solid ", solidIndex, ": no motion given"));
     Solid& solid = *mSolids[solidIndex];
     if (!solid.moving) {
-        throw ValueError(msg("solid '", solid.shape.name(), "' was added as a static solid: its motion "
-                             "cannot change (give it a velocity or motion keys to make it a moving one)"));
+        throw ValueError(
+            msg("solid '", solid.shape.name(),
+                "' was added as a static solid: its motion "
+                "cannot change (give it a velocity or motion keys to make it a moving one)"));
     }
     solid.motion = std::move(motion);
 }

@@ -78,8 +78,8 @@ void GhostSolver::searchNeighbors()
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
-            mLiquidMask[i] = kind[i] == ParticleKind::Liquid;
-            mQueryMask[i] = mLiquidMask[i] || kind[i] == ParticleKind::GhostAir;
+        mLiquidMask[i] = kind[i] == ParticleKind::Liquid;
+        mQueryMask[i] = mLiquidMask[i] || kind[i] == ParticleKind::GhostAir;
         },
         4096);
     const Real R = mSettings.supportRadius();
@@ -108,51 +108,50 @@ void GhostSolver::computeDensity()
     parallel::forRange(
         0, n,
         [&](std::size_t lo, std::size_t hi) {
-            const CubicSplineKernel kernel = mKernel;
-            PairBatch batch;
-            std::vector<Index> firstTouch[2];
-            for (std::size_t i = lo; i < hi; ++i) {
-                if (kind[i] != ParticleKind::Liquid) {
-                    rho[i] = rho0;
-                    continue;
-                }
-                const Vec3 xi = x[i];
-                const NeighborLists::List fluid = mFluidLists[i];
-                Real sum = 0;
-                batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
-                    for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                    sum += b.sum(b.f);
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        std::vector<Index> firstTouch[2];
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) {
+                rho[i] = rho0;
+                continue;
+            }
+            const Vec3 xi = x[i];
+            const NeighborLists::List fluid = mFluidLists[i];
+            Real sum = 0;
+            batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
+                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                sum += b.sum(b.f);
+            });
+            std::size_t count = fluid.size();
+            for (int k = 0; ghost && k < 2; ++k) {
+                SolidBlock& block = *blocks[k];
+                const NeighborLists::List solid = block.lists[i];
+                Real w = 0;
+                batch.forEachBatch(xi, block.block.particles().positions().data(), solid,
+                                   [&](PairBatch& b) {
+                    for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
+                    w += b.sum(b.f);
+                    for (int c = 0; c < b.n; ++c) {
+                        if (atomicMin(&block.nearest[b.j[c]], nearestKey(b.r[c], Index(i)))) {
+                            firstTouch[k].push_back(b.j[c]);
+                        }
+                    }
                 });
-                std::size_t count = fluid.size();
-                for (int k = 0; ghost && k < 2; ++k) {
-                    SolidBlock& block = *blocks[k];
-                    const NeighborLists::List solid = block.lists[i];
-                    Real w = 0;
-                    batch.forEachBatch(xi, block.block.particles().positions().data(), solid,
-                                       [&](PairBatch& b) {
-                                           for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
-                                           w += b.sum(b.f);
-                                           for (int c = 0; c < b.n; ++c) {
-                                               if (atomicMin(&block.nearest[b.j[c]],
-                                                             nearestKey(b.r[c], Index(i)))) {
-                                                   firstTouch[k].push_back(b.j[c]);
-                                               }
-                                           }
-                                       });
-                    sum += mMass * w;
-                    count += solid.size();
-                }
-                rho[i] = sum;
-                neighbours[i] = std::uint32_t(count);
+                sum += mMass * w;
+                count += solid.size();
             }
-            if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
-                std::lock_guard<std::mutex> lock(touchedMutex);
-                for (int k = 0; k < 2; ++k) {
-                    blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(),
-                                              firstTouch[k].end());
-                }
+            rho[i] = sum;
+            neighbours[i] = std::uint32_t(count);
+        }
+        if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
+            std::lock_guard<std::mutex> lock(touchedMutex);
+            for (int k = 0; k < 2; ++k) {
+                blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(),
+                                          firstTouch[k].end());
             }
+        }
         },
         512);
     const double liquidCount = parallel::sum(
@@ -172,11 +171,11 @@ void GhostSolver::computeDensity()
         parallel::forEach(
             0, b->touched.size(),
             [&](std::size_t t) {
-                const Index s = b->touched[t];
-                const Index j = nearestIndex(b->nearest[s]);
-                b->rho[s] = rho[j];
-                b->p[s] = p[j];
-                b->pOverRho2[s] = p[j] / sqr(rho[j]);
+            const Index s = b->touched[t];
+            const Index j = nearestIndex(b->nearest[s]);
+            b->rho[s] = rho[j];
+            b->p[s] = p[j];
+            b->pOverRho2[s] = p[j] / sqr(rho[j]);
             },
             1024);
     }
@@ -197,15 +196,15 @@ void GhostSolver::extrapolateSolidVelocity()
         parallel::forEach(
             0, b->touched.size(),
             [&](std::size_t t) {
-                const Index s = b->touched[t];
-                const Vec3 vs = solidV ? (*solidV)[s] : Vec3(0);
-                if (!freeSlip) {
-                    b->vstar[s] = vs;
-                    return;
-                }
-                const Vec3& nrm = normal[s];
-                const Vec3& vl = vstar[nearestIndex(b->nearest[s])];
-                b->vstar[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
+            const Index s = b->touched[t];
+            const Vec3 vs = solidV ? (*solidV)[s] : Vec3(0);
+            if (!freeSlip) {
+                b->vstar[s] = vs;
+                return;
+            }
+            const Vec3& nrm = normal[s];
+            const Vec3& vl = vstar[nearestIndex(b->nearest[s])];
+            b->vstar[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
             },
             1024);
     }
@@ -250,36 +249,34 @@ void GhostSolver::stepGhost(Real dt)
     parallel::forRange(
         0, n,
         [&](std::size_t lo, std::size_t hi) {
-            const CubicSplineKernel kernel = mKernel;
-            PairBatch batch;
-            for (std::size_t i = lo; i < hi; ++i) {
-                if (kind[i] != ParticleKind::Liquid) {
-                    vstar[i] = v[i];
-                    continue;
-                }
-                const Vec3 xi = x[i];
-                const Real pi = mScratch[i];
-                // The particle itself is in its list: r = 0 gives grad W = 0.
-                Vec3 a = g;
-                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + mScratch[b.j[k]]);
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) {
+                vstar[i] = v[i];
+                continue;
+            }
+            const Vec3 xi = x[i];
+            const Real pi = mScratch[i];
+            // The particle itself is in its list: r = 0 gives grad W = 0.
+            Vec3 a = g;
+            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + mScratch[b.j[k]]);
+                for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
+                a += b.sumScaledOffsets(b.f);
+            });
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                const Real* ratio = block->pOverRho2.data();
+                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
+                                   [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = M * (pi + ratio[b.j[k]]);
                     for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
                     a += b.sumScaledOffsets(b.f);
                 });
-                for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                    const Real* ratio = block->pOverRho2.data();
-                    batch.forEachBatch(xi, block->block.particles().positions().data(),
-                                       block->lists[i], [&](PairBatch& b) {
-                                           for (int k = 0; k < b.n; ++k)
-                                               b.f[k] = M * (pi + ratio[b.j[k]]);
-                                           for (int k = 0; k < b.n; ++k)
-                                               b.f[k] *= -kernel.gradFactor(b.r[k]);
-                                           a += b.sumScaledOffsets(b.f);
-                                       });
-                }
-                vstar[i] = v[i] + dt * a;
-                accel[i] = a.length();
             }
+            vstar[i] = v[i] + dt * a;
+            accel[i] = a.length();
+        }
         },
         512);
     mMaxAcceleration = *std::max_element(accel.begin(), accel.end());
@@ -295,37 +292,35 @@ void GhostSolver::stepGhost(Real dt)
     parallel::forEach(
         0, n,
         [&](std::size_t j) {
-            mScratch[j] = kind[j] == ParticleKind::GhostAir ? Real(0) : eps * m[j] / rho[j];
+        mScratch[j] = kind[j] == ParticleKind::GhostAir ? Real(0) : eps * m[j] / rho[j];
         },
         2048);
     parallel::forRange(
         0, n,
         [&](std::size_t lo, std::size_t hi) {
-            const CubicSplineKernel kernel = mKernel;
-            PairBatch batch;
-            for (std::size_t i = lo; i < hi; ++i) {
-                if (kind[i] != ParticleKind::Liquid) continue;
-                const Vec3 xi = x[i], vi = vstar[i];
-                // The particle itself adds w W(0) (v_i - v_i) = 0.
-                Vec3 dv(0);
-                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = mScratch[b.j[k]];
+        const CubicSplineKernel kernel = mKernel;
+        PairBatch batch;
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) continue;
+            const Vec3 xi = x[i], vi = vstar[i];
+            // The particle itself adds w W(0) (v_i - v_i) = 0.
+            Vec3 dv(0);
+            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = mScratch[b.j[k]];
+                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                dv += b.sumScaledDifferences(b.f, vstar.data(), vi);
+            });
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                const Real* rhoSolid = block->rho.data();
+                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
+                                   [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = epsSolid * M / rhoSolid[b.j[k]];
                     for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                    dv += b.sumScaledDifferences(b.f, vstar.data(), vi);
+                    dv += b.sumScaledDifferences(b.f, block->vstar.data(), vi);
                 });
-                for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                    const Real* rhoSolid = block->rho.data();
-                    batch.forEachBatch(xi, block->block.particles().positions().data(),
-                                       block->lists[i], [&](PairBatch& b) {
-                                           for (int k = 0; k < b.n; ++k)
-                                               b.f[k] = epsSolid * M / rhoSolid[b.j[k]];
-                                           for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                                           dv +=
-                                               b.sumScaledDifferences(b.f, block->vstar.data(), vi);
-                                       });
-                }
-                v[i] = vi + dv;
             }
+            v[i] = vi + dv;
+        }
         },
         512);
 
@@ -338,19 +333,19 @@ void GhostSolver::stepGhost(Real dt)
     parallel::forEach(
         0, std::min(n, listed),
         [&](std::size_t i) {
-            if (kind[i] != ParticleKind::GhostAir) return;
-            Index j = INVALID_INDEX;
-            Real best2 = R * R;
-            for (Index k : mFluidLists[i]) {
-                if (kind[k] != ParticleKind::Liquid) continue;
-                const Real r2 = (x[i] - x[k]).lengthSqr();
-                if (r2 < best2 || (r2 == best2 && k < j)) {
-                    best2 = r2;
-                    j = k;
-                }
+        if (kind[i] != ParticleKind::GhostAir) return;
+        Index j = INVALID_INDEX;
+        Real best2 = R * R;
+        for (Index k : mFluidLists[i]) {
+            if (kind[k] != ParticleKind::Liquid) continue;
+            const Real r2 = (x[i] - x[k]).lengthSqr();
+            if (r2 < best2 || (r2 == best2 && k < j)) {
+                best2 = r2;
+                j = k;
             }
-            if (j == INVALID_INDEX) j = nearestLiquid(x[i], Real(2) * R);
-            if (j != INVALID_INDEX) v[i] = v[j];
+        }
+        if (j == INVALID_INDEX) j = nearestLiquid(x[i], Real(2) * R);
+        if (j != INVALID_INDEX) v[i] = v[j];
         },
         256);
 
@@ -480,9 +475,9 @@ void GhostSolver::checkBlowUp() const
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
-            if (isFinite(x[i]) && isFinite(v[i]) && v[i].lengthSqr() <= limit2) return;
-            std::size_t expected = bad.load();
-            while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
+        if (isFinite(x[i]) && isFinite(v[i]) && v[i].lengthSqr() <= limit2) return;
+        std::size_t expected = bad.load();
+        while (i < expected && !bad.compare_exchange_weak(expected, i)) {}
         },
         4096);
     const std::size_t i = bad.load();

@@ -52,17 +52,17 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     parallel::forEach(
         0, count,
         [&](std::size_t i) {
-            const Vec3& x = positions[i];
-            const Real limit = Real(MAX_CELL_COORD) * mCellSize;
-            if (!isFinite(x) || std::abs(x[0]) >= limit || std::abs(x[1]) >= limit
-                || std::abs(x[2]) >= limit) {
-                std::size_t expected = badIndex.load();
-                while (i < expected && !badIndex.compare_exchange_weak(expected, i)) {}
-                return;
-            }
-            const Cell c = cellOf(x);
-            key[i] = packKey(c);
-            bucket[i] = bucketOf(c);
+        const Vec3& x = positions[i];
+        const Real limit = Real(MAX_CELL_COORD) * mCellSize;
+        if (!isFinite(x) || std::abs(x[0]) >= limit || std::abs(x[1]) >= limit
+            || std::abs(x[2]) >= limit) {
+            std::size_t expected = badIndex.load();
+            while (i < expected && !badIndex.compare_exchange_weak(expected, i)) {}
+            return;
+        }
+        const Cell c = cellOf(x);
+        key[i] = packKey(c);
+        bucket[i] = bucketOf(c);
         },
         2048);
     if (badIndex.load() < count) {
@@ -102,7 +102,7 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     parallel::forEach(
         0, count,
         [&](std::size_t i) {
-            mIndex[counts[bucket[i]].fetch_add(1, std::memory_order_relaxed)] = Index(i);
+        mIndex[counts[bucket[i]].fetch_add(1, std::memory_order_relaxed)] = Index(i);
         },
         4096);
 
@@ -113,16 +113,16 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     parallel::forEach(
         0, tableSize,
         [&](std::size_t b) {
-            const std::uint32_t lo = bucketStart[b], hi = bucketStart[b + 1];
-            if (hi - lo > 1) {
-                std::sort(mIndex.begin() + lo, mIndex.begin() + hi, [&key](Index a, Index c) {
-                    return key[a] != key[c] ? key[a] < key[c] : a < c;
-                });
-            }
-            std::uint32_t cells = 0;
-            for (std::uint32_t s = lo; s < hi; ++s)
-                cells += s == lo || key[mIndex[s]] != key[mIndex[s - 1]];
-            bucketCells[b] = cells;
+        const std::uint32_t lo = bucketStart[b], hi = bucketStart[b + 1];
+        if (hi - lo > 1) {
+            std::sort(mIndex.begin() + lo, mIndex.begin() + hi, [&key](Index a, Index c) {
+                return key[a] != key[c] ? key[a] < key[c] : a < c;
+            });
+        }
+        std::uint32_t cells = 0;
+        for (std::uint32_t s = lo; s < hi; ++s)
+            cells += s == lo || key[mIndex[s]] != key[mIndex[s - 1]];
+        bucketCells[b] = cells;
         },
         4096);
 
@@ -140,15 +140,15 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     parallel::forEach(
         0, tableSize,
         [&](std::size_t b) {
-            std::uint32_t cell = mBucketCell[b];
-            for (std::uint32_t s = bucketStart[b], hi = bucketStart[b + 1]; s < hi; ++s) {
-                const std::uint64_t k = key[mIndex[s]];
-                if (s == bucketStart[b] || k != key[mIndex[s - 1]]) {
-                    mCellKey[cell] = k;
-                    mCellStart[cell] = s;
-                    ++cell;
-                }
+        std::uint32_t cell = mBucketCell[b];
+        for (std::uint32_t s = bucketStart[b], hi = bucketStart[b + 1]; s < hi; ++s) {
+            const std::uint64_t k = key[mIndex[s]];
+            if (s == bucketStart[b] || k != key[mIndex[s - 1]]) {
+                mCellKey[cell] = k;
+                mCellStart[cell] = s;
+                ++cell;
             }
+        }
         },
         4096);
 
@@ -161,11 +161,11 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     parallel::forEach(
         0, count,
         [&](std::size_t s) {
-            const Index i = mIndex[s];
-            mX[s] = positions[i][0];
-            mY[s] = positions[i][1];
-            mZ[s] = positions[i][2];
-            mSlotOf[i] = std::uint32_t(s);
+        const Index i = mIndex[s];
+        mX[s] = positions[i][0];
+        mY[s] = positions[i][1];
+        mZ[s] = positions[i][2];
+        mSlotOf[i] = std::uint32_t(s);
         },
         4096);
 }
@@ -178,8 +178,8 @@ void NeighborGrid::sortParticles(ParticleSet& particles)
     parallel::forEach(
         0, mIndex.size(),
         [&](std::size_t k) {
-            mIndex[k] = Index(k);
-            mSlotOf[k] = std::uint32_t(k);
+        mIndex[k] = Index(k);
+        mSlotOf[k] = std::uint32_t(k);
         },
         8192);
     mIdentity = true;

@@ -185,89 +185,88 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
     parallel::forEach(
         0, chunks,
         [&](std::size_t chunk) {
-            Chunk& out = mChunks[chunk];
-            std::size_t used = 0;
-            Stencil stencil;
-            alignas(16) Real r2[BATCH] = {};
-            const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
-            for (std::size_t q = chunk * CHUNK; q < qEnd; ++q) {
-                if (empty || (wanted && !wanted[q]) || !isFinite(queries[q])) {
-                    mEnd[q] = std::uint32_t(used);
+        Chunk& out = mChunks[chunk];
+        std::size_t used = 0;
+        Stencil stencil;
+        alignas(16) Real r2[BATCH] = {};
+        const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
+        for (std::size_t q = chunk * CHUNK; q < qEnd; ++q) {
+            if (empty || (wanted && !wanted[q]) || !isFinite(queries[q])) {
+                mEnd[q] = std::uint32_t(used);
+                continue;
+            }
+            const Vec3& x = queries[q];
+            const NeighborGrid::Cell c = targets.cellOf(x);
+            if (c != stencil.centre) stencil.lookUp(targets, c);
+            // Squared distance from x to the slab of each neighbouring cell, per axis: 0 for its
+            // own cell, the distance to the lower / upper face for the others. A cell is
+            // reachable when the sum over the axes is below R^2. The faces are moved out by a
+            // small slack, so float rounding in the cell assignment never drops a neighbour.
+            Real axis2[3][3];
+            const Real cell[3] = {Real(c.i), Real(c.j), Real(c.k)};
+            for (int a = 0; a < 3; ++a) {
+                const Real slack = Real(1e-3) * cellSize + Real(1e-5) * std::abs(x[a]);
+                const Real lo = x[a] - cell[a] * cellSize;
+                const Real below = std::max(Real(0), lo - slack);
+                const Real above = std::max(Real(0), cellSize - lo - slack);
+                axis2[a][0] = below * below;
+                axis2[a][1] = 0;
+                axis2[a][2] = above * above;
+            }
+            const Real qx = x[0], qy = x[1], qz = x[2];
+            // Reachable cells whose slots follow each other (neighbours along z usually do: z
+            // is the lowest Morton bit) are searched as one range.
+            auto search = [&](NeighborGrid::SlotRange range) {
+                out.reserve(used + (range.end - range.begin) + 8, used);
+                Index* dst = out.data.get();
+#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
+                if (avx2) {
+                    const float q[3] = {qx, qy, qz};
+                    used = searchRangeAvx2(X, Y, Z, range.begin, range.end, q, radius2, dst, used);
+                    return;
+                }
+#endif
+                for (std::uint32_t s0 = range.begin; s0 < range.end; s0 += BATCH) {
+                    const std::size_t len = std::min<std::size_t>(BATCH, range.end - s0);
+                    const std::size_t padded = (len + 3) & ~std::size_t(3);
+                    const Real* xs = X + s0;
+                    const Real* ys = Y + s0;
+                    const Real* zs = Z + s0;
+                    // Distances first (vectorises; the grid pads its arrays, so reading up to
+                    // three slots past the range is safe), then the hits.
+                    for (std::size_t k = 0; k < padded; ++k) {
+                        const Real dx = qx - xs[k], dy = qy - ys[k], dz = qz - zs[k];
+                        r2[k] = dx * dx + dy * dy + dz * dz;
+                    }
+                    used = appendHits(r2, len, radius2, s0, dst, used);
+                }
+            };
+            NeighborGrid::SlotRange run;
+            for (int n = 0; n < stencil.count; ++n) {
+                const std::uint8_t* o = stencil.offset[n];
+                if (axis2[0][o[0]] + axis2[1][o[1]] + axis2[2][o[2]] >= radius2) continue;
+                const NeighborGrid::SlotRange range = stencil.range[n];
+                if (!run.empty() && range.begin == run.end) {
+                    run.end = range.end;
                     continue;
                 }
-                const Vec3& x = queries[q];
-                const NeighborGrid::Cell c = targets.cellOf(x);
-                if (c != stencil.centre) stencil.lookUp(targets, c);
-                // Squared distance from x to the slab of each neighbouring cell, per axis: 0 for its
-                // own cell, the distance to the lower / upper face for the others. A cell is
-                // reachable when the sum over the axes is below R^2. The faces are moved out by a
-                // small slack, so float rounding in the cell assignment never drops a neighbour.
-                Real axis2[3][3];
-                const Real cell[3] = {Real(c.i), Real(c.j), Real(c.k)};
-                for (int a = 0; a < 3; ++a) {
-                    const Real slack = Real(1e-3) * cellSize + Real(1e-5) * std::abs(x[a]);
-                    const Real lo = x[a] - cell[a] * cellSize;
-                    const Real below = std::max(Real(0), lo - slack);
-                    const Real above = std::max(Real(0), cellSize - lo - slack);
-                    axis2[a][0] = below * below;
-                    axis2[a][1] = 0;
-                    axis2[a][2] = above * above;
-                }
-                const Real qx = x[0], qy = x[1], qz = x[2];
-                // Reachable cells whose slots follow each other (neighbours along z usually do: z
-                // is the lowest Morton bit) are searched as one range.
-                auto search = [&](NeighborGrid::SlotRange range) {
-                    out.reserve(used + (range.end - range.begin) + 8, used);
-                    Index* dst = out.data.get();
-#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-                    if (avx2) {
-                        const float q[3] = {qx, qy, qz};
-                        used =
-                            searchRangeAvx2(X, Y, Z, range.begin, range.end, q, radius2, dst, used);
-                        return;
-                    }
-#endif
-                    for (std::uint32_t s0 = range.begin; s0 < range.end; s0 += BATCH) {
-                        const std::size_t len = std::min<std::size_t>(BATCH, range.end - s0);
-                        const std::size_t padded = (len + 3) & ~std::size_t(3);
-                        const Real* xs = X + s0;
-                        const Real* ys = Y + s0;
-                        const Real* zs = Z + s0;
-                        // Distances first (vectorises; the grid pads its arrays, so reading up to
-                        // three slots past the range is safe), then the hits.
-                        for (std::size_t k = 0; k < padded; ++k) {
-                            const Real dx = qx - xs[k], dy = qy - ys[k], dz = qz - zs[k];
-                            r2[k] = dx * dx + dy * dy + dz * dz;
-                        }
-                        used = appendHits(r2, len, radius2, s0, dst, used);
-                    }
-                };
-                NeighborGrid::SlotRange run;
-                for (int n = 0; n < stencil.count; ++n) {
-                    const std::uint8_t* o = stencil.offset[n];
-                    if (axis2[0][o[0]] + axis2[1][o[1]] + axis2[2][o[2]] >= radius2) continue;
-                    const NeighborGrid::SlotRange range = stencil.range[n];
-                    if (!run.empty() && range.begin == run.end) {
-                        run.end = range.end;
-                        continue;
-                    }
-                    if (!run.empty()) search(run);
-                    run = range;
-                }
                 if (!run.empty()) search(run);
-                if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
-                    throw ValueError("neighbour lists: more than 2^32 pairs in one chunk");
-                }
-                mEnd[q] = std::uint32_t(used);
+                run = range;
             }
-            // A chunk that holds far more than it needs gives the room back (its lists shrank,
-            // e.g. after a splash settled): capacity is what the process holds.
-            if (out.capacity > 2 * used + 4096) out.shrink(used);
-            // Slots to particle indices (nothing to do for a grid over a sorted set).
-            if (!targets.identityOrder()) {
-                Index* dst = out.data.get();
-                for (std::size_t k = 0; k < used; ++k) dst[k] = targets.particleAt(dst[k]);
+            if (!run.empty()) search(run);
+            if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
+                throw ValueError("neighbour lists: more than 2^32 pairs in one chunk");
             }
+            mEnd[q] = std::uint32_t(used);
+        }
+        // A chunk that holds far more than it needs gives the room back (its lists shrank,
+        // e.g. after a splash settled): capacity is what the process holds.
+        if (out.capacity > 2 * used + 4096) out.shrink(used);
+        // Slots to particle indices (nothing to do for a grid over a sorted set).
+        if (!targets.identityOrder()) {
+            Index* dst = out.data.get();
+            for (std::size_t k = 0; k < used; ++k) dst[k] = targets.particleAt(dst[k]);
+        }
         },
         1);
 }

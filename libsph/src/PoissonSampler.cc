@@ -636,11 +636,11 @@ SampleSet PoissonDiskSampler::sampleVolumeTiled(const LevelSet& shape) const
     parallel::forEach(
         0, tiled.size(),
         [&](std::size_t k) {
-            const Vec3& x = tiled[k];
-            if (!bounds.contains(x)) return;
-            const Real phi = shape.phi(x);
-            if (!(phi < Real(0)) || near.anyWithin(x, depth) || !band.accepts(x, phi)) return;
-            keep[k] = near.anyWithin(x, depth + Real(2) * r) ? 2 : 1;
+        const Vec3& x = tiled[k];
+        if (!bounds.contains(x)) return;
+        const Real phi = shape.phi(x);
+        if (!(phi < Real(0)) || near.anyWithin(x, depth) || !band.accepts(x, phi)) return;
+        keep[k] = near.anyWithin(x, depth + Real(2) * r) ? 2 : 1;
         },
         1024);
     std::vector<std::uint8_t> seeds(surface, 1);
@@ -817,10 +817,10 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
             parallel::forEach(
                 first, last,
                 [&](std::size_t block) {
-                    Ball ball; // B(p): the samples within 2r of p
-                    for (std::size_t k = blockStart[block]; k < blockStart[block + 1]; ++k) {
-                        relaxOne(order[k].index, sweep, ball);
-                    }
+                Ball ball; // B(p): the samples within 2r of p
+                for (std::size_t k = blockStart[block]; k < blockStart[block + 1]; ++k) {
+                    relaxOne(order[k].index, sweep, ball);
+                }
                 },
                 1);
             first = last;

@@ -38,7 +38,6 @@ namespace {
 
 using ghostfx::testing::slurp;
 
-
 struct Result
 {
     int code = -1;

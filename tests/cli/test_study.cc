@@ -25,7 +25,6 @@ namespace {
 
 using ghostfx::testing::slurp;
 
-
 /// A CSV table as rows of column -> text.
 std::vector<std::map<std::string, std::string>> readCsv(const fs::path& p)
 {

@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <string>
 
-#include <unistd.h>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <unistd.h>
 
 namespace ghostfx {
 namespace testing {

@@ -185,8 +185,8 @@ TEST(ParallelForRange, ChunksAreDisjointCoverTheRangeAndRespectTheGrain)
         parallel::forRange(
             begin, end,
             [&](std::size_t b, std::size_t e) {
-                std::lock_guard<std::mutex> lock(mutex);
-                chunks.emplace_back(b, e);
+            std::lock_guard<std::mutex> lock(mutex);
+            chunks.emplace_back(b, e);
             },
             grain);
         std::sort(chunks.begin(), chunks.end());
@@ -213,10 +213,10 @@ TEST(ParallelForRange, TinyRangeRunsOnceOnTheCallingThread)
         parallel::forRange(
             1000, 1000 + size,
             [&](std::size_t b, std::size_t e) {
-                ++calls;
-                where = std::this_thread::get_id();
-                EXPECT_EQ(b, 1000u);
-                EXPECT_EQ(e, 1000u + size);
+            ++calls;
+            where = std::this_thread::get_id();
+            EXPECT_EQ(b, 1000u);
+            EXPECT_EQ(e, 1000u + size);
             },
             256);
         EXPECT_EQ(calls, 1) << "size " << size;
@@ -250,8 +250,8 @@ TEST(ParallelSerial, SwitchRunsEverythingInOrderOnTheCallingThread)
     parallel::forEach(
         0, 50000,
         [&](std::size_t i) {
-            seen.push_back(i);
-            if (std::this_thread::get_id() != caller) otherThread = true;
+        seen.push_back(i);
+        if (std::this_thread::get_id() != caller) otherThread = true;
         },
         16);
     EXPECT_FALSE(otherThread);
@@ -261,9 +261,9 @@ TEST(ParallelSerial, SwitchRunsEverythingInOrderOnTheCallingThread)
     parallel::forRange(
         0, 50000,
         [&](std::size_t b, std::size_t e) {
-            ++calls;
-            EXPECT_EQ(b, 0u);
-            EXPECT_EQ(e, 50000u);
+        ++calls;
+        EXPECT_EQ(b, 0u);
+        EXPECT_EQ(e, 50000u);
         },
         16);
     EXPECT_EQ(calls, 1);
@@ -285,7 +285,7 @@ TEST(ParallelThreadLimit, CapsThreadsWhileAliveAndRestoresAfter)
         parallel::forEach(
             0, 100000,
             [&](std::size_t) {
-                if (std::this_thread::get_id() != caller) otherThread = true;
+            if (std::this_thread::get_id() != caller) otherThread = true;
             },
             64);
         EXPECT_FALSE(otherThread.load());

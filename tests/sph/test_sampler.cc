@@ -209,8 +209,8 @@ TEST_P(SamplerShapes, PoissonDiskBoundaryFitAndCoverage)
 INSTANTIATE_TEST_SUITE_P(Shapes, SamplerShapes,
                          ::testing::Values("Sphere", "Box", "Torus", "TwoSpheres"),
                          [](const ::testing::TestParamInfo<std::string>& info) {
-                             return info.param;
-                         });
+    return info.param;
+});
 
 TEST(Sampler, FindsBothDisjointComponentsInProportionToVolume)
 {

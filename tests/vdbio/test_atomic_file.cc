@@ -19,7 +19,6 @@ namespace {
 
 using ghostfx::testing::slurp;
 
-
 using ghostfx::testing::freshDir;
 
 } // namespace
@@ -32,11 +31,12 @@ TEST(AtomicFile, InterruptedWriteLeavesThePreviousFileIntact)
     EXPECT_EQ(slurp(path), "frame one");
 
     // A writer that dies halfway (here: throws after writing part of the file).
-    EXPECT_THROW(vdbio::writeAtomically(path,
-                                        [](const std::string& tmp) {
-                                            std::ofstream(tmp) << "half of frame tw";
-                                            throw std::runtime_error("killed");
-                                        }),
+    EXPECT_THROW(vdbio::writeAtomically(
+                     path,
+                     [](const std::string& tmp) {
+        std::ofstream(tmp) << "half of frame tw";
+        throw std::runtime_error("killed");
+                     }),
                  std::runtime_error);
     EXPECT_EQ(slurp(path), "frame one");
     // No temporary left behind.

@@ -40,7 +40,6 @@ using ghostfx::testing::freshDir;
 
 constexpr Real H = Real(0.01);
 
-
 using ghostfx::testing::firstDifference;
 using ghostfx::testing::sameBytes;
 

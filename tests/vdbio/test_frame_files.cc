@@ -47,7 +47,6 @@ constexpr double SPHERE_RADIUS = 6 * SPACING;          // liquid sphere (m)
 const Vec3 VELOCITY(Real(0.3), Real(-1.2), Real(0.5)); // uniform liquid velocity (m/s)
 constexpr Real TEMPERATURE = Real(353.15);             // uniform liquid temperature (K)
 
-
 /// The test scene: a Poisson-disk liquid sphere and a ghost-air shell around it.
 struct Scene
 {

@@ -78,30 +78,30 @@ std::vector<openvdb::Coord> candidateLeaves(const Selected& sel, const sph::Neig
     parallel::forEach(
         0, nBlocks,
         [&](std::size_t b) {
-            std::vector<openvdb::Coord>& keys = perBlock[b];
-            const std::size_t end = std::min(n, (b + 1) * LEAF_KEY_BLOCK);
-            for (std::size_t k = b * LEAF_KEY_BLOCK; k < end; ++k) {
-                const sph::Vec3& x = sel.x[order[k]];
-                int lo[3], hi[3];
-                for (int d = 0; d < 3; ++d) {
-                    voxelRange(double(x[d]), R, invDx, lo[d], hi[d]);
-                    lo[d] &= mask;
-                    hi[d] &= mask;
-                }
-                for (int i = lo[0]; i <= hi[0]; i += LEAF_DIM) {
-                    for (int j = lo[1]; j <= hi[1]; j += LEAF_DIM) {
-                        for (int l = lo[2]; l <= hi[2]; l += LEAF_DIM) {
-                            keys.emplace_back(i, j, l);
-                        }
+        std::vector<openvdb::Coord>& keys = perBlock[b];
+        const std::size_t end = std::min(n, (b + 1) * LEAF_KEY_BLOCK);
+        for (std::size_t k = b * LEAF_KEY_BLOCK; k < end; ++k) {
+            const sph::Vec3& x = sel.x[order[k]];
+            int lo[3], hi[3];
+            for (int d = 0; d < 3; ++d) {
+                voxelRange(double(x[d]), R, invDx, lo[d], hi[d]);
+                lo[d] &= mask;
+                hi[d] &= mask;
+            }
+            for (int i = lo[0]; i <= hi[0]; i += LEAF_DIM) {
+                for (int j = lo[1]; j <= hi[1]; j += LEAF_DIM) {
+                    for (int l = lo[2]; l <= hi[2]; l += LEAF_DIM) {
+                        keys.emplace_back(i, j, l);
                     }
                 }
-                if (keys.size() > 4 * LEAF_KEY_BLOCK) { // keep the block's list short
-                    std::sort(keys.begin(), keys.end());
-                    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-                }
             }
-            std::sort(keys.begin(), keys.end());
-            keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+            if (keys.size() > 4 * LEAF_KEY_BLOCK) { // keep the block's list short
+                std::sort(keys.begin(), keys.end());
+                keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+            }
+        }
+        std::sort(keys.begin(), keys.end());
+        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
         },
         1);
     std::vector<openvdb::Coord> leaves;
@@ -188,11 +188,11 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     parallel::forEach(
         0, n,
         [&](std::size_t k) {
-            const sph::Index i = selection[k];
-            sel.x[k] = particles.positions()[i];
-            sel.m[k] = particles.masses()[i];
-            if (wantVel) sel.v[k] = particles.velocities()[i];
-            for (std::size_t c = 0; c < nChannels; ++c) sel.a[c][k] = (*source[c])[i];
+        const sph::Index i = selection[k];
+        sel.x[k] = particles.positions()[i];
+        sel.m[k] = particles.masses()[i];
+        if (wantVel) sel.v[k] = particles.velocities()[i];
+        for (std::size_t c = 0; c < nChannels; ++c) sel.a[c][k] = (*source[c])[i];
         },
         4096);
 
@@ -224,86 +224,81 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     parallel::forEach(
         0, leaves.size(),
         [&](std::size_t L) {
-            const openvdb::Coord origin = leaves[L];
-            // Per-leaf accumulators, in double: sums of a hundred-odd terms in a fixed order.
-            std::vector<double> rho(LEAF_VOXELS, 0.0);
-            std::vector<openvdb::Vec3d> mv(wantVel ? LEAF_VOXELS : 0, openvdb::Vec3d(0.0));
-            std::vector<double> ma(nChannels * LEAF_VOXELS, 0.0);
+        const openvdb::Coord origin = leaves[L];
+        // Per-leaf accumulators, in double: sums of a hundred-odd terms in a fixed order.
+        std::vector<double> rho(LEAF_VOXELS, 0.0);
+        std::vector<openvdb::Vec3d> mv(wantVel ? LEAF_VOXELS : 0, openvdb::Vec3d(0.0));
+        std::vector<double> ma(nChannels * LEAF_VOXELS, 0.0);
 
-            const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
-                                   sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
-                                   sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
-            grid.forEachInRadius(
-                centre, searchRadius, [&](sph::Index j, const sph::Vec3&, sph::Real) {
-                    const double xj[3] = {double(sel.x[j][0]), double(sel.x[j][1]),
-                                          double(sel.x[j][2])};
-                    int lo[3], hi[3];
-                    for (int d = 0; d < 3; ++d) {
-                        voxelRange(xj[d], R, invDx, lo[d], hi[d]);
-                        lo[d] = std::max(lo[d] - origin[d], 0);
-                        hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
-                        if (lo[d] > hi[d]) return; // support box misses this leaf
-                    }
-                    const double mj = double(sel.m[j]);
-                    for (int a = lo[0]; a <= hi[0]; ++a) {
-                        const double dxa = (origin.x() + a) * dx - xj[0];
-                        const double ra2 = dxa * dxa;
-                        for (int b = lo[1]; b <= hi[1]; ++b) {
-                            const double dyb = (origin.y() + b) * dx - xj[1];
-                            const double rab2 = ra2 + dyb * dyb;
-                            const double rem = R2 - rab2;
-                            if (rem <= 0.0) continue;
-                            // z range of this row inside the support sphere.
-                            int clo, chi;
-                            voxelRange(xj[2], std::sqrt(rem), invDx, clo, chi);
-                            clo = std::max(clo - origin.z(), lo[2]);
-                            chi = std::min(chi - origin.z(), hi[2]);
-                            for (int c = clo; c <= chi; ++c) {
-                                const double dzc = (origin.z() + c) * dx - xj[2];
-                                const double r = std::sqrt(rab2 + dzc * dzc);
-                                const double w = mj * double(kernel.W(sph::Real(r)));
-                                if (w == 0.0) continue;
-                                const int voxel =
-                                    (a << 6) | (b << 3) | c; // LeafNode::coordToOffset
-                                rho[voxel] += w;
-                                if (wantVel) {
-                                    mv[voxel] +=
-                                        w * openvdb::Vec3d(sel.v[j][0], sel.v[j][1], sel.v[j][2]);
-                                }
-                                for (std::size_t ch = 0; ch < nChannels; ++ch) {
-                                    ma[ch * LEAF_VOXELS + voxel] += w * double(sel.a[ch][j]);
-                                }
-                            }
+        const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
+                               sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
+                               sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
+        grid.forEachInRadius(centre, searchRadius, [&](sph::Index j, const sph::Vec3&, sph::Real) {
+            const double xj[3] = {double(sel.x[j][0]), double(sel.x[j][1]), double(sel.x[j][2])};
+            int lo[3], hi[3];
+            for (int d = 0; d < 3; ++d) {
+                voxelRange(xj[d], R, invDx, lo[d], hi[d]);
+                lo[d] = std::max(lo[d] - origin[d], 0);
+                hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
+                if (lo[d] > hi[d]) return; // support box misses this leaf
+            }
+            const double mj = double(sel.m[j]);
+            for (int a = lo[0]; a <= hi[0]; ++a) {
+                const double dxa = (origin.x() + a) * dx - xj[0];
+                const double ra2 = dxa * dxa;
+                for (int b = lo[1]; b <= hi[1]; ++b) {
+                    const double dyb = (origin.y() + b) * dx - xj[1];
+                    const double rab2 = ra2 + dyb * dyb;
+                    const double rem = R2 - rab2;
+                    if (rem <= 0.0) continue;
+                    // z range of this row inside the support sphere.
+                    int clo, chi;
+                    voxelRange(xj[2], std::sqrt(rem), invDx, clo, chi);
+                    clo = std::max(clo - origin.z(), lo[2]);
+                    chi = std::min(chi - origin.z(), hi[2]);
+                    for (int c = clo; c <= chi; ++c) {
+                        const double dzc = (origin.z() + c) * dx - xj[2];
+                        const double r = std::sqrt(rab2 + dzc * dzc);
+                        const double w = mj * double(kernel.W(sph::Real(r)));
+                        if (w == 0.0) continue;
+                        const int voxel = (a << 6) | (b << 3) | c; // LeafNode::coordToOffset
+                        rho[voxel] += w;
+                        if (wantVel) {
+                            mv[voxel] += w * openvdb::Vec3d(sel.v[j][0], sel.v[j][1], sel.v[j][2]);
+                        }
+                        for (std::size_t ch = 0; ch < nChannels; ++ch) {
+                            ma[ch * LEAF_VOXELS + voxel] += w * double(sel.a[ch][j]);
                         }
                     }
-                });
-
-            // Keep the voxels whose density reaches the cutoff; normalise.
-            LeafOutput& res = results[L];
-            bool any = false;
-            for (int voxel = 0; voxel < LEAF_VOXELS; ++voxel) {
-                const double ratio = rho[voxel] / rho0;
-                if (!(ratio > 0.0) || ratio < cutoff) continue;
-                if (!any) {
-                    any = true;
-                    res.density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                    if (wantVel) {
-                        res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
-                    }
-                    res.channels.resize(nChannels);
-                    for (auto& leaf : res.channels) {
-                        leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                    }
-                }
-                const openvdb::Index offset = openvdb::Index(voxel);
-                res.density->setValueOn(offset, float(ratio));
-                const double invRho = 1.0 / rho[voxel];
-                if (wantVel) res.vel->setValueOn(offset, openvdb::Vec3s(mv[voxel] * invRho));
-                for (std::size_t ch = 0; ch < nChannels; ++ch) {
-                    res.channels[ch]->setValueOn(offset,
-                                                 float(ma[ch * LEAF_VOXELS + voxel] * invRho));
                 }
             }
+        });
+
+        // Keep the voxels whose density reaches the cutoff; normalise.
+        LeafOutput& res = results[L];
+        bool any = false;
+        for (int voxel = 0; voxel < LEAF_VOXELS; ++voxel) {
+            const double ratio = rho[voxel] / rho0;
+            if (!(ratio > 0.0) || ratio < cutoff) continue;
+            if (!any) {
+                any = true;
+                res.density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                if (wantVel) {
+                    res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                }
+                res.channels.resize(nChannels);
+                for (auto& leaf : res.channels) {
+                    leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                }
+            }
+            const openvdb::Index offset = openvdb::Index(voxel);
+            res.density->setValueOn(offset, float(ratio));
+            const double invRho = 1.0 / rho[voxel];
+            if (wantVel) res.vel->setValueOn(offset, openvdb::Vec3s(mv[voxel] * invRho));
+            for (std::size_t ch = 0; ch < nChannels; ++ch) {
+                res.channels[ch]->setValueOn(offset, float(ma[ch * LEAF_VOXELS + voxel] * invRho));
+            }
+        }
         },
         1);
 

@@ -68,8 +68,8 @@ std::vector<openvdb::Vec3s> gatherSelected3(const std::vector<sph::Vec3>& src,
     parallel::forEach(
         0, selection.size(),
         [&](std::size_t k) {
-            const sph::Vec3& a = src[selection[k]];
-            out[k] = openvdb::Vec3s(float(a[0]), float(a[1]), float(a[2]));
+        const sph::Vec3& a = src[selection[k]];
+        out[k] = openvdb::Vec3s(float(a[0]), float(a[1]), float(a[2]));
         },
         4096);
     return out;
@@ -131,8 +131,8 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
     parallel::forEach(
         0, selection.size(),
         [&](std::size_t k) {
-            const sph::Vec3& x = particles.positions()[selection[k]];
-            positions[k] = openvdb::Vec3d(x[0], x[1], x[2]);
+        const sph::Vec3& x = particles.positions()[selection[k]];
+        positions[k] = openvdb::Vec3d(x[0], x[1], x[2]);
         },
         4096);
     const openvdb::points::PointAttributeVector<openvdb::Vec3d> positionArray(positions);

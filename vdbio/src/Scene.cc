@@ -294,8 +294,8 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
             // Walls: outside the inner box and inside the outer one, max(-inner, outer).
             grid = sph::levelSetFromSdf(
                 [lo, hi, w](const openvdb::Vec3d& x) {
-                    return std::max(-sph::boxSignedDistance(x, lo, hi),
-                                    sph::boxSignedDistance(x, lo - w, hi + w));
+                return std::max(-sph::boxSignedDistance(x, lo, hi),
+                                sph::boxSignedDistance(x, lo - w, hi + w));
                 },
                 sph::Aabb{sph::Vec3(lo - w), sph::Vec3(hi + w)}, sph::Real(voxel));
             description = msg("container, wall ", wall, " m");
@@ -344,61 +344,58 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     section(
         "points",
         [&](const JsonObject& s) {
-            out.pointsFile = s.get<std::string>("file", out.pointsFile);
-            out.pointChannels = s.get<std::vector<std::string>>("channels", out.pointChannels);
-            out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
+        out.pointsFile = s.get<std::string>("file", out.pointsFile);
+        out.pointChannels = s.get<std::vector<std::string>>("channels", out.pointChannels);
+        out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
         },
         [&] { out.pointsFile.clear(); });
     section(
         "volume",
         [&](const JsonObject& s) {
-            out.volumeFile = s.get<std::string>("file", out.volumeFile);
-            out.volumeGrids = s.get<std::vector<std::string>>("grids", out.volumeGrids);
-            for (const std::string& g : out.volumeGrids) {
-                if (g != "surface" && g != "density" && g != "vel" && g != "temperature") {
-                    const std::string near =
-                        closestKey(g, {"surface", "density", "vel", "temperature"});
-                    s.failValue("grids",
-                                msg("grid '", g,
-                                    "' is not one of surface, density, vel, temperature",
-                                    near.empty() ? "" : " (did you mean '" + near + "'?)"));
-                }
+        out.volumeFile = s.get<std::string>("file", out.volumeFile);
+        out.volumeGrids = s.get<std::vector<std::string>>("grids", out.volumeGrids);
+        for (const std::string& g : out.volumeGrids) {
+            if (g != "surface" && g != "density" && g != "vel" && g != "temperature") {
+                const std::string near =
+                    closestKey(g, {"surface", "density", "vel", "temperature"});
+                s.failValue("grids",
+                            msg("grid '", g, "' is not one of surface, density, vel, temperature",
+                                near.empty() ? "" : " (did you mean '" + near + "'?)"));
             }
-            out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
+        }
+        out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
         },
         [&] { out.volumeFile.clear(); });
     section(
         "gas_points",
         [&](const JsonObject& s) {
-            out.gasPointsFile = s.get<std::string>("file", out.gasPointsFile);
-            out.gasPointChannels =
-                s.get<std::vector<std::string>>("channels", out.gasPointChannels);
+        out.gasPointsFile = s.get<std::string>("file", out.gasPointsFile);
+        out.gasPointChannels = s.get<std::vector<std::string>>("channels", out.gasPointChannels);
         },
         [&] { out.gasPointsFile.clear(); });
     section(
         "gas_volume",
         [&](const JsonObject& s) {
-            out.gasVolumeFile = s.get<std::string>("file", out.gasVolumeFile);
-            out.gasVolumeGrids = s.get<std::vector<std::string>>("grids", out.gasVolumeGrids);
-            for (const std::string& g : out.gasVolumeGrids) {
-                if (g != "density" && g != "vel" && g != "temperature") {
-                    const std::string near = closestKey(g, {"density", "vel", "temperature"});
-                    s.failValue("grids",
-                                msg("grid '", g, "' is not one of density, vel, temperature",
-                                    near.empty() ? "" : " (did you mean '" + near + "'?)"));
-                }
+        out.gasVolumeFile = s.get<std::string>("file", out.gasVolumeFile);
+        out.gasVolumeGrids = s.get<std::vector<std::string>>("grids", out.gasVolumeGrids);
+        for (const std::string& g : out.gasVolumeGrids) {
+            if (g != "density" && g != "vel" && g != "temperature") {
+                const std::string near = closestKey(g, {"density", "vel", "temperature"});
+                s.failValue("grids", msg("grid '", g, "' is not one of density, vel, temperature",
+                                         near.empty() ? "" : " (did you mean '" + near + "'?)"));
             }
-            out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
+        }
+        out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
         },
         [&] { out.gasVolumeFile.clear(); });
     out.previewFile.clear();
     section(
         "preview",
         [&](const JsonObject& s) {
-            out.previewFile = s.get<std::string>("file", "preview.$F4.exr");
-            out.previewGrid = s.get<std::string>("grid", out.previewGrid);
-            out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
-            out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
+        out.previewFile = s.get<std::string>("file", "preview.$F4.exr");
+        out.previewGrid = s.get<std::string>("grid", out.previewGrid);
+        out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
+        out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
         },
         [&] { out.previewFile.clear(); });
     if (!out.previewFile.empty() && out.volumeFile.empty() && out.gasVolumeFile.empty()) {
@@ -407,8 +404,8 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     section(
         "checkpoint",
         [&](const JsonObject& s) {
-            out.checkpointFile = s.get<std::string>("file", out.checkpointFile);
-            out.checkpointEvery = int(s.inRange("every", out.checkpointEvery, 0, 1e6));
+        out.checkpointFile = s.get<std::string>("file", out.checkpointFile);
+        out.checkpointEvery = int(s.inRange("every", out.checkpointEvery, 0, 1e6));
         },
         [&] { out.checkpointFile.clear(); });
     section(

@@ -67,7 +67,7 @@ void forEach(std::size_t begin, std::size_t end, Fn&& fn, std::size_t grain = DE
     forRange(
         begin, end,
         [&fn](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) fn(i);
+        for (std::size_t i = b; i < e; ++i) fn(i);
         },
         grain);
 }
@@ -85,11 +85,11 @@ double sum(std::size_t begin, std::size_t end, Fn&& fn, std::size_t block = 1024
     forEach(
         0, nBlocks,
         [&](std::size_t b) {
-            const std::size_t lo = begin + b * block;
-            const std::size_t hi = lo + block < end ? lo + block : end;
-            double s = 0.0;
-            for (std::size_t i = lo; i < hi; ++i) s += double(fn(i));
-            partial[b] = s;
+        const std::size_t lo = begin + b * block;
+        const std::size_t hi = lo + block < end ? lo + block : end;
+        double s = 0.0;
+        for (std::size_t i = lo; i < hi; ++i) s += double(fn(i));
+        partial[b] = s;
         },
         1);
     double total = 0.0;
