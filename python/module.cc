@@ -151,6 +151,19 @@ std::pair<py::array_t<float>, std::array<double, 3>> levelSetToArray(const sph::
     return {out, {o.x(), o.y(), o.z()}};
 }
 
+/// Poisson-disk samples of `shape` at `spacing` (m), sampled without the GIL.
+py::array_t<double> poissonSamples(const sph::LevelSet& shape, double spacing, std::uint64_t seed)
+{
+    sph::SampleSet samples;
+    {
+        py::gil_scoped_release release;
+        sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
+        settings.seed = seed;
+        samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
+    }
+    return vectors(samples.positions);
+}
+
 class PySimulation
 {
 public:
@@ -489,34 +502,13 @@ PYBIND11_MODULE(_ghostfx, m)
                                [](const sph::LevelSet& s) { return double(s.voxelSize()); })
         .def_property_readonly("name", &sph::LevelSet::name);
 
-    m.def(
-        "sample",
-        [](const sph::LevelSet& shape, double spacing, std::uint64_t seed) {
-        sph::SampleSet samples;
-        {
-            py::gil_scoped_release release;
-            sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
-            settings.seed = seed;
-            samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
-        }
-        return vectors(samples.positions);
-        },
-        py::arg("level_set"), py::arg("spacing"), py::arg("seed") = 1,
-        "Poisson-disk samples ([SB12] Sec. 4.5) of a LevelSet at particle spacing `spacing` (m): "
-        "an "
-        "(N, 3) float64 array");
+    m.def("sample", &poissonSamples, py::arg("level_set"), py::arg("spacing"), py::arg("seed") = 1,
+          "Poisson-disk samples ([SB12] Sec. 4.5) of a LevelSet at particle spacing `spacing` (m): "
+          "an (N, 3) float64 array");
     m.def(
         "sample",
         [](const std::string& file, const std::string& grid, double spacing, std::uint64_t seed) {
-        const sph::LevelSet shape = vdbio::loadLevelSet(file, grid, "sample");
-        sph::SampleSet samples;
-        {
-            py::gil_scoped_release release;
-            sph::PoissonSettings settings = sph::PoissonSettings::forSpacing(sph::Real(spacing));
-            settings.seed = seed;
-            samples = sph::PoissonDiskSampler(settings).sampleVolume(shape);
-        }
-        return vectors(samples.positions);
+        return poissonSamples(vdbio::loadLevelSet(file, grid, "sample"), spacing, seed);
         },
         py::arg("file"), py::arg("grid"), py::arg("spacing"), py::arg("seed") = 1,
         "Poisson-disk samples ([SB12] Sec. 4.5) of the level set `grid` in the .vdb `file` at "
