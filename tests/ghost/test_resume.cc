@@ -6,6 +6,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 
+#include "common/ResumeScene.h"
 #include "common/StateDiff.h"
 
 #include <gtest/gtest.h>
@@ -23,39 +24,10 @@ namespace {
 
 constexpr Real H = Real(0.01);
 
-/// A small scene that goes through every kind of solver state: a block of liquid on a floor
-/// that slides sideways (moving solid), a nozzle pouring into it (emitter), a kill box cutting
-/// the liquid's right side (killed counter) and, for Ghost SPH, air resampled every 10 steps
-/// (so a frame boundary falls in the middle of an air fade).
-struct Scene
+/// The shared scene with this file's seed and the floor sliding at 5 cm/s.
+struct Scene : ghostfx::testing::ResumeScene
 {
-    GhostSettings settings;
-    LevelSet floor, liquid, nozzle;
-
-    explicit Scene(Method method, int substeps)
-        : floor(makeLevelSet(
-            makeBoxLevelSet(Vec3(-0.1f, -0.05f, -0.05f), Vec3(0.1f, 0.0f, 0.05f), H / 2), "floor"))
-        , liquid(makeLevelSet(
-              makeBoxLevelSet(Vec3(-0.05f, 0.0f, -0.03f), Vec3(0.05f, 0.05f, 0.03f), H / 2),
-              "liquid"))
-        , nozzle(makeLevelSet(
-              makeBoxLevelSet(Vec3(-0.02f, 0.08f, -0.02f), Vec3(0.02f, 0.1f, 0.02f), H / 2),
-              "nozzle"))
-    {
-        settings.method = method;
-        settings.spacing = H;
-        settings.frameRate = 60;
-        settings.substeps = substeps; // 0: CFL-adaptive, which reads the saved max acceleration
-        settings.seed = 5;
-        settings.killBox = Aabb{Vec3(-0.2f, -0.2f, -0.2f), Vec3(0.04f, 0.3f, 0.2f)};
-    }
-
-    /// Add the solids and emitters, in the same order for a fresh and a resumed solver.
-    void addInputs(GhostSolver& solver) const
-    {
-        solver.addSolid(floor, Vec3(Real(0.05), 0, 0));
-        solver.addEmitter(nozzle, Vec3(0, Real(-0.5), 0));
-    }
+    Scene(Method method, int substeps) : ResumeScene(method, substeps, Vec3(Real(0.05), 0, 0), 5) {}
 };
 
 using ghostfx::testing::firstDifference;

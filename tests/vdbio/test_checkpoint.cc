@@ -8,6 +8,7 @@
 #include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/Stats.h>
 
+#include "common/ResumeScene.h"
 #include "common/StateDiff.h"
 
 #include "common/Expect.h"
@@ -255,42 +256,14 @@ TEST(Checkpoint, RefusesMissingNonHdf5AndForeignFiles)
 
 namespace {
 
-/// A small scene that takes every path of the solver state: liquid on a floor that slides
-/// sideways (moving solid), a nozzle pouring into it (emitter: first filled, then grown from
-/// seeds), a kill box through the liquid (killed counter) and, for Ghost SPH, the air layer
-/// resampled every 10 steps, so the checkpoint falls in the middle of an air fade.
-struct ResumeScene
+/// The shared scene (tests/common/ResumeScene.h), described as a caller (the CLI) would
+/// describe its effective settings for the checkpoint's fingerprint.
+struct ResumeScene : ghostfx::testing::ResumeScene
 {
-    GhostSettings settings;
-    LevelSet floor, liquid, nozzle;
-    Vec3 floorVelocity{0};
+    ResumeScene(Method method, int substeps, const Vec3& floorVelocity)
+        : ghostfx::testing::ResumeScene(method, substeps, floorVelocity, 11)
+    {}
 
-    ResumeScene(Method method, int substeps, const Vec3& floorVelocity_)
-        : floor(makeLevelSet(
-            makeBoxLevelSet(Vec3(-0.1f, -0.05f, -0.05f), Vec3(0.1f, 0.0f, 0.05f), H / 2), "floor"))
-        , liquid(makeLevelSet(
-              makeBoxLevelSet(Vec3(-0.05f, 0.0f, -0.03f), Vec3(0.05f, 0.05f, 0.03f), H / 2),
-              "liquid"))
-        , nozzle(makeLevelSet(
-              makeBoxLevelSet(Vec3(-0.02f, 0.08f, -0.02f), Vec3(0.02f, 0.1f, 0.02f), H / 2),
-              "nozzle"))
-    {
-        floorVelocity = floorVelocity_;
-        settings.method = method;
-        settings.spacing = H;
-        settings.frameRate = 60;
-        settings.substeps = substeps;
-        settings.seed = 11;
-        settings.killBox = Aabb{Vec3(-0.2f, -0.2f, -0.2f), Vec3(0.04f, 0.3f, 0.2f)};
-    }
-
-    void addInputs(GhostSolver& solver) const
-    {
-        solver.addSolid(floor, floorVelocity);
-        solver.addEmitter(nozzle, Vec3(0, Real(-0.5), 0));
-    }
-
-    /// The effective settings as a caller (the CLI) would describe them.
     std::string settingsJson() const
     {
         std::ostringstream os;
