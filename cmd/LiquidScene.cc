@@ -14,14 +14,11 @@ using ghost::GhostSolver;
 using sph::Real;
 using sph::Vec3;
 
-ghost::GhostSettings liquidSettings(const vdbio::Scene& scene)
+ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method method)
 {
     const vdbio::JsonObject& s = scene.settings;
     GhostSettings g;
-    if (scene.method != "ghost" && scene.method != "basic") {
-        s.failValue("method", "the liquid solver runs 'ghost' or 'basic'");
-    }
-    g.method = ghost::methodFromName(scene.method);
+    g.method = method;
     g.spacing = Real(scene.spacing);
     g.frameRate = Real(scene.frameRate);
     g.supportFactor = Real(s.inRange("kernel_support", g.supportFactor, 1.5, 5));

@@ -12,9 +12,9 @@
 namespace ghostfx {
 namespace cmd {
 
-/// Read the liquid solver's settings from `scene.settings` (and the shared ones already read),
-/// then check that no key of `settings` is left unread. Errors name the scene key.
-ghost::GhostSettings liquidSettings(const vdbio::Scene& scene);
+/// Read the liquid solver's settings for `method` from `scene.settings` (and the shared ones
+/// already read), then check that no key of `settings` is left unread. Errors name the scene key.
+ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method method);
 
 /// A liquid solver set up for `scene`: solids (static, moving or keyed), liquid bodies,
 /// emitters. With `restored`, the solver continues from that state: liquid bodies are not

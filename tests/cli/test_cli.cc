@@ -237,9 +237,9 @@ TEST_F(Cli, BadInputGetsOneClearLine)
                     "settings.cfl = 50: expected a number in [0.001, 10]");
     EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.method=gas"),
                     "liquids: a 'gas' scene simulates gas only: liquids, emitters and heaters need "
-                    "method 'ghost' or 'basic'");
+                    "a liquid method ('ghost' or 'basic'");
     EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.gas.kappa=2"),
-                    "settings.gas: gas settings need method 'gas' or heaters (boiling)");
+                    "settings.gas: gas settings need a gas method or heaters (boiling)");
     EXPECT_CONTAINS(errorLine("run " + good + out
                               + " -D 'liquids[0].geometry={\"file\":\"none.vdb\",\"grid\":\"x\"}'"),
                     "none.vdb' does not exist");
@@ -334,7 +334,7 @@ TEST_F(Cli, OnlyWhatTheSceneRequiresIsModelledAndWritten)
     scene.erase("solids");
     scene["settings"]["gravity"] = {0, 0, 0};
     const vdbio::Scene s = vdbio::readScene(write(scene));
-    auto solver = cmd::makeLiquidSolver(s, cmd::liquidSettings(s));
+    auto solver = cmd::makeLiquidSolver(s, cmd::liquidSettings(s, ghost::Method::Ghost));
     solver->advanceFrame();
     EXPECT_EQ(solver->count(sph::ParticleKind::GhostSolid), 0u);
     EXPECT_EQ(solver->count(sph::ParticleKind::Boundary), 0u);
@@ -354,7 +354,7 @@ TEST_F(Cli, OnlyWhatTheSceneRequiresIsModelledAndWritten)
     // (Basic SPH's Lennard-Jones walls need the CFL-limited step: it blows up at 10 fixed substeps.)
     const vdbio::Scene basic =
         vdbio::readScene(write(smallScene()), {"settings.method=basic", "settings.substeps=0"});
-    auto b = cmd::makeLiquidSolver(basic, cmd::liquidSettings(basic));
+    auto b = cmd::makeLiquidSolver(basic, cmd::liquidSettings(basic, ghost::Method::Basic));
     b->advanceFrame();
     EXPECT_EQ(b->count(sph::ParticleKind::GhostAir), 0u);
     for (const std::string& c : b->particles().scalarChannelNames()) {
@@ -409,7 +409,7 @@ Json plumeScene()
     return Json::parse(R"({
         "ghostfx_scene": 1,
         "settings": { "method": "gas", "spacing": 0.04, "frame_range": [1, 3],
-                      "gas": { "variant": "fast", "substeps": 2 } },
+                      "gas": { "substeps": 2 } },
         "domain": { "kill_box": { "min": [-0.5, -0.1, -0.5], "max": [0.5, 1.5, 0.5] } },
         "gas_sources": [ { "name": "burner", "geometry": { "sphere": { "center": [0, 0.1, 0], "radius": 0.1 } },
                            "temperature": 600, "velocity": [0, 0.5, 0] } ],
@@ -462,9 +462,9 @@ TEST_F(Cli, GasPlumeRunsToDensityAndTemperatureVolumes)
     // The ambient-air baseline needs the box it fills with air.
     Json noBox = plumeScene();
     noBox.erase("domain");
-    noBox["settings"]["gas"]["variant"] = "ambient";
+    noBox["settings"]["method"] = "gas_ambient";
     EXPECT_CONTAINS(errorLine("run " + write(noBox, "nobox.json") + " --out " + out.string()),
-                    "settings.gas.variant = \"ambient\": the ambient-air baseline fills a box with "
+                    "settings.method = \"gas_ambient\": the ambient-air baseline fills a box with "
                     "air: expected domain.kill_box");
 }
 

@@ -519,7 +519,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     // Shared settings; the solver-specific rest is read by the caller.
     scene.settings = root.object("settings");
     const JsonObject& s = scene.settings;
-    scene.method = s.choice("method", "ghost", {"ghost", "basic", "gas"});
+    scene.method = s.get<std::string>("method", "ghost");
     scene.spacing = s.positive("spacing", 0.02);
     if (scene.spacing < MIN_SPACING) {
         s.failValue("spacing",
@@ -651,46 +651,8 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     if (auto outputs = root.optionalObject("outputs")) readOutputs(*outputs, scene.outputs);
     root.finish();
 
-    // Per-frame shapes are applied by the liquid solver only; a gas (or a boiling liquid's
-    // vapour) would keep the first shape while the scene says it deforms.
-    if (scene.method == "gas" || !scene.heaters.empty()) {
-        for (std::size_t i = 0; i < scene.solids.size(); ++i) {
-            if (scene.solids[i].sequenceFile.empty()) continue;
-            root.fail(msg("solids[", i, "].sequence"),
-                      msg("solid '", scene.solids[i].name,
-                          "' deforms per frame, which only a liquid scene "
-                          "supports; ",
-                          scene.method == "gas" ? "a gas" : "a boiling",
-                          " scene takes static or "
-                          "rigidly moving solids ('velocity' or 'motion')"));
-        }
-    }
-    if (scene.method == "gas") {
-        if (!scene.liquids.empty() || !scene.emitters.empty() || !scene.heaters.empty()) {
-            root.fail(scene.liquids.empty() ? (scene.emitters.empty() ? "heaters" : "emitters")
-                                            : "liquids",
-                      "a 'gas' scene simulates gas only: liquids, emitters and heaters need method "
-                      "'ghost' or "
-                      "'basic' (with heaters, the liquid boils into gas)");
-        }
-        if (scene.gasSources.empty()) {
-            root.fail("gas_sources", "the scene has no gas: expected at least one gas source");
-        }
-    } else {
-        if (scene.liquids.empty() && scene.emitters.empty()) {
-            root.fail("liquids",
-                      "the scene has no liquid: expected at least one liquid body or emitter");
-        }
-        if (!scene.gasSources.empty() && scene.heaters.empty()) {
-            root.fail("gas_sources",
-                      "gas sources need settings.method 'gas' (or heaters, for boiling)");
-        }
-        if (!scene.forceFields.empty() && scene.heaters.empty()) {
-            root.fail("force_fields",
-                      "attractors act on gas; this scene has no gas (expected settings.method "
-                      "'gas', or heaters that boil the liquid into vapour)");
-        }
-    }
+    // What the method's medium can simulate (gas sources without liquid, heaters with it) is
+    // checked by the program's method registry (cmd/Methods.cc), which knows the methods.
     return scene;
 }
 

@@ -221,7 +221,7 @@ struct Scene
 
     // Settings every solver shares.
     std::string
-        method; ///< "ghost", "basic" (liquids), "gas" (gas only: fast, ambient or uncorrected by settings.gas.variant)
+        method; ///< settings.method: a name in the program's method registry (cmd/Methods.h), not checked here
     double spacing = 0;    ///< particle spacing h (m)
     double frameRate = 30; ///< frames per second
     int firstFrame = 1,

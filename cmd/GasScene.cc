@@ -1,0 +1,117 @@
+/// @file   GasScene.cc
+#include "GasScene.h"
+
+#include "LiquidScene.h"
+
+#include <ghostfx/sph/Exceptions.h>
+
+namespace ghostfx {
+namespace cmd {
+
+using sph::Real;
+using sph::Vec3;
+
+/// The gas keys of the scene: settings.gas { ... }.
+const std::vector<std::pair<std::string, gas::Method>>& gasMethodNames()
+{
+    static const std::vector<std::pair<std::string, gas::Method>> names = {
+        {"gas", gas::Method::Fast},
+        {"gas_ambient", gas::Method::Ambient},
+        {"gas_uncorrected", gas::Method::Uncorrected}};
+    return names;
+}
+
+gas::Method gasMethod(const std::string& name)
+{
+    for (const auto& [n, m] : gasMethodNames()) {
+        if (n == name) return m;
+    }
+    throw ValueError(msg("gas method '", name, "': expected 'gas', 'gas_ambient' or 'gas_uncorrected'"));
+}
+
+gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject& g,
+                             double defaultSpacing, gas::Method method)
+{
+    gas::GasSettings s;
+    if (g.has("variant")) {
+        // The gas baselines are methods now, chosen like the liquid's (settings.method).
+        g.fail("variant", "replaced by the method: settings.method 'gas' (fast), 'gas_ambient' "
+                          "or 'gas_uncorrected' (for a boiling scene's vapour: settings.gas.method)");
+    }
+    s.method = method;
+    s.spacing = Real(g.positive("spacing", defaultSpacing));
+    s.supportFactor = Real(g.inRange("kernel_support", s.supportFactor, 1.5, 5));
+    s.particleMass = Real(g.nonNegative("particle_mass", s.particleMass));
+    s.restDensity = Real(g.positive("rest_density", s.restDensity));
+    s.kappa = Real(g.positive("kappa", s.kappa));
+    s.clampNegativePressure = g.get<bool>("clamp_negative_pressure", s.clampNegativePressure);
+    s.delta = Real(g.inRange("delta", s.delta, 0.4, 0.7));
+    s.atmosphericPressure = Real(g.nonNegative("atmospheric_pressure", s.atmosphericPressure));
+    s.interiorPressureScale =
+        Real(g.inRange("interior_pressure_scale", s.interiorPressureScale, 0, 1));
+    s.normalThreshold = Real(g.nonNegative("normal_threshold", s.normalThreshold));
+    s.damping = Real(g.nonNegative("damping", s.damping));
+    s.viscosity = Real(g.nonNegative("viscosity", s.viscosity));
+    const auto gravity =
+        g.get<std::array<double, 3>>("gravity", {s.gravity[0], s.gravity[1], s.gravity[2]});
+    s.gravity = Vec3(Real(gravity[0]), Real(gravity[1]), Real(gravity[2]));
+    s.ambientTemperature = Real(g.positive("ambient_temperature", s.ambientTemperature));
+    s.diffusion = Real(g.nonNegative("diffusion", s.diffusion));
+    s.radiationTime = Real(g.nonNegative("radiation_time", s.radiationTime));
+    s.buoyancy = Real(g.nonNegative("buoyancy", s.buoyancy));
+    const auto up = g.get<std::array<double, 3>>("buoyancy_direction", {0, 1, 0});
+    s.buoyancyDirection = Vec3(Real(up[0]), Real(up[1]), Real(up[2]));
+    s.vorticity = g.get<bool>("vorticity", s.vorticity);
+    s.vorticityGeneration = Real(g.nonNegative("vorticity_generation", s.vorticityGeneration));
+    s.vorticityStrength = Real(g.nonNegative("vorticity_strength", s.vorticityStrength));
+    s.lifeStrength = Real(g.nonNegative("life_strength", s.lifeStrength));
+    s.substeps = int(g.inRange("substeps", s.substeps, 0, 100000));
+    s.cflNumber = Real(g.inRange("cfl", s.cflNumber, 1e-3, 10));
+    s.maxSpeed = Real(g.nonNegative("max_speed", s.maxSpeed));
+    s.seed = g.get<std::uint64_t>("seed", s.seed);
+    s.frameRate = Real(scene.frameRate);
+    s.domain = scene.killBox;
+    // force_fields ([RYY15] Fig. 7): point attractors act on the gas.
+    for (const vdbio::SceneForceField& field : scene.forceFields) {
+        gas::Attractor a;
+        a.position = Vec3(field.attractor.position);
+        a.strength = Real(field.attractor.strength);
+        a.radius = Real(field.attractor.radius);
+        a.falloff = gas::falloffFromName(field.attractor.falloff);
+        s.attractors.push_back(a);
+    }
+    g.finish();
+    if (s.method == gas::Method::Ambient && s.domain.empty()) {
+        const char* what = "the ambient-air baseline fills a box with air: expected domain.kill_box";
+        if (g.has("method")) g.failValue("method", what);
+        scene.settings.failValue("method", what);
+    }
+    s.validate();
+    return s;
+}
+
+std::unique_ptr<gas::GasSolver> makeGasSolver(const vdbio::Scene& scene,
+                                              const gas::GasSettings& settings,
+                                              const sph::SolverState* restored)
+{
+    auto solver = std::make_unique<gas::GasSolver>(settings);
+    if (restored) solver->restoreState(*restored);
+    for (const vdbio::SceneSolid& solid : scene.solids) {
+        if (solid.motion.keys.empty()) solver->addSolid(solid.shape, Vec3(solid.velocity));
+        else solver->addMovingSolid(solid.shape, keyedMotion(solid.motion));
+    }
+    for (const vdbio::SceneGasSource& src : scene.gasSources) {
+        gas::GasSource s;
+        s.temperature = Real(src.temperature);
+        s.velocity = Vec3(src.velocity);
+        s.rate = Real(src.rate);
+        s.start = src.start;
+        s.end = src.end;
+        if (!src.motion.keys.empty()) s.motion = keyedMotion(src.motion);
+        solver->addSource(src.shape, s);
+    }
+    return solver;
+}
+
+} // namespace cmd
+} // namespace ghostfx

@@ -1,0 +1,145 @@
+/// @file   LiquidSimulation.cc
+/// @brief  A liquid scene ([SB12] Ghost SPH or the Basic SPH baseline) behind Simulation.
+#include "LiquidScene.h"
+#include "SimulationParts.h"
+
+#include <ghostfx/sph/Exceptions.h>
+
+namespace ghostfx {
+namespace cmd {
+
+using ghost::GhostSolver;
+using sph::ParticleKind;
+using sph::Real;
+using sph::Vec3;
+
+std::size_t liquidParticleCount(const GhostSolver& s)
+{
+    return s.particles().size() + s.count(ParticleKind::GhostSolid)
+           + s.count(ParticleKind::Boundary);
+}
+
+OutputMedium liquidMedium(const GhostSolver& s)
+{
+    OutputMedium m;
+    m.name = "liquid";
+    m.particles = &s.particles();
+    m.kinds = {ParticleKind::Liquid};
+    m.ghostKinds = {ParticleKind::GhostAir, ParticleKind::GhostSolid, ParticleKind::Boundary};
+    m.withGhosts = [&s] { return s.allParticles(); };
+    m.spacing = s.settings().spacing;
+    m.support = s.settings().supportRadius();
+    m.restDensity = s.settings().restDensity;
+    m.gravity = s.settings().gravity;
+    m.liquid = true;
+    return m;
+}
+
+namespace {
+
+class LiquidSimulation : public Simulation
+{
+public:
+    LiquidSimulation(const vdbio::Scene& scene, ghost::Method method,
+                     const sph::SolverState* restored)
+        : mScene(scene)
+        , mSolver(makeLiquidSolver(scene, liquidSettings(scene, method), restored))
+    {}
+
+    void advanceFrame() override { mSolver->advanceFrame(); }
+    int frame() const override { return mSolver->frame(); }
+    double time() const override { return mSolver->time(); }
+    std::uint64_t stepCount() const override { return mSolver->stepCount(); }
+    void beforeFrame(int frame) override { updateSolidSequences(mScene, *mSolver, frame); }
+    double fixedTimeStep() const override { return fixedStep(mSolver->settings()); }
+    double stabilityLimit() const override
+    {
+        return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
+    }
+    void setSolidMotion(std::size_t index, sph::RigidMotion motion) override
+    {
+        mSolver->setSolidMotion(index, std::move(motion));
+    }
+    void addSolid(const sph::LevelSet& shape, const Vec3& velocity) override
+    {
+        mSolver->addSolid(shape, velocity);
+    }
+    std::size_t addLiquid(const sph::LevelSet& shape, const Vec3& velocity) override
+    {
+        return mSolver->addLiquid(shape, velocity);
+    }
+
+    void setStepObserver(std::function<void(double)> observer) override
+    {
+        mSolver->setStepObserver([observer](const GhostSolver&, Real dt) { observer(double(dt)); });
+    }
+
+    vdbio::StatsRow statsRow(int frame, double dt) override
+    {
+        const GhostSolver& s = *mSolver;
+        const FieldStats f =
+            fieldStats(s.particles(), ParticleKind::Liquid, s.settings().restDensity, nullptr);
+        const ghost::PhaseTimings& t = s.timings();
+        vdbio::StatsRow row;
+        row.values = {
+            {"frame", frame},
+            {"step", double(s.stepCount())},
+            {"time", s.time()},
+            {"dt", dt},
+            {"count_liquid", double(f.count)},
+            {"count_ghost_air", double(s.count(ParticleKind::GhostAir))},
+            {"count_ghost_solid", double(s.count(ParticleKind::GhostSolid))},
+            {"count_boundary", double(s.count(ParticleKind::Boundary))},
+            {"max_speed", f.maxSpeed},
+            {"density_error_mean", f.errorMean},
+            {"density_error_max", f.errorMax},
+            {"t_neighbors_density", t.neighborsAndDensity - mBefore.neighborsAndDensity},
+            {"t_pressure_force", t.pressureForce - mBefore.pressureForce},
+            {"t_xsph_boundary", t.xsphAndBoundary - mBefore.xsphAndBoundary},
+            {"t_air_resampling", t.airResampling - mBefore.airResampling},
+            {"t_emission", t.emission - mBefore.emission},
+            {"t_step", t.total - mBefore.total},
+            bytesPerParticle(*this),
+        };
+        mBefore = t;
+        return row;
+    }
+
+    std::string counts() const override
+    {
+        return msg(mSolver->count(ParticleKind::Liquid), " liquid, ",
+                   mSolver->count(ParticleKind::GhostAir), " air, ",
+                   mSolver->count(ParticleKind::GhostSolid)
+                       + mSolver->count(ParticleKind::Boundary),
+                   " solid ghosts");
+    }
+    std::size_t particleCount() const override { return liquidParticleCount(*mSolver); }
+    std::size_t memoryBytes() const override { return mSolver->memoryBytes(); }
+
+    std::vector<OutputMedium> media() const override { return {liquidMedium(*mSolver)}; }
+
+    std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
+
+private:
+    const vdbio::Scene& mScene;
+    std::unique_ptr<GhostSolver> mSolver;
+    ghost::PhaseTimings mBefore;
+};
+
+} // namespace
+
+std::unique_ptr<Simulation> makeLiquidSimulation(const vdbio::Scene& scene, ghost::Method method,
+                                                 const sph::SolverState* restored)
+{
+    if (!scene.heaters.empty()) return makeBoilingSimulation(scene, method);
+    return std::make_unique<LiquidSimulation>(scene, method, restored);
+}
+
+void checkLiquidSimulation(const vdbio::Scene& scene, ghost::Method method)
+{
+    if (!scene.heaters.empty()) checkBoilingSimulation(scene, method);
+    else liquidSettings(scene, method);
+}
+
+} // namespace cmd
+} // namespace ghostfx
