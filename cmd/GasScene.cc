@@ -26,7 +26,8 @@ gas::Method gasMethod(const std::string& name)
     for (const auto& [n, m] : gasMethodNames()) {
         if (n == name) return m;
     }
-    throw ValueError(msg("gas method '", name, "': expected 'gas', 'gas_ambient' or 'gas_uncorrected'"));
+    throw ValueError(
+        msg("gas method '", name, "': expected 'gas', 'gas_ambient' or 'gas_uncorrected'"));
 }
 
 gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject& g,
@@ -35,8 +36,9 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
     gas::GasSettings s;
     if (g.has("variant")) {
         // The gas baselines are methods now, chosen like the liquid's (settings.method).
-        g.fail("variant", "replaced by the method: settings.method 'gas' (fast), 'gas_ambient' "
-                          "or 'gas_uncorrected' (for a boiling scene's vapour: settings.gas.method)");
+        g.fail("variant",
+               "replaced by the method: settings.method 'gas' (fast), 'gas_ambient' "
+               "or 'gas_uncorrected' (for a boiling scene's vapour: settings.gas.method)");
     }
     s.method = method;
     s.spacing = Real(g.positive("spacing", defaultSpacing));
@@ -82,7 +84,8 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
     }
     g.finish();
     if (s.method == gas::Method::Ambient && s.domain.empty()) {
-        const char* what = "the ambient-air baseline fills a box with air: expected domain.kill_box";
+        const char* what =
+            "the ambient-air baseline fills a box with air: expected domain.kill_box";
         if (g.has("method")) g.failValue("method", what);
         scene.settings.failValue("method", what);
     }

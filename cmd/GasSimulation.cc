@@ -66,8 +66,7 @@ namespace {
 class GasSimulation : public Simulation
 {
 public:
-    GasSimulation(const vdbio::Scene& scene, gas::Method method,
-                  const sph::SolverState* restored)
+    GasSimulation(const vdbio::Scene& scene, gas::Method method, const sph::SolverState* restored)
         : mSolver(makeGasSolver(scene, readSettings(scene, method), restored))
     {}
 

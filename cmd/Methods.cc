@@ -22,10 +22,13 @@ const sph::SolverState* first(const Restored* restored)
 /// An entry for a liquid method of libghost ([SB12]); with heaters it boils (BoilingSimulation).
 Method liquidMethod(ghost::Method m, std::string baselineOf, std::string summary)
 {
-    return {ghost::methodName(m), Medium::Liquid, std::move(baselineOf), std::move(summary),
+    return {ghost::methodName(m),
+            Medium::Liquid,
+            std::move(baselineOf),
+            std::move(summary),
             [m](const vdbio::Scene& scene) { checkLiquidSimulation(scene, m); },
             [m](const vdbio::Scene& scene, const Restored* restored) {
-                return makeLiquidSimulation(scene, m, first(restored));
+        return makeLiquidSimulation(scene, m, first(restored));
             }};
 }
 
@@ -33,10 +36,13 @@ Method liquidMethod(ghost::Method m, std::string baselineOf, std::string summary
 Method gasSolverMethod(const std::string& name, std::string baselineOf, std::string summary)
 {
     const gas::Method m = gasMethod(name);
-    return {name, Medium::Gas, std::move(baselineOf), std::move(summary),
+    return {name,
+            Medium::Gas,
+            std::move(baselineOf),
+            std::move(summary),
             [m](const vdbio::Scene& scene) { checkGasSimulation(scene, m); },
             [m](const vdbio::Scene& scene, const Restored* restored) {
-                return makeGasSimulation(scene, m, first(restored));
+        return makeGasSimulation(scene, m, first(restored));
             }};
 }
 
@@ -103,11 +109,11 @@ const std::vector<Method>& methods()
         liquidMethod(ghost::Method::Basic, "ghost",
                      "Basic SPH, the [SB12] baseline: no ghosts, boundary particles in the walls"),
         gasSolverMethod("gas", "",
-                  "fast gas [RYY15]: no ambient air, density and force compensation"),
+                        "fast gas [RYY15]: no ambient air, density and force compensation"),
         gasSolverMethod("gas_ambient", "gas",
-                  "the [RYY15] standard baseline: domain.kill_box filled with ambient air"),
+                        "the [RYY15] standard baseline: domain.kill_box filled with ambient air"),
         gasSolverMethod("gas_uncorrected", "gas",
-                  "the [RYY15] Fig. 4c ablation: no ambient air and no compensation"),
+                        "the [RYY15] Fig. 4c ablation: no ambient air and no compensation"),
     };
     return all;
 }
@@ -133,8 +139,9 @@ const Method& methodOf(const vdbio::Scene& scene)
     std::vector<std::string> names;
     for (const Method& m : methods()) names.push_back(m.name);
     const std::string near = vdbio::closestKey(scene.method, names);
-    scene.settings.failValue("method", "expected " + methodNames()
-                                           + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
+    scene.settings.failValue("method",
+                             "expected " + methodNames()
+                                 + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
 }
 
 } // namespace cmd

@@ -12,12 +12,12 @@
 #include "LiquidScene.h"
 #include "Simulation.h"
 #include "StudyMetrics.h"
+#include "StudyPlot.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/JsonReader.h>
-#include <ghostfx/vdbio/Plot.h>
 #include <ghostfx/vdbio/Scene.h>
 
 #include <algorithm>
@@ -225,6 +225,9 @@ StudySpec readStudy(const std::string& path)
     s.directory = out.get<std::string>("directory", "out/study_" + fs::path(path).stem().string());
     s.table = out.get<std::string>("table", "study.csv");
     s.plot = out.get<std::string>("plot", "study.png");
+    const std::string ext = fs::path(s.plot).extension().string();
+    if (ext != ".png" && ext != ".pdf" && ext != ".svg")
+        out.failValue("plot", "expected an image file name ending in .png, .pdf or .svg");
     out.finish();
 
     const vdbio::JsonObject plot = root.has("plot") ? root.object("plot") : vdbio::JsonObject();
@@ -708,13 +711,12 @@ std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutco
     return report;
 }
 
-void writeStudyPlot(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
-                    const std::string& path, std::string& skipped)
+/// The plotted runs (ok, with a positive cost and error; not the reference); the indices of the
+/// others go to `skipped`.
+std::vector<PlotPoint> plotPoints(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
+                                  std::string& skipped)
 {
-    vdbio::PlotSpec plot;
-    plot.title = spec.plotTitle;
-    plot.xLabel = spec.plotCost;
-    plot.yLabel = spec.plotError;
+    std::vector<PlotPoint> points;
     for (std::size_t k = 0; k < outcomes.size(); ++k) {
         const StudyCase& c = spec.cases[k];
         if (c.reference) continue;
@@ -724,19 +726,19 @@ void writeStudyPlot(const StudySpec& spec, const std::vector<CaseOutcome>& outco
             skipped += msg(skipped.empty() ? "" : ", ", k);
             continue;
         }
-        vdbio::PlotPoint p;
+        PlotPoint p;
         p.x = x;
         p.y = y;
         auto series = c.values.find(spec.plotSeries);
-        // The key's last part names the series ("variant=fast"): legends have little room.
+        // The key's last part names the series ("method=ghost"): legends have little room.
         const std::string key = spec.plotSeries.substr(spec.plotSeries.find_last_of('.') + 1);
         p.series = series == c.values.end() ? "runs" : key + "=" + valueText(series->second);
         for (const auto& [name, value] : c.values) {
             if (name != spec.plotSeries) p.label += (p.label.empty() ? "" : " ") + valueText(value);
         }
-        plot.points.push_back(p);
+        points.push_back(p);
     }
-    if (!plot.points.empty()) vdbio::writePlotPng(path, plot);
+    return points;
 }
 
 struct StudyOptions
@@ -844,15 +846,32 @@ int finishStudy(const StudyOptions& o, const StudySpec& spec,
     const std::string order =
         convergenceReport(spec, outcomes, (fs::path(folder) / "convergence.csv").string());
     if (!order.empty()) say("convergence (convergence.csv):\n" + order.substr(0, order.size() - 1));
-    std::string skipped;
-    const std::string plot = (fs::path(folder) / spec.plot).string();
-    writeStudyPlot(spec, outcomes, plot, skipped);
     writeMarkdown(spec, outcomes,
                   (fs::path(fs::path(folder) / spec.table).replace_extension(".md")).string());
-    say(msg("table: ", (fs::path(folder) / spec.table).string(), "; plot: ", plot,
-            skipped.empty()
-                ? ""
-                : " (not plotted, failed or without a positive value: cases " + skipped + ")"));
+    // The plotted points (with their Pareto front) as a table, drawn by the matplotlib script.
+    std::string skipped;
+    const std::vector<PlotPoint> points = plotPoints(spec, outcomes, skipped);
+    const std::string plot = (fs::path(folder) / spec.plot).string();
+    const std::string pointsFile = (fs::path(folder) / "plot.csv").string();
+    writePlotPoints(pointsFile, spec.plotCost, spec.plotError, points);
+    const std::string notPlotted =
+        skipped.empty()
+            ? ""
+            : " (not plotted, failed or without a positive value: cases " + skipped + ")";
+    say(msg("table: ", (fs::path(folder) / spec.table).string(), "; plot points: ", pointsFile,
+            notPlotted));
+    if (points.empty()) {
+        say("plot: nothing to draw (no run finished with a positive cost and error)");
+        return 0;
+    }
+    const std::string why = drawPlot(pointsFile, plot, spec.plotTitle);
+    // The table is the study's result; a plot that cannot be drawn (no matplotlib on this
+    // machine) is a warning with the command that draws it elsewhere, not a failed study.
+    if (why.empty()) say("plot: " + plot);
+    else {
+        std::fprintf(stderr, "ghostfx study: warning: plot not drawn: %s; to draw it: %s\n",
+                     why.c_str(), plotCommand(pointsFile, plot, spec.plotTitle).c_str());
+    }
     return 0;
 }
 

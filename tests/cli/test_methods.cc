@@ -72,8 +72,7 @@ protected:
     std::string checkError(const Json& doc) const
     {
         const vdbio::Scene scene = read(doc);
-        return ghostfx::testing::errorOf<SceneError>(
-            [&] { cmd::checkSimulationSettings(scene); });
+        return ghostfx::testing::errorOf<SceneError>([&] { cmd::checkSimulationSettings(scene); });
     }
 
     std::filesystem::path mDir;

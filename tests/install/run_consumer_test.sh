@@ -19,6 +19,8 @@ cmake --install "$build" --prefix "$work/prefix" > "$work/install.log"
 # The installed program runs from the prefix without LD_LIBRARY_PATH (install RPATH), also when
 # the environment points elsewhere.
 env -u LD_LIBRARY_PATH "$work/prefix/bin/ghostfx" --version | grep -q "^ghostfx "
+# The study plot script, where the installed program looks for it (share/ghostfx).
+test -x "$work/prefix/share/ghostfx/plot_study.py"
 # The Python module, where it was built (not under the sanitizers): importable from the prefix's
 # dist-packages, finding the libraries through its install RPATH.
 module="$(find "$work/prefix" -name '_ghostfx*.so' | head -n 1)"
