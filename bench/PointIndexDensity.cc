@@ -3,6 +3,7 @@
 ///         PointIndexIterator queries) for bench_neighbors.
 #include "PointIndexDensity.h"
 
+#include "ghostfx/sph/EnumNames.h"
 #include "ghostfx/sph/Parallel.h"
 
 #include <openvdb/tools/PointIndexGrid.h>
@@ -40,13 +41,10 @@ constexpr std::size_t GRAIN = parallel::DEFAULT_GRAIN;
 
 const char* queryName(PointIndexQuery query)
 {
-    switch (query) {
-    case PointIndexQuery::BoxThenDistance:
-        return "box+distance";
-    case PointIndexQuery::RadialSubvoxel:
-        return "radial(subvoxel)";
-    }
-    return "?";
+    static const sph::EnumName<PointIndexQuery> names[] = {
+        {PointIndexQuery::BoxThenDistance, "box+distance"},
+        {PointIndexQuery::RadialSubvoxel, "radial(subvoxel)"}};
+    return sph::nameOf(names, query);
 }
 
 struct PointIndexDensity::Impl

@@ -6,6 +6,8 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <memory>
+#include <string>
 
 namespace ghostfx {
 namespace cmd {
@@ -17,6 +19,29 @@ struct Command
     CLI::App* app = nullptr;
     std::function<int()> run;
 };
+
+/// The arguments of a command that turns one file into another with options (`preview`,
+/// `mesh2sdf`): the positional input, `-o` and the options, shared with the action.
+template <typename Options>
+struct FileToFileArgs
+{
+    std::string input, output;
+    Options options;
+};
+
+/// A sub-command `name` with `description` and FileToFileArgs: the input's positional option
+/// (`inputName`, `inputHelp`) and a required `-o,--output` (`outputHelp`).
+template <typename Options>
+CLI::App* addFileToFileCommand(CLI::App& parent, const std::string& name,
+                               const std::string& description, const std::string& inputName,
+                               const std::string& inputHelp, const std::string& outputHelp,
+                               FileToFileArgs<Options>& args)
+{
+    CLI::App* c = parent.add_subcommand(name, description);
+    c->add_option(inputName, args.input, inputHelp)->required();
+    c->add_option("-o,--output", args.output, outputHelp)->required();
+    return c;
+}
 
 Command addSampleCommand(CLI::App& parent);
 Command addRunCommand(CLI::App& parent);

@@ -2,6 +2,7 @@
 #include "GasScene.h"
 
 #include "LiquidScene.h"
+#include "StepSettings.h"
 
 #include <ghostfx/sph/Exceptions.h>
 
@@ -67,10 +68,7 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
     s.vorticityGeneration = Real(g.nonNegative("vorticity_generation", s.vorticityGeneration));
     s.vorticityStrength = Real(g.nonNegative("vorticity_strength", s.vorticityStrength));
     s.lifeStrength = Real(g.nonNegative("life_strength", s.lifeStrength));
-    s.substeps = int(g.inRange("substeps", s.substeps, 0, 100000));
-    s.cflNumber = Real(g.inRange("cfl", s.cflNumber, 1e-3, 10));
-    s.maxSpeed = Real(g.nonNegative("max_speed", s.maxSpeed));
-    s.seed = g.get<std::uint64_t>("seed", s.seed);
+    readStepSettings(g, s);
     s.frameRate = Real(scene.frameRate);
     s.domain = scene.killBox;
     // force_fields ([RYY15] Fig. 7): point attractors act on the gas.

@@ -1,6 +1,8 @@
 /// @file   LiquidScene.cc
 #include "LiquidScene.h"
 
+#include "StepSettings.h"
+
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
@@ -37,10 +39,7 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.basicXsphEpsilon = Real(s.inRange("basic_xsph_epsilon", g.basicXsphEpsilon, 0, 1));
     g.basicViscosityAlpha = Real(s.nonNegative("basic_viscosity_alpha", g.basicViscosityAlpha));
     g.lennardJonesStrength = Real(s.nonNegative("lennard_jones_strength", g.lennardJonesStrength));
-    g.substeps = int(s.inRange("substeps", g.substeps, 0, 100000));
-    g.cflNumber = Real(s.inRange("cfl", g.cflNumber, 1e-3, 10));
-    g.maxSpeed = Real(s.nonNegative("max_speed", g.maxSpeed));
-    g.seed = s.get<std::uint64_t>("seed", g.seed);
+    readStepSettings(s, g);
     g.tiledSampling = s.get<bool>("tiled_sampling", g.tiledSampling);
     g.killBox = scene.killBox;
     s.finish();

@@ -12,25 +12,14 @@
 namespace ghostfx {
 namespace cmd {
 
-namespace {
-
-struct Mesh2SdfArgs
-{
-    std::string input, output;
-    vdbio::MeshToSdfOptions options;
-};
-
-} // namespace
-
 Command addMesh2SdfCommand(CLI::App& parent)
 {
-    auto args = std::make_shared<Mesh2SdfArgs>();
+    auto args = std::make_shared<FileToFileArgs<vdbio::MeshToSdfOptions>>();
     vdbio::MeshToSdfOptions& o = args->options;
-    CLI::App* c = parent.add_subcommand(
-        "mesh2sdf", "Convert a closed triangle mesh (OBJ, PLY, STL, ... read with Assimp) to a "
-                    "narrow-band level set .vdb");
-    c->add_option("mesh", args->input, "input mesh file")->required();
-    c->add_option("-o,--output", args->output, "output .vdb file")->required();
+    CLI::App* c = addFileToFileCommand(parent, "mesh2sdf",
+                                       "Convert a closed triangle mesh (OBJ, PLY, STL, ... read "
+                                       "with Assimp) to a narrow-band level set .vdb",
+                                       "mesh", "input mesh file", "output .vdb file", *args);
     c->add_option("--voxel-size", o.voxelSize, "voxel edge (m, after --scale)")->required();
     c->add_option("--half-width", o.halfWidth, "narrow-band half width (voxels)")
         ->capture_default_str();

@@ -19,31 +19,34 @@ const sph::SolverState* first(const Restored* restored)
     return restored && !restored->empty() ? &restored->front() : nullptr;
 }
 
-/// An entry for a liquid method of libghost ([SB12]); with heaters it boils (BoilingSimulation).
-Method liquidMethod(ghost::Method m, std::string baselineOf, std::string summary)
+/// An entry whose simulation is `make(scene, solverMethod, state)` and whose check is
+/// `check(scene, solverMethod)`.
+template <typename SolverMethod>
+Method entry(std::string name, Medium medium, std::string baselineOf, std::string summary,
+             SolverMethod m, void (*check)(const vdbio::Scene&, SolverMethod),
+             std::unique_ptr<Simulation> (*make)(const vdbio::Scene&, SolverMethod,
+                                                 const sph::SolverState*))
 {
-    return {ghost::methodName(m),
-            Medium::Liquid,
-            std::move(baselineOf),
-            std::move(summary),
-            [m](const vdbio::Scene& scene) { checkLiquidSimulation(scene, m); },
-            [m](const vdbio::Scene& scene, const Restored* restored) {
-        return makeLiquidSimulation(scene, m, first(restored));
-            }};
+    Method method{std::move(name), medium, std::move(baselineOf), std::move(summary), {}, {}};
+    method.check = [m, check](const vdbio::Scene& scene) { check(scene, m); };
+    method.make = [m, make](const vdbio::Scene& scene, const Restored* restored) {
+        return make(scene, m, first(restored));
+    };
+    return method;
 }
 
-/// An entry for a gas method of libgas ([RYY15]), named as in gasMethodNames().
+/// A liquid method of libghost ([SB12]); with heaters it boils (BoilingSimulation).
+Method liquidMethod(ghost::Method m, std::string baselineOf, std::string summary)
+{
+    return entry(ghost::methodName(m), Medium::Liquid, std::move(baselineOf), std::move(summary), m,
+                 &checkLiquidSimulation, &makeLiquidSimulation);
+}
+
+/// A gas method of libgas ([RYY15]), named as in gasMethodNames().
 Method gasSolverMethod(const std::string& name, std::string baselineOf, std::string summary)
 {
-    const gas::Method m = gasMethod(name);
-    return {name,
-            Medium::Gas,
-            std::move(baselineOf),
-            std::move(summary),
-            [m](const vdbio::Scene& scene) { checkGasSimulation(scene, m); },
-            [m](const vdbio::Scene& scene, const Restored* restored) {
-        return makeGasSimulation(scene, m, first(restored));
-            }};
+    return entry(name, Medium::Gas, std::move(baselineOf), std::move(summary), gasMethod(name),
+                 &checkGasSimulation, &makeGasSimulation);
 }
 
 /// The entries of `scene` that its medium cannot simulate, refused with the key that holds them.

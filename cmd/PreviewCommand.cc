@@ -11,25 +11,14 @@
 namespace ghostfx {
 namespace cmd {
 
-namespace {
-
-struct PreviewArgs
-{
-    std::string input, output;
-    vdbio::PreviewOptions options;
-};
-
-} // namespace
-
 Command addPreviewCommand(CLI::App& parent)
 {
-    auto args = std::make_shared<PreviewArgs>();
+    auto args = std::make_shared<FileToFileArgs<vdbio::PreviewOptions>>();
     vdbio::PreviewOptions& o = args->options;
-    CLI::App* c = parent.add_subcommand(
-        "preview", "Render a fog volume (density) or level set (surface) of a .vdb to an EXR "
-                   "image, camera framed on the grid");
-    c->add_option("file", args->input, "input .vdb file")->required();
-    c->add_option("-o,--output", args->output, "output .exr image")->required();
+    CLI::App* c = addFileToFileCommand(parent, "preview",
+                                       "Render a fog volume (density) or level set (surface) of "
+                                       "a .vdb to an EXR image, camera framed on the grid",
+                                       "file", "input .vdb file", "output .exr image", *args);
     c->add_option("--grid", o.grid,
                   "grid to render (default: 'density' if present, else 'surface', else the "
                   "first float grid)");

@@ -125,13 +125,7 @@ private:
 class DensityError : public Metric
 {
 public:
-    explicit DensityError(std::string medium) : mMedium(std::move(medium)) {}
-    const std::string& name() const override
-    {
-        static const std::string n = "density_error";
-        return n;
-    }
-    std::string medium() const override { return mMedium; }
+    explicit DensityError(std::string medium) : Metric("density_error", std::move(medium)) {}
 
     void frame(const MetricSample& s) override
     {
@@ -156,7 +150,6 @@ public:
     }
 
 private:
-    std::string mMedium;
     double mMeanSum = 0, mMax = 0;
     int mFrames = 0;
 };
@@ -170,13 +163,7 @@ private:
 class VolumeDrift : public Metric
 {
 public:
-    explicit VolumeDrift(std::string medium) : mMedium(std::move(medium)) {}
-    const std::string& name() const override
-    {
-        static const std::string n = "volume_drift";
-        return n;
-    }
-    std::string medium() const override { return mMedium; }
+    explicit VolumeDrift(std::string medium) : Metric("volume_drift", std::move(medium)) {}
 
     void frame(const MetricSample& s) override
     {
@@ -199,7 +186,6 @@ public:
     }
 
 private:
-    std::string mMedium;
     double mVolume = 0, mMass0 = -1, mMassDrift = 0;
 };
 
@@ -221,12 +207,10 @@ private:
 class HydrostaticPressure : public Metric
 {
 public:
-    explicit HydrostaticPressure(double fromFraction) : mFrom(fromFraction) {}
-    const std::string& name() const override
-    {
-        static const std::string n = "hydrostatic_pressure";
-        return n;
-    }
+    explicit HydrostaticPressure(double fromFraction)
+        : Metric("hydrostatic_pressure")
+        , mFrom(fromFraction)
+    {}
 
     void start(const MetricSample& s) override
     {
@@ -328,11 +312,7 @@ private:
 class FreeFall : public Metric
 {
 public:
-    const std::string& name() const override
-    {
-        static const std::string n = "free_fall";
-        return n;
-    }
+    FreeFall() : Metric("free_fall") {}
 
     void start(const MetricSample& s) override
     {
@@ -387,11 +367,7 @@ private:
 class CubeShape : public Metric
 {
 public:
-    const std::string& name() const override
-    {
-        static const std::string n = "cube_shape";
-        return n;
-    }
+    CubeShape() : Metric("cube_shape") {}
 
     void start(const MetricSample& s) override
     {
@@ -450,13 +426,10 @@ class Front : public Metric
 {
 public:
     Front(std::string name, std::string medium, const Vec3& direction, double percentileRank)
-        : mName(std::move(name))
-        , mMedium(std::move(medium))
+        : Metric(std::move(name), std::move(medium))
         , mDirection(direction)
         , mRank(percentileRank)
     {}
-    const std::string& name() const override { return mName; }
-    std::string medium() const override { return mMedium; }
 
     /// The trace starts with the initial state (NaN where the medium is still empty, as a gas
     /// before its source has emitted).
@@ -465,7 +438,7 @@ public:
 
     std::vector<std::pair<std::string, double>> values() const override
     {
-        return {{mName + "_final", mTrace.empty() ? NAN : mTrace.back()}};
+        return {{name() + "_final", mTrace.empty() ? NAN : mTrace.back()}};
     }
     std::vector<double> trace() const override { return mTrace; }
 
@@ -477,7 +450,6 @@ private:
         for (std::size_t i : members(*s.medium)) along.push_back(p.positions()[i].dot(mDirection));
         return percentile(std::move(along), mRank);
     }
-    std::string mName, mMedium;
     Vec3 mDirection;
     double mRank;
     std::vector<double> mTrace;

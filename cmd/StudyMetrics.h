@@ -31,11 +31,16 @@ struct MetricSample
 class Metric
 {
 public:
+    /// `name` as written in a study file ("density_error"); `medium` "liquid" or "gas".
+    explicit Metric(std::string name, std::string medium = "liquid")
+        : mName(std::move(name))
+        , mMedium(std::move(medium))
+    {}
     virtual ~Metric() = default;
     /// The metric's name as written in a study file ("density_error").
-    virtual const std::string& name() const = 0;
+    const std::string& name() const { return mName; }
     /// "liquid" or "gas": the medium it watches.
-    virtual std::string medium() const { return "liquid"; }
+    const std::string& medium() const { return mMedium; }
     /// The initial state (before the first step).
     virtual void start(const MetricSample&) {}
     /// After every frame.
@@ -44,6 +49,9 @@ public:
     virtual std::vector<std::pair<std::string, double>> values() const = 0;
     /// A per-frame trace to compare with a reference run (empty if the metric has none).
     virtual std::vector<double> trace() const { return {}; }
+
+private:
+    std::string mName, mMedium;
 };
 
 /// Settings of one metric in a study file: its name and its options (a JSON object).

@@ -92,8 +92,8 @@ void writePlotPoints(const std::string& path, const std::string& xName, const st
         out << "series,label," << csvField(xName) << "," << csvField(yName) << ",pareto\n";
         for (std::size_t i = 0; i < points.size(); ++i) {
             const PlotPoint& p = points[i];
-            out << csvField(p.series) << "," << csvField(p.label) << "," << p.x << "," << p.y
-                << "," << int(onFront[i]) << "\n";
+            out << csvField(p.series) << "," << csvField(p.label) << "," << p.x << "," << p.y << ","
+                << int(onFront[i]) << "\n";
         }
         if (!out) throw IoError(msg("plot points '", path, "': write failed"));
     });
@@ -122,8 +122,7 @@ std::string plotCommand(const std::string& points, const std::string& image,
            + (title.empty() ? "" : " --title " + shellQuoted(title));
 }
 
-std::string drawPlot(const std::string& points, const std::string& image,
-                     const std::string& title)
+std::string drawPlot(const std::string& points, const std::string& image, const std::string& title)
 {
     const std::string script = plotScript();
     if (script.empty()) {

@@ -41,8 +41,7 @@ std::string plotCommand(const std::string& points, const std::string& image,
 
 /// Draw the plot with the script ($GHOSTFX_PYTHON or the configured python3). Returns "" when
 /// the image was written, else one line saying why not (no script, no matplotlib, ...).
-std::string drawPlot(const std::string& points, const std::string& image,
-                     const std::string& title);
+std::string drawPlot(const std::string& points, const std::string& image, const std::string& title);
 
 } // namespace cmd
 } // namespace ghostfx

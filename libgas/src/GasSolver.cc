@@ -131,19 +131,19 @@ void GasSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
 void GasSolver::sampleSolid(std::size_t solidIndex)
 {
     const Solid& body = *mSolids[solidIndex];
-    const RigidTransform xf = body.at(mTime);
+    const RigidTransform xf = body.at(mRun.time);
     if (!isFinite(xf.translation)) {
         throw ValueError(msg("gas solid '", body.shape.name(),
                              "': motion gives a non-finite "
                              "placement at t = ",
-                             mTime, " s"));
+                             mRun.time, " s"));
     }
     // [RYY15] Sec. 3.3: rigid boundaries are boundary particles. Sampled like the liquid's
     // solids ([SB12] Sec. 4.5) in a band one kernel radius deep, so a gas particle at the wall
     // sees a full neighbourhood of gas and boundary particles.
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.bandDepth = mSettings.supportRadius();
-    ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mStep;
+    ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step;
     const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(body.shape);
 
     std::vector<Vec3> world(samples.positions);
@@ -154,7 +154,7 @@ void GasSolver::sampleSolid(std::size_t solidIndex)
     for (std::size_t k = 0; k < samples.size(); ++k) {
         local[first + k] = samples.positions[k];
         index[first + k] = Real(solidIndex);
-        mParticles.velocities()[first + k] = body.velocity(samples.positions[k], mTime);
+        mParticles.velocities()[first + k] = body.velocity(samples.positions[k], mRun.time);
     }
 }
 
@@ -168,7 +168,7 @@ bool GasSolver::blockedBySolid(const Vec3& x) const
     const Real clearance = Real(0.5) * mSettings.spacing;
     for (const auto& solid : mSolids) {
         const Real band = solid->shape.bandWidth();
-        if (solid->phi(x, mTime) < std::min(clearance, Real(0.99) * band)) return true;
+        if (solid->phi(x, mRun.time) < std::min(clearance, Real(0.99) * band)) return true;
     }
     return false;
 }
@@ -275,7 +275,7 @@ Index GasSolver::addGasParticles(const std::vector<Vec3>& positions,
 
 Real GasSolver::referenceParticleMass() const
 {
-    if (mInitialized) return mMass;
+    if (mRun.initialized) return mMass;
     if (mSettings.particleMass > Real(0)) return mSettings.particleMass;
     return referenceMass();
 }
@@ -382,14 +382,14 @@ void GasSolver::assignMissingMasses()
 
 void GasSolver::initialize()
 {
-    if (mInitialized) return;
+    if (mRun.initialized) return;
     mMass = mSettings.particleMass > Real(0) ? mSettings.particleMass : referenceMass();
     assignMissingMasses();
     if (mSettings.method == Method::Ambient) {
         buildDomainWalls();
         fillAmbientAir();
     }
-    mInitialized = true;
+    mRun.initialized = true;
 }
 
 void GasSolver::buildDomainWalls()
@@ -467,9 +467,9 @@ void GasSolver::emit(Real dt)
     auto& T = mParticles.scalarChannel(channel::TEMPERATURE);
     for (std::size_t e = 0; e < mSources.size(); ++e) {
         Source& src = *mSources[e];
-        if (!src.active(mTime)) continue;
+        if (!src.active(mRun.time)) continue;
         const GasSource& par = src.params;
-        const RigidTransform xf = src.at(mTime);
+        const RigidTransform xf = src.at(mRun.time);
         auto inside = [&](const Vec3& x) { return src.shape.phi(xf.toLocal(x)) < Real(0); };
         // Rate-limited sources accumulate their allowance; 0 = no limit.
         std::size_t allowed = std::numeric_limits<std::size_t>::max();
@@ -517,7 +517,7 @@ void GasSolver::emit(Real dt)
                 NeighborGrid grid(r);
                 grid.build(obstacles);
                 for (const Vec3& xl :
-                     sampleShape(src.shape, mSettings.seed + 31337ULL * (e + 1) + mStep)) {
+                     sampleShape(src.shape, mSettings.seed + 31337ULL * (e + 1) + mRun.step)) {
                     const Vec3 x = xf.toWorld(xl);
                     bool clear = !blockedBySolid(x);
                     if (clear && !obstacles.empty()) {
@@ -528,7 +528,7 @@ void GasSolver::emit(Real dt)
                 }
             } else {
                 PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-                ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mStep + 1) + e);
+                ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
                 auto accept = [&](const Vec3& x) { return inside(x) && !blockedBySolid(x); };
                 fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
             }
@@ -542,7 +542,7 @@ void GasSolver::emit(Real dt)
             added = fresh.size();
         }
         if (par.rate > Real(0)) src.budget -= double(added);
-        mEmitted += added;
+        mRun.emitted += added;
         // The source is a heater: visible gas inside it is held at the source temperature.
         const std::vector<Real>* ambient = mParticles.hasScalarChannel(channel::AMBIENT)
                                                ? &mParticles.scalarChannel(channel::AMBIENT)
@@ -603,8 +603,8 @@ void GasSolver::computeDensity()
     });
     const double gasCount = parallel::sum(
         0, n, [&](std::size_t i) { return kind[i] == ParticleKind::Gas ? 1.0 : 0.0; });
-    mMeanNeighbors = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); })
-                     / std::max(1.0, gasCount);
+    mRun.meanNeighbors = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); })
+                         / std::max(1.0, gasCount);
 
     // Eq. 5: V_0 = |sum_j m_j / rho_bar_j grad W_ij| / |grad W_ik|, with the uncorrected
     // neighbour densities as in Eq. 4 and the derivation of Eqs. 7 - 8 (Appendix A); the virtual
@@ -774,7 +774,7 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
     for (std::size_t i = 0; i < n; ++i) {
         if (kind[i] == ParticleKind::Gas) amax = std::max(amax, accel[i].length());
     }
-    mMaxAcceleration = amax;
+    mRun.maxAcceleration = amax;
 }
 
 // Solids, domain, isolated particles ---------------------------------------------------------------
@@ -782,8 +782,7 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
 void GasSolver::moveSolids(double t1)
 {
     if (mSolids.empty()) return;
-    std::vector<RigidTransform> placement;
-    for (const auto& solid : mSolids) placement.push_back(solid->at(t1));
+    const std::vector<RigidTransform> placement = sph::placementsAt(mSolids, t1);
     auto& x = mParticles.positions();
     auto& v = mParticles.velocities();
     const auto& kind = mParticles.kinds();
@@ -803,9 +802,8 @@ void GasSolver::projectOutOfSolids(Real dt)
     auto& x = mParticles.positions();
     auto& v = mParticles.velocities();
     const auto& kind = mParticles.kinds();
-    const double time = mTime;
-    std::vector<RigidTransform> placement;
-    for (const auto& solid : mSolids) placement.push_back(solid->at(time));
+    const double time = mRun.time;
+    const std::vector<RigidTransform> placement = sph::placementsAt(mSolids, time);
     // A gas particle that crossed into a solid goes back to its surface and loses the velocity
     // into it (the boundary particles' pressure alone cannot stop a fast particle in one step):
     // sph::collideWithSolid, shared with the liquid. The step moved it by dt v.
@@ -827,7 +825,7 @@ void GasSolver::projectOutOfSolids(Real dt)
         while (b + 1 < mSolids.size() && !(mSolids[b]->phi(x[i], time) < Real(0))) ++b;
         const LevelSet& shape = mSolids[b]->shape;
         throw NumericalError(
-            msg("gas solver at step ", mStep, " (t = ", mTime, " s): gas particle id ",
+            msg("gas solver at step ", mRun.step, " (t = ", mRun.time, " s): gas particle id ",
                 mParticles.ids()[i], " is inside solid '", shape.name(),
                 "' deeper than its level set's band (", shape.bandWidth(),
                 " m), and so was its position before the step: it cannot be put back; "
@@ -870,7 +868,7 @@ void GasSolver::applyDomain()
         }
     }
     if (killed) mParticles.removeIf(remove);
-    mKilled += killed;
+    mRun.killed += killed;
 }
 
 void GasSolver::applyLifeStrength(Real dt)
@@ -889,7 +887,7 @@ void GasSolver::applyLifeStrength(Real dt)
             life[i] = mSettings.lifeStrength;
             return;
         }
-        life[i] -= dt * (Real(1) + lifeEpsilon(mSettings.seed, ids[i], mStep));
+        life[i] -= dt * (Real(1) + lifeEpsilon(mSettings.seed, ids[i], mRun.step));
         remove[i] = life[i] < Real(0);
     });
     std::size_t removed = 0;
@@ -924,9 +922,9 @@ void GasSolver::checkBlowUp(Real dt) const
         4096);
     const std::size_t i = bad.load();
     if (i == n) return;
-    const std::string where =
-        msg("gas solver (", methodName(mSettings.method), ") blew up at frame ", mFrame, ", step ",
-            mStep, " (t = ", mTime, " s): gas particle id ", mParticles.ids()[i]);
+    const std::string where = msg(
+        "gas solver (", methodName(mSettings.method), ") blew up at frame ", mRun.frame, ", step ",
+        mRun.step, " (t = ", mRun.time, " s): gas particle id ", mParticles.ids()[i]);
     if (!isFinite(x[i]) || !isFinite(v[i]) || !std::isfinite(T[i]) || !std::isfinite(rho[i])) {
         throw NumericalError(msg(where,
                                  " has a non-finite position, velocity, temperature or "
@@ -970,12 +968,12 @@ void GasSolver::step(Real dt)
     mTimings.forces += secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
-    const double t1 = mTime + double(dt);
+    const double t1 = mRun.time + double(dt);
     moveSolids(t1);
-    mTime = t1;
+    mRun.time = t1;
     projectOutOfSolids(dt);
     checkBlowUp(dt);
-    ++mStep;
+    ++mRun.step;
     applyLifeStrength(dt); // before any removal: mIsolated is indexed like the density pass
     applyDomain();
     mTimings.integration += secondsSince(t0);
@@ -996,7 +994,7 @@ Real GasSolver::stableTimeStep() const
     // Acoustic limit with the sound speed sqrt(kappa) of Eq. 11.
     Real dt = cfl * s / (mSettings.soundSpeed() + vmax);
     // Force limit (Monaghan 1992) with the last step's largest acceleration.
-    const Real a = std::max(mMaxAcceleration, mSettings.gravity.length());
+    const Real a = std::max(mRun.maxAcceleration, mSettings.gravity.length());
     if (a > Real(0)) dt = std::min(dt, cfl * std::sqrt(s / a));
     // Explicit viscosity and diffusion. Eq. 15 is (D_c / rho) times half Brookshaw's SPH
     // Laplacian, a diffusivity alpha = D_c / (2 rho); explicit Euler on it is stable for
@@ -1011,12 +1009,9 @@ void GasSolver::advanceFrame()
 {
     checkRestoredInputs();
     initialize();
-    const double frameEnd = double(mFrame + 1) / double(mSettings.frameRate);
-    sph::stepFrame(
-        frameEnd, mSettings.frameRate, mSettings.substeps, [this] { return mTime; },
-        [this] { return stableTimeStep(); }, [this](Real dt) { step(dt); });
-    mTime = frameEnd;
-    ++mFrame;
+    sph::advanceRunOneFrame(
+        mRun, mSettings.frameRate, mSettings.substeps, [this] { return stableTimeStep(); },
+        [this](Real dt) { step(dt); });
 }
 
 // Save and restore ---------------------------------------------------------------------------------
@@ -1026,19 +1021,12 @@ SolverState GasSolver::saveState() const
     SolverState state;
     state.solver = "gas";
     state.particles = mParticles;
-    state.reals["time"] = mTime;
+    mRun.save(state);
     state.reals["particle_mass"] = double(mMass);
-    state.reals["max_acceleration"] = double(mMaxAcceleration);
-    state.reals["mean_neighbors"] = mMeanNeighbors;
     for (std::size_t k = 0; k < mSources.size(); ++k) {
         state.reals["source_budget_" + std::to_string(k)] = mSources[k]->budget;
     }
-    state.integers["step"] = std::int64_t(mStep);
-    state.integers["frame"] = mFrame;
-    state.integers["initialized"] = mInitialized ? 1 : 0;
     state.integers["method"] = std::int64_t(mSettings.method);
-    state.integers["emitted"] = std::int64_t(mEmitted);
-    state.integers["killed"] = std::int64_t(mKilled);
     state.integers["isolated_removed"] = std::int64_t(mIsolatedRemoved);
     state.integers["solids"] = std::int64_t(mSolids.size());
     state.integers["sources"] = std::int64_t(mSources.size());
@@ -1051,21 +1039,16 @@ void GasSolver::restoreState(const SolverState& state)
         throw ValueError(msg("restoreState: the state was saved by the '", state.solver,
                              "' solver, not by the gas solver"));
     }
-    if (mRestored || mInitialized || mStep != 0 || !mParticles.empty() || !mSolids.empty()
+    if (mRestored || mRun.initialized || mRun.step != 0 || !mParticles.empty() || !mSolids.empty()
         || !mSources.empty()) {
         throw ValueError("restoreState: call it on a freshly constructed gas solver, before adding "
                          "solids, sources or gas and before the first step");
     }
-    const double time = state.real("time");
+    const sph::RunCounters run = sph::RunCounters::load(state);
     const double mass = state.real("particle_mass");
-    const double maxAcceleration = state.real("max_acceleration");
-    const double meanNeighbors = state.real("mean_neighbors");
-    const std::int64_t step = state.integer("step"), frame = state.integer("frame");
-    const std::int64_t initialized = state.integer("initialized");
     const std::int64_t method = state.integer("method");
-    const std::int64_t emitted = state.integer("emitted"), killed = state.integer("killed");
-    const std::int64_t isolated = state.integer("isolated_removed");
-    const std::int64_t solids = state.integer("solids"), sources = state.integer("sources");
+    const std::int64_t isolated = state.count("isolated_removed");
+    const std::int64_t solids = state.count("solids"), sources = state.count("sources");
     if (method != std::int64_t(mSettings.method)) {
         const bool known = method >= 0 && method <= std::int64_t(Method::Uncorrected);
         throw ValueError(msg("restoreState: the state was saved by gas method '",
@@ -1074,21 +1057,6 @@ void GasSolver::restoreState(const SolverState& state)
                              "'; resume with the method the run "
                              "started with"));
     }
-    auto requireRange = [](const char* key, std::int64_t value, std::int64_t lo, std::int64_t hi) {
-        if (value < lo || value > hi) {
-            throw ValueError(
-                msg("restoreState: integer '", key, "' = ", value, ": expected ", lo, " to ", hi));
-        }
-    };
-    constexpr std::int64_t BIG = std::numeric_limits<std::int64_t>::max();
-    requireRange("step", step, 0, BIG);
-    requireRange("frame", frame, 0, std::numeric_limits<int>::max());
-    requireRange("initialized", initialized, 0, 1);
-    requireRange("emitted", emitted, 0, BIG);
-    requireRange("killed", killed, 0, BIG);
-    requireRange("isolated_removed", isolated, 0, BIG);
-    requireRange("solids", solids, 0, BIG);
-    requireRange("sources", sources, 0, BIG);
     std::vector<double> budgets;
     for (std::int64_t k = 0; k < sources; ++k) {
         budgets.push_back(state.real("source_budget_" + std::to_string(k)));
@@ -1122,15 +1090,8 @@ void GasSolver::restoreState(const SolverState& state)
     mParticles.addScalarChannel(channel::LIFE, mSettings.lifeStrength);
     if (mSettings.method == Method::Ambient) mParticles.addScalarChannel(channel::AMBIENT, Real(0));
     if (mSettings.vorticity) mParticles.addVectorChannel(channel::VORTICITY);
-    mTime = time;
+    mRun = run;
     mMass = Real(mass);
-    mMaxAcceleration = Real(maxAcceleration);
-    mMeanNeighbors = meanNeighbors;
-    mStep = std::uint64_t(step);
-    mFrame = int(frame);
-    mInitialized = initialized != 0;
-    mEmitted = std::size_t(emitted);
-    mKilled = std::size_t(killed);
     mIsolatedRemoved = std::size_t(isolated);
     mRestoredSolids = std::size_t(solids);
     mRestoredSources = std::size_t(sources);

@@ -3,6 +3,7 @@
 ///         Bonet 2007).
 #include "ghostfx/gas/SplitPatterns.h"
 
+#include <ghostfx/sph/EnumNames.h>
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/Kernels.h>
 
@@ -256,17 +257,12 @@ double refinementError(const std::vector<Vec3d>& offsets, const std::vector<doub
 
 const char* patternShapeName(PatternShape shape)
 {
-    switch (shape) {
-    case PatternShape::Icosahedron:
-        return "icosahedron";
-    case PatternShape::IcosahedronCentre:
-        return "icosahedron+centre";
-    case PatternShape::Cube:
-        return "cube";
-    case PatternShape::CubeCentre:
-        return "cube+centre";
-    }
-    return "unknown";
+    static const sph::EnumName<PatternShape> names[] = {
+        {PatternShape::Icosahedron, "icosahedron"},
+        {PatternShape::IcosahedronCentre, "icosahedron+centre"},
+        {PatternShape::Cube, "cube"},
+        {PatternShape::CubeCentre, "cube+centre"}};
+    return sph::nameOf(names, shape);
 }
 
 std::vector<Vec3d> patternOffsets(PatternShape shape)
@@ -304,6 +300,32 @@ std::size_t SplitPattern::centreIndex() const
     return offsets.size();
 }
 
+namespace {
+
+/// The pattern with mass ratios `lambda` scaled to sum to 1 (to the round-off of this one sum,
+/// which keeps daughters' masses summing to the mother's), and its Eq. 18 error from `t`.
+SplitPattern patternWith(const std::string& name, const std::vector<Vec3d>& offsets, double epsilon,
+                         double alpha, SplitKernel kernel, std::vector<double> lambda,
+                         const RefinementTerms& t)
+{
+    SplitPattern p;
+    p.name = name;
+    p.offsets = offsets;
+    p.epsilon = epsilon;
+    p.alpha = alpha;
+    p.kernel = kernel;
+    double sum = 0.0;
+    for (double l : lambda) sum += l;
+    for (double& l : lambda) l /= sum;
+    p.lambda = std::move(lambda);
+    p.hasCentre = p.centreIndex() < p.offsets.size();
+    p.error = t.error(p.lambda);
+    p.relativeError = p.error / t.C;
+    return p;
+}
+
+} // namespace
+
 SplitPattern optimisePattern(const std::string& name, const std::vector<Vec3d>& offsets,
                              double epsilon, double alpha, SplitKernel kernel,
                              const Quadrature& quad)
@@ -323,22 +345,10 @@ SplitPattern optimisePattern(const std::string& name, const std::vector<Vec3d>& 
     rhs(n) = 1.0;
     const Eigen::VectorXd sol = K.fullPivLu().solve(rhs);
 
-    SplitPattern p;
-    p.name = name;
-    p.offsets = offsets;
-    p.epsilon = epsilon;
-    p.alpha = alpha;
-    p.kernel = kernel;
-    p.lambda.resize(n);
-    for (int k = 0; k < n; ++k) p.lambda[k] = sol(k);
-    // Remove the constraint residual of the solve (order 1e-15) so sum(lambda) = 1 to round-off
-    // of this one sum, which keeps daughters' masses summing to the mother's.
-    double sum = 0.0;
-    for (double l : p.lambda) sum += l;
-    for (double& l : p.lambda) l /= sum;
-    p.hasCentre = p.centreIndex() < p.offsets.size();
-    p.error = t.error(p.lambda);
-    p.relativeError = p.error / t.C;
+    // patternWith removes the constraint residual of the solve (order 1e-15).
+    std::vector<double> lambda(n);
+    for (int k = 0; k < n; ++k) lambda[k] = sol(k);
+    const SplitPattern p = patternWith(name, offsets, epsilon, alpha, kernel, lambda, t);
     if (!std::isfinite(p.error)) {
         throw NumericalError(msg("split pattern '", name, "' (epsilon ", epsilon, ", alpha ", alpha,
                                  "): the optimal mass ratios are not finite"));
@@ -360,18 +370,7 @@ SplitPattern evaluatePattern(const std::string& name, const std::vector<Vec3d>& 
                              sum, ": expected one per daughter (", offsets.size(),
                              ") summing to 1"));
     }
-    SplitPattern p;
-    p.name = name;
-    p.offsets = offsets;
-    p.epsilon = epsilon;
-    p.alpha = alpha;
-    p.kernel = kernel;
-    p.lambda = lambda;
-    for (double& l : p.lambda) l /= sum;
-    p.hasCentre = p.centreIndex() < p.offsets.size();
-    p.error = t.error(p.lambda);
-    p.relativeError = p.error / t.C;
-    return p;
+    return patternWith(name, offsets, epsilon, alpha, kernel, lambda, t);
 }
 
 const SplitPattern& paperCubePattern()

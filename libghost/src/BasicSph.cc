@@ -86,7 +86,7 @@ void GhostSolver::stepBasic(Real dt)
         accel[i] = a.length();
         },
         512);
-    mMaxAcceleration = n ? *std::max_element(accel.begin(), accel.end()) : Real(0);
+    mRun.maxAcceleration = n ? *std::max_element(accel.begin(), accel.end()) : Real(0);
     mTimings.pressureForce += secondsSince(t0);
 
     // XSPH on positions: x += dt (v + eps sum_j 2 m_j / (rho_i + rho_j) (v_j - v_i) W_ij).

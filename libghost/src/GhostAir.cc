@@ -106,7 +106,7 @@ void GhostSolver::resampleAir(int phase)
     const auto start = std::chrono::steady_clock::now();
     const Real R = mSettings.supportRadius();
     const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
-    const double time = mTime;
+    const double time = mRun.time;
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
     const auto& kind = mParticles.kinds();
@@ -134,11 +134,9 @@ void GhostSolver::resampleAir(int phase)
     //    only, so escaped spray neither attracts air nor stretches the sampling region.
     std::vector<Real> indicator(n, std::numeric_limits<Real>::max());
     std::vector<std::uint8_t> body(n, 0);
-    parallel::forRange(
-        0, n,
-        [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
             // Only the liquid within a kernel radius of the region is asked about, and only the
             // seeding candidates need the indicator.
@@ -161,8 +159,8 @@ void GhostSolver::resampleAir(int phase)
             }
             const std::size_t count =
                 mFluidLists[i].size() + mStatic.lists[i].size() + mMoving.lists[i].size();
-            if (!air && mMass > Real(0) && mMeanNeighbors > 0
-                && double(count) >= 0.9 * mMeanNeighbors) {
+            if (!air && mMass > Real(0) && mRun.meanNeighbors > 0
+                && double(count) >= 0.9 * mRun.meanNeighbors) {
                 indicator[i] = std::numeric_limits<Real>::max();
                 continue;
             }
@@ -321,14 +319,14 @@ void GhostSolver::resampleAir(int phase)
     };
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
-    ps.seed = mSettings.seed ^ (0x9e3779b97f4a7c15ULL * (mStep + 1));
+    ps.seed = mSettings.seed ^ (0x9e3779b97f4a7c15ULL * (mRun.step + 1));
     const std::vector<Vec3> air =
         PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, bounds.padded(R));
 
     // 5. The new air: faded in from weight 0 (the very first layer is there from the start),
     //    with the velocity of the nearest body particle ([SB12] Sec. 4.3).
     const Index first = mParticles.addBatch(air, mMass, ParticleKind::GhostAir);
-    const bool fade = mInitialized;
+    const bool fade = mRun.initialized;
     auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
     auto& v = mParticles.velocities();
     parallel::forEach(first, mParticles.size(), [&](std::size_t i) {

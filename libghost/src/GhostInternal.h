@@ -5,6 +5,9 @@
 
 #include "ghostfx/ghost/GhostSolver.h"
 
+#include <ghostfx/sph/Kernels.h>
+#include <ghostfx/sph/PairBatch.h>
+#include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/Timing.h>
 #include <ghostfx/sph/Types.h>
@@ -38,6 +41,22 @@ constexpr const char* SOLID_LOCAL_NORMAL =
     "solid_n";                                   ///< moving solid particle: normal, solid frame
 constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, mass = weight m
 constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
+
+/// parallel::forRange over particles [0, n): each task gets its own copy of `kernel` and a
+/// PairBatch of its own, and calls body(lo, hi, kernel, batch) on its range.
+template <typename Body>
+void forRangeWithBatch(std::size_t n, const sph::CubicSplineKernel& kernel, Body&& body,
+                       std::size_t grain = parallel::DEFAULT_GRAIN)
+{
+    parallel::forRange(
+        0, n,
+        [&](std::size_t lo, std::size_t hi) {
+        const sph::CubicSplineKernel local = kernel;
+        sph::PairBatch batch;
+        body(lo, hi, local, batch);
+        },
+        grain);
+}
 
 /// Tait equation of state ([SB12] Sec. 3, Monaghan 1994): p = k ((rho / rho0)^7 - 1).
 inline Real taitPressure(Real rho, Real rho0, Real k)

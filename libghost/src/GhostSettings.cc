@@ -2,29 +2,26 @@
 /// @brief  Method names and validation of the liquid solver settings.
 #include "ghostfx/ghost/GhostSettings.h"
 
+#include <ghostfx/sph/EnumNames.h>
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/SettingCheck.h>
 
 #include <cmath>
 
 namespace ghostfx {
 namespace ghost {
 
-const char* methodName(Method method)
-{
-    switch (method) {
-    case Method::Ghost:
-        return "ghost";
-    case Method::Basic:
-        return "basic";
-    }
-    return "unknown";
-}
+namespace {
+
+const sph::EnumName<Method> METHOD_NAMES[] = {{Method::Ghost, "ghost"}, {Method::Basic, "basic"}};
+
+} // namespace
+
+const char* methodName(Method method) { return sph::nameOf(METHOD_NAMES, method); }
 
 Method methodFromName(const std::string& name)
 {
-    if (name == "ghost") return Method::Ghost;
-    if (name == "basic") return Method::Basic;
-    throw ValueError(msg("liquid method '", name, "': expected 'ghost' or 'basic'"));
+    return sph::valueOf(METHOD_NAMES, name, "liquid method");
 }
 
 Real GhostSettings::soundSpeed() const
@@ -40,35 +37,35 @@ Real GhostSettings::speedLimit() const
 
 void GhostSettings::validate() const
 {
-    auto require = [](bool ok, const char* field, double value, const char* expected) {
-        if (!ok)
-            throw ValueError(msg("liquid setting ", field, " = ", value, ": expected ", expected));
-    };
-    auto finite = [](Real v) { return std::isfinite(v); };
-    require(spacing > 0 && finite(spacing), "spacing", spacing, "a finite value > 0 (m)");
-    require(supportFactor >= Real(1.5) && supportFactor <= Real(6), "supportFactor", supportFactor,
-            "1.5 to 6 particle spacings ([SB12]: 3)");
-    require(restDensity > 0 && finite(restDensity), "restDensity", restDensity, "> 0 (kg/m^3)");
-    require(stiffness > 0 && finite(stiffness), "stiffness", stiffness, "> 0 (Pa)");
-    require(sph::isFinite(gravity), "gravity", gravity.length(), "finite components (m/s^2)");
-    require(xsphEpsilon >= 0 && xsphEpsilon <= 1, "xsphEpsilon", xsphEpsilon,
-            "0 to 1 ([SB12]: 0.05)");
-    require(solidEpsilon >= 0 && solidEpsilon <= 1, "solidEpsilon", solidEpsilon, "0 to 1");
-    require(airResampleSteps >= 1, "airResampleSteps", airResampleSteps, ">= 1 ([SB12]: about 10)");
-    require(airKeepFraction >= 0 && finite(airKeepFraction), "airKeepFraction", airKeepFraction,
-            ">= 0 (fraction of the Poisson radius)");
-    require(basicXsphEpsilon >= 0 && basicXsphEpsilon <= 1, "basicXsphEpsilon", basicXsphEpsilon,
-            "0 to 1 ([SB12]: 0.5)");
-    require(basicViscosityAlpha >= 0 && finite(basicViscosityAlpha), "basicViscosityAlpha",
-            basicViscosityAlpha, ">= 0 ([SB12]: 0.0005)");
-    require(lennardJonesStrength >= 0 && finite(lennardJonesStrength), "lennardJonesStrength",
-            lennardJonesStrength, ">= 0 (m^2/s^2; 0 = automatic)");
-    require(frameRate > 0 && finite(frameRate), "frameRate", frameRate, "> 0 (frames/s)");
-    require(substeps >= 0 && substeps <= 100000, "substeps", substeps,
-            "0 (CFL-adaptive) to 100000");
-    require(cflNumber > 0 && cflNumber <= 2, "cflNumber", cflNumber, "0 < cfl <= 2");
-    require(maxSpeed >= 0 && finite(maxSpeed), "maxSpeed", maxSpeed,
-            ">= 0 (m/s; 0 = 20 x sound speed)");
+    const sph::SettingCheck check("liquid setting");
+    check.require(spacing > 0 && check.finite(spacing), "spacing", spacing,
+                  "a finite value > 0 (m)");
+    check.require(supportFactor >= Real(1.5) && supportFactor <= Real(6), "supportFactor",
+                  supportFactor, "1.5 to 6 particle spacings ([SB12]: 3)");
+    check.require(restDensity > 0 && check.finite(restDensity), "restDensity", restDensity,
+                  "> 0 (kg/m^3)");
+    check.require(stiffness > 0 && check.finite(stiffness), "stiffness", stiffness, "> 0 (Pa)");
+    check.require(sph::isFinite(gravity), "gravity", gravity.length(), "finite components (m/s^2)");
+    check.require(xsphEpsilon >= 0 && xsphEpsilon <= 1, "xsphEpsilon", xsphEpsilon,
+                  "0 to 1 ([SB12]: 0.05)");
+    check.require(solidEpsilon >= 0 && solidEpsilon <= 1, "solidEpsilon", solidEpsilon, "0 to 1");
+    check.require(airResampleSteps >= 1, "airResampleSteps", airResampleSteps,
+                  ">= 1 ([SB12]: about 10)");
+    check.require(airKeepFraction >= 0 && check.finite(airKeepFraction), "airKeepFraction",
+                  airKeepFraction, ">= 0 (fraction of the Poisson radius)");
+    check.require(basicXsphEpsilon >= 0 && basicXsphEpsilon <= 1, "basicXsphEpsilon",
+                  basicXsphEpsilon, "0 to 1 ([SB12]: 0.5)");
+    check.require(basicViscosityAlpha >= 0 && check.finite(basicViscosityAlpha),
+                  "basicViscosityAlpha", basicViscosityAlpha, ">= 0 ([SB12]: 0.0005)");
+    check.require(lennardJonesStrength >= 0 && check.finite(lennardJonesStrength),
+                  "lennardJonesStrength", lennardJonesStrength, ">= 0 (m^2/s^2; 0 = automatic)");
+    check.require(frameRate > 0 && check.finite(frameRate), "frameRate", frameRate,
+                  "> 0 (frames/s)");
+    check.require(substeps >= 0 && substeps <= 100000, "substeps", substeps,
+                  "0 (CFL-adaptive) to 100000");
+    check.require(cflNumber > 0 && cflNumber <= 2, "cflNumber", cflNumber, "0 < cfl <= 2");
+    check.require(maxSpeed >= 0 && check.finite(maxSpeed), "maxSpeed", maxSpeed,
+                  ">= 0 (m/s; 0 = 20 x sound speed)");
 }
 
 } // namespace ghost

@@ -144,10 +144,10 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
 {
     const Solid& body = *mSolids[solidIndex];
     const LevelSet& solid = body.shape;
-    const RigidTransform xf = body.at(mTime);
+    const RigidTransform xf = body.at(mRun.time);
     if (!isFinite(xf.translation)) {
         throw ValueError(msg("solid '", solid.name(),
-                             "': motion gives a non-finite placement at t = ", mTime, " s"));
+                             "': motion gives a non-finite placement at t = ", mRun.time, " s"));
     }
 
     // [SB12] Sec. 4.4 / 4.5: ghost solid particles in a band one kernel radius deep, sampled
@@ -156,7 +156,7 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.tiledInterior = mSettings.tiledSampling;
     ps.bandDepth = mSettings.supportRadius();
-    ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mStep;
+    ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step;
     const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(solid);
 
     // Outward normal of each particle from its nearest surface sample: phi is clamped beyond
@@ -204,7 +204,7 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
         if (body.moving) {
             (*localNormals)[first + k] = localNormal;
             (*locals)[first + k] = samples.positions[k];
-            (*solidV)[first + k] = body.velocity(samples.positions[k], mTime);
+            (*solidV)[first + k] = body.velocity(samples.positions[k], mRun.time);
             set.velocities()[first + k] = (*solidV)[first + k];
         }
     }
@@ -249,8 +249,7 @@ void GhostSolver::moveSolids(double time)
     mMaxSolidSpeed = 0;
     ParticleSet& set = mMoving.block.particles();
     if (set.empty()) return;
-    std::vector<RigidTransform> placement;
-    for (const auto& solid : mSolids) placement.push_back(solid->at(time));
+    const std::vector<RigidTransform> placement = sph::placementsAt(mSolids, time);
     auto& x = set.positions();
     auto& v = set.velocities();
     const auto& local = set.vectorChannel(SOLID_LOCAL);
@@ -332,7 +331,7 @@ bool GhostSolver::blockedBySolid(const Vec3& x) const
     // Liquid keeps half a spacing from solid surfaces, where the solid's own surface samples sit.
     const Real clearance = Real(0.5) * mSettings.spacing;
     for (const auto& solid : mSolids) {
-        if (solid->phi(x, mTime) < clearance) return true;
+        if (solid->phi(x, mRun.time) < clearance) return true;
     }
     return false;
 }
@@ -354,7 +353,7 @@ void GhostSolver::emit()
 {
     for (std::size_t e = 0; e < mEmitters.size(); ++e) {
         const Emitter& em = *mEmitters[e];
-        if (mTime < em.start || mTime >= em.end) continue;
+        if (mRun.time < em.start || mRun.time >= em.end) continue;
         const Real R = mSettings.supportRadius();
         const Aabb box = em.shape.bounds();
         const Aabb near = box.padded(R);
@@ -386,7 +385,7 @@ void GhostSolver::emit()
         if (seeds.empty()) {
             // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
             PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-            ps.seed = mSettings.seed + 31337ULL * (e + 1) + mStep;
+            ps.seed = mSettings.seed + 31337ULL * (e + 1) + mRun.step;
             for (const Vec3& x : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
                 bool clear = !blockedBySolid(x);
                 for (const Vec3& o : obstacles) {
@@ -398,7 +397,7 @@ void GhostSolver::emit()
         } else {
             PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
             ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
-            ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mStep + 1) + e);
+            ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
             auto accept = [&](const Vec3& x) {
                 return em.shape.phi(x) < Real(0) && !blockedBySolid(x);
             };
@@ -408,7 +407,7 @@ void GhostSolver::emit()
         const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);
         std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(),
                   em.velocity);
-        mEmitted += fresh.size();
+        mRun.emitted += fresh.size();
     }
 }
 
@@ -426,20 +425,20 @@ void GhostSolver::applyKillBox()
         }
     }
     if (any) mParticles.removeIf(remove);
-    mKilled += killed;
+    mRun.killed += killed;
 }
 
 // Initialisation: the first air layer and the mass scaling ---------------------------------------
 
 bool GhostSolver::initialize()
 {
-    if (mInitialized) return true;
+    if (mRun.initialized) return true;
     if (mParticles.count(ParticleKind::Liquid) == 0) emit();
     if (mParticles.count(ParticleKind::Liquid) == 0) {
         // Nothing to simulate yet, but an emitter starts later: wait for it (the mass scaling
         // and the first air layer are made from its first liquid).
         for (const auto& em : mEmitters) {
-            if (em->end > mTime && em->start < std::numeric_limits<double>::infinity())
+            if (em->end > mRun.time && em->start < std::numeric_limits<double>::infinity())
                 return false;
         }
         throw ValueError("liquid solver: no liquid particles (add a liquid body, particles, or an "
@@ -511,7 +510,7 @@ bool GhostSolver::initialize()
                                         : sqr(Real(0.1) * mSettings.soundSpeed());
         }
     }
-    mInitialized = true;
+    mRun.initialized = true;
     return true;
 }
 
@@ -577,16 +576,9 @@ SolverState GhostSolver::saveState() const
     state.particles = mParticles;
     for (const SolidBlock* b : {&mStatic, &mMoving}) state.particles.append(b->block.particles());
     state.particles.append(mPendingSolids);
-    state.reals["time"] = mTime;
+    mRun.save(state);
     state.reals["particle_mass"] = double(mMass);
     state.reals["lennard_jones"] = double(mLennardJones);
-    state.reals["max_acceleration"] = double(mMaxAcceleration);
-    state.reals["mean_neighbors"] = mMeanNeighbors;
-    state.integers["step"] = std::int64_t(mStep);
-    state.integers["frame"] = mFrame;
-    state.integers["initialized"] = mInitialized ? 1 : 0;
-    state.integers["emitted"] = std::int64_t(mEmitted);
-    state.integers["killed"] = std::int64_t(mKilled);
     state.integers["solids"] = std::int64_t(mSolids.size());
     state.integers["emitters"] = std::int64_t(mEmitters.size());
     return state;
@@ -601,35 +593,16 @@ void GhostSolver::restoreState(const SolverState& state)
                              "'; resume with the method "
                              "the run started with"));
     }
-    if (mRestored || mInitialized || mStep != 0 || !mParticles.empty() || !mSolids.empty()
+    if (mRestored || mRun.initialized || mRun.step != 0 || !mParticles.empty() || !mSolids.empty()
         || !mEmitters.empty()) {
         throw ValueError("restoreState: call it on a freshly constructed solver, before adding "
                          "solids, emitters or liquid and before the first step");
     }
     // Read every key first, so a state missing one leaves the solver untouched.
-    const double time = state.real("time");
+    const sph::RunCounters run = sph::RunCounters::load(state);
     const double mass = state.real("particle_mass");
     const double lennardJones = state.real("lennard_jones");
-    const double maxAcceleration = state.real("max_acceleration");
-    const double meanNeighbors = state.real("mean_neighbors");
-    const std::int64_t step = state.integer("step"), frame = state.integer("frame");
-    const std::int64_t initialized = state.integer("initialized");
-    const std::int64_t emitted = state.integer("emitted"), killed = state.integer("killed");
-    const std::int64_t solids = state.integer("solids"), emitters = state.integer("emitters");
-    auto requireRange = [](const char* key, std::int64_t value, std::int64_t lo, std::int64_t hi) {
-        if (value < lo || value > hi) {
-            throw ValueError(
-                msg("restoreState: integer '", key, "' = ", value, ": expected ", lo, " to ", hi));
-        }
-    };
-    constexpr std::int64_t BIG = std::numeric_limits<std::int64_t>::max();
-    requireRange("step", step, 0, BIG);
-    requireRange("frame", frame, 0, std::numeric_limits<int>::max());
-    requireRange("initialized", initialized, 0, 1);
-    requireRange("emitted", emitted, 0, BIG);
-    requireRange("killed", killed, 0, BIG);
-    requireRange("solids", solids, 0, BIG);
-    requireRange("emitters", emitters, 0, BIG);
+    const std::int64_t solids = state.count("solids"), emitters = state.count("emitters");
 
     // Every solid particle must name a solid the caller will add again.
     const ParticleSet& p = state.particles;
@@ -667,16 +640,9 @@ void GhostSolver::restoreState(const SolverState& state)
         mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
-    mTime = time;
+    mRun = run;
     mMass = Real(mass);
     mLennardJones = Real(lennardJones);
-    mMaxAcceleration = Real(maxAcceleration);
-    mMeanNeighbors = meanNeighbors;
-    mStep = std::uint64_t(step);
-    mFrame = int(frame);
-    mInitialized = initialized != 0;
-    mEmitted = std::size_t(emitted);
-    mKilled = std::size_t(killed);
     mRestoredSolids = std::size_t(solids);
     mRestoredEmitters = std::size_t(emitters);
     mRestored = true;
@@ -713,7 +679,7 @@ Real GhostSolver::stableTimeStep() const
     Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
     // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration
     // of the last step (gravity before the first), which covers stiff Lennard-Jones walls.
-    const Real a = std::max(mMaxAcceleration, mSettings.gravity.length());
+    const Real a = std::max(mRun.maxAcceleration, mSettings.gravity.length());
     if (a > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / a));
     return dt;
 }
@@ -722,12 +688,9 @@ void GhostSolver::advanceFrame()
 {
     checkRestoredInputs();
     initialize();
-    const double frameEnd = double(mFrame + 1) / double(mSettings.frameRate);
-    sph::stepFrame(
-        frameEnd, mSettings.frameRate, mSettings.substeps, [this] { return mTime; },
-        [this] { return stableTimeStep(); }, [this](Real dt) { step(dt); });
-    mTime = frameEnd; // no drift from summing substeps
-    ++mFrame;
+    sph::advanceRunOneFrame(
+        mRun, mSettings.frameRate, mSettings.substeps, [this] { return stableTimeStep(); },
+        [this](Real dt) { step(dt); });
 }
 
 } // namespace ghost

@@ -105,11 +105,9 @@ void GhostSolver::computeDensity()
     // Ghost SPH also finds each solid particle's nearest liquid particle (lines 5-7).
     std::vector<std::uint32_t> neighbours(n, 0);
     std::mutex touchedMutex;
-    parallel::forRange(
-        0, n,
-        [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         std::vector<Index> firstTouch[2];
         for (std::size_t i = lo; i < hi; ++i) {
             if (kind[i] != ParticleKind::Liquid) {
@@ -157,7 +155,7 @@ void GhostSolver::computeDensity()
     const double liquidCount = parallel::sum(
         0, n, [&](std::size_t i) { return kind[i] == ParticleKind::Liquid ? 1.0 : 0.0; });
     const double pairs = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); });
-    mMeanNeighbors = pairs / std::max(1.0, liquidCount);
+    mRun.meanNeighbors = pairs / std::max(1.0, liquidCount);
     mPairCount = std::size_t(pairs);
 
     // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0).
@@ -223,7 +221,7 @@ void GhostSolver::stepGhost(Real dt)
     searchNeighbors();
     const double search = secondsSince(t0);
     mTimings.sortAndSearch += search;
-    if (mStep > 0) resampleAir(int(mStep % std::uint64_t(mSettings.airResampleSteps)));
+    if (mRun.step > 0) resampleAir(int(mRun.step % std::uint64_t(mSettings.airResampleSteps)));
     t0 = std::chrono::steady_clock::now();
     computeDensity();
     mTimings.neighborsAndDensity += search + secondsSince(t0);
@@ -246,11 +244,9 @@ void GhostSolver::stepGhost(Real dt)
     parallel::forEach(
         0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);
     std::vector<Real> accel(n, Real(0));
-    parallel::forRange(
-        0, n,
-        [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
             if (kind[i] != ParticleKind::Liquid) {
                 vstar[i] = v[i];
@@ -279,7 +275,7 @@ void GhostSolver::stepGhost(Real dt)
         }
         },
         512);
-    mMaxAcceleration = *std::max_element(accel.begin(), accel.end());
+    mRun.maxAcceleration = *std::max_element(accel.begin(), accel.end());
     mTimings.pressureForce += secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
@@ -295,11 +291,9 @@ void GhostSolver::stepGhost(Real dt)
         mScratch[j] = kind[j] == ParticleKind::GhostAir ? Real(0) : eps * m[j] / rho[j];
         },
         2048);
-    parallel::forRange(
-        0, n,
-        [&](std::size_t lo, std::size_t hi) {
-        const CubicSplineKernel kernel = mKernel;
-        PairBatch batch;
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
             if (kind[i] != ParticleKind::Liquid) continue;
             const Vec3 xi = x[i], vi = vstar[i];
@@ -364,14 +358,14 @@ void GhostSolver::step(Real dt)
         throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
     }
     checkRestoredInputs();
-    const bool fresh = !mInitialized;
+    const bool fresh = !mRun.initialized;
     const auto start = std::chrono::steady_clock::now();
     if (!initialize()) {
         // Waiting for an emitter that starts later: only time and the solids move.
-        const double t1 = mTime + double(dt);
+        const double t1 = mRun.time + double(dt);
         moveSolids(t1);
-        mTime = t1;
-        ++mStep;
+        mRun.time = t1;
+        ++mRun.step;
         mTimings.total += secondsSince(start);
         ++mTimings.steps;
         if (mObserver) mObserver(*this, dt);
@@ -387,10 +381,10 @@ void GhostSolver::step(Real dt)
     if (mSettings.method == Method::Ghost) stepGhost(dt);
     else stepBasic(dt);
 
-    const double t1 = mTime + double(dt);
+    const double t1 = mRun.time + double(dt);
     moveSolids(t1);
-    mTime = t1;
-    ++mStep;
+    mRun.time = t1;
+    ++mRun.step;
     projectOutOfSolids(dt);
     applyKillBox();
     checkBlowUp();
@@ -413,9 +407,8 @@ void GhostSolver::projectOutOfSolids(Real dt)
     auto& x = mParticles.positions();
     auto& v = mParticles.velocities();
     const auto& kind = mParticles.kinds();
-    const double time = mTime;
-    std::vector<RigidTransform> placement;
-    for (const auto& solid : mSolids) placement.push_back(solid->at(time));
+    const double time = mRun.time;
+    const std::vector<RigidTransform> placement = sph::placementsAt(mSolids, time);
     // Only particles near a solid can have entered it. A liquid particle with no solid particle
     // within R at the start of the step is at least R - 2h from every solid surface (surface
     // samples lie about h apart); it cannot have crossed that this step unless it, or a moving
@@ -453,10 +446,11 @@ void GhostSolver::projectOutOfSolids(Real dt)
         std::ostringstream where;
         where << "(" << x[i][0] << ", " << x[i][1] << ", " << x[i][2] << ")";
         const LevelSet& shape = mSolids[b]->shape;
-        throw NumericalError(msg("liquid solver at frame ", mFrame, ", step ", mStep,
-                                 " (t = ", mTime, " s): liquid particle id ", mParticles.ids()[i],
-                                 " at ", where.str(), " is inside solid '", shape.name(),
-                                 "' deeper than its level set's band (", shape.bandWidth(),
+        throw NumericalError(msg("liquid solver at frame ", mRun.frame, ", step ", mRun.step,
+                                 " (t = ", mRun.time, " s): liquid particle id ",
+                                 mParticles.ids()[i], " at ", where.str(), " is inside solid '",
+                                 shape.name(), "' deeper than its level set's band (",
+                                 shape.bandWidth(),
                                  " m), and so was its position before the step: it cannot "
                                  "be put back; reduce the time step (substeps / cflNumber)"));
     }
@@ -484,15 +478,16 @@ void GhostSolver::checkBlowUp() const
     if (i == n) return;
     const char* kind = kindName(mParticles.kinds()[i]);
     if (!isFinite(x[i]) || !isFinite(v[i])) {
-        throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep,
-                                 " (t = ", mTime, " s): ", kind, " particle id ",
+        throw NumericalError(msg("liquid solver blew up at frame ", mRun.frame, ", step ",
+                                 mRun.step, " (t = ", mRun.time, " s): ", kind, " particle id ",
                                  mParticles.ids()[i],
                                  " has a non-finite position or velocity; reduce the time step "
                                  "(substeps / cflNumber) or the stiffness"));
     }
-    throw NumericalError(msg("liquid solver blew up at frame ", mFrame, ", step ", mStep,
-                             " (t = ", mTime, " s): ", kind, " particle id ", mParticles.ids()[i],
-                             " moves at ", v[i].length(), " m/s, beyond maxSpeed = ", limit,
+    throw NumericalError(msg("liquid solver blew up at frame ", mRun.frame, ", step ", mRun.step,
+                             " (t = ", mRun.time, " s): ", kind, " particle id ",
+                             mParticles.ids()[i], " moves at ", v[i].length(),
+                             " m/s, beyond maxSpeed = ", limit,
                              " m/s; reduce the time step (substeps / cflNumber) or the stiffness"));
 }
 

@@ -23,24 +23,26 @@ namespace {
 /// Candidates per distance batch (the width of a hit mask).
 constexpr std::uint32_t BATCH = 64;
 
-/// Left-packing table for four lanes: for a 4-bit hit mask, the lane numbers of its set bits
-/// in increasing order (unused entries 0), and how many there are.
+/// Left-packing table for `Lanes` lanes: for a hit mask of that many bits, the lane numbers of
+/// its set bits in increasing order (unused entries 0), and how many there are.
+template <int Lanes>
 struct PackTable
 {
-    alignas(16) std::int32_t lanes[16][4];
-    std::uint8_t count[16];
+    static constexpr int MASKS = 1 << Lanes;
+    alignas(4 * Lanes) std::int32_t lanes[MASKS][Lanes];
+    std::uint8_t count[MASKS];
     constexpr PackTable() : lanes(), count()
     {
-        for (int m = 0; m < 16; ++m) {
+        for (int m = 0; m < MASKS; ++m) {
             int c = 0;
-            for (int b = 0; b < 4; ++b) {
+            for (int b = 0; b < Lanes; ++b) {
                 if (m & (1 << b)) lanes[m][c++] = b;
             }
             count[m] = std::uint8_t(c);
         }
     }
 };
-constexpr PackTable PACK;
+constexpr PackTable<4> PACK;
 
 /// Append `first + k` to dst (from index `used`) for every k < len with r2[k] < radius2, in
 /// increasing k; returns the new count. Branch-free: with SSE2 and float, four lanes are
@@ -71,24 +73,8 @@ inline std::size_t appendHits(const Real* r2, std::size_t len, Real radius2, std
 }
 
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-/// Left-packing table for eight lanes (AVX2): the lane numbers of the set bits of an 8-bit hit
-/// mask, in increasing order, and their count.
-struct PackTable8
-{
-    alignas(32) std::int32_t lanes[256][8];
-    std::uint8_t count[256];
-    constexpr PackTable8() : lanes(), count()
-    {
-        for (int m = 0; m < 256; ++m) {
-            int c = 0;
-            for (int b = 0; b < 8; ++b) {
-                if (m & (1 << b)) lanes[m][c++] = b;
-            }
-            count[m] = std::uint8_t(c);
-        }
-    }
-};
-constexpr PackTable8 PACK8;
+/// The eight-lane table (AVX2).
+constexpr PackTable<8> PACK8;
 
 /// The same search as the portable path (the same products and sums in the same order, no
 /// fused multiply-add, so the same hits), eight candidates at a time. Compiled for AVX2 and

@@ -2,6 +2,7 @@
 /// @brief  Structure-of-arrays particle storage.
 #include "ghostfx/sph/ParticleSet.h"
 
+#include "ghostfx/sph/EnumNames.h"
 #include "ghostfx/sph/Exceptions.h"
 #include "ghostfx/sph/Parallel.h"
 
@@ -13,19 +14,12 @@ namespace sph {
 
 const char* kindName(ParticleKind kind)
 {
-    switch (kind) {
-    case ParticleKind::Liquid:
-        return "liquid";
-    case ParticleKind::GhostAir:
-        return "ghost_air";
-    case ParticleKind::GhostSolid:
-        return "ghost_solid";
-    case ParticleKind::Gas:
-        return "gas";
-    case ParticleKind::Boundary:
-        return "boundary";
-    }
-    return "unknown";
+    static const EnumName<ParticleKind> names[] = {{ParticleKind::Liquid, "liquid"},
+                                                   {ParticleKind::GhostAir, "ghost_air"},
+                                                   {ParticleKind::GhostSolid, "ghost_solid"},
+                                                   {ParticleKind::Gas, "gas"},
+                                                   {ParticleKind::Boundary, "boundary"}};
+    return nameOf(names, kind);
 }
 
 namespace {
@@ -56,6 +50,29 @@ std::string joinNames(const std::vector<std::string>& names)
     std::string s;
     for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
     return s;
+}
+
+/// The names of a channel map, in order.
+template <typename Map>
+std::vector<std::string> keysOf(const Map& channels)
+{
+    std::vector<std::string> names;
+    for (const auto& entry : channels) names.push_back(entry.first);
+    return names;
+}
+
+/// The channel `name` of `channels`; ValueError naming the `kind` ("scalar" or "vector")
+/// channels that exist.
+template <typename Map>
+const typename Map::mapped_type& findChannel(const Map& channels, const std::string& name,
+                                             const char* kind)
+{
+    const auto it = channels.find(name);
+    if (it == channels.end()) {
+        throw ValueError(msg("particle channel '", name, "' (", kind, ") does not exist; ", kind,
+                             " channels: ", joinNames(keysOf(channels))));
+    }
+    return it->second;
 }
 
 } // namespace
@@ -259,14 +276,7 @@ std::vector<Real>& ParticleSet::scalarChannel(const std::string& name)
 
 const std::vector<Real>& ParticleSet::scalarChannel(const std::string& name) const
 {
-    auto it = mScalars.find(name);
-    if (it == mScalars.end()) {
-        throw ValueError(msg("particle channel '", name,
-                             "' (scalar) does not exist; scalar "
-                             "channels: ",
-                             joinNames(scalarChannelNames())));
-    }
-    return it->second.data;
+    return findChannel(mScalars, name, "scalar").data;
 }
 
 std::vector<Vec3>& ParticleSet::vectorChannel(const std::string& name)
@@ -276,14 +286,7 @@ std::vector<Vec3>& ParticleSet::vectorChannel(const std::string& name)
 
 const std::vector<Vec3>& ParticleSet::vectorChannel(const std::string& name) const
 {
-    auto it = mVectors.find(name);
-    if (it == mVectors.end()) {
-        throw ValueError(msg("particle channel '", name,
-                             "' (vector) does not exist; vector "
-                             "channels: ",
-                             joinNames(vectorChannelNames())));
-    }
-    return it->second.data;
+    return findChannel(mVectors, name, "vector").data;
 }
 
 Real ParticleSet::scalarChannelDefault(const std::string& name) const
@@ -310,19 +313,9 @@ std::size_t ParticleSet::memoryBytes() const
     return total;
 }
 
-std::vector<std::string> ParticleSet::scalarChannelNames() const
-{
-    std::vector<std::string> names;
-    for (const auto& [name, ch] : mScalars) names.push_back(name);
-    return names;
-}
+std::vector<std::string> ParticleSet::scalarChannelNames() const { return keysOf(mScalars); }
 
-std::vector<std::string> ParticleSet::vectorChannelNames() const
-{
-    std::vector<std::string> names;
-    for (const auto& [name, ch] : mVectors) names.push_back(name);
-    return names;
-}
+std::vector<std::string> ParticleSet::vectorChannelNames() const { return keysOf(mVectors); }
 
 } // namespace sph
 } // namespace ghostfx

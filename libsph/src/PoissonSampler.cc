@@ -5,6 +5,7 @@
 #include "ghostfx/sph/Exceptions.h"
 #include "ghostfx/sph/Parallel.h"
 #include "ghostfx/sph/Random.h"
+#include "ghostfx/sph/SettingCheck.h"
 
 #include <algorithm>
 #include <cmath>
@@ -360,19 +361,18 @@ PoissonSettings PoissonSettings::forSpacing(Real spacing)
 
 void PoissonSettings::validate() const
 {
-    auto require = [](bool ok, const char* field, double value, const char* expected) {
-        if (!ok)
-            throw ValueError(msg("sampler setting ", field, " = ", value, ": expected ", expected));
-    };
-    require(radius > Real(0) && std::isfinite(radius), "radius", radius, "a finite value > 0 (m)");
-    require(surfaceAttempts >= 1, "surfaceAttempts", surfaceAttempts, ">= 1");
-    require(surfaceStep > Real(1), "surfaceStep", surfaceStep, "> 1 (steps of e r must clear r)");
-    require(volumeAttempts >= 1, "volumeAttempts", volumeAttempts, ">= 1");
-    require(relaxAttempts >= 1, "relaxAttempts", relaxAttempts, ">= 1");
-    require(surfaceRelaxSweeps >= 0, "surfaceRelaxSweeps", surfaceRelaxSweeps, ">= 0");
-    require(volumeRelaxSweeps >= 0, "volumeRelaxSweeps", volumeRelaxSweeps, ">= 0");
-    require(bandDepth > Real(0), "bandDepth", bandDepth, "> 0 (m), or infinity");
-    require(maxSamples >= 1, "maxSamples", double(maxSamples), ">= 1");
+    const SettingCheck check("sampler setting");
+    check.require(radius > Real(0) && std::isfinite(radius), "radius", radius,
+                  "a finite value > 0 (m)");
+    check.require(surfaceAttempts >= 1, "surfaceAttempts", surfaceAttempts, ">= 1");
+    check.require(surfaceStep > Real(1), "surfaceStep", surfaceStep,
+                  "> 1 (steps of e r must clear r)");
+    check.require(volumeAttempts >= 1, "volumeAttempts", volumeAttempts, ">= 1");
+    check.require(relaxAttempts >= 1, "relaxAttempts", relaxAttempts, ">= 1");
+    check.require(surfaceRelaxSweeps >= 0, "surfaceRelaxSweeps", surfaceRelaxSweeps, ">= 0");
+    check.require(volumeRelaxSweeps >= 0, "volumeRelaxSweeps", volumeRelaxSweeps, ">= 0");
+    check.require(bandDepth > Real(0), "bandDepth", bandDepth, "> 0 (m), or infinity");
+    check.require(maxSamples >= 1, "maxSamples", double(maxSamples), ">= 1");
 }
 
 std::size_t SampleSet::surfaceCount() const

@@ -11,6 +11,7 @@
 #include <ghostfx/vdbio/Scene.h>
 
 #include "common/Expect.h"
+#include "common/StateDiff.h"
 
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
@@ -44,6 +45,15 @@ struct Result
     std::string err;
 };
 
+/// "" when the checkpoints `a` and `b` of the scene `scene` hold the same state bit for bit,
+/// else what differs first.
+std::string checkpointDifference(const std::string& scene, const fs::path& a, const fs::path& b)
+{
+    const std::string fingerprint = vdbio::readScene(scene).simulationFingerprint();
+    return ghostfx::testing::firstDifference(vdbio::readCheckpoint(a.string(), fingerprint),
+                                             vdbio::readCheckpoint(b.string(), fingerprint));
+}
+
 #define EXPECT_CONTAINS(text, part)                                                                \
     EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
@@ -52,14 +62,7 @@ struct Result
 class Cli : public ::testing::Test
 {
 protected:
-    void SetUp() override
-    {
-        mDir = fs::temp_directory_path()
-               / ("ghostfx_cli_"
-                  + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(mDir);
-        fs::create_directories(mDir);
-    }
+    void SetUp() override { mDir = ghostfx::testing::freshTestDir("cli"); }
 
     static Json smallScene()
     {
@@ -185,22 +188,7 @@ TEST_F(Cli, ResumedRunMatchesAnUninterruptedOneBitForBit)
                                + (b / "checkpoint.0002.h5").string());
     ASSERT_EQ(resumed.code, 0) << resumed.err;
 
-    const std::string fingerprint = vdbio::readScene(path).simulationFingerprint();
-    const sph::SolverState sa =
-        vdbio::readCheckpoint((a / "checkpoint.0004.h5").string(), fingerprint);
-    const sph::SolverState sb =
-        vdbio::readCheckpoint((b / "checkpoint.0004.h5").string(), fingerprint);
-    ASSERT_EQ(sa.particles.size(), sb.particles.size());
-    const std::size_t n = sa.particles.size();
-    EXPECT_EQ(std::memcmp(sa.particles.positions().data(), sb.particles.positions().data(),
-                          n * sizeof(sph::Vec3)),
-              0);
-    EXPECT_EQ(std::memcmp(sa.particles.velocities().data(), sb.particles.velocities().data(),
-                          n * sizeof(sph::Vec3)),
-              0);
-    EXPECT_EQ(sa.particles.ids(), sb.particles.ids());
-    EXPECT_EQ(sa.reals, sb.reals);
-    EXPECT_EQ(sa.integers, sb.integers);
+    EXPECT_EQ(checkpointDifference(path, a / "checkpoint.0004.h5", b / "checkpoint.0004.h5"), "");
     EXPECT_EQ(pointCount(a / "liquid_points.0004.vdb"), pointCount(b / "liquid_points.0004.vdb"));
     EXPECT_TRUE(fs::exists(b / "liquid_points.0003.vdb")) << "the resumed run writes frames 3-4";
     // The statistics continue where the checkpoint left off: 4 frames x 10 steps.
@@ -229,20 +217,31 @@ TEST_F(Cli, BadInputGetsOneClearLine)
                     "nope.json': cannot open the file");
 
     const std::string good = write(smallScene());
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.stifness=5000"),
-                    "settings.stifness: unknown key (did you mean 'stiffness'?)");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.stiffness=-1"),
-                    "settings.stiffness = -1: expected a number > 0");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.cfl=50"),
-                    "settings.cfl = 50: expected a number in [0.001, 10]");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.method=gas"),
-                    "liquids: a 'gas' scene simulates gas only: liquids, emitters and heaters need "
-                    "a liquid method ('ghost' or 'basic'");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.gas.kappa=2"),
-                    "settings.gas: gas settings need a gas method or heaters (boiling)");
-    EXPECT_CONTAINS(errorLine("run " + good + out
-                              + " -D 'liquids[0].geometry={\"file\":\"none.vdb\",\"grid\":\"x\"}'"),
-                    "none.vdb' does not exist");
+    // (arguments after "run <scene> --out <folder>", what the one error line says)
+    const std::pair<const char*, const char*> refusals[] = {
+        {" -D settings.stifness=5000",
+         "settings.stifness: unknown key (did you mean 'stiffness'?)"},
+        {" -D settings.stiffness=-1", "settings.stiffness = -1: expected a number > 0"},
+        {" -D settings.cfl=50", "settings.cfl = 50: expected a number in [0.001, 10]"},
+        {" -D settings.method=gas", "liquids: a 'gas' scene simulates gas only: liquids, emitters "
+                                    "and heaters need a liquid method ('ghost' or 'basic'"},
+        {" -D settings.gas.kappa=2",
+         "settings.gas: gas settings need a gas method or heaters (boiling)"},
+        {" -D 'liquids[0].geometry={\"file\":\"none.vdb\",\"grid\":\"x\"}'",
+         "none.vdb' does not exist"},
+        {" --frames 5-2", "--frames '5-2': expected 1 <= first <= last"},
+        // Frame numbers that do not fit: refused, not wrapped into "nothing to do" with exit 0.
+        {" --frames 1-3000000000", "--frames '1-3000000000': expected A-B (e.g. 1-48) or a last "
+                                   "frame, whole numbers up to 9999999"},
+        {" --frames 1-2x", "--frames '1-2x': expected A-B"},
+        {" -D settings.frame_range=[1,3000000000]",
+         "settings.frame_range = [1,3000000000]: expected [first, last] with 1 <= first <= last <= "
+         "9999999"},
+        {" -D settings.frame_range=[1,99999999999999999999]",
+         "settings.frame_range = [1,1e+20]: expected [first, last]"},
+    };
+    for (const auto& [args, expected] : refusals)
+        EXPECT_CONTAINS(errorLine("run " + good + out + args), expected);
     // Liquid entirely inside the tank wall: no particles.
     EXPECT_CONTAINS(errorLine("run " + good + out
                               + " -D liquids[0].geometry.box.min=[-0.04,0.05,0.05]"
@@ -253,20 +252,6 @@ TEST_F(Cli, BadInputGetsOneClearLine)
     EXPECT_CONTAINS(errorLine("run " + good + " --out " + (mDir / "afile").string()),
                     "output folder '" + (mDir / "afile").string()
                         + "': exists and is not a folder");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 5-2"),
-                    "--frames '5-2': expected 1 <= first <= last");
-    // Frame numbers that do not fit: refused, not wrapped into "nothing to do" with exit 0.
-    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 1-3000000000"),
-                    "--frames '1-3000000000': expected A-B (e.g. 1-48) or a last frame, whole "
-                    "numbers up to 9999999");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " --frames 1-2x"),
-                    "--frames '1-2x': expected A-B");
-    EXPECT_CONTAINS(errorLine("run " + good + out + " -D settings.frame_range=[1,3000000000]"),
-                    "settings.frame_range = [1,3000000000]: expected [first, last] with 1 <= first "
-                    "<= last <= 9999999");
-    EXPECT_CONTAINS(
-        errorLine("run " + good + out + " -D settings.frame_range=[1,99999999999999999999]"),
-        "settings.frame_range = [1,1e+20]: expected [first, last]");
     // Nothing was written by any of the failed runs.
     EXPECT_FALSE(fs::exists(mDir / "out") && !fs::is_empty(mDir / "out"));
 }
@@ -449,15 +434,9 @@ TEST_F(Cli, GasPlumeRunsToDensityAndTemperatureVolumes)
         run("run " + path + " --out " + (mDir / "b").string() + " -q --frames 1-3 --resume "
             + (out / "checkpoint.0002.h5").string());
     ASSERT_EQ(resumed.code, 0) << resumed.err;
-    const std::string fingerprint = vdbio::readScene(path).simulationFingerprint();
-    const sph::SolverState sa =
-        vdbio::readCheckpoint((out / "checkpoint.0003.h5").string(), fingerprint);
-    const sph::SolverState sb =
-        vdbio::readCheckpoint((mDir / "b" / "checkpoint.0003.h5").string(), fingerprint);
-    ASSERT_EQ(sa.particles.size(), sb.particles.size());
-    EXPECT_EQ(std::memcmp(sa.particles.positions().data(), sb.particles.positions().data(),
-                          sa.particles.size() * sizeof(sph::Vec3)),
-              0);
+    EXPECT_EQ(
+        checkpointDifference(path, out / "checkpoint.0003.h5", mDir / "b" / "checkpoint.0003.h5"),
+        "");
 
     // The ambient-air baseline needs the box it fills with air.
     Json noBox = plumeScene();

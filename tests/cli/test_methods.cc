@@ -24,11 +24,7 @@ namespace {
 class Methods : public ::testing::Test
 {
 protected:
-    void SetUp() override
-    {
-        mDir = ghostfx::testing::freshDir(
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    }
+    void SetUp() override { mDir = ghostfx::testing::freshTestDir("methods"); }
 
     /// A liquid block in a small tank; few particles, so every method steps it in a moment.
     static Json liquidScene(const std::string& method)

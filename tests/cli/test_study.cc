@@ -67,11 +67,7 @@ class Study : public ::testing::Test
 protected:
     void SetUp() override
     {
-        mDir = fs::temp_directory_path()
-               / ("ghostfx_study_"
-                  + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(mDir);
-        fs::create_directories(mDir);
+        mDir = ghostfx::testing::freshTestDir("study");
         // A drop of water in free fall, no solid anywhere: its centre of mass must follow
         // x0 + v0 t + g t^2 / 2 whatever the internal forces do (they cancel in pairs).
         std::ofstream(mDir / "drop.json") << R"({

@@ -33,6 +33,14 @@ std::string errorOf(F&& f)
     return "";
 }
 
+/// `settings` with its method set to `method` (any solver's settings).
+template <typename Settings, typename Method>
+Settings withMethod(Settings settings, Method method)
+{
+    settings.method = method;
+    return settings;
+}
+
 inline bool contains(const std::string& text, const std::string& part)
 {
     return text.find(part) != std::string::npos;
@@ -40,6 +48,14 @@ inline bool contains(const std::string& text, const std::string& part)
 
 /// An empty folder of the system's temporary directory for one test
 /// ("ghostfx_test_<name>_<pid>": test processes that ctest runs side by side never share one).
+inline std::filesystem::path freshDir(const std::string& name);
+
+/// freshDir("<prefix>_<name of the running test>"), for a fixture's SetUp.
+inline std::filesystem::path freshTestDir(const std::string& prefix)
+{
+    return freshDir(prefix + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+}
+
 inline std::filesystem::path freshDir(const std::string& name)
 {
     const std::filesystem::path dir = std::filesystem::temp_directory_path()

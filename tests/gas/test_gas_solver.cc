@@ -12,6 +12,9 @@
 
 #include "common/StateDiff.h"
 
+#include "common/Expect.h"
+
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -501,16 +504,9 @@ TEST(GasResume, InMemoryContinuationIsBitIdentical)
     EXPECT_LE(whole.emittedCount(), 400u);
 
     // The contract: another solver, a stale budget, gas after a restore.
-    GasSettings ambient = scene.settings;
-    ambient.method = Method::Ambient;
-    GasSolver wrong(ambient);
-    try {
-        wrong.restoreState(saved);
-        FAIL() << "restoring a fast state into an ambient solver must throw";
-    } catch (const ValueError& e) {
-        EXPECT_NE(std::string(e.what()).find("saved by gas method 'fast'"), std::string::npos)
-            << e.what();
-    }
+    GasSolver wrong(ghostfx::testing::withMethod(scene.settings, Method::Ambient));
+    EXPECT_THAT(ghostfx::testing::errorOf<ValueError>([&] { wrong.restoreState(saved); }),
+                ::testing::HasSubstr("saved by gas method 'fast'"));
     GasSolver again(scene.settings);
     again.restoreState(saved);
     EXPECT_THROW(again.addParticles({Vec3(0)}, Vec3(0), TAMB), ValueError);

@@ -14,6 +14,8 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 
+#include "common/Shapes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,16 +35,7 @@ constexpr Real DEPTH = Real(0.04);        ///< water depth (m)
 /// Open-top pan: walls 4 h thick around the inside [-a, a] x [0, top] x [-a, a].
 LevelSet panLevelSet(Real a, Real top)
 {
-    const double wall = 4 * double(H);
-    const openvdb::Vec3d outerLo(-a - wall, -wall, -a - wall), outerHi(a + wall, top, a + wall);
-    const openvdb::Vec3d innerLo(-a, 0, -a), innerHi(a, top + 1, a);
-    auto sdf = [&](const openvdb::Vec3d& x) {
-        return std::max(boxSignedDistance(x, outerLo, outerHi),
-                        -boxSignedDistance(x, innerLo, innerHi));
-    };
-    Aabb bounds{Vec3(Real(outerLo.x()), Real(outerLo.y()), Real(outerLo.z())),
-                Vec3(Real(outerHi.x()), Real(outerHi.y()), Real(outerHi.z()))};
-    return makeLevelSet(levelSetFromSdf(sdf, bounds, H / 2), "pan");
+    return makeLevelSet(ghostfx::testing::openTankGrid(a, top, 4 * double(H), H / 2), "pan");
 }
 
 /// The pan's bottom plate as a heater.

@@ -9,6 +9,9 @@
 #include "common/ResumeScene.h"
 #include "common/StateDiff.h"
 
+#include "common/Expect.h"
+
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -115,18 +118,9 @@ TEST(Resume, RestoreContract)
     }
 
     // Another method.
-    GhostSettings basicSettings = scene.settings;
-    basicSettings.method = Method::Basic;
-    GhostSolver basic(basicSettings);
-    try {
-        basic.restoreState(saved);
-        FAIL() << "restoring a ghost state into a basic solver must throw";
-    } catch (const ValueError& e) {
-        EXPECT_NE(std::string(e.what()).find("saved by the 'ghost' solver, this solver runs "
-                                             "'basic'"),
-                  std::string::npos)
-            << e.what();
-    }
+    GhostSolver basic(ghostfx::testing::withMethod(scene.settings, Method::Basic));
+    EXPECT_THAT(ghostfx::testing::errorOf<ValueError>([&] { basic.restoreState(saved); }),
+                ::testing::HasSubstr("saved by the 'ghost' solver, this solver runs 'basic'"));
 
     // Liquid after a restore.
     GhostSolver resumed(scene.settings);

@@ -4,6 +4,8 @@
 #include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 
+#include "common/Shapes.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -19,16 +21,7 @@ constexpr Real H = Real(0.01);
 /// Open-top box container: walls 4 h thick around the inside [-a, a] x [0, top] x [-a, a].
 openvdb::FloatGrid::Ptr tankGrid(Real a, Real top)
 {
-    const double wall = 4 * double(H);
-    const openvdb::Vec3d outerLo(-a - wall, -wall, -a - wall), outerHi(a + wall, top, a + wall);
-    const openvdb::Vec3d innerLo(-a, 0, -a), innerHi(a, top + 1, a);
-    auto sdf = [&](const openvdb::Vec3d& x) {
-        return std::max(boxSignedDistance(x, outerLo, outerHi),
-                        -boxSignedDistance(x, innerLo, innerHi));
-    };
-    Aabb bounds{Vec3(Real(outerLo.x()), Real(outerLo.y()), Real(outerLo.z())),
-                Vec3(Real(outerHi.x()), Real(outerHi.y()), Real(outerHi.z()))};
-    return levelSetFromSdf(sdf, bounds, H / 2);
+    return ghostfx::testing::openTankGrid(a, top, 4 * double(H), H / 2);
 }
 
 /// Least-squares slope of pressure against height over the liquid away from the walls and

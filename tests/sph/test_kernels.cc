@@ -46,24 +46,17 @@ struct CubicOther
     static Kernel make() { return Kernel(Real(0.3)); } // R = 0.3 m: 2/R does not round exactly
     static constexpr double MIN_FD_RADIUS = 0.02;
 };
-struct Poly6
+/// A kernel of support R = 0.1 m, finite differences from `MinFdPercent` % of R.
+template <typename K, int MinFdPercent>
+struct TenthMetre
 {
-    using Kernel = Poly6Kernel;
+    using Kernel = K;
     static Kernel make() { return Kernel(Real(0.1)); }
-    static constexpr double MIN_FD_RADIUS = 0.02;
+    static constexpr double MIN_FD_RADIUS = MinFdPercent / 100.0;
 };
-struct Spiky
-{
-    using Kernel = SpikyKernel;
-    static Kernel make() { return Kernel(Real(0.1)); }
-    static constexpr double MIN_FD_RADIUS = 0.2;
-};
-struct Viscosity
-{
-    using Kernel = ViscosityKernel;
-    static Kernel make() { return Kernel(Real(0.1)); }
-    static constexpr double MIN_FD_RADIUS = 0.3;
-};
+using Poly6 = TenthMetre<Poly6Kernel, 2>;
+using Spiky = TenthMetre<SpikyKernel, 20>;
+using Viscosity = TenthMetre<ViscosityKernel, 30>;
 
 class CaseNames
 {

@@ -6,6 +6,8 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/ParticleSet.h>
 
+#include "common/Expect.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -258,28 +260,20 @@ TEST(ParticleSet, MissingChannelErrorNamesTheChannelAndTheExistingOnes)
 {
     ParticleSet set = makeFilledSet(3);
     const ParticleSet& constSet = set;
-    try {
-        set.scalarChannel("pressure_old");
-        ADD_FAILURE() << "missing scalar channel returned";
-    } catch (const ghostfx::ValueError& e) {
-        EXPECT_THAT(e.what(), HasSubstr("'pressure_old' (scalar)"));
-        EXPECT_THAT(e.what(), HasSubstr("scalar channels: temperature"));
-    }
-    try {
-        constSet.vectorChannel("temperature"); // exists, but as a scalar
-        ADD_FAILURE() << "scalar channel returned as a vector channel";
-    } catch (const ghostfx::ValueError& e) {
-        EXPECT_THAT(e.what(), HasSubstr("'temperature' (vector)"));
-        EXPECT_THAT(e.what(), HasSubstr("vector channels: vorticity"));
-    }
+    using ghostfx::testing::errorOf;
+    const std::string scalar =
+        errorOf<ghostfx::ValueError>([&] { set.scalarChannel("pressure_old"); });
+    EXPECT_THAT(scalar, HasSubstr("'pressure_old' (scalar)"));
+    EXPECT_THAT(scalar, HasSubstr("scalar channels: temperature"));
+    // "temperature" exists, but as a scalar.
+    const std::string vector =
+        errorOf<ghostfx::ValueError>([&] { constSet.vectorChannel("temperature"); });
+    EXPECT_THAT(vector, HasSubstr("'temperature' (vector)"));
+    EXPECT_THAT(vector, HasSubstr("vector channels: vorticity"));
     ParticleSet bare;
-    try {
-        bare.vectorChannel("normal");
-        ADD_FAILURE() << "missing vector channel returned";
-    } catch (const ghostfx::ValueError& e) {
-        EXPECT_THAT(e.what(), HasSubstr("'normal'"));
-        EXPECT_THAT(e.what(), HasSubstr("vector channels: none"));
-    }
+    const std::string none = errorOf<ghostfx::ValueError>([&] { bare.vectorChannel("normal"); });
+    EXPECT_THAT(none, HasSubstr("'normal'"));
+    EXPECT_THAT(none, HasSubstr("vector channels: none"));
 }
 
 TEST(ParticleSet, SetNextIdMustExceedEveryId)

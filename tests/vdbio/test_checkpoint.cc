@@ -101,6 +101,17 @@ std::string messageOf(const std::function<void()>& fn)
     return "(no exception)";
 }
 
+/// The message of reading the checkpoint `path` for `settings`, which must throw E; printed as
+/// "[measured] <what> refusal: ...".
+template <typename E>
+std::string readRefusal(const char* what, const std::string& path, const std::string& settings)
+{
+    const std::string message =
+        ghostfx::testing::errorOf<E>([&] { readCheckpoint(path, settings); });
+    std::printf("[measured] %s refusal: %s\n", what, message.c_str());
+    return message;
+}
+
 } // namespace
 
 // Checkpoint files ----------------------------------------------------------------------------
@@ -164,17 +175,14 @@ TEST(Checkpoint, RefusesOtherSchemaAndPrecision)
     writeCheckpoint(path, awkwardState(), SETTINGS, 1);
     vdbio::detail::patchCheckpointAttribute(path, "schema_version", std::int64_t(2));
     EXPECT_EQ(readCheckpointHeader(path).schemaVersion, 2); // reported, not refused
-    const std::string schema = messageOf([&] { readCheckpoint(path, SETTINGS); });
-    std::printf("[measured] schema refusal: %s\n", schema.c_str());
-    EXPECT_EQ(schema, "checkpoint '" + path + "': schema version 2, this ghostfx reads 1");
-    EXPECT_THROW(readCheckpoint(path, SETTINGS), IoError);
+    EXPECT_EQ(readRefusal<IoError>("schema", path, SETTINGS),
+              "checkpoint '" + path + "': schema version 2, this ghostfx reads 1");
 
     // Written by a build of the other precision (float vs double).
     writeCheckpoint(path, awkwardState(), SETTINGS, 1);
     const std::string other = sizeof(Real) == 4 ? "double" : "float";
     vdbio::detail::patchCheckpointAttribute(path, "real", other);
-    const std::string precision = messageOf([&] { readCheckpoint(path, SETTINGS); });
-    std::printf("[measured] precision refusal: %s\n", precision.c_str());
+    const std::string precision = readRefusal<IoError>("precision", path, SETTINGS);
     EXPECT_NE(precision.find("checkpoint '" + path + "': written by a build with Real = " + other),
               std::string::npos)
         << precision;
@@ -189,12 +197,10 @@ TEST(Checkpoint, RefusesDifferentSettingsNamingTheKeyAndBothValues)
 
     std::string here = SETTINGS;
     here.replace(here.find("2000"), 4, "5000");
-    const std::string changed = messageOf([&] { readCheckpoint(path, here); });
-    std::printf("[measured] settings refusal: %s\n", changed.c_str());
-    EXPECT_EQ(changed, "checkpoint '" + path
-                           + "' was written with different settings: "
-                             "/settings/stiffness is 2000 there, 5000 in this scene");
-    EXPECT_THROW(readCheckpoint(path, here), SceneError);
+    EXPECT_EQ(readRefusal<SceneError>("settings", path, here),
+              "checkpoint '" + path
+                  + "' was written with different settings: "
+                    "/settings/stiffness is 2000 there, 5000 in this scene");
 
     // A key only one side has, and a difference inside an array.
     EXPECT_EQ(firstSettingsDifference(R"({"a": {"b": 1}})", R"({"a": {"b": 1, "c": "x"}})"),
@@ -217,31 +223,24 @@ TEST(Checkpoint, RefusesMissingNonHdf5AndForeignFiles)
 {
     const fs::path dir = freshDir("refuse");
     const std::string missing = (dir / "missing.h5").string();
-    const std::string missingMessage = messageOf([&] { readCheckpoint(missing, SETTINGS); });
-    std::printf("[measured] missing file: %s\n", missingMessage.c_str());
-    EXPECT_EQ(missingMessage, "checkpoint '" + missing + "': no such file");
+    EXPECT_EQ(readRefusal<IoError>("missing file", missing, SETTINGS),
+              "checkpoint '" + missing + "': no such file");
     EXPECT_THROW(readCheckpointHeader(missing), IoError);
 
     const std::string text = (dir / "notes.h5").string();
     std::ofstream(text) << "this is not an HDF5 file\n";
-    const std::string textMessage = messageOf([&] { readCheckpoint(text, SETTINGS); });
-    std::printf("[measured] non-HDF5 file: %s\n", textMessage.c_str());
-    EXPECT_EQ(textMessage, "checkpoint '" + text
-                               + "': not an HDF5 file, so not a ghostfx "
-                                 "checkpoint");
-    EXPECT_THROW(readCheckpoint(text, SETTINGS), IoError);
+    EXPECT_EQ(readRefusal<IoError>("non-HDF5 file", text, SETTINGS),
+              "checkpoint '" + text + "': not an HDF5 file, so not a ghostfx checkpoint");
 
     // An HDF5 file that is not a checkpoint: a statistics file.
     const std::string stats = (dir / "stats.h5").string();
     StatsWriter writer(stats, (dir / "stats.csv").string());
     writer.append({{{"step", 1}, {"time", 0.01}}});
     writer.flush();
-    const std::string foreign = messageOf([&] { readCheckpoint(stats, SETTINGS); });
-    std::printf("[measured] foreign HDF5 file: %s\n", foreign.c_str());
+    const std::string foreign = readRefusal<IoError>("foreign HDF5 file", stats, SETTINGS);
     EXPECT_NE(foreign.find("checkpoint '" + stats + "': not a ghostfx checkpoint"),
               std::string::npos)
         << foreign;
-    EXPECT_THROW(readCheckpoint(stats, SETTINGS), IoError);
 
     // Writing into a folder that does not exist fails with the file's name.
     const std::string nowhere = (dir / "no" / "such" / "c.h5").string();

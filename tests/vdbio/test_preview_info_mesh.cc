@@ -309,6 +309,34 @@ openvdb::FloatGrid::Ptr sphereLevelSet()
     return grid;
 }
 
+struct Rendered
+{
+    vdbio::PreviewSummary summary;
+    vdbio::RgbaImage image;
+    const float* centre = nullptr; ///< the centre pixel's rgba
+    Vec3d centroid;                ///< alphaCentroid(image)
+};
+
+/// Render `grid` at IMAGE_W x IMAGE_H to the EXR `file`, read the image back and print its
+/// centre pixel and alpha centroid as "[measured] <label>: ...".
+Rendered renderAndRead(const openvdb::FloatGrid& grid, const fs::path& file, const char* label)
+{
+    vdbio::PreviewOptions options;
+    options.width = IMAGE_W;
+    options.height = IMAGE_H;
+    Rendered r{vdbio::renderPreview(grid, options, file.string()), {}};
+    r.image = vdbio::readExrImage(file.string());
+    EXPECT_EQ(r.image.width, IMAGE_W);
+    EXPECT_EQ(r.image.height, IMAGE_H);
+    r.centre = r.image.pixel(IMAGE_W / 2, IMAGE_H / 2);
+    r.centroid = alphaCentroid(r.image);
+    const float* c = r.centre;
+    std::printf("[measured] %s: centre pixel rgba = (%.3f, %.3f, %.3f, %.3f), alpha centroid "
+                "(%.2f, %.2f) px, %.2f s\n",
+                label, c[0], c[1], c[2], c[3], r.centroid.x(), r.centroid.y(), r.summary.seconds);
+    return r;
+}
+
 } // namespace
 
 TEST(Preview, FogSphereIsVisibleButNotBlackOnATransparentBackground)
@@ -318,21 +346,9 @@ TEST(Preview, FogSphereIsVisibleButNotBlackOnATransparentBackground)
     openvdb::tools::sdfToFogVolume(*fog); // density 1 inside, 0 outside, ramp across the band
     fog->setName("density");
 
-    vdbio::PreviewOptions options;
-    options.width = IMAGE_W;
-    options.height = IMAGE_H;
-    const std::string exr = (dir / "fog.exr").string();
-    const vdbio::PreviewSummary summary = vdbio::renderPreview(*fog, options, exr);
-    EXPECT_EQ(summary.gridClass, "fog volume");
-
-    const vdbio::RgbaImage image = vdbio::readExrImage(exr);
-    ASSERT_EQ(image.width, IMAGE_W);
-    ASSERT_EQ(image.height, IMAGE_H);
-    const float* c = image.pixel(IMAGE_W / 2, IMAGE_H / 2);
-    const Vec3d centroid = alphaCentroid(image);
-    std::printf("[measured] fog sphere: centre pixel rgba = (%.3f, %.3f, %.3f, %.3f), alpha "
-                "centroid (%.2f, %.2f) px, %.2f s\n",
-                c[0], c[1], c[2], c[3], centroid.x(), centroid.y(), summary.seconds);
+    const Rendered r = renderAndRead(*fog, dir / "fog.exr", "fog sphere");
+    EXPECT_EQ(r.summary.gridClass, "fog volume");
+    const float* c = r.centre;
     // Through the middle the optical depth is 10 /m * 0.2 m = 2 (PreviewOptions::extinction),
     // so alpha = 1 - e^-2 = 0.86, a little less for the ramp in the band: require 0.7 .. 0.9.
     EXPECT_GT(c[3], 0.7f);
@@ -344,11 +360,11 @@ TEST(Preview, FogSphereIsVisibleButNotBlackOnATransparentBackground)
         EXPECT_GT(c[k], 0.15f);
         EXPECT_LT(c[k], 0.9f);
     }
-    expectTransparentCorners(image);
+    expectTransparentCorners(r.image);
     // Auto-framing centres the sphere; its voxelised band is symmetric to one voxel, which
     // projects to less than a pixel here: allow 1 pixel.
-    EXPECT_NEAR(centroid.x(), IMAGE_W / 2.0, 1.0);
-    EXPECT_NEAR(centroid.y(), IMAGE_H / 2.0, 1.0);
+    EXPECT_NEAR(r.centroid.x(), IMAGE_W / 2.0, 1.0);
+    EXPECT_NEAR(r.centroid.y(), IMAGE_H / 2.0, 1.0);
 }
 
 TEST(Preview, PngMatchesTheExrThroughTheSrgbCurve)
@@ -386,21 +402,9 @@ TEST(Preview, LevelSetSphereIsOpaqueAndShaded)
 {
     const fs::path dir = freshDir("preview_surface");
     const openvdb::FloatGrid::Ptr surface = sphereLevelSet();
-    vdbio::PreviewOptions options;
-    options.width = IMAGE_W;
-    options.height = IMAGE_H;
-    const std::string exr = (dir / "surface.exr").string();
-    const vdbio::PreviewSummary summary = vdbio::renderPreview(*surface, options, exr);
-    EXPECT_EQ(summary.gridClass, "level set");
-
-    const vdbio::RgbaImage image = vdbio::readExrImage(exr);
-    ASSERT_EQ(image.width, IMAGE_W);
-    ASSERT_EQ(image.height, IMAGE_H);
-    const float* c = image.pixel(IMAGE_W / 2, IMAGE_H / 2);
-    const Vec3d centroid = alphaCentroid(image);
-    std::printf("[measured] level-set sphere: centre pixel rgba = (%.3f, %.3f, %.3f, %.3f), "
-                "alpha centroid (%.2f, %.2f) px, %.2f s\n",
-                c[0], c[1], c[2], c[3], centroid.x(), centroid.y(), summary.seconds);
+    const Rendered r = renderAndRead(*surface, dir / "surface.exr", "level-set sphere");
+    EXPECT_EQ(r.summary.gridClass, "level set");
+    const float* c = r.centre;
     EXPECT_EQ(c[3], 1.0f); // a surface hit is opaque
     // The centre of the sphere faces the camera; the key light is 33 degrees off the view
     // direction (Preview.cc: toCamera + 0.5 up - 0.4 right), so Lambert gives cos = 0.84 and,
@@ -410,9 +414,9 @@ TEST(Preview, LevelSetSphereIsOpaqueAndShaded)
         EXPECT_GT(c[k], 0.5f);
         EXPECT_LE(c[k], 0.9f);
     }
-    expectTransparentCorners(image);
-    EXPECT_NEAR(centroid.x(), IMAGE_W / 2.0, 1.0); // as for the fog sphere
-    EXPECT_NEAR(centroid.y(), IMAGE_H / 2.0, 1.0);
+    expectTransparentCorners(r.image);
+    EXPECT_NEAR(r.centroid.x(), IMAGE_W / 2.0, 1.0); // as for the fog sphere
+    EXPECT_NEAR(r.centroid.y(), IMAGE_H / 2.0, 1.0);
 }
 
 TEST(Preview, FromFilePicksAGridAndErrorsNameFileAndGrid)

@@ -5,6 +5,8 @@
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/vdbio/Scene.h>
 
+#include "common/Expect.h"
+
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetUtil.h>
@@ -26,11 +28,7 @@ class SceneTest : public ::testing::Test
 protected:
     void SetUp() override
     {
-        mDir = fs::temp_directory_path()
-               / ("ghostfx_scene_"
-                  + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(mDir);
-        fs::create_directories(mDir);
+        mDir = ghostfx::testing::freshTestDir("scene");
         auto sphere = sph::makeSphereLevelSet(sph::Vec3(0.5f, 0.5f, 0.5f), 0.2f, 0.01f);
         sphere->setName("surface");
         writeGrids("water.vdb", {sphere});

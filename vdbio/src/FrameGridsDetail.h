@@ -36,6 +36,11 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
                                       const std::vector<sph::Index>& selection,
                                       const VolumeOptions& options);
 
+/// Write `grids` with `fileMetadata` to the .vdb `path` atomically (AtomicFile.h); IoError
+/// "<what> '<path>': cannot write (...)" on an OpenVDB or stream failure.
+void writeVdbFile(const std::string& path, const char* what, const openvdb::GridCPtrVec& grids,
+                  const openvdb::MetaMap& fileMetadata);
+
 /// Metadata every ghostfx grid carries: creator, full float precision on write.
 void setCommonGridMetadata(openvdb::GridBase& grid);
 

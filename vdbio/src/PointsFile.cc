@@ -192,17 +192,7 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
         written += (written.empty() ? "" : ",") + std::string(sph::kindName(k));
     grid->insertMeta("kinds_written", openvdb::StringMetadata(written));
 
-    writeAtomically(path, [&](const std::string& tmp) {
-        try {
-            openvdb::io::File file(tmp);
-            file.write(openvdb::GridCPtrVec{grid}, fileMetadata);
-            file.close();
-        } catch (const openvdb::Exception& e) {
-            throw IoError(msg("points output '", path, "': cannot write (", e.what(), ")"));
-        } catch (const std::ios_base::failure& e) {
-            throw IoError(msg("points output '", path, "': cannot write (", e.what(), ")"));
-        }
-    });
+    detail::writeVdbFile(path, "points output", openvdb::GridCPtrVec{grid}, fileMetadata);
 }
 
 } // namespace vdbio

@@ -325,6 +325,24 @@ KeyedMotion readMotion(const JsonObject& motion)
     return m;
 }
 
+/// The `grids` of an output section: each one of `allowed`, or a one-line error with the
+/// closest name.
+std::vector<std::string> readGridNames(const JsonObject& s,
+                                       const std::vector<std::string>& fallback,
+                                       const std::vector<std::string>& allowed)
+{
+    const auto grids = s.get<std::vector<std::string>>("grids", fallback);
+    for (const std::string& g : grids) {
+        if (std::find(allowed.begin(), allowed.end(), g) != allowed.end()) continue;
+        std::string list;
+        for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        const std::string near = closestKey(g, allowed);
+        s.failValue("grids", msg("grid '", g, "' is not one of ", list,
+                                 near.empty() ? "" : " (did you mean '" + near + "'?)"));
+    }
+    return grids;
+}
+
 void readOutputs(const JsonObject& o, SceneOutputs& out)
 {
     out.directory = o.get<std::string>("directory", out.directory);
@@ -353,16 +371,8 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         "volume",
         [&](const JsonObject& s) {
         out.volumeFile = s.get<std::string>("file", out.volumeFile);
-        out.volumeGrids = s.get<std::vector<std::string>>("grids", out.volumeGrids);
-        for (const std::string& g : out.volumeGrids) {
-            if (g != "surface" && g != "density" && g != "vel" && g != "temperature") {
-                const std::string near =
-                    closestKey(g, {"surface", "density", "vel", "temperature"});
-                s.failValue("grids",
-                            msg("grid '", g, "' is not one of surface, density, vel, temperature",
-                                near.empty() ? "" : " (did you mean '" + near + "'?)"));
-            }
-        }
+        out.volumeGrids =
+            readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
         out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
         },
         [&] { out.volumeFile.clear(); });
@@ -377,14 +387,8 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         "gas_volume",
         [&](const JsonObject& s) {
         out.gasVolumeFile = s.get<std::string>("file", out.gasVolumeFile);
-        out.gasVolumeGrids = s.get<std::vector<std::string>>("grids", out.gasVolumeGrids);
-        for (const std::string& g : out.gasVolumeGrids) {
-            if (g != "density" && g != "vel" && g != "temperature") {
-                const std::string near = closestKey(g, {"density", "vel", "temperature"});
-                s.failValue("grids", msg("grid '", g, "' is not one of density, vel, temperature",
-                                         near.empty() ? "" : " (did you mean '" + near + "'?)"));
-            }
-        }
+        out.gasVolumeGrids =
+            readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature"});
         out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
         },
         [&] { out.gasVolumeFile.clear(); });
@@ -463,6 +467,25 @@ Json documentFromRoles(const std::string& path)
         doc["settings"]["method"] = "gas";
     }
     return doc;
+}
+
+/// A shaped scene entry (solid, liquid, emitter, gas source, heater): its name (default: its
+/// path) and its geometry, sampled as `sampled` says.
+template <typename Entry>
+Entry readShaped(const JsonObject& o, Scene& scene, Sampled sampled, bool allowFog = false)
+{
+    const std::string name = o.get<std::string>("name", o.path());
+    std::string geometry;
+    sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, sampled, allowFog);
+    return Entry(name, geometry, std::move(shape));
+}
+
+/// `start` (>= 0, default 0) and `end` (> start, default never) of an emitting entry (s).
+void readInterval(const JsonObject& o, double& start, double& end)
+{
+    start = o.nonNegative("start", 0);
+    end = o.get<double>("end", std::numeric_limits<double>::infinity());
+    if (!(end > start)) o.failValue("end", msg("expected end > start (", start, " s)"));
 }
 
 } // namespace
@@ -551,10 +574,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     }
 
     for (const JsonObject& o : root.objects("solids")) {
-        const std::string name = o.get<std::string>("name", o.path());
-        std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Band);
-        SceneSolid solid{name, geometry, shape};
+        SceneSolid solid = readShaped<SceneSolid>(o, scene, Sampled::Band);
         solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         if (auto motion = o.optionalObject("motion")) {
             solid.motion = readMotion(*motion);
@@ -573,49 +593,31 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         scene.solids.push_back(std::move(solid));
     }
     for (const JsonObject& o : root.objects("liquids")) {
-        const std::string name = o.get<std::string>("name", o.path());
-        std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume);
-        SceneLiquid liquid{name, geometry, shape};
+        SceneLiquid liquid = readShaped<SceneLiquid>(o, scene, Sampled::Volume);
         liquid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         o.finish();
         scene.liquids.push_back(std::move(liquid));
     }
     for (const JsonObject& o : root.objects("emitters")) {
-        const std::string name = o.get<std::string>("name", o.path());
-        std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume);
-        SceneEmitter emitter{name, geometry, shape};
+        SceneEmitter emitter = readShaped<SceneEmitter>(o, scene, Sampled::Volume);
         emitter.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
-        emitter.start = o.nonNegative("start", 0);
-        emitter.end = o.get<double>("end", std::numeric_limits<double>::infinity());
-        if (!(emitter.end > emitter.start))
-            o.failValue("end", msg("expected end > start (", emitter.start, " s)"));
+        readInterval(o, emitter.start, emitter.end);
         o.finish();
         scene.emitters.push_back(std::move(emitter));
     }
     for (const JsonObject& o : root.objects("gas_sources")) {
-        const std::string name = o.get<std::string>("name", o.path());
-        std::string geometry;
-        sph::LevelSet shape =
-            readGeometry(o.object("geometry"), scene, geometry, Sampled::Volume, /*allowFog=*/true);
-        SceneGasSource source{name, geometry, shape};
+        SceneGasSource source =
+            readShaped<SceneGasSource>(o, scene, Sampled::Volume, /*allowFog=*/true);
         source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         source.temperature = o.positive("temperature", source.temperature);
         source.rate = o.nonNegative("rate", 0);
-        source.start = o.nonNegative("start", 0);
-        source.end = o.get<double>("end", std::numeric_limits<double>::infinity());
-        if (!(source.end > source.start))
-            o.failValue("end", msg("expected end > start (", source.start, " s)"));
+        readInterval(o, source.start, source.end);
         if (auto motion = o.optionalObject("motion")) source.motion = readMotion(*motion);
         o.finish();
         scene.gasSources.push_back(std::move(source));
     }
     for (const JsonObject& o : root.objects("heaters")) {
-        const std::string name = o.get<std::string>("name", o.path());
-        std::string geometry;
-        sph::LevelSet shape = readGeometry(o.object("geometry"), scene, geometry, Sampled::None);
-        SceneHeater heater{name, geometry, shape};
+        SceneHeater heater = readShaped<SceneHeater>(o, scene, Sampled::None);
         heater.temperature = o.positive("temperature", heater.temperature);
         o.finish();
         scene.heaters.push_back(std::move(heater));

@@ -60,6 +60,22 @@ void setCommonGridMetadata(openvdb::GridBase& grid)
     grid.setSaveFloatAsHalf(false);
 }
 
+void writeVdbFile(const std::string& path, const char* what, const openvdb::GridCPtrVec& grids,
+                  const openvdb::MetaMap& fileMetadata)
+{
+    writeAtomically(path, [&](const std::string& tmp) {
+        try {
+            openvdb::io::File file(tmp);
+            file.write(grids, fileMetadata);
+            file.close();
+        } catch (const openvdb::Exception& e) {
+            throw IoError(msg(what, " '", path, "': cannot write (", e.what(), ")"));
+        } catch (const std::ios_base::failure& e) {
+            throw IoError(msg(what, " '", path, "': cannot write (", e.what(), ")"));
+        }
+    });
+}
+
 void checkOutputFolder(const std::string& path, const char* what)
 {
     const std::filesystem::path folder = std::filesystem::path(path).parent_path();
@@ -203,17 +219,8 @@ void writeVolumeFile(const std::string& path, const openvdb::GridPtrVec& grids,
     }
 
     detail::checkOutputFolder(path, "volume output");
-    writeAtomically(path, [&](const std::string& tmp) {
-        try {
-            openvdb::io::File file(tmp);
-            file.write(grids, fileMetadata);
-            file.close();
-        } catch (const openvdb::Exception& e) {
-            throw IoError(msg("volume output '", path, "': cannot write (", e.what(), ")"));
-        } catch (const std::ios_base::failure& e) {
-            throw IoError(msg("volume output '", path, "': cannot write (", e.what(), ")"));
-        }
-    });
+    detail::writeVdbFile(path, "volume output", openvdb::GridCPtrVec(grids.begin(), grids.end()),
+                         fileMetadata);
 }
 
 } // namespace vdbio

@@ -195,17 +195,17 @@ public:
     /// Ambient air particles (Method::Ambient).
     std::size_t ambientCount() const;
 
-    double time() const { return mTime; }
-    std::uint64_t stepCount() const { return mStep; }
-    int frame() const { return mFrame; }
+    double time() const { return mRun.time; }
+    std::uint64_t stepCount() const { return mRun.step; }
+    int frame() const { return mRun.frame; }
 
     const GasTimings& timings() const { return mTimings; }
     void resetTimings() { mTimings = GasTimings(); }
     /// Mean number of neighbours per gas particle in the last density pass (self included).
-    double meanNeighbors() const { return mMeanNeighbors; }
+    double meanNeighbors() const { return mRun.meanNeighbors; }
 
-    std::size_t emittedCount() const { return mEmitted; }
-    std::size_t killedCount() const { return mKilled; }
+    std::size_t emittedCount() const { return mRun.emitted; }
+    std::size_t killedCount() const { return mRun.killed; }
     /// Isolated particles removed by the life strength rule (Sec. 5).
     std::size_t isolatedRemovedCount() const { return mIsolatedRemoved; }
 
@@ -242,13 +242,8 @@ private:
     std::vector<Vec3> mNbar;             ///< n_bar_i with uncorrected densities (Eq. 5), per step
     std::vector<std::uint8_t> mIsolated; ///< no neighbour this step (Sec. 5)
     Real mMass = 0;
-    Real mMaxAcceleration = 0;
-    bool mInitialized = false;
-    double mTime = 0;
-    std::uint64_t mStep = 0;
-    int mFrame = 0;
-    std::size_t mEmitted = 0, mKilled = 0, mIsolatedRemoved = 0;
-    double mMeanNeighbors = 0;
+    sph::RunCounters mRun; ///< clock and counters
+    std::size_t mIsolatedRemoved = 0;
     GasTimings mTimings;
     StepObserver mObserver;
     bool mRestored = false;

@@ -177,20 +177,20 @@ public:
     /// Of which the step's neighbour lists (rebuilt every step: about 4.5 bytes per pair).
     std::size_t neighborListBytes() const;
 
-    double time() const { return mTime; }
-    std::uint64_t stepCount() const { return mStep; }
-    int frame() const { return mFrame; }
+    double time() const { return mRun.time; }
+    std::uint64_t stepCount() const { return mRun.step; }
+    int frame() const { return mRun.frame; }
 
     const PhaseTimings& timings() const { return mTimings; }
     void resetTimings() { mTimings = PhaseTimings(); }
     /// Mean number of neighbours per liquid particle in the last density pass (self included).
-    double meanNeighbors() const { return mMeanNeighbors; }
+    double meanNeighbors() const { return mRun.meanNeighbors; }
     /// Liquid-neighbour pairs in the last neighbour search, solid neighbours included.
     std::size_t lastPairCount() const { return mPairCount; }
 
     /// Liquid particles emitted and removed by the kill box since the start.
-    std::size_t emittedCount() const { return mEmitted; }
-    std::size_t killedCount() const { return mKilled; }
+    std::size_t emittedCount() const { return mRun.emitted; }
+    std::size_t killedCount() const { return mRun.killed; }
     /// Liquid particles put back where they started a step because they ended it deeper in a
     /// solid than its level set's band (sph::collideWithSolid), since the solver was made.
     std::uint64_t restoredFromSolidsCount() const { return mRestoredFromSolids; }
@@ -251,19 +251,13 @@ private:
     ParticleSet mPendingSolids;            ///< restored solid particles until their solid is added
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Emitter>> mEmitters;
-    std::size_t mEmitted = 0, mKilled = 0;
     std::uint64_t mRestoredFromSolids = 0;
     Real mMass = 0;
     Real mLennardJones = 0;
-    Real mMaxAcceleration = 0; ///< largest liquid acceleration of the last step (m/s^2)
-    Real mMaxSolidSpeed = 0;   ///< fastest moving-solid particle (m/s), for the collision test
-    bool mProjectAll = true;   ///< a solid changed shape: test every liquid particle for collision
-    bool mInitialized = false;
-    double mTime = 0;
-    std::uint64_t mStep = 0;
-    int mFrame = 0;
+    Real mMaxSolidSpeed = 0; ///< fastest moving-solid particle (m/s), for the collision test
+    bool mProjectAll = true; ///< a solid changed shape: test every liquid particle for collision
+    sph::RunCounters mRun;   ///< clock and counters (maxAcceleration: of the liquid)
     PhaseTimings mTimings;
-    double mMeanNeighbors = 0;
     std::size_t mPairCount = 0;
     StepObserver mObserver;
     bool mRestored = false;            ///< restoreState() was called: no liquid may be added

@@ -3,6 +3,7 @@
 ///         CFL-limited steps that land exactly on the frame's end.
 #pragma once
 
+#include <ghostfx/sph/SolverState.h>
 #include <ghostfx/sph/Types.h>
 
 namespace ghostfx {
@@ -29,6 +30,19 @@ void stepFrame(double frameEnd, Real frameRate, int substeps, Time&& time, Stabl
         if (double(dt) > remaining - tolerance) dt = Real(remaining);
         step(dt);
     }
+}
+
+/// One frame of a solver's run: the steps of stepFrame() from run.time to the next frame's end,
+/// then the clock set to that end exactly (no drift from summing substeps) and the frame counted.
+template <typename StableStep, typename Step>
+void advanceRunOneFrame(RunCounters& run, Real frameRate, int substeps, StableStep&& stableStep,
+                        Step&& step)
+{
+    const double frameEnd = double(run.frame + 1) / double(frameRate);
+    stepFrame(
+        frameEnd, frameRate, substeps, [&run] { return run.time; }, stableStep, step);
+    run.time = frameEnd;
+    ++run.frame;
 }
 
 } // namespace sph

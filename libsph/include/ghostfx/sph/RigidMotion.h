@@ -9,6 +9,7 @@
 #include <openvdb/math/Mat3.h>
 
 #include <functional>
+#include <vector>
 
 namespace ghostfx {
 namespace sph {
@@ -68,6 +69,16 @@ struct MovingLevelSet
         return (at(t1).toWorld(local) - at(t0).toWorld(local)) / Real(t1 - t0);
     }
 };
+
+/// Where each of `solids` (pointers to MovingLevelSet or derived) is at `time` (s).
+template <typename Solids>
+std::vector<RigidTransform> placementsAt(const Solids& solids, double time)
+{
+    std::vector<RigidTransform> placements;
+    placements.reserve(solids.size());
+    for (const auto& solid : solids) placements.push_back(solid->at(time));
+    return placements;
+}
 
 /// What collideWithSolid did with one particle.
 enum class Collision {

@@ -78,9 +78,10 @@ constexpr int MAX_FRAME = 9999999;
 /// scale must exceed 3e-15).
 constexpr double MIN_SPACING = 4e-5;
 
-struct SceneSolid
+/// What every shaped entry of a scene has: a name, where its shape came from, and the shape.
+struct SceneShape
 {
-    SceneSolid(std::string name_, std::string geometry_, sph::LevelSet shape_)
+    SceneShape(std::string name_, std::string geometry_, sph::LevelSet shape_)
         : name(std::move(name_))
         , geometry(std::move(geometry_))
         , shape(std::move(shape_))
@@ -89,54 +90,39 @@ struct SceneSolid
     std::string name;
     std::string geometry; ///< where the shape came from, for messages and reports
     sph::LevelSet shape;
+};
+
+struct SceneSolid : SceneShape
+{
+    using SceneShape::SceneShape;
+
     sph::Vec3d velocity{0}; ///< constant velocity (m/s), if no keys
     KeyedMotion motion;     ///< keyed rigid motion (empty: constant velocity)
     /// Per-frame shapes (deforming solid): file pattern with $F and grid name; empty if static.
     std::string sequenceFile, sequenceGrid;
 };
 
-struct SceneLiquid
+struct SceneLiquid : SceneShape
 {
-    SceneLiquid(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_))
-        , geometry(std::move(geometry_))
-        , shape(std::move(shape_))
-    {}
+    using SceneShape::SceneShape;
 
-    std::string name;
-    std::string geometry;
-    sph::LevelSet shape;
     sph::Vec3d velocity{0};
 };
 
-struct SceneEmitter
+struct SceneEmitter : SceneShape
 {
-    SceneEmitter(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_))
-        , geometry(std::move(geometry_))
-        , shape(std::move(shape_))
-    {}
+    using SceneShape::SceneShape;
 
-    std::string name;
-    std::string geometry;
-    sph::LevelSet shape;
     sph::Vec3d velocity{0};
     double start = 0, end = std::numeric_limits<double>::infinity();
 };
 
 /// A gas source ([RYY15]): keeps its volume filled with gas at `temperature` (K) moving at
 /// `velocity`, optionally limited to `rate` particles per second, between `start` and `end`.
-struct SceneGasSource
+struct SceneGasSource : SceneShape
 {
-    SceneGasSource(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_))
-        , geometry(std::move(geometry_))
-        , shape(std::move(shape_))
-    {}
+    using SceneShape::SceneShape;
 
-    std::string name;
-    std::string geometry;
-    sph::LevelSet shape;
     sph::Vec3d velocity{0};
     double temperature = 373.15;
     double rate = 0; ///< particles per second; 0: keep the volume full
@@ -145,17 +131,10 @@ struct SceneGasSource
 };
 
 /// A heater for the liquid-gas phase transition: liquid near it is heated towards `temperature`.
-struct SceneHeater
+struct SceneHeater : SceneShape
 {
-    SceneHeater(std::string name_, std::string geometry_, sph::LevelSet shape_)
-        : name(std::move(name_))
-        , geometry(std::move(geometry_))
-        , shape(std::move(shape_))
-    {}
+    using SceneShape::SceneShape;
 
-    std::string name;
-    std::string geometry;
-    sph::LevelSet shape;
     double temperature = 400;
 };
 

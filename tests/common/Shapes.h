@@ -1,0 +1,28 @@
+/// @file   Shapes.h
+/// @brief  Test helper: level sets the solver tests share.
+#pragma once
+
+#include <ghostfx/sph/LevelSetGrid.h>
+
+#include <algorithm>
+
+namespace ghostfx {
+namespace testing {
+
+/// Open-top box container: walls `wall` (m) thick around the inside [-a, a] x [0, top] x [-a, a],
+/// at voxels of `voxel` (m).
+inline openvdb::FloatGrid::Ptr openTankGrid(sph::Real a, sph::Real top, double wall,
+                                            sph::Real voxel)
+{
+    const openvdb::Vec3d outerLo(-a - wall, -wall, -a - wall), outerHi(a + wall, top, a + wall);
+    const openvdb::Vec3d innerLo(-a, 0, -a), innerHi(a, top + 1, a);
+    auto sdf = [&](const openvdb::Vec3d& x) {
+        return std::max(sph::boxSignedDistance(x, outerLo, outerHi),
+                        -sph::boxSignedDistance(x, innerLo, innerHi));
+    };
+    const sph::Aabb bounds{sph::Vec3(outerLo), sph::Vec3(outerHi)};
+    return sph::levelSetFromSdf(sdf, bounds, voxel);
+}
+
+} // namespace testing
+} // namespace ghostfx
