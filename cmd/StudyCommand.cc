@@ -733,8 +733,11 @@ std::vector<PlotPoint> plotPoints(const StudySpec& spec, const std::vector<CaseO
         // The key's last part names the series ("method=ghost"): legends have little room.
         const std::string key = spec.plotSeries.substr(spec.plotSeries.find_last_of('.') + 1);
         p.series = series == c.values.end() ? "runs" : key + "=" + valueText(series->second);
+        // The other swept keys name the point, by their last part: "damping=7 spacing=0.025".
         for (const auto& [name, value] : c.values) {
-            if (name != spec.plotSeries) p.label += (p.label.empty() ? "" : " ") + valueText(value);
+            if (name == spec.plotSeries) continue;
+            p.label += (p.label.empty() ? "" : " ") + name.substr(name.find_last_of('.') + 1) + "="
+                       + valueText(value);
         }
         points.push_back(p);
     }
