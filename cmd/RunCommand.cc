@@ -2,6 +2,7 @@
 /// @brief  `ghostfx run`: scene -> solver -> frames, checkpoints, statistics and previews.
 #include "RunCommand.h"
 
+#include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "Simulation.h"
 
@@ -219,9 +220,10 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
 
 } // namespace
 
-void writeFrameOutputs(const vdbio::Scene& scene, const Simulation& sim, const std::string& folder,
-                       int frame)
+void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
+                       const std::string& folder)
 {
+    const int frame = snapshot.frame;
     const vdbio::SceneOutputs& out = scene.outputs;
     auto inFolder = [&](const std::string& pattern) {
         return pattern.empty()
@@ -232,9 +234,9 @@ void writeFrameOutputs(const vdbio::Scene& scene, const Simulation& sim, const s
     fileMeta.insertMeta("ghostfx_scene", openvdb::StringMetadata(scene.file));
     fileMeta.insertMeta("ghostfx_method", openvdb::StringMetadata(scene.method));
     fileMeta.insertMeta("frame", openvdb::Int32Metadata(frame));
-    fileMeta.insertMeta("time", openvdb::DoubleMetadata(sim.time()));
+    fileMeta.insertMeta("time", openvdb::DoubleMetadata(snapshot.time));
     openvdb::GridPtrVec previewGrids;
-    for (const OutputMedium& m : sim.media()) {
+    for (const OutputMedium& m : snapshot.media) {
         const bool liquid = m.liquid;
         const openvdb::GridPtrVec grids =
             writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile),
@@ -352,6 +354,8 @@ int runScene(const RunOptions& o)
     });
 
     InterruptGuard interruptGuard;
+    // Frame N's files are written while frame N + 1 simulates (FrameWriter.h).
+    FrameWriter writer(scene, folder, !o.serialOutput);
     auto writeCheckpoint = [&](int f) {
         if (!checkpoints) return std::string();
         const std::string path = inFolder(out.checkpointFile, f);
@@ -368,12 +372,13 @@ int runScene(const RunOptions& o)
         sim->advanceFrame();
 
         const bool write = frame >= first;
-        if (write) writeFrameOutputs(scene, *sim, folder, frame);
+        if (write) writer.submit(snapshotFrame(out, *sim, frame));
         if (stats) stats->flush();
         const bool interrupted = gInterrupted.load();
         std::string checkpoint;
         if (interrupted || frame == last
             || (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
+            writer.finish(); // the frames on disk reach at least as far as the checkpoint
             checkpoint = writeCheckpoint(frame);
         }
         progress.frame(*sim, frame, int(sim->stepCount() - stepsBefore),
@@ -387,6 +392,7 @@ int runScene(const RunOptions& o)
             return EXIT_INTERRUPTED;
         }
     }
+    writer.finish();
     const double total = seconds(runStart, Clock::now());
     const std::uint64_t steps = sim->stepCount() - stepsAtStart;
     progress.message(
@@ -412,6 +418,10 @@ Command addRunCommand(CLI::App& parent)
         ->allow_extra_args(false);
     c->add_option("--resume", o->resume, "continue from this checkpoint (.h5)");
     c->add_flag("-q,--quiet", o->quiet, "print errors only");
+    c->add_flag("--serial-output", o->serialOutput,
+                "write each frame's files before simulating the next (by default they are "
+                "written while the next frame simulates, holding up to two copies of the "
+                "output particles)");
     c->add_option("--progress", o->progress, "auto, bar, log or none")
         ->check(CLI::IsMember({"auto", "bar", "log", "none"}));
     return {c, [o] { return runScene(*o); }};

@@ -20,6 +20,8 @@ struct RunOptions
     std::vector<std::string> defines; ///< -D path=value
     std::string resume;               ///< checkpoint to continue from
     bool quiet = false;
+    /// Write each frame before simulating the next, instead of overlapping (FrameWriter.h).
+    bool serialOutput = false;
     /// Progress display: "auto" (bar on a terminal, log lines otherwise), "bar", "log", "none".
     std::string progress = "auto";
 };

@@ -87,11 +87,6 @@ std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
 /// building a solver or sampling a particle: a cheap check of a scene before a long job.
 void checkSimulationSettings(const vdbio::Scene& scene);
 
-/// Write the scene's outputs of `frame` (points, volume and preview files, as the scene's
-/// `outputs` name them) for the simulation's current state into `folder`; every file atomically.
-void writeFrameOutputs(const vdbio::Scene& scene, const Simulation& sim, const std::string& folder,
-                       int frame);
-
 /// How many solver states a checkpoint of this scene holds (1, or 2 for boiling).
 std::size_t stateCount(const vdbio::Scene& scene);
 

@@ -6,6 +6,7 @@
 ///          step, so a view would dangle after the next advance_frame(). Long calls (a frame, a
 ///          sampling) release the GIL. Errors of the library keep their one-line text: a bad scene
 ///          raises ValueError with the message the command line prints after "ghostfx: error: ".
+#include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "Simulation.h"
 
@@ -195,7 +196,8 @@ public:
             folder.is_none() ? mScene->outputs.directory : py::str(folder).cast<std::string>();
         py::gil_scoped_release release;
         vdbio::ensureWritableDirectory(dir);
-        cmd::writeFrameOutputs(*mScene, *mSim, dir, mSim->frame());
+        cmd::writeFrameOutputs(*mScene, cmd::snapshotFrame(mScene->outputs, *mSim, mSim->frame()),
+                               dir);
     }
 
     /// From now on, solid `name` moves at `velocity` (m/s) from where it is, without turning.

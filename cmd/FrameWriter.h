@@ -1,0 +1,77 @@
+/// @file   FrameWriter.h
+/// @brief  Frame outputs written while the next frame simulates: a snapshot of the media is
+///         taken after a frame (the particles copied, so the solver can step on) and a writer
+///         thread builds and writes its files.
+/// @details At most one snapshot waits while another is being written, so overlapping costs up
+///          to two copies of the output particles (the points and volumes need nothing else).
+///          Every file is still written atomically (AtomicFile.h), so a killed run leaves only
+///          complete frames; finish() waits until every submitted frame is on disk, and the run
+///          calls it before each checkpoint, so a checkpoint never gets ahead of the frames. A
+///          write error is reported by the next submit() or finish().
+#pragma once
+
+#include "Simulation.h"
+
+#include <condition_variable>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace ghostfx {
+namespace cmd {
+
+/// What one frame's outputs need, owned: the media with copies of their particles.
+struct FrameSnapshot
+{
+    int frame = 0;
+    double time = 0; ///< s
+    std::vector<OutputMedium> media;
+    std::vector<std::shared_ptr<const sph::ParticleSet>> particles; ///< what `media` point to
+};
+
+/// Copy what the scene's outputs of `frame` read from `sim` (with the ghosts only where the
+/// points output asks for them).
+FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation& sim, int frame);
+
+/// Write the scene's outputs of a snapshot into `folder` (points, volume and preview files, as
+/// the scene's `outputs` name them); every file atomically.
+void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
+                       const std::string& folder);
+
+class FrameWriter
+{
+public:
+    /// `overlap` false: submit() writes at once, as a run without a writer thread would.
+    FrameWriter(const vdbio::Scene& scene, std::string folder, bool overlap);
+    /// Finishes the frames still queued (their errors are dropped: this runs while the run is
+    /// already ending, normally after finish()).
+    ~FrameWriter();
+    FrameWriter(const FrameWriter&) = delete;
+    FrameWriter& operator=(const FrameWriter&) = delete;
+
+    /// Hand a frame over; waits while a frame is already queued. Throws a previous frame's
+    /// write error.
+    void submit(FrameSnapshot snapshot);
+    /// Wait until every submitted frame is on disk; throws the first write error.
+    void finish();
+
+private:
+    void work();
+    void rethrow();
+
+    const vdbio::Scene& mScene;
+    const std::string mFolder;
+    std::mutex mMutex;
+    std::condition_variable mChanged;
+    std::optional<FrameSnapshot> mQueued;
+    bool mWriting = false, mStop = false;
+    std::exception_ptr mError;
+    std::thread mThread;
+};
+
+} // namespace cmd
+} // namespace ghostfx
