@@ -7,12 +7,14 @@
 #include "Simulation.h"
 
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/FrameFiles.h>
 #include <ghostfx/vdbio/Preview.h>
 #include <ghostfx/vdbio/Scene.h>
+#include <ghostfx/vdbio/ScenePreview.h>
 #include <ghostfx/vdbio/Stats.h>
 
 #include <openvdb/openvdb.h>
@@ -168,6 +170,60 @@ private:
 
 namespace {
 
+/// The world box of the media's active voxels.
+openvdb::BBoxd mediaBox(const std::vector<vdbio::PreviewLayer>& media)
+{
+    openvdb::BBoxd box;
+    for (const vdbio::PreviewLayer& l : media) {
+        const openvdb::CoordBBox ibox = l.grid->evalActiveVoxelBoundingBox();
+        if (ibox.empty()) continue;
+        box.expand(l.grid->indexToWorld(ibox.min()));
+        box.expand(l.grid->indexToWorld(ibox.max()));
+    }
+    return box;
+}
+
+/// The scene's solids where they are at the snapshot's time (rigid motion from the scene's keys
+/// or velocity, a per-frame shape from its file), as preview layers. A solid around the media's
+/// centre (the centre is inside its box but outside the solid: a tank) is cut away so what it
+/// holds shows.
+std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
+                                             const FrameSnapshot& snapshot,
+                                             const openvdb::BBoxd& media)
+{
+    std::vector<vdbio::PreviewLayer> layers;
+    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+        const vdbio::SceneSolid& solid = scene.solids[i];
+        sph::LevelSet shape = solid.shape;
+        if (!solid.sequenceFile.empty()) {
+            shape = vdbio::loadLevelSet(
+                vdbio::expandFramePattern(solid.sequenceFile, snapshot.frame), solid.sequenceGrid,
+                msg("scene '", scene.file, "': solids[", i, "].sequence"));
+        }
+        vdbio::PreviewLayer layer;
+        layer.name = solid.name;
+        layer.grid = sph::gridOf(shape);
+        layer.albedo = vdbio::SOLID_ALBEDO;
+        if (solid.motion.keys.empty()) {
+            layer.translation = solid.velocity * snapshot.time;
+        } else {
+            const vdbio::RigidKey key = solid.motion.at(snapshot.time);
+            layer.rotation = vdbio::KeyedMotion::rotation(key.rotateDegrees);
+            layer.translation = key.translate;
+        }
+        if (media.max().x() >= media.min().x()) {
+            const openvdb::Vec3d centre = media.getCenter();
+            const openvdb::Vec3d local = layer.rotation.transpose() * (centre - layer.translation);
+            const openvdb::CoordBBox ibox = layer.grid->evalActiveVoxelBoundingBox();
+            const openvdb::BBoxd box(layer.grid->indexToWorld(ibox.min()),
+                                     layer.grid->indexToWorld(ibox.max()));
+            layer.cutaway = box.isInside(local) && shape.phi(sph::Vec3(local)) > 0;
+        }
+        layers.push_back(layer);
+    }
+    return layers;
+}
+
 /// Write one medium's points and volume files for `frame`; returns its grids (for previews).
 openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
                                 const std::string& pointsPath, const std::string& volumePath,
@@ -235,29 +291,56 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
     fileMeta.insertMeta("ghostfx_method", openvdb::StringMetadata(scene.method));
     fileMeta.insertMeta("frame", openvdb::Int32Metadata(frame));
     fileMeta.insertMeta("time", openvdb::DoubleMetadata(snapshot.time));
-    openvdb::GridPtrVec previewGrids;
+    // The media's grids as preview layers: the liquid's surface (else its density), the gas's
+    // density, or the grid outputs.preview.grid names.
+    std::vector<vdbio::PreviewLayer> media;
     for (const OutputMedium& m : snapshot.media) {
         const bool liquid = m.liquid;
         const openvdb::GridPtrVec grids =
             writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile),
                         inFolder(liquid ? out.volumeFile : out.gasVolumeFile), fileMeta);
-        if (previewGrids.empty()) previewGrids = grids;
+        if (out.previewFile.empty()) continue;
+        const std::vector<std::string> wanted =
+            !out.previewGrid.empty() ? std::vector<std::string>{out.previewGrid}
+            : liquid                 ? std::vector<std::string>{"surface", "density"}
+                                     : std::vector<std::string>{"density"};
+        for (const std::string& name : wanted) {
+            auto g = std::find_if(grids.begin(), grids.end(),
+                                  [&](const auto& grid) { return grid->getName() == name; });
+            auto floatGrid =
+                g == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(*g);
+            if (!floatGrid) continue;
+            vdbio::PreviewLayer layer;
+            layer.name = m.name + " " + name;
+            layer.grid = floatGrid;
+            layer.kind = floatGrid->getGridClass() == openvdb::GRID_LEVEL_SET
+                             ? vdbio::PreviewLayer::Kind::Surface
+                             : vdbio::PreviewLayer::Kind::Fog;
+            layer.albedo = liquid ? vdbio::LIQUID_ALBEDO : vdbio::GAS_ALBEDO;
+            media.push_back(layer);
+            break;
+        }
     }
-    if (out.previewFile.empty() || previewGrids.empty()) return;
+    if (out.previewFile.empty()) return;
+    if (media.empty()) {
+        throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '",
+                             out.previewGrid.empty() ? "(default)" : out.previewGrid,
+                             "': the volume output has no such grid"));
+    }
+    std::vector<vdbio::PreviewLayer> layers;
+    if (out.previewSolids) layers = solidLayers(scene, snapshot, mediaBox(media));
+    layers.insert(layers.end(), media.begin(), media.end());
     vdbio::PreviewOptions pv;
     pv.width = out.previewWidth;
     pv.height = out.previewHeight;
-    const std::string& name = out.previewGrid;
-    openvdb::GridBase::Ptr grid;
-    for (const auto& g : previewGrids) {
-        if (name.empty() ? g->getName() == "density" : g->getName() == name) grid = g;
+    pv.azimuth = out.previewAzimuth;
+    pv.elevation = out.previewElevation;
+    openvdb::BBoxd framed; // empty: the camera frames everything drawn
+    if (!out.previewFrame.empty()) {
+        framed = openvdb::BBoxd(openvdb::Vec3d(out.previewFrame.min),
+                                openvdb::Vec3d(out.previewFrame.max));
     }
-    if (!grid && name.empty()) grid = previewGrids.front();
-    if (!grid) {
-        throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '", name,
-                             "': the volume output has no such grid"));
-    }
-    vdbio::renderPreview(*grid, pv, inFolder(out.previewFile));
+    vdbio::renderScenePreview(layers, pv, framed, inFolder(out.previewFile));
 }
 
 int runScene(const RunOptions& o)

@@ -26,8 +26,8 @@
 #include <fstream>
 #include <iterator>
 #include <map>
-#include <sstream>
 #include <spawn.h>
+#include <sstream>
 #include <sys/wait.h>
 #include <thread>
 

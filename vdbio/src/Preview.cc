@@ -5,6 +5,7 @@
 #include <ghostfx/vdbio/Preview.h>
 
 #include "PngFile.h"
+#include "PreviewDetail.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
@@ -36,9 +37,10 @@ namespace {
 constexpr int MAX_IMAGE_SIDE = 16384;
 // The camera frames the bounding sphere of the active voxels with this much room around it.
 constexpr double FRAMING_MARGIN = 1.05;
-// PerspectiveCamera's defaults (Houdini's default camera): 50 mm lens, 41.2136 mm aperture.
-constexpr double FOCAL_LENGTH_MM = 50.0;
-constexpr double APERTURE_MM = 41.2136;
+using detail::APERTURE_MM;
+using detail::CameraSetup;
+using detail::FOCAL_LENGTH_MM;
+using detail::SURFACE_AMBIENT;
 // Fog: single-scattering albedo (fraction of the extinction that scatters, the rest absorbs).
 constexpr double FOG_ALBEDO = 0.9;
 // Fog: ray-marching step along primary rays (voxels, VolumeRender's unit): one voxel, so thin
@@ -51,21 +53,12 @@ constexpr double SHADOW_STEP_DEPTH = 0.2;
 constexpr double MIN_SHADOW_STEP_VOXELS = 2.0, MAX_SHADOW_STEP_VOXELS = 8.0;
 // Level set: surface albedo and the share of light that reaches faces turned from the key light.
 const Film::RGBA SURFACE_ALBEDO(0.75f, 0.8f, 0.88f, 1.0f);
-constexpr float SURFACE_AMBIENT = 0.2f;
 // Film colour of level-set rays that miss the surface (see renderSurface).
 const Film::RGBA MISSED_RAY(-1.0f, -1.0f, -1.0f, 0.0f);
 // Above this |elevation| (degrees) the camera looks (nearly) along y, so "up" cannot be +y.
 constexpr double POLAR_ELEVATION = 89.0;
 
 double radians(double degrees) { return degrees * openvdb::math::pi<double>() / 180.0; }
-
-/// Where the camera sits and where the key light comes from.
-struct CameraSetup
-{
-    Vec3R eye, target, up;
-    Vec3R toLight; ///< unit vector from the scene towards the key light
-    double nearPlane = 1e-3, farPlane = 1e30;
-};
 
 /// Place the camera so the bounding sphere of `grid`'s active voxels fills the frame.
 CameraSetup frameGrid(const openvdb::GridBase& grid, const PreviewOptions& options,
@@ -85,35 +78,7 @@ CameraSetup frameGrid(const openvdb::GridBase& grid, const PreviewOptions& optio
         wmin = openvdb::math::minComponent(wmin, w);
         wmax = openvdb::math::maxComponent(wmax, w);
     }
-    CameraSetup s;
-    s.target = 0.5 * (wmin + wmax);
-    const double radius = 0.5 * (wmax - wmin).length();
-
-    // Direction from the target to the camera: azimuth about +y from +z, elevation above xz.
-    const double az = radians(options.azimuth), el = radians(options.elevation);
-    const Vec3R toCamera(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
-    s.up = std::abs(options.elevation) > POLAR_ELEVATION
-               ? Vec3R(-std::sin(az), 0.0, -std::cos(az)) * (options.elevation > 0 ? 1.0 : -1.0)
-               : Vec3R(0.0, 1.0, 0.0);
-
-    // Distance at which the sphere fits the narrower field of view.
-    const double tanHalfWidth = 0.5 * APERTURE_MM / FOCAL_LENGTH_MM;
-    const double tanHalf =
-        tanHalfWidth * std::min(1.0, double(options.height) / double(options.width));
-    const double sinHalf = tanHalf / std::sqrt(1.0 + tanHalf * tanHalf);
-    const double distance = FRAMING_MARGIN * radius / sinHalf;
-    s.eye = s.target + distance * toCamera;
-    s.nearPlane = std::max(1e-6 * distance, 0.5 * (distance - radius));
-    s.farPlane = distance + 2.0 * radius;
-
-    // Key light from above and to the left of the camera.
-    const Vec3R forward = -toCamera;
-    Vec3R right = forward.cross(s.up);
-    right.normalize();
-    const Vec3R cameraUp = right.cross(forward);
-    s.toLight = toCamera + 0.5 * cameraUp - 0.4 * right;
-    s.toLight.normalize();
-    return s;
+    return detail::frameBox(wmin, wmax, options);
 }
 
 /// Lambertian shading from one key light plus a constant ambient share, opaque, two-sided
@@ -244,8 +209,55 @@ void writeExr(const Film& film, const std::string& exrPath)
     });
 }
 
+} // namespace
+
+namespace detail {
+
+CameraSetup frameBox(const Vec3R& wmin, const Vec3R& wmax, const PreviewOptions& options)
+{
+    CameraSetup s;
+    s.target = 0.5 * (wmin + wmax);
+    const double radius = 0.5 * (wmax - wmin).length();
+
+    // Direction from the target to the camera: azimuth about +y from +z, elevation above xz.
+    const double az = radians(options.azimuth), el = radians(options.elevation);
+    const Vec3R toCamera(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+    s.up = std::abs(options.elevation) > POLAR_ELEVATION
+               ? Vec3R(-std::sin(az), 0.0, -std::cos(az)) * (options.elevation > 0 ? 1.0 : -1.0)
+               : Vec3R(0.0, 1.0, 0.0);
+
+    // Distance at which the sphere fits the narrower field of view.
+    const double tanHalfWidth = 0.5 * APERTURE_MM / FOCAL_LENGTH_MM;
+    const double tanHalf =
+        tanHalfWidth * std::min(1.0, double(options.height) / double(options.width));
+    const double sinHalf = tanHalf / std::sqrt(1.0 + tanHalf * tanHalf);
+    const double distance = FRAMING_MARGIN * radius / sinHalf;
+    s.eye = s.target + distance * toCamera;
+    s.nearPlane = std::max(1e-6 * distance, 0.5 * (distance - radius));
+    s.farPlane = distance + 2.0 * radius;
+
+    // Key light from above and to the left of the camera.
+    const Vec3R forward = -toCamera;
+    Vec3R right = forward.cross(s.up);
+    right.normalize();
+    const Vec3R cameraUp = right.cross(forward);
+    s.toLight = toCamera + 0.5 * cameraUp - 0.4 * right;
+    s.toLight.normalize();
+    return s;
+}
+
+float keyLightShade(const CameraSetup& setup, Vec3R normal, const Vec3R& rayDir)
+{
+    if (!normal.normalize()) normal = -rayDir;
+    if (normal.dot(rayDir) > 0) normal = -normal;
+    const float diffuse = float(std::max(0.0, normal.dot(setup.toLight)));
+    return SURFACE_AMBIENT + (1.0f - SURFACE_AMBIENT) * diffuse;
+}
+
+void writeImage(const Film& film, const std::string& path) { writeExr(film, path); }
+
 /// Fail before rendering if the image cannot be created where asked.
-void checkOutputFolder(const std::string& exrPath)
+void checkImagePath(const std::string& exrPath)
 {
     const fs::path folder = fs::path(exrPath).parent_path();
     std::error_code ec;
@@ -258,6 +270,10 @@ void checkOutputFolder(const std::string& exrPath)
             msg("preview image '", exrPath, "' is a folder, expected an .exr or .png file"));
     }
 }
+
+} // namespace detail
+
+namespace {
 
 PreviewSummary render(const openvdb::GridBase& grid, const PreviewOptions& options,
                       const std::string& exrPath, const std::string& where)
@@ -283,7 +299,7 @@ PreviewSummary render(const openvdb::GridBase& grid, const PreviewOptions& optio
         throw GridError(msg(where, " has non-uniform voxels ", grid.voxelSize(),
                             ": preview needs cubic voxels"));
     }
-    checkOutputFolder(exrPath);
+    detail::checkImagePath(exrPath);
 
     const CameraSetup setup = frameGrid(grid, options, where);
     Film film(std::size_t(options.width), std::size_t(options.height),

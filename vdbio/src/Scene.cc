@@ -400,6 +400,17 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         out.previewGrid = s.get<std::string>("grid", out.previewGrid);
         out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
         out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
+        out.previewSolids = s.get<bool>("solids", out.previewSolids);
+        out.previewAzimuth = s.inRange("azimuth", out.previewAzimuth, -360, 360);
+        out.previewElevation = s.inRange("elevation", out.previewElevation, -90, 90);
+        if (auto box = s.optionalObject("frame")) {
+            const Vec3d lo = vec(box->require<std::array<double, 3>>("min"));
+            const Vec3d hi = vec(box->require<std::array<double, 3>>("max"));
+            box->finish();
+            if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2]))
+                s.failValue("frame", "expected max > min on every axis");
+            out.previewFrame = sph::Aabb{sph::Vec3(lo), sph::Vec3(hi)};
+        }
         },
         [&] { out.previewFile.clear(); });
     if (!out.previewFile.empty() && out.volumeFile.empty() && out.gasVolumeFile.empty()) {

@@ -176,10 +176,14 @@ struct SceneOutputs
     std::string gasVolumeFile = "gas.$F4.vdb";
     std::vector<std::string> gasVolumeGrids{"density", "temperature", "vel"};
     double gasVoxelSize = 0; ///< 0: half the gas particle spacing
-    // EXR preview of one grid of the volume file (the liquid's, else the gas's).
+    // Preview image of the scene (ScenePreview.h): solids, the liquid and the gas.
     std::string previewFile;
-    std::string previewGrid; ///< "" : density if written, else surface
+    std::string
+        previewGrid; ///< the medium's grid to draw; "": liquid surface (else density), gas density
     int previewWidth = 640, previewHeight = 360;
+    bool previewSolids = true;                         ///< draw the solids (containers cut away)
+    double previewAzimuth = 30, previewElevation = 20; ///< camera direction (degrees)
+    sph::Aabb previewFrame; ///< the world box the camera frames; empty: everything drawn
     // HDF5 checkpoint every N frames (0: only at the end and on interruption).
     std::string checkpointFile = "checkpoint.$F4.h5";
     int checkpointEvery = 10;

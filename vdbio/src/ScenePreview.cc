@@ -1,0 +1,241 @@
+/// @file   ScenePreview.cc
+/// @brief  The scene preview's ray caster (ScenePreview.h).
+#include <ghostfx/vdbio/ScenePreview.h>
+
+#include "PreviewDetail.h"
+
+#include <ghostfx/sph/Exceptions.h>
+
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/RayIntersector.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+namespace ghostfx {
+namespace vdbio {
+
+using openvdb::Vec3d;
+using openvdb::tools::Film;
+
+namespace {
+
+using Ray = openvdb::math::Ray<double>;
+using Intersector = openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid>;
+using Sampler = openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor,
+                                            openvdb::tools::BoxSampler>;
+
+/// Fog stops being marched once less than this much light gets through.
+constexpr double OPAQUE_TRANSMITTANCE = 0.01;
+/// Fog: the light a voxel scatters towards the camera, as a share of its albedo (no shadows).
+constexpr float FOG_SHADE = 0.85f;
+
+/// The box of a layer's active voxels (their extent, every corner through the grid's transform
+/// and then, with `placed`, the layer's placement); empty for an empty grid.
+openvdb::BBoxd layerBox(const PreviewLayer& layer, bool placed)
+{
+    const openvdb::CoordBBox ibox = layer.grid->evalActiveVoxelBoundingBox();
+    openvdb::BBoxd box;
+    if (ibox.empty()) return box;
+    const Vec3d lo = ibox.min().asVec3d() - Vec3d(0.5), hi = ibox.max().asVec3d() + Vec3d(0.5);
+    for (int corner = 0; corner < 8; ++corner) {
+        const Vec3d c((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(),
+                      (corner & 4) ? hi.z() : lo.z());
+        const Vec3d w = layer.grid->transform().indexToWorld(c);
+        box.expand(placed ? layer.rotation * w + layer.translation : w);
+    }
+    return box;
+}
+
+bool isEmpty(const openvdb::BBoxd& box) { return !(box.max().x() >= box.min().x()); }
+
+/// Crossings of a cutaway layer skipped along one ray, at most (near wall in and out, a lid...).
+constexpr int MAX_CUTAWAY_CROSSINGS = 8;
+
+/// A cutaway layer's face worth drawing: the ray enters the solid there (the normal, outward
+/// from the solid, faces the ray) and it is not on the outer hull (more than 1.5 voxels inside
+/// the surface's box, the layer's box less its narrow band `band`): the inner face of a
+/// container's far wall or floor.
+bool isInnerFace(const Vec3d& xyz, const Vec3d& normal, const Vec3d& dir,
+                 const openvdb::BBoxd& box, double voxel, double band)
+{
+    if (normal.dot(dir) >= 0) return false;
+    const double margin = band + 1.5 * voxel;
+    for (int a = 0; a < 3; ++a) {
+        if (xyz[a] < box.min()[a] + margin || xyz[a] > box.max()[a] - margin) return false;
+    }
+    return true;
+}
+
+/// A ray of the world taken into a layer's own frame (rotation^T (x - translation)).
+Ray intoLayer(const Ray& world, const PreviewLayer& layer)
+{
+    const openvdb::math::Mat3d back = layer.rotation.transpose();
+    Ray local(back * (world.eye() - layer.translation), back * world.dir());
+    local.setTimes(world.t0(), world.t1());
+    return local;
+}
+
+void checkLayer(const PreviewLayer& layer)
+{
+    const std::string where = msg("preview layer '", layer.name, "'");
+    if (!layer.grid) throw ValueError(msg(where, ": no grid"));
+    if (!layer.grid->hasUniformVoxels()) {
+        throw GridError(msg(where, " has non-uniform voxels ", layer.grid->voxelSize(),
+                            ": preview needs cubic voxels"));
+    }
+    if (layer.kind == PreviewLayer::Kind::Surface
+        && layer.grid->getGridClass() != openvdb::GRID_LEVEL_SET) {
+        throw GridError(msg(where, " is drawn as a surface but is not a level set"));
+    }
+}
+
+/// Per task: an intersector for every surface layer and a sampler for every fog layer (neither
+/// is thread-safe: they cache tree nodes).
+struct Tracers
+{
+    std::vector<std::unique_ptr<Intersector>> surfaces; ///< null for fog layers
+    std::vector<std::unique_ptr<openvdb::FloatGrid::ConstAccessor>> accessors;
+    std::vector<std::unique_ptr<Sampler>> fogs; ///< null for surface layers
+
+    explicit Tracers(const std::vector<PreviewLayer>& layers)
+    {
+        for (const PreviewLayer& l : layers) {
+            const bool surface = l.kind == PreviewLayer::Kind::Surface;
+            surfaces.push_back(surface ? std::make_unique<Intersector>(*l.grid) : nullptr);
+            accessors.push_back(
+                std::make_unique<openvdb::FloatGrid::ConstAccessor>(l.grid->getConstAccessor()));
+            fogs.push_back(surface ? nullptr
+                                   : std::make_unique<Sampler>(*accessors.back(),
+                                                               l.grid->transform()));
+        }
+    }
+};
+
+} // namespace
+
+ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
+                                       const PreviewOptions& options,
+                                       const openvdb::BBoxd& bounds, const std::string& path)
+{
+    options.validate();
+    if (layers.empty()) throw ValueError(msg("preview '", path, "': nothing to draw"));
+    for (const PreviewLayer& l : layers) checkLayer(l);
+    detail::checkImagePath(path);
+
+    // Fog layers are marched inside their own box (in the layer's frame).
+    std::vector<openvdb::BBoxd> localBoxes;
+    std::vector<double> voxel;
+    const bool frameLayers = !(bounds.max().x() > bounds.min().x());
+    openvdb::BBoxd frame = frameLayers ? openvdb::BBoxd() : bounds;
+    for (const PreviewLayer& l : layers) {
+        localBoxes.push_back(layerBox(l, false));
+        voxel.push_back(l.grid->voxelSize()[0]);
+        const openvdb::BBoxd placed = layerBox(l, true);
+        if (frameLayers && !isEmpty(placed)) frame.expand(placed);
+    }
+    if (isEmpty(frame)) {
+        throw GridError(msg("preview '", path, "': every layer is empty, nothing to frame"));
+    }
+    const detail::CameraSetup setup = detail::frameBox(frame.min(), frame.max(), options);
+    Film film(std::size_t(options.width), std::size_t(options.height),
+              Film::RGBA(0.0f, 0.0f, 0.0f, 0.0f));
+    openvdb::tools::PerspectiveCamera camera(film, Vec3d(0.0), setup.eye, detail::FOCAL_LENGTH_MM,
+                                             detail::APERTURE_MM, setup.nearPlane,
+                                             setup.farPlane);
+    camera.lookAt(setup.target, setup.up);
+
+    const std::size_t n = layers.size();
+    std::vector<std::atomic<std::size_t>> pixels(n);
+    for (auto& p : pixels) p = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, film.height()), [&](const auto& rows) {
+        Tracers tracers(layers);
+        std::vector<std::size_t> counts(n, 0);
+        for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
+            for (std::size_t x = 0; x < film.width(); ++x) {
+                const Ray ray = camera.getRay(x, y);
+                // The nearest surface.
+                double nearest = std::numeric_limits<double>::max();
+                std::size_t hitLayer = n;
+                Vec3d hitNormal(0.0);
+                for (std::size_t k = 0; k < n; ++k) {
+                    if (!tracers.surfaces[k]) continue;
+                    Ray local = intoLayer(ray, layers[k]);
+                    Vec3d xyz, normal;
+                    bool hit = false;
+                    for (int crossing = 0; crossing < MAX_CUTAWAY_CROSSINGS; ++crossing) {
+                        if (!tracers.surfaces[k]->intersectsWS(local, xyz, normal)) break;
+                        if (!layers[k].cutaway
+                            || isInnerFace(xyz, normal, local.dir(), localBoxes[k], voxel[k],
+                                           double(layers[k].grid->background()))) {
+                            hit = true;
+                            break;
+                        }
+                        // Past this crossing, and look for the next one.
+                        const double along = (xyz - local.eye()).dot(local.dir()) / local.dir().lengthSqr();
+                        local.setTimes(along + 1.5 * voxel[k] / local.dir().length(), local.t1());
+                    }
+                    if (!hit) continue;
+                    const double t = (xyz - local.eye()).length();
+                    if (t < nearest) {
+                        nearest = t;
+                        hitLayer = k;
+                        hitNormal = layers[k].rotation * normal;
+                    }
+                }
+                float r = 0, g = 0, b = 0, surfaceAlpha = 0;
+                if (hitLayer < n) {
+                    const float shade = detail::keyLightShade(setup, hitNormal, ray.dir());
+                    const auto& a = layers[hitLayer].albedo;
+                    r = a[0] * shade, g = a[1] * shade, b = a[2] * shade, surfaceAlpha = 1;
+                    ++counts[hitLayer];
+                }
+                // Fog in front of it: march each fog layer's box up to the surface.
+                double transmittance = 1;
+                float fr = 0, fg = 0, fb = 0;
+                for (std::size_t k = 0; k < n; ++k) {
+                    if (!tracers.fogs[k]) continue;
+                    const Ray local = intoLayer(ray, layers[k]);
+                    double tin = 0, tout = 0;
+                    if (isEmpty(localBoxes[k]) || !local.intersects(localBoxes[k], tin, tout))
+                        continue;
+                    tout = std::min(tout, nearest);
+                    const double step = layers[k].grid->voxelSize()[0];
+                    const double before = transmittance;
+                    for (double t = std::max(tin, 0.0) + 0.5 * step; t < tout; t += step) {
+                        const double d = tracers.fogs[k]->wsSample(local(t));
+                        if (!(d > 0)) continue;
+                        const double pass = std::exp(-options.extinction * d * step);
+                        const float scattered = float(transmittance * (1 - pass)) * FOG_SHADE;
+                        fr += scattered * layers[k].albedo[0];
+                        fg += scattered * layers[k].albedo[1];
+                        fb += scattered * layers[k].albedo[2];
+                        transmittance *= pass;
+                        if (transmittance < OPAQUE_TRANSMITTANCE) break;
+                    }
+                    if (before - transmittance > 0.05) ++counts[k];
+                }
+                const float tr = float(transmittance);
+                film.pixel(x, y) = Film::RGBA(fr + tr * r, fg + tr * g, fb + tr * b,
+                                              (1 - tr) + tr * surfaceAlpha);
+            }
+        }
+        for (std::size_t k = 0; k < n; ++k) pixels[k] += counts[k];
+    });
+    ScenePreviewSummary summary;
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (auto& p : pixels) summary.pixels.push_back(p.load());
+    detail::writeImage(film, path);
+    return summary;
+}
+
+} // namespace vdbio
+} // namespace ghostfx
