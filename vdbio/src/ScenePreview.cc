@@ -34,6 +34,9 @@ using Sampler = openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor,
 
 /// Fog stops being marched once less than this much light gets through.
 constexpr double OPAQUE_TRANSMITTANCE = 0.01;
+/// Fog is sampled every this many voxels along a ray: a density rasterised with an SPH kernel
+/// of support 2-3 h (4-6 voxels at the default h / 2) varies little within two voxels.
+constexpr double FOG_STEP_VOXELS = 2.0;
 /// Fog: the light a voxel scatters towards the camera, as a share of its albedo (no shadows).
 constexpr float FOG_SHADE = 0.85f;
 
@@ -208,7 +211,7 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                     if (isEmpty(localBoxes[k]) || !local.intersects(localBoxes[k], tin, tout))
                         continue;
                     tout = std::min(tout, nearest);
-                    const double step = layers[k].grid->voxelSize()[0];
+                    const double step = FOG_STEP_VOXELS * layers[k].grid->voxelSize()[0];
                     const double before = transmittance;
                     for (double t = std::max(tin, 0.0) + 0.5 * step; t < tout; t += step) {
                         const double d = tracers.fogs[k]->wsSample(local(t));
