@@ -294,16 +294,17 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
     // The media's grids as preview layers: the liquid's surface (else its density), the gas's
     // density, or the grid outputs.preview.grid names.
     std::vector<vdbio::PreviewLayer> media;
+    bool namedGridFound = false;
     for (const OutputMedium& m : snapshot.media) {
         const bool liquid = m.liquid;
         const openvdb::GridPtrVec grids =
             writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile),
                         inFolder(liquid ? out.volumeFile : out.gasVolumeFile), fileMeta);
         if (out.previewFile.empty()) continue;
-        const std::vector<std::string> wanted =
-            !out.previewGrid.empty() ? std::vector<std::string>{out.previewGrid}
-            : liquid                 ? std::vector<std::string>{"surface", "density"}
-                                     : std::vector<std::string>{"density"};
+        // outputs.preview.grid where the medium has it, else the medium's default.
+        std::vector<std::string> wanted = liquid ? std::vector<std::string>{"surface", "density"}
+                                                 : std::vector<std::string>{"density"};
+        if (!out.previewGrid.empty()) wanted.insert(wanted.begin(), out.previewGrid);
         for (const std::string& name : wanted) {
             auto g = std::find_if(grids.begin(), grids.end(),
                                   [&](const auto& grid) { return grid->getName() == name; });
@@ -318,11 +319,12 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
                              : vdbio::PreviewLayer::Kind::Fog;
             layer.albedo = liquid ? vdbio::LIQUID_ALBEDO : vdbio::GAS_ALBEDO;
             media.push_back(layer);
+            namedGridFound = namedGridFound || name == out.previewGrid;
             break;
         }
     }
     if (out.previewFile.empty()) return;
-    if (media.empty()) {
+    if (media.empty() || (!out.previewGrid.empty() && !namedGridFound)) {
         throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '",
                              out.previewGrid.empty() ? "(default)" : out.previewGrid,
                              "': the volume output has no such grid"));

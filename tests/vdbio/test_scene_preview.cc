@@ -91,7 +91,8 @@ TEST(ScenePreview, SolidAndLiquidAppearWhereTheSceneHasThemInTheirColours)
     EXPECT_GT(s.pixels[1], 200u);
     const vdbio::RgbaImage image = vdbio::readExrImage(png);
     ASSERT_EQ(image.width, W);
-    const std::array<float, 3> left = meanColour(image, 0, W / 2), right = meanColour(image, W / 2, W);
+    const std::array<float, 3> left = meanColour(image, 0, W / 2),
+                               right = meanColour(image, W / 2, W);
     // The solid's albedo is warm grey (r > b), the liquid's blue (b > 2 r): the halves show them.
     EXPECT_GT(left[0], left[2]) << "left half: the grey block";
     EXPECT_GT(right[2], 2 * right[0]) << "right half: the blue drop";
@@ -103,9 +104,9 @@ TEST(ScenePreview, AContainerIsCutAwaySoItsContentsShow)
 {
     const auto dir = ghostfx::testing::freshDir("scene_preview_cut");
     PreviewLayer tank = surface("tank", closedTank(0.2, 0.03, 0.01f), vdbio::SOLID_ALBEDO);
-    const PreviewLayer drop = surface(
-        "drop", sph::makeSphereLevelSet(sph::Vec3(0.0f, -0.1f, 0.0f), 0.08f, 0.01f),
-        vdbio::LIQUID_ALBEDO);
+    const PreviewLayer drop =
+        surface("drop", sph::makeSphereLevelSet(sph::Vec3(0.0f, -0.1f, 0.0f), 0.08f, 0.01f),
+                vdbio::LIQUID_ALBEDO);
     vdbio::PreviewOptions view = frontView();
     view.elevation = 25;
     const std::string closed = (dir / "closed.exr").string(), cut = (dir / "cut.exr").string();
@@ -123,7 +124,8 @@ TEST(ScenePreview, AContainerIsCutAwaySoItsContentsShow)
 TEST(ScenePreview, FogLiesInFrontOfTheSurfaceBehindIt)
 {
     const auto dir = ghostfx::testing::freshDir("scene_preview_fog");
-    openvdb::FloatGrid::Ptr fog = sph::makeSphereLevelSet(sph::Vec3(0.0f, 0.0f, 0.1f), 0.08f, 0.01f);
+    openvdb::FloatGrid::Ptr fog =
+        sph::makeSphereLevelSet(sph::Vec3(0.0f, 0.0f, 0.1f), 0.08f, 0.01f);
     openvdb::tools::sdfToFogVolume(*fog);
     PreviewLayer gas = surface("gas", fog, vdbio::GAS_ALBEDO);
     gas.kind = PreviewLayer::Kind::Fog;
@@ -139,14 +141,15 @@ TEST(ScenePreview, FogLiesInFrontOfTheSurfaceBehindIt)
     // edge of the frame, where no gas is.
     const float* centre = image.pixel(W / 2, H / 2);
     const float* edge = image.pixel(W / 2 + 20, H / 2); // 0.2 m right of the gas: bare wall
-    std::printf("[measured] fog over wall: centre rgb (%.3f %.3f %.3f), bare wall (%.3f %.3f %.3f)\n",
-                centre[0], centre[1], centre[2], edge[0], edge[1], edge[2]);
+    std::printf(
+        "[measured] fog over wall: centre rgb (%.3f %.3f %.3f), bare wall (%.3f %.3f %.3f)\n",
+        centre[0], centre[1], centre[2], edge[0], edge[1], edge[2]);
     EXPECT_GT(s.pixels[1], 100u); // the 8 cm gas ball, where it is more than 5 % opaque
     EXPECT_EQ(centre[3], 1.0f);
     EXPECT_GT(centre[2] - centre[0], -0.01f); // the gas is neutral white, not the wall's warm grey
     EXPECT_GT(edge[0] - edge[2], 0.02f);      // the bare wall is warm grey
     // Bad input is refused before anything is written.
-    EXPECT_THROW(vdbio::renderScenePreview({}, frontView(), openvdb::BBoxd(),
-                                           (dir / "none.exr").string()),
-                 ValueError);
+    EXPECT_THROW(
+        vdbio::renderScenePreview({}, frontView(), openvdb::BBoxd(), (dir / "none.exr").string()),
+        ValueError);
 }

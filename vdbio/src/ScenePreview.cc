@@ -29,8 +29,8 @@ namespace {
 
 using Ray = openvdb::math::Ray<double>;
 using Intersector = openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid>;
-using Sampler = openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor,
-                                            openvdb::tools::BoxSampler>;
+using Sampler =
+    openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler>;
 
 /// Fog stops being marched once less than this much light gets through.
 constexpr double OPAQUE_TRANSMITTANCE = 0.01;
@@ -66,8 +66,8 @@ constexpr int MAX_CUTAWAY_CROSSINGS = 8;
 /// from the solid, faces the ray) and it is not on the outer hull (more than 1.5 voxels inside
 /// the surface's box, the layer's box less its narrow band `band`): the inner face of a
 /// container's far wall or floor.
-bool isInnerFace(const Vec3d& xyz, const Vec3d& normal, const Vec3d& dir,
-                 const openvdb::BBoxd& box, double voxel, double band)
+bool isInnerFace(const Vec3d& xyz, const Vec3d& normal, const Vec3d& dir, const openvdb::BBoxd& box,
+                 double voxel, double band)
 {
     if (normal.dot(dir) >= 0) return false;
     const double margin = band + 1.5 * voxel;
@@ -115,9 +115,9 @@ struct Tracers
             surfaces.push_back(surface ? std::make_unique<Intersector>(*l.grid) : nullptr);
             accessors.push_back(
                 std::make_unique<openvdb::FloatGrid::ConstAccessor>(l.grid->getConstAccessor()));
-            fogs.push_back(surface ? nullptr
-                                   : std::make_unique<Sampler>(*accessors.back(),
-                                                               l.grid->transform()));
+            fogs.push_back(surface
+                               ? nullptr
+                               : std::make_unique<Sampler>(*accessors.back(), l.grid->transform()));
         }
     }
 };
@@ -125,8 +125,8 @@ struct Tracers
 } // namespace
 
 ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
-                                       const PreviewOptions& options,
-                                       const openvdb::BBoxd& bounds, const std::string& path)
+                                       const PreviewOptions& options, const openvdb::BBoxd& bounds,
+                                       const std::string& path)
 {
     options.validate();
     if (layers.empty()) throw ValueError(msg("preview '", path, "': nothing to draw"));
@@ -151,8 +151,7 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
     Film film(std::size_t(options.width), std::size_t(options.height),
               Film::RGBA(0.0f, 0.0f, 0.0f, 0.0f));
     openvdb::tools::PerspectiveCamera camera(film, Vec3d(0.0), setup.eye, detail::FOCAL_LENGTH_MM,
-                                             detail::APERTURE_MM, setup.nearPlane,
-                                             setup.farPlane);
+                                             detail::APERTURE_MM, setup.nearPlane, setup.farPlane);
     camera.lookAt(setup.target, setup.up);
 
     const std::size_t n = layers.size();
@@ -183,7 +182,8 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                             break;
                         }
                         // Past this crossing, and look for the next one.
-                        const double along = (xyz - local.eye()).dot(local.dir()) / local.dir().lengthSqr();
+                        const double along =
+                            (xyz - local.eye()).dot(local.dir()) / local.dir().lengthSqr();
                         local.setTimes(along + 1.5 * voxel[k] / local.dir().length(), local.t1());
                     }
                     if (!hit) continue;
@@ -227,8 +227,8 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                     if (before - transmittance > 0.05) ++counts[k];
                 }
                 const float tr = float(transmittance);
-                film.pixel(x, y) = Film::RGBA(fr + tr * r, fg + tr * g, fb + tr * b,
-                                              (1 - tr) + tr * surfaceAlpha);
+                film.pixel(x, y) =
+                    Film::RGBA(fr + tr * r, fg + tr * g, fb + tr * b, (1 - tr) + tr * surfaceAlpha);
             }
         }
         for (std::size_t k = 0; k < n; ++k) pixels[k] += counts[k];

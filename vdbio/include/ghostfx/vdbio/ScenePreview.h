@@ -26,8 +26,8 @@ struct PreviewLayer
 {
     enum class Kind { Surface, Fog };
 
-    std::string name;                   ///< for messages
-    openvdb::FloatGrid::ConstPtr grid;  ///< a level set (Surface) or a fog volume (Fog)
+    std::string name;                  ///< for messages
+    openvdb::FloatGrid::ConstPtr grid; ///< a level set (Surface) or a fog volume (Fog)
     Kind kind = Kind::Surface;
     std::array<float, 3> albedo{{0.6f, 0.6f, 0.6f}}; ///< linear RGB
     /// Rigid placement of the grid's frame in the world, x_world = rotation x + translation (a
@@ -59,8 +59,8 @@ struct ScenePreviewSummary
 /// for bad options or no layers, GridError for a layer that is not a float grid of its kind
 /// with cubic voxels, IoError if the image cannot be written.
 ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
-                                       const PreviewOptions& options,
-                                       const openvdb::BBoxd& bounds, const std::string& path);
+                                       const PreviewOptions& options, const openvdb::BBoxd& bounds,
+                                       const std::string& path);
 
 } // namespace vdbio
 } // namespace ghostfx
