@@ -337,6 +337,10 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
     pv.height = out.previewHeight;
     pv.azimuth = out.previewAzimuth;
     pv.elevation = out.previewElevation;
+    if (out.previewBackground) {
+        const auto& c = *out.previewBackground;
+        pv.background = {float(c[0]), float(c[1]), float(c[2]), 1.0f};
+    }
     openvdb::BBoxd framed; // empty: the camera frames everything drawn
     if (!out.previewFrame.empty()) {
         framed = openvdb::BBoxd(openvdb::Vec3d(out.previewFrame.min),

@@ -97,6 +97,8 @@ TEST_F(SceneTest, ReadsAValidScene)
     EXPECT_LT(scene.solids[0].shape.phi(sph::Vec3(-0.01f, 0.5f, 0.5f)), 0.0f);
     EXPECT_EQ(scene.outputs.previewWidth, 320);
     EXPECT_EQ(scene.outputs.previewFile, "preview.$F4.exr");
+    ASSERT_TRUE(scene.outputs.previewBackground); // opaque dark grey unless asked otherwise
+    EXPECT_TRUE(scene.outputs.previewSolids);
     EXPECT_EQ(scene.outputs.volumeGrids.size(), 3u);
     // The solver-specific keys are left to the caller: the settings object is still open.
     EXPECT_NO_THROW(scene.settings.finish());
@@ -136,6 +138,14 @@ TEST_F(SceneTest, WrongTypesAndRangesNameTheValue)
     EXPECT_CONTAINS(errorOf(s), "settings.spacing = \"fine\": expected a number");
     s["settings"]["spacing"] = -0.01;
     EXPECT_CONTAINS(errorOf(s), "settings.spacing = -0.01: expected a number > 0");
+    s = baseScene();
+    s["outputs"]["preview"]["background"] = {2, 0, 0};
+    EXPECT_CONTAINS(errorOf(s),
+                    "outputs.preview.background = [2,0,0]: expected [r, g, b] in 0 to 1");
+    s["outputs"]["preview"]["background"] = "transparent";
+    EXPECT_FALSE(vdbio::readScene(write(s)).outputs.previewBackground);
+    s["outputs"]["preview"]["frame"] = {{"min", {0, 0, 0}}, {"max", {1, 0, 1}}};
+    EXPECT_CONTAINS(errorOf(s), "outputs.preview.frame = ");
     s = baseScene();
     s["settings"]["frame_range"] = {5, 2};
     EXPECT_CONTAINS(errorOf(s), "settings.frame_range = [5,2]: expected [first, last]");

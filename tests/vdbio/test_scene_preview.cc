@@ -98,6 +98,23 @@ TEST(ScenePreview, SolidAndLiquidAppearWhereTheSceneHasThemInTheirColours)
     EXPECT_GT(right[2], 2 * right[0]) << "right half: the blue drop";
     // Nothing is drawn in the image's top-left corner (the background stays transparent).
     EXPECT_EQ(image.pixel(0, 0)[3], 0.0f);
+
+    // An opaque background shows there instead, and the drop still covers its own pixels.
+    vdbio::PreviewOptions dark = frontView();
+    dark.background = {0.16f, 0.17f, 0.19f, 1.0f};
+    const std::string exr = (dir / "dark.exr").string();
+    vdbio::renderScenePreview(layers, dark, openvdb::BBoxd(), exr);
+    const vdbio::RgbaImage onDark = vdbio::readExrImage(exr);
+    const float* corner = onDark.pixel(0, 0);
+    EXPECT_NEAR(corner[0], 0.16f, 1e-3f); // half floats: 3 significant digits
+    EXPECT_NEAR(corner[2], 0.19f, 1e-3f);
+    EXPECT_EQ(corner[3], 1.0f);
+    // The drop's centre, 0.2 m right of the frame's centre at about 1 cm per pixel.
+    const float* drop = onDark.pixel(W / 2 + 20, H / 2);
+    EXPECT_GT(drop[2], 2 * drop[0]) << "the drop is still blue over the background";
+    EXPECT_GT(drop[2], 0.3f);
+    dark.background[0] = 2.0f;
+    EXPECT_THROW(vdbio::renderScenePreview(layers, dark, openvdb::BBoxd(), exr), ValueError);
 }
 
 TEST(ScenePreview, AContainerIsCutAwaySoItsContentsShow)

@@ -350,6 +350,11 @@ void PreviewOptions::validate() const
     if (!(elevation >= -90.0 && elevation <= 90.0)) {
         throw ValueError(msg("preview elevation = ", elevation, ": expected -90 to 90 degrees"));
     }
+    for (float c : background) {
+        if (!(c >= 0.0f && c <= 1.0f)) {
+            throw ValueError(msg("preview background component = ", c, ": expected 0 to 1"));
+        }
+    }
     if (!(extinction > 0.0) || !std::isfinite(extinction)) {
         throw ValueError(msg("preview extinction = ", extinction, ": expected > 0 (1/m)"));
     }

@@ -403,6 +403,19 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         out.previewSolids = s.get<bool>("solids", out.previewSolids);
         out.previewAzimuth = s.inRange("azimuth", out.previewAzimuth, -360, 360);
         out.previewElevation = s.inRange("elevation", out.previewElevation, -90, 90);
+        if (const Json* bg = s.raw("background")) {
+            if (bg->is_string() && bg->get<std::string>() == "transparent") {
+                out.previewBackground.reset();
+            } else {
+                const auto c = s.get<std::array<double, 3>>("background", {0, 0, 0});
+                for (double v : c) {
+                    if (!(v >= 0 && v <= 1))
+                        s.failValue("background",
+                                    "expected [r, g, b] in 0 to 1 (linear), or \"transparent\"");
+                }
+                out.previewBackground = c;
+            }
+        }
         if (auto box = s.optionalObject("frame")) {
             const Vec3d lo = vec(box->require<std::array<double, 3>>("min"));
             const Vec3d hi = vec(box->require<std::array<double, 3>>("max"));

@@ -227,8 +227,13 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                     if (before - transmittance > 0.05) ++counts[k];
                 }
                 const float tr = float(transmittance);
-                film.pixel(x, y) =
-                    Film::RGBA(fr + tr * r, fg + tr * g, fb + tr * b, (1 - tr) + tr * surfaceAlpha);
+                // The scene over the background: what the surface leaves uncovered shows it.
+                const float behind = tr * (1 - surfaceAlpha);
+                const auto& bg = options.background;
+                film.pixel(x, y) = Film::RGBA(fr + tr * r + behind * bg[0] * bg[3],
+                                              fg + tr * g + behind * bg[1] * bg[3],
+                                              fb + tr * b + behind * bg[2] * bg[3],
+                                              (1 - tr) + tr * surfaceAlpha + behind * bg[3]);
             }
         }
         for (std::size_t k = 0; k < n; ++k) pixels[k] += counts[k];

@@ -12,6 +12,7 @@
 
 #include <openvdb/openvdb.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ struct PreviewOptions
     /// Extinction of a fog volume at density 1 (1/m). The default 10 /m gives a 0.2 m thick body
     /// of normalised liquid density an optical depth of 2 (86 % opaque). Must be > 0.
     double extinction = 10;
+    /// Colour behind the scene (linear RGB and alpha, each in [0, 1]); the default is
+    /// transparent. The scene preview (ScenePreview.h) composites the image over it; the
+    /// single-grid preview ignores it.
+    std::array<float, 4> background{{0.0f, 0.0f, 0.0f, 0.0f}};
 
     /// Throws ValueError naming the field and the bad value.
     void validate() const;

@@ -27,8 +27,10 @@
 
 #include <openvdb/math/Mat3.h>
 
+#include <array>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -184,6 +186,9 @@ struct SceneOutputs
     bool previewSolids = true;                         ///< draw the solids (containers cut away)
     double previewAzimuth = 30, previewElevation = 20; ///< camera direction (degrees)
     sph::Aabb previewFrame; ///< the world box the camera frames; empty: everything drawn
+    /// Opaque colour behind the scene (linear RGB); none: a transparent background.
+    std::optional<std::array<double, 3>> previewBackground =
+        std::array<double, 3>{0.16, 0.17, 0.19};
     // HDF5 checkpoint every N frames (0: only at the end and on interruption).
     std::string checkpointFile = "checkpoint.$F4.h5";
     int checkpointEvery = 10;
