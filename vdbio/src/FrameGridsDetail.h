@@ -1,9 +1,10 @@
 /// @file   FrameGridsDetail.h
 /// @brief  Private interface between the frame-output translation units of vdbio.
 /// @details Each heavy OpenVDB instantiation lives in its own .cc (STACK.md, compile times):
-///          SurfaceGrid.cc (ParticlesToLevelSet + LevelSetFilter), ParticleGrids.cc (gathered
-///          density / velocity / channel fog grids), PointsFile.cc (PointDataGrid). VolumeFile.cc
-///          validates options, selects particles and calls these.
+///          SurfaceGrid.cc (ParticlesToLevelSet + LevelSetFilter), AnisotropicSurface.cc
+///          (anisotropic-kernel field + fast sweeping), ParticleGrids.cc (gathered density /
+///          velocity / channel fog grids), PointsFile.cc (PointDataGrid). VolumeFile.cc validates
+///          options, selects particles and calls these.
 #pragma once
 
 #include <ghostfx/sph/ParticleSet.h>
@@ -29,6 +30,13 @@ std::string joinNames(const std::vector<std::string>& names);
 openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,
                                         const std::vector<sph::Index>& selection,
                                         const VolumeOptions& options);
+
+/// Liquid surface level set "surface" of the selected particles by anisotropic kernels (Yu and
+/// Turk 2013; AnisotropicSurface.cc): same name, class, transform, background and metadata as
+/// makeSurfaceGrid, plus "surface_method" = "anisotropic". Options already validated.
+openvdb::FloatGrid::Ptr makeAnisotropicSurfaceGrid(const sph::ParticleSet& particles,
+                                                   const std::vector<sph::Index>& selection,
+                                                   const VolumeOptions& options);
 
 /// "density", "vel" and the scalar channel grids, as asked by `options` (already validated;
 /// channel names already checked), gathered on one shared sparse topology.

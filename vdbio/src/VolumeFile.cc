@@ -25,6 +25,56 @@ const char* const RESERVED_GRID_NAMES[] = {"surface", "density", "vel"};
 
 bool isPositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
 
+/// The anisotropic surface's fields (VolumeOptions, Yu and Turk 2013); `where` prefixes messages.
+void validateAnisotropic(const VolumeOptions& o, const char* where)
+{
+    if (!isPositiveFinite(o.restDensity)) {
+        throw ValueError(msg(where, "rest density = ", o.restDensity,
+                             " kg/m^3: expected > 0 (anisotropic surface volumes are m / rho0)"));
+    }
+    if (!isPositiveFinite(o.anisotropicKernelSpacings)) {
+        throw ValueError(msg(where, "anisotropic kernel = ", o.anisotropicKernelSpacings,
+                             " spacings: expected > 0 (2 by default)"));
+    }
+    if (!isPositiveFinite(o.anisotropicIsolatedScale)) {
+        throw ValueError(msg(where, "anisotropic isolated scale = ", o.anisotropicIsolatedScale,
+                             ": expected > 0 (the paper uses 0.5)"));
+    }
+    const double isolatedRadius =
+        o.anisotropicIsolatedScale * o.anisotropicKernelSpacings * o.particleSpacing;
+    if (isolatedRadius < o.voxelSize) {
+        throw ValueError(msg(where, "anisotropic isolated kernel radius = ", isolatedRadius,
+                             " m (isolated scale x kernel) is below one voxel (", o.voxelSize,
+                             " m): lower the voxel size (h / 2 is typical)"));
+    }
+    if (!(std::isfinite(o.anisotropicNeighborhoodSpacings)
+          && o.anisotropicNeighborhoodSpacings >= 1.0)) {
+        throw ValueError(msg(where, "anisotropic neighbourhood = ",
+                             o.anisotropicNeighborhoodSpacings,
+                             " spacings: expected >= 1 (the paper uses twice the kernel)"));
+    }
+    if (!(o.anisotropicSmoothing >= 0.0 && o.anisotropicSmoothing <= 1.0)) {
+        throw ValueError(msg(where, "anisotropic smoothing = ", o.anisotropicSmoothing,
+                             ": expected in [0, 1] (the paper uses 0.9 to 1)"));
+    }
+    if (!(std::isfinite(o.anisotropicMaxStretch) && o.anisotropicMaxStretch >= 1.0)) {
+        throw ValueError(msg(where, "anisotropic max stretch = ", o.anisotropicMaxStretch,
+                             ": expected >= 1 (the paper uses 4)"));
+    }
+    if (o.anisotropicMinNeighbors < 0) {
+        throw ValueError(msg(where, "anisotropic min neighbours = ", o.anisotropicMinNeighbors,
+                             ": expected >= 0 (the paper uses 25)"));
+    }
+    if (!isPositiveFinite(o.anisotropicScale)) {
+        throw ValueError(msg(where, "anisotropic scale = ", o.anisotropicScale,
+                             ": expected > 0 (1: interior kernels of the kernel radius)"));
+    }
+    if (!(o.anisotropicIsoValue > 0.0 && o.anisotropicIsoValue < 1.0)) {
+        throw ValueError(msg(where, "anisotropic iso-value = ", o.anisotropicIsoValue,
+                             ": expected in (0, 1) (a volume fraction)"));
+    }
+}
+
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -123,7 +173,7 @@ void VolumeOptions::validate() const
                 msg(where, "surface radius = ", surfaceRadiusSpacings, " spacings: expected > 0"));
         }
         const double radius = surfaceRadiusSpacings * particleSpacing;
-        if (radius < voxelSize) {
+        if (surfaceMethod == SurfaceMethod::Spheres && radius < voxelSize) {
             throw ValueError(msg(where, "surface sphere radius = ", radius, " m (",
                                  surfaceRadiusSpacings, " spacings) is below one voxel (",
                                  voxelSize, " m): lower the voxel size (h / 2 is typical)"));
@@ -145,6 +195,12 @@ void VolumeOptions::validate() const
         if (surfaceHalfWidthVoxels < 3) {
             throw ValueError(msg(where, "surface half width = ", surfaceHalfWidthVoxels,
                                  " voxels: expected >= 3 (the level-set filters' stencils)"));
+        }
+        if (surfaceMethod == SurfaceMethod::Anisotropic) {
+            validateAnisotropic(*this, where);
+        } else if (surfaceMethod != SurfaceMethod::Spheres) {
+            throw ValueError(msg(where, "surface method = ", int(surfaceMethod), ": expected ",
+                                 sph::quotedNames(SURFACE_METHOD_NAMES)));
         }
     }
     std::set<std::string> seen;
@@ -180,7 +236,11 @@ openvdb::GridPtrVec makeVolumeGrids(const sph::ParticleSet& particles, const Vol
 
     const std::vector<sph::Index> selection = detail::selectKinds(particles, options.kinds);
     openvdb::GridPtrVec grids;
-    if (options.surface) grids.push_back(detail::makeSurfaceGrid(particles, selection, options));
+    if (options.surface) {
+        grids.push_back(options.surfaceMethod == SurfaceMethod::Anisotropic
+                            ? detail::makeAnisotropicSurfaceGrid(particles, selection, options)
+                            : detail::makeSurfaceGrid(particles, selection, options));
+    }
     if (options.density || options.velocity || !options.scalarChannels.empty()) {
         openvdb::GridPtrVec gathered = detail::makeParticleGrids(particles, selection, options);
         grids.insert(grids.end(), gathered.begin(), gathered.end());

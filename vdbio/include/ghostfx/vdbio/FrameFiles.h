@@ -25,6 +25,7 @@
 #pragma once
 
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/vdbio/SurfaceMethod.h>
 
 #include <openvdb/openvdb.h>
 
@@ -139,6 +140,49 @@ struct VolumeOptions
     double surfaceOffsetSpacings = 0.5;
     /// Narrow-band half width (voxels) of the written level set; background = this * voxelSize.
     int surfaceHalfWidthVoxels = 3;
+
+    // Anisotropic surface (surfaceMethod = Anisotropic; AnisotropicSurface.cc, after Yu and Turk,
+    // "Reconstructing surfaces of particle-based fluids using anisotropic kernels", SCA 2010 /
+    // ACM TOG 2013). Each particle j gets a kernel stretched along the principal
+    // axes of its neighbours' weighted covariance and centred at its Laplacian-smoothed position
+    // xbar_j; the surface is an iso-contour of phi(x) = sum_j (m_j / rho0) det(G_j) P(|G_j (x -
+    // xbar_j)|), a volume fraction (about 1 inside the liquid). The sphere fields above
+    // (radius, closing, smoothing, offset) do not apply; the half width does.
+
+    /// Surface reconstruction: union of spheres (default) or anisotropic kernels.
+    SurfaceMethod surfaceMethod = SurfaceMethod::Spheres;
+    /// Support radius h_k of the isotropic kernel P (M4 spline) / h. The paper uses the
+    /// simulation's kernel radius; 2 h here (33 lattice particles within it).
+    double anisotropicKernelSpacings = 2.0;
+    /// Radius r of the weighted mean and covariance (weights 1 - (d / r)^3) / h. The paper uses
+    /// r = 2 h_k; with the default h_k that is 4 h (about 270 neighbours inside the liquid).
+    double anisotropicNeighborhoodSpacings = 4.0;
+    /// lambda: kernel centres xbar = (1 - lambda) x + lambda (weighted mean of the neighbours).
+    /// Paper: 0.9 to 1 (0.9 here); 0 keeps the particle positions.
+    double anisotropicSmoothing = 0.9;
+    /// k_r: largest ratio between the largest and smallest kernel axes (paper: 4).
+    double anisotropicMaxStretch = 4.0;
+    /// N_eps: particles with this many neighbours or fewer within r (itself not counted) get a
+    /// round kernel of radius k_n h_k (paper: 25).
+    int anisotropicMinNeighbors = 25;
+    /// k_s: kernel semi-axis / h_k per covariance eigenvalue, the eigenvalues in units of that
+    /// of a full uniform neighbourhood (0.15 r^2 for these weights), so an interior particle's
+    /// kernel is round with radius k_s h_k at any resolution (the paper's k_s = 1400 plays this
+    /// role in its own scene units). Not 1: the smoothing (lambda = 0.9) moves a flat surface's
+    /// outer kernels about 0.5 h_k inwards while they reach about as far out, so with k_s = 1 no
+    /// iso-value puts the surface outside the outer particles (measured: the crossing stays at
+    /// the outer layer as the iso-value goes to 0). With 3 the calibrated iso-value is 0.2,
+    /// where phi is still steep; with 2.5 it is 0.08, in the spline's tail, where a jittered
+    /// face came out 1.3x rougher. The cost grows as k_s^3 (bench/RESULTS.md).
+    double anisotropicScale = 3.0;
+    /// k_n: kernel radius / h_k of a particle with too few neighbours (paper: 0.5).
+    double anisotropicIsolatedScale = 0.5;
+    /// Iso-value of phi (a volume fraction) taken as the surface, in (0, 1). Calibrated with the
+    /// defaults above at voxel h / 2 so a flat free surface of a lattice block ends 0.50 h
+    /// outside the outermost particle centres, as the sphere method's `surfaceOffsetSpacings`
+    /// (tests/vdbio/test_surface_accuracy.cc: 0.19 gives 0.52 h, 0.20 gives 0.49 h). Other
+    /// kernel settings need their own value.
+    double anisotropicIsoValue = 0.196;
 
     /// Throw ValueError naming the first bad field and its value, e.g.
     /// "volume output: voxel size = 0 m: expected > 0".
