@@ -253,8 +253,14 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
         return std::find(wanted.begin(), wanted.end(), g) != wanted.end();
     };
     vdbio::VolumeOptions vo;
-    const double voxel = m.liquid ? out.voxelSize : out.gasVoxelSize;
-    vo.voxelSize = voxel > 0 ? voxel : 0.5 * m.spacing;
+    // The liquid's surface at h / 2 by default; the gathered grids (the gas has no surface) at
+    // h (VolumeOptions::densityVoxelSize says what that keeps).
+    if (m.liquid) {
+        vo.voxelSize = out.voxelSize > 0 ? out.voxelSize : 0.5 * m.spacing;
+        vo.densityVoxelSize = out.densityVoxelSize;
+    } else {
+        vo.voxelSize = vo.densityVoxelSize = out.gasVoxelSize > 0 ? out.gasVoxelSize : m.spacing;
+    }
     vo.kernelSupport = m.support;
     vo.restDensity = m.restDensity;
     vo.particleSpacing = m.spacing;

@@ -31,6 +31,7 @@
 #include <ghostfx/sph/Parallel.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -65,11 +66,25 @@ inline void voxelRange(double x, double reach, double invDx, int& lo, int& hi)
     hi = int(std::floor((x + reach) * invDx));
 }
 
-/// Leaf origins (multiples of 8) of every leaf whose voxels meet the support box of a particle.
-std::vector<openvdb::Coord> candidateLeaves(const Selected& sel, const sph::NeighborGrid& grid,
-                                            double dx, double R)
+/// The leaves of the output grids built for one candidate leaf (null where nothing is active).
+struct LeafOutput
 {
-    const std::vector<sph::Index>& order = grid.order(); // cell order: neighbours are close
+    std::unique_ptr<FloatLeaf> density;
+    std::unique_ptr<VecLeaf> vel;
+    std::vector<std::unique_ptr<FloatLeaf>> channels;
+};
+
+openvdb::math::Transform::Ptr makeTransform(double voxelSize)
+{
+    return openvdb::math::Transform::createLinearTransform(voxelSize);
+}
+
+} // namespace
+
+std::vector<openvdb::Coord> leavesNearParticles(const std::vector<sph::Vec3>& x,
+                                                const std::vector<sph::Index>& order, double dx,
+                                                double reach)
+{
     const std::size_t n = order.size();
     const std::size_t nBlocks = (n + LEAF_KEY_BLOCK - 1) / LEAF_KEY_BLOCK;
     std::vector<std::vector<openvdb::Coord>> perBlock(nBlocks);
@@ -79,19 +94,30 @@ std::vector<openvdb::Coord> candidateLeaves(const Selected& sel, const sph::Neig
         0, nBlocks,
         [&](std::size_t b) {
         std::vector<openvdb::Coord>& keys = perBlock[b];
+        // Leaves listed lately, by a hash of their origin: neighbouring particles (cell order)
+        // share most of their leaves, so this drops most repeats before the sort.
+        std::array<openvdb::Coord, 512> recent;
+        recent.fill(openvdb::Coord(1, 1, 1)); // not a leaf origin
         const std::size_t end = std::min(n, (b + 1) * LEAF_KEY_BLOCK);
         for (std::size_t k = b * LEAF_KEY_BLOCK; k < end; ++k) {
-            const sph::Vec3& x = sel.x[order[k]];
+            const sph::Vec3& p = x[order[k]];
             int lo[3], hi[3];
             for (int d = 0; d < 3; ++d) {
-                voxelRange(double(x[d]), R, invDx, lo[d], hi[d]);
+                voxelRange(double(p[d]), reach, invDx, lo[d], hi[d]);
                 lo[d] &= mask;
                 hi[d] &= mask;
             }
             for (int i = lo[0]; i <= hi[0]; i += LEAF_DIM) {
                 for (int j = lo[1]; j <= hi[1]; j += LEAF_DIM) {
                     for (int l = lo[2]; l <= hi[2]; l += LEAF_DIM) {
-                        keys.emplace_back(i, j, l);
+                        const openvdb::Coord key(i, j, l);
+                        const std::size_t slot =
+                            (std::size_t(i >> 3) * 73856093u ^ std::size_t(j >> 3) * 19349663u
+                             ^ std::size_t(l >> 3) * 83492791u)
+                            & (recent.size() - 1);
+                        if (recent[slot] == key) continue;
+                        recent[slot] = key;
+                        keys.push_back(key);
                     }
                 }
             }
@@ -111,26 +137,11 @@ std::vector<openvdb::Coord> candidateLeaves(const Selected& sel, const sph::Neig
     return leaves;
 }
 
-/// The leaves of the output grids built for one candidate leaf (null where nothing is active).
-struct LeafOutput
-{
-    std::unique_ptr<FloatLeaf> density;
-    std::unique_ptr<VecLeaf> vel;
-    std::vector<std::unique_ptr<FloatLeaf>> channels;
-};
-
-openvdb::math::Transform::Ptr makeTransform(double voxelSize)
-{
-    return openvdb::math::Transform::createLinearTransform(voxelSize);
-}
-
-} // namespace
-
 openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
                                       const std::vector<sph::Index>& selection,
                                       const VolumeOptions& options)
 {
-    const double dx = options.voxelSize;
+    const double dx = options.fogVoxelSize();
     const double R = options.kernelSupport;
     const double rho0 = options.restDensity;
     const bool wantVel = options.velocity;
@@ -211,7 +222,7 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     sph::NeighborGrid grid{sph::Real(R)};
     grid.build(sel.x);
 
-    const std::vector<openvdb::Coord> leaves = candidateLeaves(sel, grid, dx, R);
+    const std::vector<openvdb::Coord> leaves = leavesNearParticles(sel.x, grid.order(), dx, R);
     std::vector<LeafOutput> results(leaves.size());
 
     const double invDx = 1.0 / dx;

@@ -374,6 +374,7 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         out.volumeGrids =
             readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
         out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
+        out.densityVoxelSize = s.nonNegative("density_voxel_size", out.densityVoxelSize);
         },
         [&] { out.volumeFile.clear(); });
     section(

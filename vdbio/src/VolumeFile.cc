@@ -158,6 +158,14 @@ void VolumeOptions::validate() const
         if (!isPositiveFinite(restDensity)) {
             throw ValueError(msg(where, "rest density = ", restDensity, " kg/m^3: expected > 0"));
         }
+        if (!(std::isfinite(densityVoxelSize) && densityVoxelSize >= 0.0)) {
+            throw ValueError(msg(where, "density voxel size = ", densityVoxelSize,
+                                 " m: expected > 0, or 0 for the particle spacing"));
+        }
+        if (densityVoxelSize == 0.0 && !isPositiveFinite(particleSpacing)) {
+            throw ValueError(msg(where, "particle spacing = ", particleSpacing,
+                                 " m: expected > 0 (the density voxel defaults to it)"));
+        }
         if (!(densityCutoff >= 0.0 && densityCutoff < 1.0)) {
             throw ValueError(msg(where, "density cutoff = ", densityCutoff,
                                  ": expected in [0, 1) (a fraction of the rest density)"));

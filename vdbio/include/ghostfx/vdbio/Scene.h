@@ -171,13 +171,14 @@ struct SceneOutputs
     // Volumes.
     std::string volumeFile = "liquid.$F4.vdb";
     std::vector<std::string> volumeGrids{"surface", "density", "vel"};
-    double voxelSize = 0; ///< 0: half the particle spacing
+    double voxelSize = 0;        ///< of the surface; 0: half the particle spacing
+    double densityVoxelSize = 0; ///< of density, vel, temperature; 0: the particle spacing
     // Gas (gas scenes and boiling): points and volumes of the gas particles.
     std::string gasPointsFile = "gas_points.$F4.vdb";
     std::vector<std::string> gasPointChannels{"v", "id", "temperature"};
     std::string gasVolumeFile = "gas.$F4.vdb";
     std::vector<std::string> gasVolumeGrids{"density", "temperature", "vel"};
-    double gasVoxelSize = 0; ///< 0: half the gas particle spacing
+    double gasVoxelSize = 0; ///< 0: the gas particle spacing
     // Preview image of the scene (ScenePreview.h): solids, the liquid and the gas.
     std::string previewFile;
     std::string
