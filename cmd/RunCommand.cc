@@ -266,6 +266,7 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
     vo.particleSpacing = m.spacing;
     vo.kinds = m.kinds;
     vo.surface = m.liquid && wants("surface");
+    vo.surfaceMethod = out.surfaceMethod;
     vo.density = wants("density");
     vo.velocity = wants("vel");
     if (wants("temperature")) {

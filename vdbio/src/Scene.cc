@@ -373,6 +373,10 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         out.volumeFile = s.get<std::string>("file", out.volumeFile);
         out.volumeGrids =
             readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
+        const std::string method =
+            s.choice("surface_method", sph::nameOf(SURFACE_METHOD_NAMES, out.surfaceMethod),
+                     surfaceMethodNames());
+        out.surfaceMethod = sph::valueOf(SURFACE_METHOD_NAMES, method, "surface method");
         out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
         out.densityVoxelSize = s.nonNegative("density_voxel_size", out.densityVoxelSize);
         },

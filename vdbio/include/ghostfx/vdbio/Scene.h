@@ -24,6 +24,7 @@
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/Types.h>
 #include <ghostfx/vdbio/JsonReader.h>
+#include <ghostfx/vdbio/SurfaceMethod.h>
 
 #include <openvdb/math/Mat3.h>
 
@@ -171,6 +172,7 @@ struct SceneOutputs
     // Volumes.
     std::string volumeFile = "liquid.$F4.vdb";
     std::vector<std::string> volumeGrids{"surface", "density", "vel"};
+    SurfaceMethod surfaceMethod = SurfaceMethod::Spheres; ///< of the liquid surface
     double voxelSize = 0;        ///< of the surface; 0: half the particle spacing
     double densityVoxelSize = 0; ///< of density, vel, temperature; 0: the particle spacing
     // Gas (gas scenes and boiling): points and volumes of the gas particles.
