@@ -33,17 +33,22 @@
 ///             (tools::fogToSdf, Zhao 2005) turns the narrow band around it into signed
 ///             distances, negative inside.
 ///
-///          Sparse and deterministic, as ParticleGrids.cc: phi is gathered per 8^3 leaf that a
-///          kernel's bounding box meets, each leaf summing its particles in the neighbour grid's
-///          order (which does not depend on threads) over the rows of voxels that meet each
-///          ellipsoid (splatKernel). The band is
+///          Sparse and deterministic, as ParticleGrids.cc: phi is gathered per 8^3 leaf near the
+///          kernels' bounding boxes, each leaf summing the kernels near it nearest first, in an
+///          order that does not depend on threads, over the rows of voxels that meet each
+///          ellipsoid (splatKernel). Inside the liquid only the sign of phi - iso matters, so a
+///          leaf stops once every voxel exceeds the iso-value (after about 100 of its 2500
+///          kernels at the defaults) unless it touches the surface (gatherField); the level set
+///          is bit-identical to that of full sums (checked on a 60k-particle block). The band is
 ///          the voxels within `surfaceHalfWidthVoxels` + 1 (Chebyshev) of a voxel whose face
 ///          neighbour lies across the iso-value; only those are swept. Fast sweeping updates the
 ///          voxels of one diagonal slice independently, so the level set is the same at any
 ///          thread count.
 ///
 ///          Calibration (tests/vdbio/test_surface_accuracy.cc, "[measured]" lines): see
-///          VolumeOptions::anisotropicIsoValue.
+///          VolumeOptions::anisotropicIsoValue. Cost (bench/bench_surface.cc, 1e5 particles):
+///          about 3.5x the sphere method's, two thirds of it the field on the leaves at and
+///          outside the surface, where no sum can stop early (bench/RESULTS.md).
 #include "FrameGridsDetail.h"
 
 #include <ghostfx/sph/Kernels.h>
@@ -58,6 +63,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 namespace ghostfx {
@@ -71,8 +77,6 @@ using MaskLeaf = openvdb::MaskTree::LeafNodeType;
 
 constexpr int LEAF_DIM = int(FloatLeaf::DIM);           // 8 voxels per leaf edge
 constexpr int LEAF_VOXELS = int(FloatLeaf::NUM_VALUES); // 512
-/// Particles per block when listing candidate leaves (as in ParticleGrids.cc).
-constexpr std::size_t LEAF_KEY_BLOCK = 4096;
 
 /// Covariance eigenvalue of a full uniform neighbourhood per r^2, for the weights
 /// w = 1 - (d / r)^3: int_0^r w d^4 dd / (3 int_0^r w d^2 dd) = (3 r^5 / 40) / (r^3 / 2) = 0.15.
@@ -180,41 +184,37 @@ inline void voxelRange(double x, double reach, double invDx, int& lo, int& hi)
     hi = int(std::floor((x + reach) * invDx));
 }
 
-/// Origins of the leaves that a kernel's bounding box meets, sorted and unique; `order` visits
-/// the kernels in cell order so a block's leaves stay few.
+/// Origins of the leaves that meet the bounding box of the kernels of some cell of `grid` (the
+/// particles' neighbour grid), sorted and unique: a few more leaves than the kernels' own boxes
+/// meet (those leaves sum to phi = 0 and are dropped), at a fiftieth of the keys to sort.
 std::vector<openvdb::Coord> candidateLeaves(const std::vector<Kernel>& kernels,
-                                            const std::vector<sph::Index>& order, double dx)
+                                            const sph::NeighborGrid& grid, double dx)
 {
-    const std::size_t n = order.size();
-    const std::size_t nBlocks = (n + LEAF_KEY_BLOCK - 1) / LEAF_KEY_BLOCK;
-    std::vector<std::vector<openvdb::Coord>> perBlock(nBlocks);
+    const std::size_t nCells = grid.cellCount();
+    std::vector<std::vector<openvdb::Coord>> perCell(nCells);
     const double invDx = 1.0 / dx;
     const int mask = ~(LEAF_DIM - 1);
     parallel::forEach(
-        0, nBlocks, [&](std::size_t b) {
-        std::vector<openvdb::Coord>& keys = perBlock[b];
-        const std::size_t end = std::min(n, (b + 1) * LEAF_KEY_BLOCK);
-        for (std::size_t s = b * LEAF_KEY_BLOCK; s < end; ++s) {
-            const Kernel& k = kernels[order[s]];
-            int lo[3], hi[3];
-            for (int d = 0; d < 3; ++d) {
-                voxelRange(k.centre[d], k.halfExtent[d], invDx, lo[d], hi[d]);
-                lo[d] &= mask;
-                hi[d] &= mask;
-            }
-            for (int i = lo[0]; i <= hi[0]; i += LEAF_DIM)
-                for (int j = lo[1]; j <= hi[1]; j += LEAF_DIM)
-                    for (int l = lo[2]; l <= hi[2]; l += LEAF_DIM) keys.emplace_back(i, j, l);
-            if (keys.size() > 4 * LEAF_KEY_BLOCK) { // keep the block's list short
-                std::sort(keys.begin(), keys.end());
-                keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-            }
+        0, nCells, [&](std::size_t c) {
+        openvdb::Vec3d lo(std::numeric_limits<double>::max()), hi(-lo);
+        const sph::NeighborGrid::SlotRange slots = grid.cellSlotsAt(c);
+        for (std::uint32_t s = slots.begin; s < slots.end; ++s) {
+            const Kernel& k = kernels[grid.particleAt(s)];
+            lo = openvdb::math::minComponent(lo, k.centre - k.halfExtent);
+            hi = openvdb::math::maxComponent(hi, k.centre + k.halfExtent);
         }
-        std::sort(keys.begin(), keys.end());
-        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-        }, 1);
+        int first[3], last[3];
+        for (int d = 0; d < 3; ++d) {
+            first[d] = int(std::ceil(lo[d] * invDx)) & mask;
+            last[d] = int(std::floor(hi[d] * invDx)) & mask;
+        }
+        std::vector<openvdb::Coord>& keys = perCell[c];
+        for (int i = first[0]; i <= last[0]; i += LEAF_DIM)
+            for (int j = first[1]; j <= last[1]; j += LEAF_DIM)
+                for (int l = first[2]; l <= last[2]; l += LEAF_DIM) keys.emplace_back(i, j, l);
+        }, 16);
     std::vector<openvdb::Coord> leaves;
-    for (const auto& keys : perBlock) leaves.insert(leaves.end(), keys.begin(), keys.end());
+    for (const auto& keys : perCell) leaves.insert(leaves.end(), keys.begin(), keys.end());
     std::sort(leaves.begin(), leaves.end());
     leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
     return leaves;
@@ -261,43 +261,160 @@ void splatKernel(const Kernel& k, const openvdb::Coord& origin, double dx,
     }
 }
 
-/// phi (step 4) on every candidate leaf, as inactive values of a fog tree (background 0).
-openvdb::FloatTree::Ptr gatherField(const std::vector<Kernel>& kernels,
-                                    const std::vector<openvdb::Coord>& leaves, double dx)
+/// Gathers phi (step 4) on one leaf from the kernels near it.
+class LeafGather
 {
-    // Neighbour grid over the kernel centres, cells as large as the largest kernel.
-    double maxReach = 0.0;
-    std::vector<sph::Vec3> centres(kernels.size());
-    for (std::size_t j = 0; j < kernels.size(); ++j) {
-        const Kernel& k = kernels[j];
-        centres[j] = sph::Vec3(sph::Real(k.centre[0]), sph::Real(k.centre[1]),
-                               sph::Real(k.centre[2]));
-        maxReach = std::max(maxReach, k.reach);
+public:
+    LeafGather(const std::vector<Kernel>& kernels, double dx)
+        : mKernels(kernels), mDx(dx), mGrid(sph::Real(largestReach(kernels)))
+    {
+        // Neighbour grid over the kernel centres, cells as large as the largest kernel.
+        std::vector<sph::Vec3> centres(kernels.size());
+        for (std::size_t j = 0; j < kernels.size(); ++j) {
+            const openvdb::Vec3d& c = kernels[j].centre;
+            centres[j] = sph::Vec3(sph::Real(c[0]), sph::Real(c[1]), sph::Real(c[2]));
+        }
+        mGrid.build(centres);
+        // Half-diagonal of a leaf between its outermost voxel centres, plus float rounding of
+        // the centres (m).
+        const double leafHalfDiagonal = 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx;
+        mSearchRadius =
+            sph::Real((largestReach(kernels) + leafHalfDiagonal) * (1.0 + 1e-5));
     }
-    sph::NeighborGrid grid{sph::Real(maxReach)};
-    grid.build(centres);
-    // Half-diagonal of a leaf between its outermost voxel centres, plus float rounding of the
-    // centres (m).
-    const double leafHalfDiagonal = 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx;
-    const sph::Real searchRadius = sph::Real((maxReach + leafHalfDiagonal) * (1.0 + 1e-5));
 
-    const sph::CubicSplineKernel unit{sph::Real(1)}; // P: the M4 spline of unit support
-    std::vector<std::unique_ptr<FloatLeaf>> results(leaves.size());
-    parallel::forEach(
-        0, leaves.size(), [&](std::size_t L) {
-        const openvdb::Coord origin = leaves[L];
-        float phi[LEAF_VOXELS] = {}; // float: summed in the neighbour grid's fixed order
-        const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
-        grid.forEachInRadius(centre, searchRadius, [&](sph::Index j, const sph::Vec3&, sph::Real) {
-            splatKernel(kernels[j], origin, dx, unit, phi);
+    /// Add to `phi` the kernels near the leaf at `origin` in order of distance from the leaf's
+    /// centre (nearestFirst: the same order at any thread count), from the `next`-th on; on
+    /// return `next` is where the sum stopped. With `stopAbove` >= 0 the sum stops as soon as
+    /// every voxel exceeds it, and returns true: the leaf is then known to lie inside, and
+    /// calling again with the same `phi` and `next` and no stop completes the same sum.
+    bool gather(const openvdb::Coord& origin, float stopAbove, float* phi, std::size_t& next) const
+    {
+        const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * mDx),
+                               sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * mDx),
+                               sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * mDx));
+        const std::vector<sph::Index> near = nearestFirst(centre);
+        for (; next < near.size(); ++next) {
+            splatKernel(mKernels[near[next]], origin, mDx, mUnit, phi);
+            if (stopAbove >= 0.0f && next % SATURATION_CHECK == SATURATION_CHECK - 1
+                && *std::min_element(phi, phi + LEAF_VOXELS) > stopAbove) {
+                ++next;
+                return true;
+            }
+        }
+        return false;
+    }
+
+private:
+    /// The kernels within the search radius of `centre`, nearest first by shells of
+    /// 1 / DISTANCE_BINS of the radius; within a shell in the grid's order (a stable counting
+    /// sort: cheaper than sorting, and as good for stopping early).
+    std::vector<sph::Index> nearestFirst(const sph::Vec3& centre) const
+    {
+        std::vector<std::pair<int, sph::Index>> found;
+        const sph::Real toBin = sph::Real(DISTANCE_BINS) / mSearchRadius;
+        mGrid.forEachInRadius(centre, mSearchRadius, [&](sph::Index j, const sph::Vec3&,
+                                                         sph::Real r) {
+            found.emplace_back(std::min(int(r * toBin), DISTANCE_BINS - 1), j);
         });
+        std::size_t start[DISTANCE_BINS + 1] = {};
+        for (const auto& f : found) ++start[f.first + 1];
+        for (int b = 0; b < DISTANCE_BINS; ++b) start[b + 1] += start[b];
+        std::vector<sph::Index> order(found.size());
+        for (const auto& f : found) order[start[f.first]++] = f.second;
+        return order;
+    }
+
+    static double largestReach(const std::vector<Kernel>& kernels)
+    {
+        double reach = 0.0;
+        for (const Kernel& k : kernels) reach = std::max(reach, k.reach);
+        return reach;
+    }
+
+    /// Kernels summed between two checks for saturation.
+    static constexpr std::size_t SATURATION_CHECK = 16;
+    /// Distance shells of the nearest-first order.
+    static constexpr int DISTANCE_BINS = 32;
+
+    const std::vector<Kernel>& mKernels;
+    double mDx;
+    sph::NeighborGrid mGrid; ///< kernel centres
+    sph::Real mSearchRadius; ///< (m)
+    const sph::CubicSplineKernel mUnit{sph::Real(1)}; // P: the M4 spline of unit support
+};
+
+/// Whether a leaf whose phi is only known to exceed `iso` everywhere ("saturated") touches a
+/// voxel at or below `iso` across one of its faces: then its values take part in placing the
+/// surface (fast sweeping interpolates phi between such neighbours) and must be exact.
+/// `leaves` is sorted; `phi` and `saturated` are indexed like it; a missing leaf holds 0.
+bool touchesOutside(std::size_t L, const std::vector<openvdb::Coord>& leaves,
+                    const std::vector<std::unique_ptr<FloatLeaf>>& phi,
+                    const std::vector<std::uint8_t>& saturated, float iso)
+{
+    for (int axis = 0; axis < 3; ++axis) {
+        for (int side : {-1, 1}) {
+            openvdb::Coord origin = leaves[L];
+            origin[axis] += side * LEAF_DIM;
+            const auto it = std::lower_bound(leaves.begin(), leaves.end(), origin);
+            if (it == leaves.end() || *it != origin) return true;
+            const std::size_t M = std::size_t(it - leaves.begin());
+            if (!phi[M]) return true; // phi = 0 there
+            if (saturated[M]) continue;
+            // The neighbour's layer of voxels against this leaf.
+            const int layer = side > 0 ? 0 : LEAF_DIM - 1;
+            for (int a = 0; a < LEAF_DIM; ++a) {
+                for (int b = 0; b < LEAF_DIM; ++b) {
+                    openvdb::Coord ijk;
+                    ijk[axis] = layer;
+                    ijk[(axis + 1) % 3] = a;
+                    ijk[(axis + 2) % 3] = b;
+                    if (phi[M]->getValue(FloatLeaf::coordToOffset(ijk)) <= iso) return true;
+                }
+            }
+        }
+    }
+    return false;
+}
+
+/// phi (step 4) on every candidate leaf, as inactive values of a fog tree (background 0).
+/// @details Inside the liquid only the sign of phi - iso matters (fast sweeping reads phi only
+///          where it crosses the iso-value between face neighbours), so a leaf stops summing
+///          once all its voxels exceed the iso-value; the kernels come nearest first, so a leaf
+///          inside the liquid stops after a fraction of them. Such a leaf that touches a voxel
+///          at or below the iso-value across a face then completes its sum. Both passes are
+///          deterministic, so the result is the same at any thread count.
+openvdb::FloatTree::Ptr gatherField(const std::vector<Kernel>& kernels,
+                                    const std::vector<openvdb::Coord>& leaves, double dx, float iso)
+{
+    const LeafGather gather(kernels, dx);
+    std::vector<std::unique_ptr<FloatLeaf>> results(leaves.size());
+    std::vector<std::uint8_t> saturated(leaves.size(), 0);
+    std::vector<std::size_t> next(leaves.size(), 0); // where each leaf's sum stopped
+    auto sumLeaf = [&](std::size_t L, float stopAbove) {
+        float phi[LEAF_VOXELS] = {}; // float: summed in a fixed order
+        if (const FloatLeaf* partial = results[L].get()) { // resume a saturated leaf
+            std::copy(partial->buffer().data(), partial->buffer().data() + LEAF_VOXELS, phi);
+        }
+        saturated[L] = gather.gather(leaves[L], stopAbove, phi, next[L]);
+        results[L].reset();
         if (std::none_of(phi, phi + LEAF_VOXELS, [](float v) { return v > 0.0f; })) return;
-        auto leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+        auto leaf = std::make_unique<FloatLeaf>(leaves[L], 0.0f, false);
         for (int v = 0; v < LEAF_VOXELS; ++v) leaf->setValueOnly(openvdb::Index(v), phi[v]);
         results[L] = std::move(leaf);
-        }, 1);
+    };
+    parallel::forEach(0, leaves.size(), [&](std::size_t L) { sumLeaf(L, iso); }, 1);
+
+    // Complete the saturated leaves whose values place the surface (their sums resume).
+    std::vector<std::uint8_t> redo(leaves.size(), 0);
+    parallel::forEach(
+        0, leaves.size(), [&](std::size_t L) {
+        redo[L] = saturated[L] && touchesOutside(L, leaves, results, saturated, iso);
+        }, 16);
+    std::vector<std::size_t> again;
+    for (std::size_t L = 0; L < leaves.size(); ++L) {
+        if (redo[L]) again.push_back(L);
+    }
+    parallel::forEach(0, again.size(), [&](std::size_t n) { sumLeaf(again[n], -1.0f); }, 1);
 
     auto tree = std::make_shared<openvdb::FloatTree>(0.0f);
     for (auto& leaf : results) { // serial, in leaf order: tree insertion is not thread-safe
@@ -419,11 +536,12 @@ openvdb::FloatGrid::Ptr makeAnisotropicSurfaceGrid(const sph::ParticleSet& parti
     sph::NeighborGrid neighbors{sph::Real(params.neighborhoodRadius)};
     neighbors.build(x);
     const std::vector<Kernel> kernels = makeKernels(neighbors, x, volume, params);
-    const std::vector<openvdb::Coord> leaves = candidateLeaves(kernels, neighbors.order(), dx);
+    const std::vector<openvdb::Coord> leaves = candidateLeaves(kernels, neighbors, dx);
 
-    openvdb::FloatGrid::Ptr fog = openvdb::FloatGrid::create(gatherField(kernels, leaves, dx));
-    fog->setTransform(grid->transform().copy());
     const float iso = float(options.anisotropicIsoValue);
+    openvdb::FloatGrid::Ptr fog =
+        openvdb::FloatGrid::create(gatherField(kernels, leaves, dx, iso));
+    fog->setTransform(grid->transform().copy());
     activateBand(fog->tree(), bandMask(fog->tree(), iso, options.surfaceHalfWidthVoxels));
     if (fog->tree().activeVoxelCount() == 0) return grid; // phi never reaches the iso-value
     grid->setTree(isoSurfaceToLevelSet(*fog, iso, grid->background()));
