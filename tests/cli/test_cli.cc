@@ -354,8 +354,8 @@ TEST_F(Cli, KilledRunLeavesOnlyCompleteFrames)
     scene["outputs"]["preview"] = {{"file", "preview.$F4.exr"}, {"width", 64}, {"height", 36}};
     const std::string path = write(scene);
     const fs::path out = mDir / "out";
-    std::vector<std::string> args = {GHOSTFX_EXE, "run", path, "--out", out.string(),
-                                     "--progress", "none"};
+    std::vector<std::string> args = {GHOSTFX_EXE,  "run",        path,  "--out",
+                                     out.string(), "--progress", "none"};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);

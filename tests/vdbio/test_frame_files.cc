@@ -18,8 +18,8 @@
 #include <ghostfx/vdbio/FrameFiles.h>
 
 #include <openvdb/io/File.h>
-#include <openvdb/tools/Interpolation.h>
 #include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tools/Interpolation.h>
 
 #include "common/Expect.h"
 
@@ -362,8 +362,8 @@ TEST(FrameFiles, DensityVoxelOfOneSpacingKeepsWhatHalfASpacingHolds)
     std::printf("[measured] density at h against h / 2, %zu voxels: trilinear max |diff| %.3g "
                 "(interior %.3g), rms %.3g (rho/rho0); mass %.6g / %.6g kg (liquid %.6g); radius "
                 "of rho/rho0 > 0.5: %.4f / %.4f h\n",
-                count, worst, worstInterior, rms, coarseMass, fineMass, sc.liquidMass, coarseRadius / SPACING,
-                fineRadius / SPACING);
+                count, worst, worstInterior, rms, coarseMass, fineMass, sc.liquidMass,
+                coarseRadius / SPACING, fineRadius / SPACING);
     // Tolerances: linear interpolation at spacing dx errs by at most dx^2 / 8 max|f''|. Across a
     // flat free surface of a lattice (mass rho0 h^3, R = 3 h) rho / rho0 falls from 1 to 0 over
     // about 4 h with max|f''| = 0.39 / h^2 (the plane-integrated M4 profile summed over the
@@ -609,7 +609,8 @@ TEST(FrameFiles, SurfaceOfABodyWithABubbleHasTheRightSideEverywhere)
                 const openvdb::Coord c(i, j, k);
                 const Vec3 p = toVec3(surface->indexToWorld(c));
                 Real d = 0;
-                if (grid.nearest(p, Real(3 * SPACING), [](Index) { return true; }, &d)
+                if (grid.nearest(
+                        p, Real(3 * SPACING), [](Index) { return true; }, &d)
                     == INVALID_INDEX) {
                     d = Real(1e9);
                 }

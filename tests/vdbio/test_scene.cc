@@ -136,8 +136,7 @@ TEST_F(SceneTest, VolumeSurfaceMethodIsReadByName)
     Json s = baseScene();
     EXPECT_EQ(vdbio::readScene(write(s)).outputs.surfaceMethod, vdbio::SurfaceMethod::Spheres);
     s["outputs"]["volume"] = {{"surface_method", "anisotropic"}};
-    EXPECT_EQ(vdbio::readScene(write(s)).outputs.surfaceMethod,
-              vdbio::SurfaceMethod::Anisotropic);
+    EXPECT_EQ(vdbio::readScene(write(s)).outputs.surfaceMethod, vdbio::SurfaceMethod::Anisotropic);
     s["outputs"]["volume"] = {{"surface_method", "anisotropc"}};
     EXPECT_CONTAINS(errorOf(s), "outputs.volume.surface_method = \"anisotropc\": expected one of "
                                 "'spheres', 'anisotropic' (did you mean 'anisotropic'?)");

@@ -38,10 +38,10 @@ using vdbio::SurfaceMethod;
 
 namespace {
 
-constexpr double SPACING = 0.02;          // h (m)
-constexpr double VOXEL = 0.5 * SPACING;   // dx = h / 2 (m)
-constexpr double REST_DENSITY = 1000.0;   // rho0 (kg/m^3)
-constexpr double JITTER = 0.1;            // lattice jitter, +- this * h per axis
+constexpr double SPACING = 0.02;              // h (m)
+constexpr double VOXEL = 0.5 * SPACING;       // dx = h / 2 (m)
+constexpr double REST_DENSITY = 1000.0;       // rho0 (kg/m^3)
+constexpr double JITTER = 0.1;                // lattice jitter, +- this * h per axis
 constexpr double SPHERE_RADIUS = 8 * SPACING; // Poisson-disk liquid sphere (m)
 
 const char* nameOf(SurfaceMethod m) { return sph::nameOf(vdbio::SURFACE_METHOD_NAMES, m); }
@@ -179,8 +179,8 @@ TEST(SurfaceAccuracy, TankFreeSurfaceIsFlatAndHalfASpacingOut)
         std::printf("[measured] %s, tank top face over %zu columns: lattice offset %+.3f h "
                     "(rms %.4f h); jittered +-%.1f h: offset %+.3f h, rms from the plane %.4f h, "
                     "range [%+.3f, %+.3f] h\n",
-                    nameOf(method), exact.count, exact.mean, exact.rms, JITTER, jit.mean,
-                    jit.rms, jit.lo, jit.hi);
+                    nameOf(method), exact.count, exact.mean, exact.rms, JITTER, jit.mean, jit.rms,
+                    jit.lo, jit.hi);
         // Target 0.5 h outside the top layer. Spheres: 0.41 - 0.42 h measured
         // (test_frame_files.cc, flat face; the smoothing averages the dips in), so +-0.1 h as
         // there. Anisotropic: the iso-value was calibrated on this lattice block to
@@ -208,8 +208,8 @@ TEST(SurfaceAccuracy, SphereRadiusIsKept)
     // the sphere, so the liquid's boundary is expected 0.5 h outside the outermost centres.
     const SampleSet samples =
         PoissonDiskSampler(PoissonSettings::forSpacing(Real(SPACING)))
-            .sampleVolume(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(SPHERE_RADIUS),
-                                                          Real(VOXEL))));
+            .sampleVolume(
+                makeLevelSet(makeSphereLevelSet(Vec3(0), Real(SPHERE_RADIUS), Real(VOXEL))));
     std::vector<std::uint8_t> interior(samples.size());
     for (std::size_t i = 0; i < samples.size(); ++i) {
         interior[i] = samples.positions[i].length() < Real(SPHERE_RADIUS - 3 * SPACING);
@@ -280,8 +280,8 @@ TEST(SurfaceAccuracy, ThinSheetKeepsItsThicknessWithoutBeads)
             std::printf("[measured] %s, %d-layer sheet over %zu columns: thickness mean %.3f h "
                         "(expected %.0f h), rms along the sheet %.4f h, range [%.3f, %.3f] h, "
                         "%zu holes, %zu extra crossings\n",
-                        nameOf(method), layers, t.count, t.mean, expected, t.rms, t.lo, t.hi,
-                        holes, extraCrossings);
+                        nameOf(method), layers, t.count, t.mean, expected, t.rms, t.lo, t.hi, holes,
+                        extraCrossings);
             // No holes and a single slab in every column: a bead chain would pinch through.
             EXPECT_EQ(holes, 0u) << nameOf(method) << ", " << layers << " layers";
             EXPECT_EQ(extraCrossings, 0u) << nameOf(method) << ", " << layers << " layers";

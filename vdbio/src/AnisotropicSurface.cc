@@ -161,7 +161,8 @@ Kernel makeKernel(const sph::NeighborGrid& grid, sph::Index i, const sph::Vec3& 
         k.halfExtent[a] = std::sqrt(extent2);
     }
     k.reach = p.kernelRadius * std::max({stretch[0], stretch[1], stretch[2]});
-    k.weight = volume / (stretch[0] * stretch[1] * stretch[2] * openvdb::math::Pow3(p.kernelRadius));
+    k.weight =
+        volume / (stretch[0] * stretch[1] * stretch[2] * openvdb::math::Pow3(p.kernelRadius));
     return k;
 }
 
@@ -171,9 +172,9 @@ std::vector<Kernel> makeKernels(const sph::NeighborGrid& grid, const std::vector
 {
     std::vector<Kernel> kernels(x.size());
     parallel::forEach(
-        0, x.size(), [&](std::size_t i) {
-        kernels[i] = makeKernel(grid, sph::Index(i), x[i], volume[i], p);
-        }, 64);
+        0, x.size(),
+        [&](std::size_t i) { kernels[i] = makeKernel(grid, sph::Index(i), x[i], volume[i], p); },
+        64);
     return kernels;
 }
 
@@ -195,7 +196,8 @@ std::vector<openvdb::Coord> candidateLeaves(const std::vector<Kernel>& kernels,
     const double invDx = 1.0 / dx;
     const int mask = ~(LEAF_DIM - 1);
     parallel::forEach(
-        0, nCells, [&](std::size_t c) {
+        0, nCells,
+        [&](std::size_t c) {
         openvdb::Vec3d lo(std::numeric_limits<double>::max()), hi(-lo);
         const sph::NeighborGrid::SlotRange slots = grid.cellSlotsAt(c);
         for (std::uint32_t s = slots.begin; s < slots.end; ++s) {
@@ -212,7 +214,8 @@ std::vector<openvdb::Coord> candidateLeaves(const std::vector<Kernel>& kernels,
         for (int i = first[0]; i <= last[0]; i += LEAF_DIM)
             for (int j = first[1]; j <= last[1]; j += LEAF_DIM)
                 for (int l = first[2]; l <= last[2]; l += LEAF_DIM) keys.emplace_back(i, j, l);
-        }, 16);
+        },
+        16);
     std::vector<openvdb::Coord> leaves;
     for (const auto& keys : perCell) leaves.insert(leaves.end(), keys.begin(), keys.end());
     std::sort(leaves.begin(), leaves.end());
@@ -266,7 +269,9 @@ class LeafGather
 {
 public:
     LeafGather(const std::vector<Kernel>& kernels, double dx)
-        : mKernels(kernels), mDx(dx), mGrid(sph::Real(largestReach(kernels)))
+        : mKernels(kernels)
+        , mDx(dx)
+        , mGrid(sph::Real(largestReach(kernels)))
     {
         // Neighbour grid over the kernel centres, cells as large as the largest kernel.
         std::vector<sph::Vec3> centres(kernels.size());
@@ -278,8 +283,7 @@ public:
         // Half-diagonal of a leaf between its outermost voxel centres, plus float rounding of
         // the centres (m).
         const double leafHalfDiagonal = 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx;
-        mSearchRadius =
-            sph::Real((largestReach(kernels) + leafHalfDiagonal) * (1.0 + 1e-5));
+        mSearchRadius = sph::Real((largestReach(kernels) + leafHalfDiagonal) * (1.0 + 1e-5));
     }
 
     /// Add to `phi` the kernels near the leaf at `origin` in order of distance from the leaf's
@@ -312,8 +316,8 @@ private:
     {
         std::vector<std::pair<int, sph::Index>> found;
         const sph::Real toBin = sph::Real(DISTANCE_BINS) / mSearchRadius;
-        mGrid.forEachInRadius(centre, mSearchRadius, [&](sph::Index j, const sph::Vec3&,
-                                                         sph::Real r) {
+        mGrid.forEachInRadius(centre, mSearchRadius,
+                              [&](sph::Index j, const sph::Vec3&, sph::Real r) {
             found.emplace_back(std::min(int(r * toBin), DISTANCE_BINS - 1), j);
         });
         std::size_t start[DISTANCE_BINS + 1] = {};
@@ -338,8 +342,8 @@ private:
 
     const std::vector<Kernel>& mKernels;
     double mDx;
-    sph::NeighborGrid mGrid; ///< kernel centres
-    sph::Real mSearchRadius; ///< (m)
+    sph::NeighborGrid mGrid;                          ///< kernel centres
+    sph::Real mSearchRadius;                          ///< (m)
     const sph::CubicSplineKernel mUnit{sph::Real(1)}; // P: the M4 spline of unit support
 };
 
@@ -391,7 +395,7 @@ openvdb::FloatTree::Ptr gatherField(const std::vector<Kernel>& kernels,
     std::vector<std::uint8_t> saturated(leaves.size(), 0);
     std::vector<std::size_t> next(leaves.size(), 0); // where each leaf's sum stopped
     auto sumLeaf = [&](std::size_t L, float stopAbove) {
-        float phi[LEAF_VOXELS] = {}; // float: summed in a fixed order
+        float phi[LEAF_VOXELS] = {};                       // float: summed in a fixed order
         if (const FloatLeaf* partial = results[L].get()) { // resume a saturated leaf
             std::copy(partial->buffer().data(), partial->buffer().data() + LEAF_VOXELS, phi);
         }
@@ -402,19 +406,23 @@ openvdb::FloatTree::Ptr gatherField(const std::vector<Kernel>& kernels,
         for (int v = 0; v < LEAF_VOXELS; ++v) leaf->setValueOnly(openvdb::Index(v), phi[v]);
         results[L] = std::move(leaf);
     };
-    parallel::forEach(0, leaves.size(), [&](std::size_t L) { sumLeaf(L, iso); }, 1);
+    parallel::forEach(
+        0, leaves.size(), [&](std::size_t L) { sumLeaf(L, iso); }, 1);
 
     // Complete the saturated leaves whose values place the surface (their sums resume).
     std::vector<std::uint8_t> redo(leaves.size(), 0);
     parallel::forEach(
-        0, leaves.size(), [&](std::size_t L) {
+        0, leaves.size(),
+        [&](std::size_t L) {
         redo[L] = saturated[L] && touchesOutside(L, leaves, results, saturated, iso);
-        }, 16);
+        },
+        16);
     std::vector<std::size_t> again;
     for (std::size_t L = 0; L < leaves.size(); ++L) {
         if (redo[L]) again.push_back(L);
     }
-    parallel::forEach(0, again.size(), [&](std::size_t n) { sumLeaf(again[n], -1.0f); }, 1);
+    parallel::forEach(
+        0, again.size(), [&](std::size_t n) { sumLeaf(again[n], -1.0f); }, 1);
 
     auto tree = std::make_shared<openvdb::FloatTree>(0.0f);
     for (auto& leaf : results) { // serial, in leaf order: tree insertion is not thread-safe
@@ -433,7 +441,8 @@ openvdb::MaskTree bandMask(const openvdb::FloatTree& phi, float iso, int halfWid
     for (auto it = phi.cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
     std::vector<std::unique_ptr<MaskLeaf>> crossings(leaves.size());
     parallel::forEach(
-        0, leaves.size(), [&](std::size_t L) {
+        0, leaves.size(),
+        [&](std::size_t L) {
         const FloatLeaf& leaf = *leaves[L];
         openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(phi);
         std::unique_ptr<MaskLeaf> mask;
@@ -456,7 +465,8 @@ openvdb::MaskTree bandMask(const openvdb::FloatTree& phi, float iso, int halfWid
             mask->setValueOn(it.pos());
         }
         crossings[L] = std::move(mask);
-        }, 4);
+        },
+        4);
     openvdb::MaskTree band(false);
     for (auto& leaf : crossings) {
         if (leaf) band.addLeaf(leaf.release());
@@ -476,16 +486,17 @@ void activateBand(openvdb::FloatTree& phi, const openvdb::MaskTree& band)
     leaves.reserve(phi.leafCount());
     for (auto it = phi.beginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
     parallel::forEach(
-        0, leaves.size(), [&](std::size_t L) {
+        0, leaves.size(),
+        [&](std::size_t L) {
         FloatLeaf& leaf = *leaves[L];
         const MaskLeaf* mask = band.probeConstLeaf(leaf.origin());
         leaf.setValueMask(mask ? mask->getValueMask() : FloatLeaf::NodeMaskType());
-        }, 16);
+        },
+        16);
 }
 
 /// Narrow-band level set of `phi` = iso (inside: phi > iso), background `background` (m).
-openvdb::FloatTree::Ptr isoSurfaceToLevelSet(openvdb::FloatGrid& fog, float iso,
-                                            float background)
+openvdb::FloatTree::Ptr isoSurfaceToLevelSet(openvdb::FloatGrid& fog, float iso, float background)
 {
     openvdb::FloatGrid::Ptr sdf = openvdb::tools::fogToSdf(fog, iso, /*nIter=*/1);
     openvdb::FloatTree& tree = sdf->tree();
@@ -519,13 +530,11 @@ openvdb::FloatGrid::Ptr makeAnisotropicSurfaceGrid(const sph::ParticleSet& parti
     grid->insertMeta("surface_method", openvdb::StringMetadata("anisotropic"));
     if (selection.empty()) return grid;
 
-    const Params params{options.anisotropicKernelSpacings * h,
-                        options.anisotropicNeighborhoodSpacings * h,
-                        options.anisotropicSmoothing,
-                        options.anisotropicMaxStretch,
-                        options.anisotropicMinNeighbors,
-                        options.anisotropicScale,
-                        options.anisotropicIsolatedScale};
+    const Params params{
+        options.anisotropicKernelSpacings * h, options.anisotropicNeighborhoodSpacings * h,
+        options.anisotropicSmoothing,          options.anisotropicMaxStretch,
+        options.anisotropicMinNeighbors,       options.anisotropicScale,
+        options.anisotropicIsolatedScale};
     const std::size_t n = selection.size();
     std::vector<sph::Vec3> x(n);
     std::vector<double> volume(n);
@@ -539,8 +548,7 @@ openvdb::FloatGrid::Ptr makeAnisotropicSurfaceGrid(const sph::ParticleSet& parti
     const std::vector<openvdb::Coord> leaves = candidateLeaves(kernels, neighbors, dx);
 
     const float iso = float(options.anisotropicIsoValue);
-    openvdb::FloatGrid::Ptr fog =
-        openvdb::FloatGrid::create(gatherField(kernels, leaves, dx, iso));
+    openvdb::FloatGrid::Ptr fog = openvdb::FloatGrid::create(gatherField(kernels, leaves, dx, iso));
     fog->setTransform(grid->transform().copy());
     activateBand(fog->tree(), bandMask(fog->tree(), iso, options.surfaceHalfWidthVoxels));
     if (fog->tree().activeVoxelCount() == 0) return grid; // phi never reaches the iso-value

@@ -38,9 +38,9 @@
 ///          than `reach` - ceil(R / dx + 1/2) voxels from N; with reach at least the sum, the
 ///          positive voxels farther than m from N are the deep interior and are set inside, and
 ///          tools::signedFloodFill fills the rest. Every kept voxel gets the value the full
-///          union gives it (FrameFiles.SurfaceOfABodyWithABubble* checks the sides against a brute-force
-///          nearest-particle distance), at a fraction of the work in a deep body of liquid (bench/RESULTS.md,
-///          "Frame output").
+///          union gives it (FrameFiles.SurfaceOfABodyWithABubble* checks the sides against a
+///          brute-force nearest-particle distance), at a fraction of the work in a deep body of
+///          liquid (bench/RESULTS.md, "Frame output").
 ///          The union and the filters use min / Jacobi updates, so the result does not depend on
 ///          the thread count. The recipe is that of Houdini's "VDB from Particles" followed by
 ///          "VDB Reshape SDF" (dilate, smooth, erode) and "VDB Smooth SDF".
@@ -84,8 +84,7 @@ inline openvdb::Coord nearestVoxel(const sph::Vec3& x, double invDx)
 /// Mask of the voxel centres within `radius` (m) of a selected particle: the inside of the
 /// union of spheres. Built per thread and merged by topology union (order-independent).
 openvdb::MaskTree coveredVoxels(const std::vector<sph::Vec3>& x,
-                                const std::vector<sph::Index>& selection, double dx,
-                                double radius)
+                                const std::vector<sph::Index>& selection, double dx, double radius)
 {
     const double invDx = 1.0 / dx;
     const double r = radius * invDx; // voxels
@@ -129,15 +128,14 @@ struct Shell
 /// @param covered  voxel centres certainly inside the union (within r of a particle)
 /// @param radius   the union's sphere radius R (m); @param halfWidth w (voxels)
 Shell surfaceParticles(const std::vector<sph::Vec3>& x, const std::vector<sph::Index>& selection,
-                       const openvdb::MaskTree& covered, double dx, double radius,
-                       int halfWidth)
+                       const openvdb::MaskTree& covered, double dx, double radius, int halfWidth)
 {
     using openvdb::tools::IGNORE_TILES;
     using openvdb::tools::NN_FACE_EDGE_VERTEX;
     const double R = radius / dx; // voxels
     const int m = int(std::ceil(R + halfWidth + 0.5));
-    const int reach = std::max(int(std::ceil(R + std::sqrt(3.0) * halfWidth + 0.5)),
-                               int(std::ceil(R + 0.5)) + m);
+    const int reach =
+        std::max(int(std::ceil(R + std::sqrt(3.0) * halfWidth + 0.5)), int(std::ceil(R + 0.5)) + m);
     Shell shell;
     // N: uncovered voxels next to the covered set.
     shell.exteriorReach.topologyUnion(covered);
@@ -199,8 +197,8 @@ void rasterizeUnion(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& posi
         const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
                                sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
                                sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
-        neighbours.forEachInRadius(centre, searchRadius, [&](sph::Index j, const sph::Vec3&,
-                                                             sph::Real) {
+        neighbours.forEachInRadius(centre, searchRadius,
+                                   [&](sph::Index j, const sph::Vec3&, sph::Real) {
             const double xj[3] = {double(x[j][0]), double(x[j][1]), double(x[j][2])};
             int lo[3], hi[3];
             for (int d = 0; d < 3; ++d) {
@@ -303,8 +301,8 @@ openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,
     const std::vector<sph::Vec3>& x = particles.positions();
     const double unionRadius = radius + closing; // R: the closing by c, exactly (step 1)
     const openvdb::MaskTree covered = coveredVoxels(x, selection, dx, radius);
-    const Shell shell = surfaceParticles(x, selection, covered, dx, unionRadius,
-                                         options.surfaceHalfWidthVoxels);
+    const Shell shell =
+        surfaceParticles(x, selection, covered, dx, unionRadius, options.surfaceHalfWidthVoxels);
     rasterizeUnion(*grid, x, shell, unionRadius);
     openvdb::tools::pruneLevelSet(grid->tree());
     trimInterior(*grid, options.surfaceHalfWidthVoxels);

@@ -49,8 +49,8 @@ void validateAnisotropic(const VolumeOptions& o, const char* where)
     }
     if (!(std::isfinite(o.anisotropicNeighborhoodSpacings)
           && o.anisotropicNeighborhoodSpacings >= 1.0)) {
-        throw ValueError(msg(where, "anisotropic neighbourhood = ",
-                             o.anisotropicNeighborhoodSpacings,
+        throw ValueError(msg(where,
+                             "anisotropic neighbourhood = ", o.anisotropicNeighborhoodSpacings,
                              " spacings: expected >= 1 (the paper uses twice the kernel)"));
     }
     if (!(o.anisotropicSmoothing >= 0.0 && o.anisotropicSmoothing <= 1.0)) {

@@ -199,7 +199,10 @@ struct VolumeOptions
     void validate() const;
 
     /// The voxel edge (m) the density, velocity and channel grids use.
-    double fogVoxelSize() const { return densityVoxelSize > 0 ? densityVoxelSize : particleSpacing; }
+    double fogVoxelSize() const
+    {
+        return densityVoxelSize > 0 ? densityVoxelSize : particleSpacing;
+    }
 };
 
 /// Build the grids asked for, in this order: "surface" (GRID_LEVEL_SET FloatGrid, background
