@@ -564,6 +564,55 @@ TEST(FrameFiles, SurfaceOfAFlatFaceSitsHalfASpacingOutside)
     EXPECT_NEAR(offset, 0.5, 0.1);
 }
 
+TEST(FrameFiles, SprayKeepsADropletOfItsVolume)
+{
+    // A 10^3 lattice block and one particle 6 h from its +x face. Closing, smoothing and
+    // erosion would erase the lone particle's sphere; the spray droplet keeps a sphere of
+    // radius 0.62 h (volume h^3) about it: its zero crossing along x through the particle,
+    // found by linear interpolation between voxels, within a tenth of a voxel of that radius
+    // (the band holds exact distances, so only the interpolation errs). With the droplet off,
+    // nothing of the particle is inside.
+    ParticleSet p;
+    const int n = 10;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            for (int k = 0; k < n; ++k) {
+                p.add(Vec3(Real(i * SPACING), Real(j * SPACING), Real(k * SPACING)), Vec3(0),
+                      Real(1), ParticleKind::Liquid);
+            }
+    const int lone = int(std::lround((n - 1 + 6) * SPACING / VOXEL)); // voxel index along x
+    const int mid = int(std::lround((n - 1) * SPACING / 2 / VOXEL));
+    const Vec3 spray(Real(lone * VOXEL), Real(mid * VOXEL), Real(mid * VOXEL));
+    p.add(spray, Vec3(0), Real(1), ParticleKind::Liquid);
+    for (const double droplet : {0.62, 0.0}) {
+        vdbio::VolumeOptions o = volumeOptions();
+        o.density = o.velocity = false;
+        o.surfaceSprayRadiusSpacings = droplet;
+        const auto surface =
+            openvdb::gridPtrCast<openvdb::FloatGrid>(vdbio::makeVolumeGrids(p, o).at(0));
+        const auto acc = surface->getConstAccessor();
+        const float centre = acc.getValue(openvdb::Coord(lone, mid, mid));
+        if (droplet == 0.0) {
+            std::printf("[measured] spray without a droplet: phi at the particle %+.3f h\n",
+                        double(centre) / SPACING);
+            EXPECT_GT(centre, 0.0f);
+            continue;
+        }
+        double crossing = std::nan("");
+        for (int i = lone; i < lone + 4; ++i) {
+            const float a = acc.getValue(openvdb::Coord(i, mid, mid));
+            const float b = acc.getValue(openvdb::Coord(i + 1, mid, mid));
+            if (a < 0 && b >= 0) crossing = (i + double(a) / double(a - b) - lone) * VOXEL;
+        }
+        ASSERT_FALSE(std::isnan(crossing));
+        std::printf(
+            "[measured] spray droplet: phi at the particle %+.3f h, radius along x %.3f h\n",
+            double(centre) / SPACING, crossing / SPACING);
+        EXPECT_NEAR(centre, -droplet * SPACING, 1e-6);
+        EXPECT_NEAR(crossing, droplet * SPACING, 0.1 * VOXEL);
+    }
+}
+
 TEST(FrameFiles, SurfaceOfABodyWithABubbleHasTheRightSideEverywhere)
 {
     // A 40^3 jittered lattice block (h = 2 cm) with a spherical bubble of radius 5 h at its

@@ -247,6 +247,60 @@ void rasterizeUnion(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& posi
 constexpr int NORMALISATION_SWEEPS = 1;
 constexpr openvdb::math::BiasedGradientScheme RENORMALISATION_SCHEME = openvdb::math::FIRST_BIAS;
 
+/// A particle with no other within this many spacings is spray (see addSprayDroplets).
+constexpr double SPRAY_ISOLATION_SPACINGS = 2.0;
+
+/// Spray: the closing, smoothing and erosion shrink the sphere of an isolated particle below a
+/// voxel and erase it (a lone particle leaves no surface), so every rasterised particle with no
+/// other rasterised particle within `isolation` (m) gets a droplet of radius `droplet` (m) added
+/// by CSG union: exact distances |x - p| - droplet in its band. Spray is never deep (uncovered
+/// voxels surround it). A particle whose only neighbours are deep ones would pass the test too,
+/// but then every voxel centre within 2.6 h of it is covered (the deep neighbour's reach), the
+/// surface lies more than the band's half width from its droplet, and the union changes nothing.
+void addSprayDroplets(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& x,
+                      const std::vector<sph::Index>& shell, double droplet, double isolation)
+{
+    std::vector<sph::Vec3> positions(shell.size());
+    for (std::size_t k = 0; k < shell.size(); ++k) positions[k] = x[shell[k]];
+    sph::NeighborGrid neighbours{sph::Real(isolation)};
+    neighbours.build(positions);
+    std::vector<std::uint8_t> isolated(positions.size());
+    parallel::forEach(
+        0, positions.size(),
+        [&](std::size_t k) {
+        int within = 0;
+        neighbours.forEachInRadius(positions[k], sph::Real(isolation),
+                                   [&](sph::Index, const sph::Vec3&, sph::Real) { ++within; });
+        isolated[k] = within <= 1; // itself only
+        },
+        1024);
+    std::vector<sph::Vec3> spray;
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+        if (isolated[k]) spray.push_back(positions[k]);
+    }
+    if (spray.empty()) return;
+    const double dx = grid.voxelSize()[0];
+    const double invDx = 1.0 / dx;
+    const float background = grid.background();
+    const double reach = droplet + double(background);
+    openvdb::FloatGrid::Accessor acc = grid.getAccessor();
+    for (const sph::Vec3& p : spray) {
+        int lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) voxelRange(double(p[d]), reach, invDx, lo[d], hi[d]);
+        openvdb::Coord c;
+        for (c.x() = lo[0]; c.x() <= hi[0]; ++c.x()) {
+            for (c.y() = lo[1]; c.y() <= hi[1]; ++c.y()) {
+                for (c.z() = lo[2]; c.z() <= hi[2]; ++c.z()) {
+                    const openvdb::Vec3d r(c.x() * dx - double(p[0]), c.y() * dx - double(p[1]),
+                                           c.z() * dx - double(p[2]));
+                    const float phi = std::max(float(r.length() - droplet), -background);
+                    if (phi < background && phi < acc.getValue(c)) acc.setValue(c, phi);
+                }
+            }
+        }
+    }
+}
+
 /// Make every interior voxel farther than `halfWidthVoxels` (Chebyshev, in voxels) from the
 /// exterior (phi >= 0) an inactive interior voxel (value -background), then prune.
 void trimInterior(openvdb::FloatGrid& grid, int halfWidthVoxels)
@@ -313,6 +367,10 @@ openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,
     for (int i = 0; i < options.surfaceSmoothingIterations; ++i) filter.meanCurvature();
     const double erosion = unionRadius - offset;
     if (erosion != 0.0) filter.offset(float(erosion));
+    if (options.surfaceSprayRadiusSpacings > 0.0) {
+        addSprayDroplets(*grid, x, shell.particles, options.surfaceSprayRadiusSpacings * h,
+                         SPRAY_ISOLATION_SPACINGS * h);
+    }
     return grid;
 }
 

@@ -200,6 +200,10 @@ void VolumeOptions::validate() const
                                  " spacings: expected finite and <= radius + closing = ",
                                  surfaceRadiusSpacings + surfaceClosingSpacings));
         }
+        if (!(std::isfinite(surfaceSprayRadiusSpacings) && surfaceSprayRadiusSpacings >= 0.0)) {
+            throw ValueError(msg(where, "surface spray radius = ", surfaceSprayRadiusSpacings,
+                                 " spacings: expected >= 0 (0 leaves spray out)"));
+        }
         if (surfaceHalfWidthVoxels < 3) {
             throw ValueError(msg(where, "surface half width = ", surfaceHalfWidthVoxels,
                                  " voxels: expected >= 3 (the level-set filters' stencils)"));

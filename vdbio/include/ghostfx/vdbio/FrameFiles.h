@@ -148,6 +148,10 @@ struct VolumeOptions
     /// particle stands for a cube of side h about its centre, so 0.5 makes the enclosed volume
     /// match N h^3 for a lattice.
     double surfaceOffsetSpacings = 0.5;
+    /// Radius / h of the droplet kept around spray, a particle with no other within 2 h: the
+    /// closing and smoothing erase a lone sphere, so without it spray leaves no surface. 0.62
+    /// gives the droplet the particle's volume h^3; 0 leaves spray out.
+    double surfaceSprayRadiusSpacings = 0.62;
     /// Narrow-band half width (voxels) of the written level set; background = this * voxelSize.
     int surfaceHalfWidthVoxels = 3;
 
