@@ -58,6 +58,7 @@ struct Options
     int warmup = 20;              ///< steps before the measurement (>= 1)
     double cfl = 0;               ///< > 0: CFL-limited dt with this number instead of PAPER_DT
     double stiffness = 0;         ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
+    double shifting = -1;         ///< >= 0: particle shifting coefficient instead of the default
     double lennardJones = 0;      ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
     int threads = 0;              ///< TBB threads, 0 = all
     std::string scenes = "all";   ///< dam, sphere or all
@@ -313,6 +314,7 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     settings.seed = opt.seed;
     if (opt.cfl > 0) settings.cflNumber = Real(opt.cfl);
     if (opt.stiffness > 0) settings.stiffness = Real(opt.stiffness);
+    if (opt.shifting >= 0) settings.shiftingCoefficient = Real(opt.shifting);
     if (opt.lennardJones > 0) settings.lennardJonesStrength = Real(opt.lennardJones);
 
     std::vector<RunResult> results;
@@ -375,6 +377,8 @@ int main(int argc, char** argv)
     app.add_option("--cfl", opt.cfl,
                    "CFL-limited dt with this number (default: fixed dt = 1/600 s)")
         ->check(CLI::Range(1e-6, 2.0));
+    app.add_option("--shifting", opt.shifting,
+                   "particle shifting coefficient A (default 2; 0 = off)");
     app.add_option("--stiffness", opt.stiffness, "Tait stiffness k (Pa; default: [SB12] 2000)")
         ->check(CLI::PositiveNumber);
     app.add_option("--lj", opt.lennardJones,

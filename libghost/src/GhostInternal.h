@@ -19,6 +19,14 @@
 namespace ghostfx {
 namespace ghost {
 
+/// A continuous liquid source.
+struct GhostSolver::Emitter
+{
+    sph::LevelSet shape;
+    sph::Vec3 velocity;
+    double start, end;
+};
+
 /// A solid: its level set (in its local frame), its rigid motion, and whether it moves (a
 /// static solid's particles live in the static block and are never re-placed).
 struct GhostSolver::Solid : sph::MovingLevelSet

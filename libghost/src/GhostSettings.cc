@@ -30,6 +30,28 @@ Real GhostSettings::soundSpeed() const
     return std::sqrt(Real(7) * stiffness / restDensity);
 }
 
+Real GhostSettings::solidDragReferenceStep(Real vmax) const
+{
+    // Why a rate (issue 18): with epsilon per step, the wall drag per second grows as 1 / dt,
+    // i.e. as sqrt(k) on acoustic steps, and a stiff liquid crept along the floor. The
+    // liquid's own epsilon stays per step, as [SB12] defines it: it damps the acoustic noise,
+    // whose frequency grows with sqrt(k) as the steps do (bench/RESULTS.md, "Stiff liquid").
+    const Real referenceStiffness = Real(2000), referenceCfl = Real(0.4);
+    const Real c = std::sqrt(Real(7) * referenceStiffness / restDensity);
+    return referenceCfl * spacing / (c + vmax);
+}
+
+Real GhostSettings::shifting() const
+{
+    if (shiftingCoefficient >= Real(0)) return shiftingCoefficient;
+    return stiffness > Real(20000) ? Real(2) : Real(0);
+}
+
+Real GhostSettings::solidEpsilonForStep(Real dt, Real vmax) const
+{
+    return std::min(Real(1), solidEpsilon * (dt / solidDragReferenceStep(vmax)));
+}
+
 Real GhostSettings::speedLimit() const
 {
     return maxSpeed > Real(0) ? maxSpeed : Real(20) * soundSpeed();
@@ -49,6 +71,9 @@ void GhostSettings::validate() const
     check.require(xsphEpsilon >= 0 && xsphEpsilon <= 1, "xsphEpsilon", xsphEpsilon,
                   "0 to 1 ([SB12]: 0.05)");
     check.require(solidEpsilon >= 0 && solidEpsilon <= 1, "solidEpsilon", solidEpsilon, "0 to 1");
+    check.require(shiftingCoefficient <= 20 && check.finite(shiftingCoefficient),
+                  "shiftingCoefficient", shiftingCoefficient,
+                  "0 (off) to 20, or negative (automatic)");
     check.require(airResampleSteps >= 1, "airResampleSteps", airResampleSteps,
                   ">= 1 ([SB12]: about 10)");
     check.require(airKeepFraction >= 0 && check.finite(airKeepFraction), "airKeepFraction",

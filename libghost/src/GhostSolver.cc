@@ -21,14 +21,6 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-/// A continuous liquid source.
-struct GhostSolver::Emitter
-{
-    LevelSet shape;
-    Vec3 velocity;
-    double start, end;
-};
-
 GhostSolver::GhostSolver(const GhostSettings& settings)
     : mSettings(settings)
     , mKernel((settings.validate(), settings.supportRadius()))

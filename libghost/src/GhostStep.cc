@@ -244,6 +244,9 @@ void GhostSolver::stepGhost(Real dt)
     parallel::forEach(
         0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);
     std::vector<Real> accel(n, Real(0));
+    // Particle shifting needs grad C = sum_j (m_j / rho0) grad W_ij over the same pairs.
+    const bool shifting = mSettings.shifting() > Real(0);
+    std::vector<Vec3> gradMass(shifting ? n : 0, Vec3(0));
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
@@ -260,6 +263,10 @@ void GhostSolver::stepGhost(Real dt)
                 for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + mScratch[b.j[k]]);
                 for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
                 a += b.sumScaledOffsets(b.f);
+                if (shifting) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * kernel.gradFactor(b.r[k]);
+                    gradMass[i] += b.sumScaledOffsets(b.f);
+                }
             });
             for (const SolidBlock* block : {&mStatic, &mMoving}) {
                 const Real* ratio = block->pOverRho2.data();
@@ -268,6 +275,10 @@ void GhostSolver::stepGhost(Real dt)
                     for (int k = 0; k < b.n; ++k) b.f[k] = M * (pi + ratio[b.j[k]]);
                     for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
                     a += b.sumScaledOffsets(b.f);
+                    if (shifting) {
+                        for (int k = 0; k < b.n; ++k) b.f[k] = M * kernel.gradFactor(b.r[k]);
+                        gradMass[i] += b.sumScaledOffsets(b.f);
+                    }
                 });
             }
             vstar[i] = v[i] + dt * a;
@@ -284,7 +295,14 @@ void GhostSolver::stepGhost(Real dt)
     // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid
     // neighbours only: air would bias the outermost particles ([SB12] Sec. 4.3). The weight
     // eps m_j / rho_j of each neighbour is computed once (zero for air).
-    const Real eps = mSettings.xsphEpsilon, epsSolid = mSettings.solidEpsilon;
+    // The wall drag is a rate (GhostSettings::solidEpsilonForStep), scaled by this step's dt
+    // against the reference step at the liquid's largest speed.
+    Real vmax = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (kind[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
+    }
+    const Real eps = mSettings.xsphEpsilon;
+    const Real epsSolid = mSettings.solidEpsilonForStep(dt, vmax);
     parallel::forEach(
         0, n,
         [&](std::size_t j) {
@@ -347,6 +365,32 @@ void GhostSolver::stepGhost(Real dt)
     auto& xw = mParticles.positions();
     parallel::forEach(
         0, n, [&](std::size_t i) { xw[i] += dt * v[i]; }, 4096);
+    if (shifting) {
+        // Particle shifting (GhostSettings::shiftingCoefficient): down the concentration
+        // gradient, by a diffusion coefficient A h |v| dt that grows with the distance moved,
+        // so a liquid at rest is not shifted. grad C = grad(sum m W) / rho0.
+        const Real h = mSettings.spacing;
+        const Real scale = mSettings.shifting() * h * dt / mSettings.restDensity;
+        const Real cap = Real(0.1) * h;
+        const Real completeDensity = Real(0.9) * mSettings.restDensity;
+        parallel::forEach(
+            0, n,
+            [&](std::size_t i) {
+            // A particle whose neighbourhood is far from complete (a fresh emitter layer, a
+            // drop outside the air layer) has no even spacing to move towards: not shifted.
+            // Liquid inside an emitter keeps the emitter's packing: the volume rate is set by
+            // how the emitter fills its shape.
+            if (kind[i] != ParticleKind::Liquid || rho[i] < completeDensity) return;
+            for (const auto& em : mEmitters) {
+                if (em->shape.bounds().contains(x[i]) && em->shape.phi(x[i]) < Real(0)) return;
+            }
+            Vec3 d = -(scale * v[i].length()) * gradMass[i];
+            const Real length = d.length();
+            if (length > cap) d *= cap / length;
+            xw[i] += d;
+            },
+            4096);
+    }
     mTimings.xsphAndBoundary += secondsSince(t0);
 }
 

@@ -46,8 +46,17 @@ struct GhostSettings
     Vec3 gravity{0, Real(-9.81), 0}; ///< (m/s^2)
 
     // Ghost SPH ([SB12] Sec. 4) ------------------------------------------------------------------
-    Real xsphEpsilon = Real(0.05);  ///< epsilon of Eq. 2 (XSPH on velocities)
-    Real solidEpsilon = Real(0.05); ///< epsilon of Eq. 2 for ghost-solid neighbours
+    Real xsphEpsilon = Real(0.05); ///< epsilon of Eq. 2 (XSPH on velocities)
+    /// Epsilon of Eq. 2 for ghost-solid neighbours: the wall drag of one reference step
+    /// (solidDragReferenceStep()); a step of dt applies solidEpsilon dt / dt_ref, so the drag is
+    /// a rate that does not grow with the number of steps (a stiffer k or a smaller CFL).
+    Real solidEpsilon = Real(0.05);
+    /// Particle shifting (Skillen et al. 2013's form): after each step a liquid particle moves
+    /// by -A h |v| dt grad C, C the summed particle concentration with the ghosts, towards an
+    /// even spacing (at most 0.1 h a step). It keeps the density noise of a stiff k from
+    /// growing; ghost air gives surface particles a full neighbourhood, so no surface special
+    /// case is needed. 0 = off; negative = automatic (shifting()).
+    Real shiftingCoefficient = Real(-1);
     SolidSlip solidSlip = SolidSlip::Free;
     int airResampleSteps = 10; ///< resample the ghost air every N steps ([SB12]: about 10)
     /// At a resampling, air particles closer than this fraction of the Poisson radius r to the
@@ -85,6 +94,16 @@ struct GhostSettings
     Real soundSpeed() const;
     /// The blow-up speed bound actually used (m/s).
     Real speedLimit() const;
+    /// The shifting coefficient in use: shiftingCoefficient, or when automatic 2 above
+    /// k = 2e4 Pa and 0 below (where the collapse of issue 18 does not need it, and it costs
+    /// 24 % of a step: bench/RESULTS.md, "Stiff liquid").
+    Real shifting() const;
+    /// The step at which solidEpsilon is the per-step wall drag: the acoustic step of [SB12]'s
+    /// k = 2000 Pa at CFL 0.4 (the defaults), 0.4 h / (c(2000 Pa) + vmax) (s).
+    Real solidDragReferenceStep(Real vmax) const;
+    /// XSPH weight towards ghost solids for a step of dt: solidEpsilon at the reference step,
+    /// proportional to dt, at most 1.
+    Real solidEpsilonForStep(Real dt, Real vmax) const;
 
     void validate() const;
 };
