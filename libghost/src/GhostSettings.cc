@@ -47,6 +47,15 @@ Real GhostSettings::shifting() const
     return stiffness > Real(20000) ? Real(2) : Real(0);
 }
 
+Real GhostSettings::xsphEpsilonPerStep() const
+{
+    // Not dt over the acoustic step: where the force limit shortens the steps (a stiff k's
+    // pressure noise), the per-step damping is what keeps that noise down (issue 18: scaled by
+    // dt, k = 2e5 reached 8 x the free-fall speed).
+    if (substeps > 0) return xsphEpsilon;
+    return std::min(Real(1), xsphEpsilon * (cflNumber / Real(0.4)));
+}
+
 Real GhostSettings::solidEpsilonForStep(Real dt, Real vmax) const
 {
     return std::min(Real(1), solidEpsilon * (dt / solidDragReferenceStep(vmax)));

@@ -301,7 +301,7 @@ void GhostSolver::stepGhost(Real dt)
     for (std::size_t i = 0; i < n; ++i) {
         if (kind[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
     }
-    const Real eps = mSettings.xsphEpsilon;
+    const Real eps = mSettings.xsphEpsilonPerStep();
     const Real epsSolid = mSettings.solidEpsilonForStep(dt, vmax);
     parallel::forEach(
         0, n,

@@ -98,6 +98,10 @@ struct GhostSettings
     /// k = 2e4 Pa and 0 below (where the collapse of issue 18 does not need it, and it costs
     /// 24 % of a step: bench/RESULTS.md, "Stiff liquid").
     Real shifting() const;
+    /// XSPH weight among liquid particles per step. Fixed steps: xsphEpsilon, as [SB12]
+    /// defines it. CFL steps: xsphEpsilon at CFL 0.4 and in proportion to the CFL number
+    /// (the steps' length), so a smaller CFL number does not add damping.
+    Real xsphEpsilonPerStep() const;
     /// The step at which solidEpsilon is the per-step wall drag: the acoustic step of [SB12]'s
     /// k = 2000 Pa at CFL 0.4 (the defaults), 0.4 h / (c(2000 Pa) + vmax) (s).
     Real solidDragReferenceStep(Real vmax) const;
