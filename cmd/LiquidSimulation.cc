@@ -56,6 +56,10 @@ public:
     {
         return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
     }
+    double boundaryLayerDepth() const override
+    {
+        return double(mSolver->settings().supportRadius());
+    }
     void setSolidMotion(std::size_t index, sph::RigidMotion motion) override
     {
         mSolver->setSolidMotion(index, std::move(motion));

@@ -426,6 +426,22 @@ int runScene(const RunOptions& o)
                              .c_str());
         }
     }
+    // A solid thinner than the kernel support holds too few ghost solids (or boundary
+    // particles): liquid beside it is under-dense, and a stiff liquid sticks to it (issue 18).
+    if (const double depth = sim->boundaryLayerDepth(); depth > 0) {
+        for (const vdbio::SceneSolid& solid : scene.solids) {
+            const double thin = solid.shape.fractionThinnerThan(sph::Real(depth));
+            if (thin < 0.01) continue;
+            std::fprintf(stderr, "%s\n",
+                         msg("ghostfx: warning: scene '", scene.file, "': solid '", solid.name,
+                             "' is thinner than the kernel support ", depth, " m over ",
+                             std::lround(100 * thin),
+                             " % of its surface: liquid there lacks boundary particles (too "
+                             "low a density; a stiff liquid sticks to it); make it at least ",
+                             depth, " m thick")
+                             .c_str());
+        }
+    }
     const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0;
     if (!out.checkpointFile.empty() && !checkpoints) {
         progress.message("note: boiling scenes write no checkpoints yet (the phase transition's "

@@ -302,6 +302,24 @@ openvdb::FloatGrid::Ptr makeSphereLevelSet(const Vec3& center, Real radius, Real
         float(voxelSize), float(halfWidthVoxels));
 }
 
+double LevelSet::fractionThinnerThan(Real depth) const
+{
+    const openvdb::FloatGrid& grid = *gridOf(*this);
+    const double half = 0.5 * double(voxelSize());
+    std::size_t surface = 0, thin = 0;
+    for (auto it = grid.cbeginValueOn(); it; ++it) {
+        if (std::abs(double(*it)) > half) continue;
+        const openvdb::Vec3d w = grid.indexToWorld(it.getCoord());
+        const Vec3 x(Real(w.x()), Real(w.y()), Real(w.z()));
+        const Vec3 n = normal(x);
+        if (n.lengthSqr() == Real(0)) continue;
+        ++surface;
+        // Half a voxel of slack: a wall exactly `depth` thick is not thin.
+        thin += double(phi(x - depth * n)) > half;
+    }
+    return surface == 0 ? 0.0 : double(thin) / double(surface);
+}
+
 double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo,
                          const openvdb::Vec3d& hi)
 {

@@ -300,6 +300,22 @@ TEST_F(Cli, FixedStepBeyondTheStabilityLimitIsWarnedAboutBeforeTheFirstStep)
     EXPECT_EQ(good.err.find("warning"), std::string::npos) << good.err;
 }
 
+TEST_F(Cli, SolidThinnerThanTheKernelSupportIsWarnedAbout)
+{
+    // The tank's walls default to one kernel radius (3 h = 0.045 m): no warning (checked by
+    // the test above). Walls of 0.02 m hold less than half the ghost-solid layer: warned, with
+    // the solid's name, the depth needed and the share of its surface.
+    Json scene = smallScene();
+    scene["solids"][0]["geometry"]["container"]["wall"] = 0.02;
+    const std::string path = write(scene);
+    const Result r = run("run " + path + " --out " + (mDir / "out").string() + " -q --frames 1-1");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_CONTAINS(r.err,
+                    "ghostfx: warning: scene '" + path
+                        + "': solid 'tank' is thinner than the kernel support 0.045 m over ");
+    EXPECT_CONTAINS(r.err, "make it at least 0.045 m thick");
+}
+
 TEST_F(Cli, CtrlCFinishesTheFrameWritesACheckpointAndExitsNonZero)
 {
     Json scene = smallScene();

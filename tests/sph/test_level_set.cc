@@ -610,3 +610,34 @@ TEST(SolidCollision, ProjectsRestoresOrReportsStuck)
     x = Vec3(0, 2, 0);
     EXPECT_EQ(collideWithSolid(cube, xf, 0, x, x, v), Collision::None);
 }
+
+TEST(LevelSet, ThinWallsAreFoundWhereAKernelRadiusDoesNotFit)
+{
+    // A closed tank (inner box 0.4 x 0.2 x 0.1 m) with walls w; boundary layers 0.03 m deep
+    // (a kernel radius at 10 mm). Walls of 0.015 m are thin over the whole surface, inner and
+    // outer faces alike, except at the outer corners and edges (the inward diagonal stays in
+    // the wall); walls of 0.03 m (exactly the depth) and 0.05 m are not thin anywhere.
+    const openvdb::Vec3d lo(0, 0, 0), hi(0.4, 0.2, 0.1);
+    auto tank = [&](double w) {
+        const openvdb::Vec3d d(w);
+        return makeLevelSet(levelSetFromSdf(
+                                [=](const openvdb::Vec3d& x) {
+            return std::max(-boxSignedDistance(x, lo, hi), boxSignedDistance(x, lo - d, hi + d));
+                                },
+                                Aabb{Vec3(lo - d), Vec3(hi + d)}, Real(0.005)),
+                            "tank");
+    };
+    const double thin = tank(0.015).fractionThinnerThan(Real(0.03));
+    const double exact = tank(0.03).fractionThinnerThan(Real(0.03));
+    const double thick = tank(0.05).fractionThinnerThan(Real(0.03));
+    std::printf("[measured] thin-wall fraction at depth 0.03 m: wall 0.015 m %.3f, 0.03 m %.3f, "
+                "0.05 m %.3f\n",
+                thin, exact, thick);
+    EXPECT_GT(thin, 0.8);
+    EXPECT_EQ(exact, 0.0);
+    EXPECT_EQ(thick, 0.0);
+    // A sphere of radius 0.1 m is deeper than 0.03 m everywhere.
+    EXPECT_EQ(makeLevelSet(makeSphereLevelSet(Vec3(0), Real(0.1), Real(0.005)), "ball")
+                  .fractionThinnerThan(Real(0.03)),
+              0.0);
+}

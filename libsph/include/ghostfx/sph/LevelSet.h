@@ -68,6 +68,10 @@ public:
     Vec3 normal(const Vec3& x) const;
     /// phi(x) < 0.
     bool inside(const Vec3& x) const { return phi(x) < Real(0); }
+    /// Fraction of the surface (its voxels within half a voxel of phi = 0) where the shape is
+    /// thinner than `depth` (m): the point `depth` inward along the normal lies outside again.
+    /// A boundary layer of particles one kernel radius deep does not fit there.
+    double fractionThinnerThan(Real depth) const;
     /// Whether x is far enough inside the narrow band for phi and its gradient to be exact
     /// (one voxel short of the clamp).
     bool inBand(const Vec3& x) const;
