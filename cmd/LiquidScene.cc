@@ -31,6 +31,12 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.gravity = Vec3(Real(gravity[0]), Real(gravity[1]), Real(gravity[2]));
     g.xsphEpsilon = Real(s.inRange("xsph_epsilon", g.xsphEpsilon, 0, 1));
     g.solidEpsilon = Real(s.inRange("solid_epsilon", g.solidEpsilon, 0, 1));
+    // Absent: automatic (GhostSettings::relaxationPasses()).
+    if (s.has("initial_relaxation")) {
+        g.initialRelaxation = int(s.inRange("initial_relaxation", 0, 0, 1000));
+        if (double(g.initialRelaxation) != s.get<double>("initial_relaxation", 0))
+            s.failValue("initial_relaxation", "expected a whole number of passes, 0 to 1000");
+    }
     // Absent: automatic (GhostSettings::shifting()).
     if (s.has("shifting")) g.shiftingCoefficient = Real(s.inRange("shifting", 0, 0, 20));
     g.solidSlip = s.choice("solid_slip", "free", {"free", "no_slip"}) == "free"

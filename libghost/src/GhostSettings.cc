@@ -47,6 +47,12 @@ Real GhostSettings::shifting() const
     return stiffness > Real(20000) ? Real(2) : Real(0);
 }
 
+int GhostSettings::relaxationPasses() const
+{
+    if (initialRelaxation >= 0) return initialRelaxation;
+    return stiffness > Real(20000) ? 20 : 0;
+}
+
 Real GhostSettings::xsphEpsilonPerStep() const
 {
     // Not dt over the acoustic step: where the force limit shortens the steps (a stiff k's
@@ -83,6 +89,8 @@ void GhostSettings::validate() const
     check.require(shiftingCoefficient <= 20 && check.finite(shiftingCoefficient),
                   "shiftingCoefficient", shiftingCoefficient,
                   "0 (off) to 20, or negative (automatic)");
+    check.require(initialRelaxation <= 1000, "initialRelaxation", initialRelaxation,
+                  "0 (off) to 1000 passes, or negative (automatic)");
     check.require(airResampleSteps >= 1, "airResampleSteps", airResampleSteps,
                   ">= 1 ([SB12]: about 10)");
     check.require(airKeepFraction >= 0 && check.finite(airKeepFraction), "airKeepFraction",

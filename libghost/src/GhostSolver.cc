@@ -484,6 +484,7 @@ bool GhostSolver::initialize()
     } else {
         setParticleMass(mMass);
     }
+    if (mSettings.method == Method::Ghost && !mRestored) relaxInitialLiquid();
 
     if (mSettings.method == Method::Basic) {
         mLennardJones = mSettings.lennardJonesStrength;

@@ -179,6 +179,81 @@ void GhostSolver::computeDensity()
     }
 }
 
+void GhostSolver::relaxInitialLiquid()
+{
+    // Each pass: the density with every ghost in place, then each liquid particle moves down
+    // its density gradient by beta h^2 grad rho / rho0 (at most 0.05 h), a step of particle
+    // shifting with no flow; the air layer is resampled around the moved liquid every 5
+    // passes and at the end. beta = 0.5: 20 passes take the column of issue 18 at 10 mm from
+    // 3.2 % mean / 13.3 % largest error to 0.6 % / 4.1 % (60 passes: 0.6 % / 3.1 %).
+    const int passes = mSettings.relaxationPasses();
+    if (passes <= 0) return;
+    const Real h = mSettings.spacing, rho0 = mSettings.restDensity;
+    const Real beta = Real(0.5), cap = Real(0.05) * h, M = mMass;
+    auto densityError = [&](double& mean, double& worst) {
+        const auto& rho = mParticles.densities();
+        double sum = 0, count = 0;
+        worst = 0;
+        for (std::size_t i = 0; i < mParticles.size(); ++i) {
+            if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
+            const double e = std::abs(double(rho[i] / rho0) - 1);
+            sum += e;
+            worst = std::max(worst, e);
+            ++count;
+        }
+        mean = count > 0 ? sum / count : 0;
+    };
+    std::vector<Vec3> shift;
+    for (int pass = 0; pass <= passes; ++pass) {
+        prepareSolidBlocks();
+        searchNeighbors();
+        if (pass > 0 && (pass % 5 == 0 || pass == passes)) {
+            resampleAir(-1);
+            searchNeighbors();
+        }
+        computeDensity();
+        if (pass == 0) densityError(mInitialError.meanSampled, mInitialError.maxSampled);
+        if (pass == passes) {
+            densityError(mInitialError.meanRelaxed, mInitialError.maxRelaxed);
+            break;
+        }
+        const std::size_t n = mParticles.size();
+        const auto& x = mParticles.positions();
+        const auto& m = mParticles.masses();
+        const auto& kind = mParticles.kinds();
+        shift.assign(n, Vec3(0));
+        forRangeWithBatch(
+            n, mKernel,
+            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (kind[i] != ParticleKind::Liquid) continue;
+                const Vec3 xi = x[i];
+                Vec3 grad(0);
+                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * kernel.gradFactor(b.r[k]);
+                    grad += b.sumScaledOffsets(b.f);
+                });
+                for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                    batch.forEachBatch(xi, block->block.particles().positions().data(),
+                                       block->lists[i], [&](PairBatch& b) {
+                                           for (int k = 0; k < b.n; ++k)
+                                               b.f[k] = M * kernel.gradFactor(b.r[k]);
+                                           grad += b.sumScaledOffsets(b.f);
+                                       });
+                }
+                Vec3 d = -(beta * h * h / rho0) * grad;
+                const Real length = d.length();
+                if (length > cap) d *= cap / length;
+                shift[i] = d;
+            }
+            },
+            512);
+        auto& xw = mParticles.positions();
+        parallel::forEach(
+            0, n, [&](std::size_t i) { xw[i] += shift[i]; }, 4096);
+    }
+}
+
 void GhostSolver::extrapolateSolidVelocity()
 {
     // Lines 15-18: ghost solid velocity, Eq. 3: the solid's normal velocity and the nearest

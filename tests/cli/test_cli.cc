@@ -249,6 +249,9 @@ TEST_F(Cli, BadInputGetsOneClearLine)
          "settings.stifness: unknown key (did you mean 'stiffness'?)"},
         {" -D settings.stiffness=-1", "settings.stiffness = -1: expected a number > 0"},
         {" -D settings.cfl=50", "settings.cfl = 50: expected a number in [0.001, 10]"},
+        {" -D settings.shifting=50", "settings.shifting = 50: expected a number in [0, 20]"},
+        {" -D settings.initial_relaxation=2.5",
+         "settings.initial_relaxation = 2.5: expected a whole number of passes, 0 to 1000"},
         {" -D settings.method=gas", "liquids: a 'gas' scene simulates gas only: liquids, emitters "
                                     "and heaters need a liquid method ('ghost' or 'basic'"},
         {" -D settings.gas.kappa=2",

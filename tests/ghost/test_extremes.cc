@@ -137,6 +137,7 @@ struct Collapse
 {
     double front = 0, column = 0, maxSpeed = 0;
     std::uint64_t steps = 0;
+    GhostSolver::InitialDensityError initial;
 };
 
 double percentile(std::vector<double> values, double q)
@@ -190,6 +191,7 @@ Collapse runCollapse(Real stiffness, Real cfl, Real epsilon)
     out.front = percentile(x, 0.99);
     out.column = percentile(back, 0.99);
     out.steps = solver.stepCount();
+    out.initial = solver.initialDensityError();
     return out;
 }
 
@@ -216,15 +218,27 @@ TEST(Extremes, StiffCollapseAgreesWithTheReferenceStiffness)
                     double(c.k), double(c.cfl), double(c.eps), o.front,
                     100 * (o.front / ref.front - 1), o.column, 100 * (o.column / ref.column - 1),
                     o.maxSpeed, o.maxSpeed / freeFall, (unsigned long long)o.steps);
-        // Measured (float, 2026-11-23): k 2e3 +3.6 % / -1.8 %, k 2e5 -16.1 % / +21.2 % (the
+        // Measured (float, 2026-11-23): k 2e3 +6.6 % / -11.2 %, k 2e5 -12.3 % / +11.1 % (the
         // liquid's XSPH acts once per step, and k = 2e5 takes 3x the steps: more damping),
-        // epsilon 0.02 and 0.1 +10.7 % and -6.2 % / +1.5 % and +11.8 %. Before particle
-        // shifting and the wall drag rate, k = 2e5 reached 9-62 m/s (4.7-31 x free fall) and
-        // its front lagged 16-28 %. Bounds: front 25 %, column 30 %, leaving room for the
-        // double build's different rounding of a chaotic flow; speed 5 x sqrt(2 g H).
-        EXPECT_NEAR(o.front / ref.front, 1.0, 0.25) << "k " << c.k << " eps " << c.eps;
-        EXPECT_NEAR(o.column / ref.column, 1.0, 0.30) << "k " << c.k << " eps " << c.eps;
-        EXPECT_LT(o.maxSpeed, 5 * freeFall) << "k " << c.k << " eps " << c.eps;
+        // CFL 0.2 -0.5 % / -0.5 %, epsilon 0.02 and 0.1 +8.7 % and -10.2 % / -6.1 % and
+        // +4.6 %; largest speed 0.9-2.3 x free fall. Before this round k = 2e5 reached 9-62 m/s
+        // (4.7-31 x) and its front lagged 16-28 %. Bounds: front 20 %, column 25 % (room for
+        // the double build's different rounding of a chaotic flow); speed 4 x sqrt(2 g H).
+        EXPECT_NEAR(o.front / ref.front, 1.0, 0.20) << "k " << c.k << " eps " << c.eps;
+        EXPECT_NEAR(o.column / ref.column, 1.0, 0.25) << "k " << c.k << " eps " << c.eps;
+        EXPECT_LT(o.maxSpeed, 4 * freeFall) << "k " << c.k << " eps " << c.eps;
+        if (c.k > Real(20000)) {
+            // Above k = 2e4 the sampled liquid is relaxed before the first step. Measured:
+            // sampled 3.2 % mean, 13.3 % largest |rho / rho0 - 1|; relaxed 0.6 % and 4.1 %.
+            // Bounds: 1 % and 6 %, below the 3.3 % and 16.5 % of a step-0 state (issue 18).
+            std::printf("[measured] initial density error k %g: sampled mean %.2f %% max %.2f "
+                        "%%, relaxed mean %.2f %% max %.2f %%\n",
+                        double(c.k), 100 * o.initial.meanSampled, 100 * o.initial.maxSampled,
+                        100 * o.initial.meanRelaxed, 100 * o.initial.maxRelaxed);
+            EXPECT_GT(o.initial.meanSampled, 0.02);
+            EXPECT_LT(o.initial.meanRelaxed, 0.01);
+            EXPECT_LT(o.initial.maxRelaxed, 0.06);
+        }
     }
-    EXPECT_LT(ref.maxSpeed, 5 * freeFall);
+    EXPECT_LT(ref.maxSpeed, 4 * freeFall);
 }

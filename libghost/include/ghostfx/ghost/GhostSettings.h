@@ -58,6 +58,12 @@ struct GhostSettings
     /// case is needed. 0 = off; negative = automatic (shifting()).
     Real shiftingCoefficient = Real(-1);
     SolidSlip solidSlip = SolidSlip::Free;
+    /// Passes that move the sampled liquid towards rest density before the first step (Ghost
+    /// SPH; GhostSolver::relaxInitialLiquid). The Poisson samples are not at rest density:
+    /// where a liquid face meets a solid, both samplings put a layer on the same plane
+    /// (density error up to 13 % at 10 mm, 3 % mean). 0 = off; negative = automatic
+    /// (relaxationPasses()).
+    int initialRelaxation = -1;
     int airResampleSteps = 10; ///< resample the ghost air every N steps ([SB12]: about 10)
     /// At a resampling, air particles closer than this fraction of the Poisson radius r to the
     /// liquid are replaced; the others stay (temporal coherence). 0 keeps all in the layer;
@@ -102,6 +108,9 @@ struct GhostSettings
     /// defines it. CFL steps: xsphEpsilon at CFL 0.4 and in proportion to the CFL number
     /// (the steps' length), so a smaller CFL number does not add damping.
     Real xsphEpsilonPerStep() const;
+    /// The relaxation passes in use: initialRelaxation, or when automatic 20 above k = 2e4 Pa
+    /// (where a 13 % density error is a 2 x k pressure kick) and 0 below.
+    int relaxationPasses() const;
     /// The step at which solidEpsilon is the per-step wall drag: the acoustic step of [SB12]'s
     /// k = 2000 Pa at CFL 0.4 (the defaults), 0.4 h / (c(2000 Pa) + vmax) (s).
     Real solidDragReferenceStep(Real vmax) const;

@@ -134,6 +134,13 @@ public:
     void step(Real dt);
     /// The CFL-limited time step for the current state (s).
     Real stableTimeStep() const;
+    /// |rho / rho0 - 1| over the liquid when the run started: mean and largest, as sampled
+    /// and after the initial relaxation (zeros until then, or without relaxation).
+    struct InitialDensityError
+    {
+        double meanSampled = 0, maxSampled = 0, meanRelaxed = 0, maxRelaxed = 0;
+    };
+    const InitialDensityError& initialDensityError() const { return mInitialError; }
 
     /// Install (or, with an empty function, remove) the observer called after every step.
     void setStepObserver(StepObserver observer);
@@ -231,6 +238,9 @@ private:
     void fadeAir();
     void searchNeighbors();
     void computeDensity();
+    /// Move the liquid towards rest density before the first step (GhostSettings::
+    /// initialRelaxation), recording the density error before and after.
+    void relaxInitialLiquid();
     void extrapolateSolidVelocity();
     void stepGhost(Real dt);
     void stepBasic(Real dt);
@@ -258,6 +268,7 @@ private:
     bool mProjectAll = true; ///< a solid changed shape: test every liquid particle for collision
     sph::RunCounters mRun;   ///< clock and counters (maxAcceleration: of the liquid)
     PhaseTimings mTimings;
+    InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;
     bool mRestored = false;            ///< restoreState() was called: no liquid may be added
