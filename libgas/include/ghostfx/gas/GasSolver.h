@@ -231,6 +231,9 @@ private:
     void applyDomain();
     void applyLifeStrength(Real dt);
     void checkBlowUp(Real dt) const;
+    /// After a frame: stop with a NumericalError when the gas is flying apart (median density
+    /// below rho0 / 2 over 100 or more gas particles; not the uncorrected baseline).
+    void checkHoldsTogether() const;
     std::vector<Vec3> sampleShape(const LevelSet& shape, std::uint64_t seed) const;
 
     GasSettings mSettings;
