@@ -241,7 +241,7 @@ TEST(PhaseTransition, ViolentBoilingAtDensityRatio1000StaysFiniteOrFailsClearly)
     scene.coupler->addHeater(plateLevelSet(A), Real(473.15));
     scene.coupler->step(DT);
     const double m0 = scene.coupler->massBudget().total();
-    double maxRatio = 0;
+    double maxRatio = 0, maxSpeed = 0;
     int done = 0;
     std::string error;
     try {
@@ -253,6 +253,7 @@ TEST(PhaseTransition, ViolentBoilingAtDensityRatio1000StaysFiniteOrFailsClearly)
                     maxRatio =
                         std::max(maxRatio, double(g.densities()[i])
                                                / double(scene.vapour.settings().restDensity));
+                    maxSpeed = std::max(maxSpeed, double(g.velocities()[i].length()));
                 }
             }
         }
@@ -261,9 +262,10 @@ TEST(PhaseTransition, ViolentBoilingAtDensityRatio1000StaysFiniteOrFailsClearly)
     }
     const double drift = std::abs(scene.coupler->massBudget().total() - m0) / m0;
     std::printf("[measured] violent boiling 1000:1: %d steps, boiled %zu of the liquid, %zu "
-                "vapour particles, max gas rho / rho0 %.1f, mass drift %.1e, %s\n",
-                done, scene.coupler->boiledCount(), scene.vapour.visibleGasCount(), maxRatio, drift,
-                error.empty() ? "no error" : error.c_str());
+                "vapour particles, max gas rho / rho0 %.1f, max vapour speed %.2f m/s, mass "
+                "drift %.1e, %s\n",
+                done, scene.coupler->boiledCount(), scene.vapour.visibleGasCount(), maxRatio,
+                maxSpeed, drift, error.empty() ? "no error" : error.c_str());
     if (!error.empty()) {
         // A blow-up must say where and what to change.
         EXPECT_NE(error.find("blew up"), std::string::npos) << error;
@@ -271,6 +273,11 @@ TEST(PhaseTransition, ViolentBoilingAtDensityRatio1000StaysFiniteOrFailsClearly)
         EXPECT_TRUE(allGasFinite(scene.vapour));
         EXPECT_GT(scene.coupler->boiledCount(), 0u);
         EXPECT_LT(drift, 1e-5);
+        // Plausible, not only finite (issue 18): a liquid particle turning into vapour at
+        // 1000:1 swells from one liquid spacing to about ten; spread over the heating time
+        // that is (10 - 1) H / 0.01 s = 9 m/s. Measured 3.9 m/s; bound 10 m/s. (The newborn
+        // vapour's density, up to 428 rho0 where daughters are placed, is issue 13's.)
+        EXPECT_LT(maxSpeed, 10.0);
     }
 }
 
