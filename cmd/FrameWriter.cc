@@ -53,7 +53,7 @@ void FrameWriter::rethrow()
 void FrameWriter::submit(FrameSnapshot snapshot)
 {
     if (!mThread.joinable()) {
-        writeFrameOutputs(mScene, snapshot, mFolder);
+        writeFrameOutputs(mScene, snapshot, mFolder, &mPreviewCache);
         return;
     }
     std::unique_lock<std::mutex> lock(mMutex);
@@ -87,7 +87,7 @@ void FrameWriter::work()
         std::exception_ptr error;
         if (!failed) { // after a failure, later frames are dropped: the run is stopping
             try {
-                writeFrameOutputs(mScene, snapshot, mFolder);
+                writeFrameOutputs(mScene, snapshot, mFolder, &mPreviewCache);
             } catch (...) {
                 error = std::current_exception();
             }

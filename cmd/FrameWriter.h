@@ -12,6 +12,8 @@
 
 #include "Simulation.h"
 
+#include <ghostfx/vdbio/ScenePreview.h>
+
 #include <condition_variable>
 #include <exception>
 #include <memory>
@@ -38,9 +40,10 @@ struct FrameSnapshot
 FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation& sim, int frame);
 
 /// Write the scene's outputs of a snapshot into `folder` (points, volume and preview files, as
-/// the scene's `outputs` name them); every file atomically.
+/// the scene's `outputs` name them); every file atomically. `previewCache` keeps the static
+/// solids' preview hits from one frame to the next (the pictures are the same without it).
 void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
-                       const std::string& folder);
+                       const std::string& folder, vdbio::PreviewCache* previewCache = nullptr);
 
 class FrameWriter
 {
@@ -65,6 +68,7 @@ private:
 
     const vdbio::Scene& mScene;
     const std::string mFolder;
+    vdbio::PreviewCache mPreviewCache; ///< used by whichever thread writes (one at a time)
     std::mutex mMutex;
     std::condition_variable mChanged;
     std::optional<FrameSnapshot> mQueued;

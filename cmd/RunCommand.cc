@@ -204,6 +204,9 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
         layer.name = solid.name;
         layer.grid = sph::gridOf(shape);
         layer.albedo = vdbio::SOLID_ALBEDO;
+        // A solid that neither moves nor changes shape looks the same in every frame.
+        layer.fixed = solid.sequenceFile.empty() && solid.motion.keys.empty()
+                      && solid.velocity == openvdb::Vec3d(0.0);
         if (solid.motion.keys.empty()) {
             layer.translation = solid.velocity * snapshot.time;
         } else {
@@ -284,7 +287,7 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
 } // namespace
 
 void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
-                       const std::string& folder)
+                       const std::string& folder, vdbio::PreviewCache* previewCache)
 {
     const int frame = snapshot.frame;
     const vdbio::SceneOutputs& out = scene.outputs;
@@ -353,7 +356,7 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
         framed = openvdb::BBoxd(openvdb::Vec3d(out.previewFrame.min),
                                 openvdb::Vec3d(out.previewFrame.max));
     }
-    vdbio::renderScenePreview(layers, pv, framed, inFolder(out.previewFile));
+    vdbio::renderScenePreview(layers, pv, framed, inFolder(out.previewFile), previewCache);
 }
 
 int runScene(const RunOptions& o)

@@ -170,3 +170,53 @@ TEST(ScenePreview, FogLiesInFrontOfTheSurfaceBehindIt)
         vdbio::renderScenePreview({}, frontView(), openvdb::BBoxd(), (dir / "none.exr").string()),
         ValueError);
 }
+
+TEST(ScenePreview, FixedSolidHitsAreKeptBetweenFramesAndChangeNothing)
+{
+    // A cut-away tank (fixed) around a drop that moves between "frames", in a fixed frame box:
+    // the tank's hits are computed once and reused while the camera and the tank stay; the
+    // images are identical, pixel for pixel, to ones drawn without the cache.
+    const auto dir = ghostfx::testing::freshDir("scene_preview_cache");
+    PreviewLayer tank = surface("tank", closedTank(0.2, 0.03, 0.01f), vdbio::SOLID_ALBEDO);
+    tank.cutaway = true;
+    tank.fixed = true;
+    vdbio::PreviewOptions view = frontView();
+    view.elevation = 25;
+    const openvdb::BBoxd box(openvdb::Vec3d(-0.25), openvdb::Vec3d(0.25));
+    vdbio::PreviewCache cache;
+    auto draw = [&](float dropY, const PreviewLayer& solid, vdbio::PreviewCache* c,
+                    const std::string& name) {
+        const PreviewLayer drop =
+            surface("drop", sph::makeSphereLevelSet(sph::Vec3(0.0f, dropY, 0.0f), 0.06f, 0.01f),
+                    vdbio::LIQUID_ALBEDO);
+        const std::string path = (dir / name).string();
+        const auto s = vdbio::renderScenePreview({solid, drop}, view, box, path, c);
+        return std::make_pair(s.pixels, vdbio::readExrImage(path));
+    };
+    auto same = [](const vdbio::RgbaImage& a, const vdbio::RgbaImage& b) {
+        for (int y = 0; y < a.height; ++y) {
+            for (int x = 0; x < a.width; ++x) {
+                for (int c = 0; c < 4; ++c) {
+                    if (a.pixel(x, y)[c] != b.pixel(x, y)[c]) return false;
+                }
+            }
+        }
+        return true;
+    };
+    for (int frame = 0; frame < 3; ++frame) {
+        const float y = -0.1f + 0.05f * float(frame);
+        const auto cached = draw(y, tank, &cache, "cached.exr");
+        const auto plain = draw(y, tank, nullptr, "plain.exr");
+        EXPECT_EQ(cached.first, plain.first) << "frame " << frame;
+        EXPECT_TRUE(same(cached.second, plain.second)) << "frame " << frame;
+        EXPECT_GT(plain.first[1], 50u) << "the drop shows through the cut-away tank";
+    }
+    EXPECT_EQ(cache.computed, 1u);
+    EXPECT_EQ(cache.reused, 2u);
+    // Moving the tank (or the camera) recomputes its hits.
+    tank.translation = openvdb::Vec3d(0.02, 0, 0);
+    const auto moved = draw(0.0f, tank, &cache, "moved.exr");
+    const auto movedPlain = draw(0.0f, tank, nullptr, "moved_plain.exr");
+    EXPECT_TRUE(same(moved.second, movedPlain.second));
+    EXPECT_EQ(cache.computed, 2u);
+}

@@ -126,7 +126,7 @@ struct Tracers
 
 ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                                        const PreviewOptions& options, const openvdb::BBoxd& bounds,
-                                       const std::string& path)
+                                       const std::string& path, PreviewCache* cache)
 {
     options.validate();
     if (layers.empty()) throw ValueError(msg("preview '", path, "': nothing to draw"));
@@ -155,6 +155,37 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
     camera.lookAt(setup.target, setup.up);
 
     const std::size_t n = layers.size();
+    // Fixed surface layers are intersected first, then the others: the same order with or
+    // without a cache, so the nearest hit (ties included) does not depend on it.
+    std::vector<std::uint8_t> fixed(n, 0);
+    std::vector<double> key = {setup.eye.x(),         setup.eye.y(),    setup.eye.z(),
+                               setup.target.x(),      setup.target.y(), setup.target.z(),
+                               setup.up.x(),          setup.up.y(),     setup.up.z(),
+                               setup.nearPlane,       setup.farPlane,   double(film.width()),
+                               double(film.height()), double(n)};
+    std::vector<const void*> fixedGrids;
+    for (std::size_t k = 0; k < n; ++k) {
+        fixed[k] = layers[k].fixed && layers[k].kind == PreviewLayer::Kind::Surface;
+        if (!fixed[k]) continue;
+        fixedGrids.push_back(layers[k].grid.get());
+        key.push_back(double(k));
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) key.push_back(layers[k].rotation(i, j));
+            key.push_back(layers[k].translation[i]);
+        }
+        key.push_back(layers[k].cutaway ? 1.0 : 0.0);
+    }
+    const std::size_t pixelCount = film.width() * film.height();
+    const bool reuse =
+        cache && cache->key == key && cache->grids == fixedGrids && cache->t.size() == pixelCount;
+    if (cache && !reuse) {
+        cache->key = key;
+        cache->grids = fixedGrids;
+        cache->t.assign(pixelCount, std::numeric_limits<double>::max());
+        cache->layer.assign(pixelCount, std::uint32_t(n));
+        cache->normal.assign(pixelCount, Vec3d(0.0));
+    }
+    if (cache) ++(reuse ? cache->reused : cache->computed);
     std::vector<std::atomic<std::size_t>> pixels(n);
     for (auto& p : pixels) p = 0;
     const auto t0 = std::chrono::steady_clock::now();
@@ -164,36 +195,54 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
         for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
             for (std::size_t x = 0; x < film.width(); ++x) {
                 const Ray ray = camera.getRay(x, y);
-                // The nearest surface.
+                // The nearest surface: the fixed layers' hit (kept, or computed and stored),
+                // then the other surface layers.
                 double nearest = std::numeric_limits<double>::max();
                 std::size_t hitLayer = n;
                 Vec3d hitNormal(0.0);
-                for (std::size_t k = 0; k < n; ++k) {
-                    if (!tracers.surfaces[k]) continue;
-                    Ray local = intoLayer(ray, layers[k]);
-                    Vec3d xyz, normal;
-                    bool hit = false;
-                    for (int crossing = 0; crossing < MAX_CUTAWAY_CROSSINGS; ++crossing) {
-                        if (!tracers.surfaces[k]->intersectsWS(local, xyz, normal)) break;
-                        if (!layers[k].cutaway
-                            || isInnerFace(xyz, normal, local.dir(), localBoxes[k], voxel[k],
-                                           double(layers[k].grid->background()))) {
-                            hit = true;
-                            break;
+                auto nearestOf = [&](bool fixedPass) {
+                    for (std::size_t k = 0; k < n; ++k) {
+                        if (!tracers.surfaces[k] || bool(fixed[k]) != fixedPass) continue;
+                        Ray local = intoLayer(ray, layers[k]);
+                        Vec3d xyz, normal;
+                        bool hit = false;
+                        for (int crossing = 0; crossing < MAX_CUTAWAY_CROSSINGS; ++crossing) {
+                            if (!tracers.surfaces[k]->intersectsWS(local, xyz, normal)) break;
+                            if (!layers[k].cutaway
+                                || isInnerFace(xyz, normal, local.dir(), localBoxes[k], voxel[k],
+                                               double(layers[k].grid->background()))) {
+                                hit = true;
+                                break;
+                            }
+                            // Past this crossing, and look for the next one.
+                            const double along =
+                                (xyz - local.eye()).dot(local.dir()) / local.dir().lengthSqr();
+                            local.setTimes(along + 1.5 * voxel[k] / local.dir().length(),
+                                           local.t1());
                         }
-                        // Past this crossing, and look for the next one.
-                        const double along =
-                            (xyz - local.eye()).dot(local.dir()) / local.dir().lengthSqr();
-                        local.setTimes(along + 1.5 * voxel[k] / local.dir().length(), local.t1());
+                        if (!hit) continue;
+                        const double t = (xyz - local.eye()).length();
+                        if (t < nearest) {
+                            nearest = t;
+                            hitLayer = k;
+                            hitNormal = layers[k].rotation * normal;
+                        }
                     }
-                    if (!hit) continue;
-                    const double t = (xyz - local.eye()).length();
-                    if (t < nearest) {
-                        nearest = t;
-                        hitLayer = k;
-                        hitNormal = layers[k].rotation * normal;
+                };
+                const std::size_t pixel = y * film.width() + x;
+                if (reuse) {
+                    nearest = cache->t[pixel];
+                    hitLayer = cache->layer[pixel];
+                    hitNormal = cache->normal[pixel];
+                } else {
+                    nearestOf(true);
+                    if (cache) {
+                        cache->t[pixel] = nearest;
+                        cache->layer[pixel] = std::uint32_t(hitLayer);
+                        cache->normal[pixel] = hitNormal;
                     }
                 }
+                nearestOf(false);
                 float r = 0, g = 0, b = 0, surfaceAlpha = 0;
                 if (hitLayer < n) {
                     const float shade = detail::keyLightShade(setup, hitNormal, ray.dir());

@@ -10,6 +10,8 @@
 ///          scattering without shadows). Transparent background, premultiplied alpha.
 #pragma once
 
+#include <cstdint>
+
 #include <ghostfx/vdbio/Preview.h>
 
 #include <openvdb/openvdb.h>
@@ -38,6 +40,22 @@ struct PreviewLayer
     /// from behind are skipped, so the camera looks through the near walls and lid at the inner
     /// faces of the far walls and floor. Surface layers only.
     bool cutaway = false;
+    /// The same grid at the same placement in every frame of a sequence (a static solid): its
+    /// surface hits may be kept between frames in a PreviewCache. Surface layers only.
+    bool fixed = false;
+};
+
+/// Surface hits of the fixed layers, per pixel, kept from one frame's preview to the next
+/// while the camera and those layers stay the same (they are recomputed when either changes).
+/// A preview drawn with a cache is identical to one drawn without.
+struct PreviewCache
+{
+    std::vector<double> key;              ///< camera, image size and fixed layers' placements
+    std::vector<const void*> grids;       ///< the fixed layers' grids
+    std::vector<double> t;                ///< per pixel: distance to the nearest fixed-layer hit
+    std::vector<std::uint32_t> layer;     ///< per pixel: its layer index, or the layer count
+    std::vector<openvdb::Vec3d> normal;   ///< per pixel: its world normal
+    std::size_t reused = 0, computed = 0; ///< previews that used the hits, that computed them
 };
 
 /// The colours `ghostfx run` gives solids, a liquid (surface or density) and gas.
@@ -58,9 +76,11 @@ struct ScenePreviewSummary
 /// (world, m); an empty box frames the union of the layers' active voxels. Throws ValueError
 /// for bad options or no layers, GridError for a layer that is not a float grid of its kind
 /// with cubic voxels, IoError if the image cannot be written.
+/// With `cache`, the fixed layers' hits come from it when the camera and those layers match
+/// the last preview drawn with it, and are stored in it otherwise.
 ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                                        const PreviewOptions& options, const openvdb::BBoxd& bounds,
-                                       const std::string& path);
+                                       const std::string& path, PreviewCache* cache = nullptr);
 
 } // namespace vdbio
 } // namespace ghostfx
