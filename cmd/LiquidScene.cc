@@ -25,6 +25,22 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.frameRate = Real(scene.frameRate);
     g.supportFactor = Real(s.inRange("kernel_support", g.supportFactor, 1.5, 5));
     g.restDensity = Real(s.positive("rest_density", g.restDensity));
+    g.pressure = ghost::pressureFromName(s.choice("pressure", "tait", {"tait", "dfsph"}));
+    if (s.has("dfsph")) {
+        const vdbio::JsonObject d = s.object("dfsph");
+        ghost::DfsphSettings& o = g.dfsph;
+        o.densityError = Real(d.inRange("density_error", o.densityError, 1e-7, 0.1));
+        o.divergenceError = Real(d.inRange("divergence_error", o.divergenceError, 1e-7, 1));
+        o.densityRelaxation = Real(d.inRange("density_relaxation", o.densityRelaxation, 1e-6, 1));
+        o.maxIterations = int(d.inRange("max_iterations", o.maxIterations, 1, 100000));
+        o.minTimeStep = Real(d.inRange("min_dt", o.minTimeStep, 1e-9, 1));
+        o.maxTimeStep = Real(d.inRange("max_dt", o.maxTimeStep, 1e-9, 1));
+        if (o.maxTimeStep < o.minTimeStep)
+            d.failValue("max_dt",
+                        "expected at least min_dt (" + std::to_string(o.minTimeStep) + " s)");
+        o.warmStart = d.get<bool>("warm_start", o.warmStart);
+        d.finish();
+    }
     g.stiffness = Real(s.positive("stiffness", g.stiffness));
     const auto gravity =
         s.get<std::array<double, 3>>("gravity", {g.gravity[0], g.gravity[1], g.gravity[2]});

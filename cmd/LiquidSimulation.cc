@@ -5,6 +5,8 @@
 
 #include <ghostfx/sph/Exceptions.h>
 
+#include <cstdio>
+
 namespace ghostfx {
 namespace cmd {
 
@@ -46,7 +48,24 @@ public:
         , mSolver(makeLiquidSolver(scene, liquidSettings(scene, method), restored))
     {}
 
-    void advanceFrame() override { mSolver->advanceFrame(); }
+    void advanceFrame() override
+    {
+        const std::uint64_t unconverged = mSolver->pressureSolveStats().unconverged;
+        mSolver->advanceFrame();
+        const ghost::PressureSolveStats& st = mSolver->pressureSolveStats();
+        if (st.unconverged > unconverged) {
+            const ghost::DfsphSettings& d = mSolver->settings().dfsph;
+            std::fprintf(stderr,
+                         "ghostfx: warning: scene '%s', frame %d: %llu DFSPH solves stopped at "
+                         "dfsph.max_iterations = %d above their error limit (last: density "
+                         "%.2e against %.0e, divergence %.2e against %.0e); raise "
+                         "max_iterations or the limits, or lower cfl / max_dt\n",
+                         mScene.file.c_str(), mSolver->frame(),
+                         static_cast<unsigned long long>(st.unconverged - unconverged),
+                         d.maxIterations, st.lastDensityError, double(d.densityError),
+                         st.lastDivergenceError, double(d.divergenceError));
+        }
+    }
     int frame() const override { return mSolver->frame(); }
     double time() const override { return mSolver->time(); }
     std::uint64_t stepCount() const override { return mSolver->stepCount(); }
@@ -105,6 +124,21 @@ public:
             {"t_step", t.total - mBefore.total},
             bytesPerParticle(*this),
         };
+        if (s.settings().pressure == ghost::PressureModel::Dfsph) {
+            // Iterations per step of the frame's DFSPH solves.
+            const ghost::PressureSolveStats& st = s.pressureSolveStats();
+            const double steps = double(st.steps - mSolveBefore.steps);
+            const auto perStep = [&](std::uint64_t now, std::uint64_t before) {
+                return steps > 0 ? double(now - before) / steps : 0.0;
+            };
+            row.values.push_back({"density_iterations",
+                                  perStep(st.densityIterations, mSolveBefore.densityIterations)});
+            row.values.push_back(
+                {"divergence_iterations",
+                 perStep(st.divergenceIterations, mSolveBefore.divergenceIterations)});
+            row.values.push_back({"density_solve_error", st.lastDensityError});
+            mSolveBefore = st;
+        }
         mBefore = t;
         return row;
     }
@@ -128,6 +162,7 @@ private:
     const vdbio::Scene& mScene;
     std::unique_ptr<GhostSolver> mSolver;
     ghost::PhaseTimings mBefore;
+    ghost::PressureSolveStats mSolveBefore;
 };
 
 } // namespace

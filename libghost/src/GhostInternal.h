@@ -49,6 +49,8 @@ constexpr const char* SOLID_LOCAL_NORMAL =
     "solid_n";                                   ///< moving solid particle: normal, solid frame
 constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, mass = weight m
 constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
+constexpr const char* DENSITY_KAPPA = "dfsph_k"; ///< DFSPH: density solve's p / rho^2 (warm start)
+constexpr const char* DIVERGENCE_KAPPA = "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
 
 /// parallel::forRange over particles [0, n): each task gets its own copy of `kernel` and a
 /// PairBatch of its own, and calls body(lo, hi, kernel, batch) on its range.

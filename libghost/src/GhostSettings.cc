@@ -15,7 +15,17 @@ namespace {
 
 const sph::EnumName<Method> METHOD_NAMES[] = {{Method::Ghost, "ghost"}, {Method::Basic, "basic"}};
 
+const sph::EnumName<PressureModel> PRESSURE_NAMES[] = {{PressureModel::Tait, "tait"},
+                                                       {PressureModel::Dfsph, "dfsph"}};
+
 } // namespace
+
+const char* pressureName(PressureModel model) { return sph::nameOf(PRESSURE_NAMES, model); }
+
+PressureModel pressureFromName(const std::string& name)
+{
+    return sph::valueOf(PRESSURE_NAMES, name, "pressure model");
+}
 
 const char* methodName(Method method) { return sph::nameOf(METHOD_NAMES, method); }
 
@@ -50,6 +60,8 @@ Real GhostSettings::shifting() const
 int GhostSettings::relaxationPasses() const
 {
     if (initialRelaxation >= 0) return initialRelaxation;
+    // DFSPH holds the density to a fraction of a percent: the sampled error is a kick.
+    if (pressure == PressureModel::Dfsph) return 20;
     return stiffness > Real(20000) ? 20 : 0;
 }
 
@@ -106,6 +118,26 @@ void GhostSettings::validate() const
     check.require(substeps >= 0 && substeps <= 100000, "substeps", substeps,
                   "0 (CFL-adaptive) to 100000");
     check.require(cflNumber > 0 && cflNumber <= 2, "cflNumber", cflNumber, "0 < cfl <= 2");
+    if (pressure == PressureModel::Dfsph) {
+        if (method != Method::Ghost) {
+            throw ValueError("liquid setting pressure = 'dfsph' with method 'basic': "
+                             "expected 'tait' (Basic SPH is [SB12]'s weakly compressible "
+                             "baseline, with no air for a pressure solve's free surface)");
+        }
+        check.require(dfsph.densityError >= Real(1e-7) && dfsph.densityError <= Real(0.1),
+                      "dfsph.densityError", dfsph.densityError, "1e-7 to 0.1 (a fraction)");
+        check.require(dfsph.divergenceError >= Real(1e-7) && dfsph.divergenceError <= Real(1),
+                      "dfsph.divergenceError", dfsph.divergenceError, "1e-7 to 1 (a fraction)");
+        check.require(dfsph.densityRelaxation > 0 && dfsph.densityRelaxation <= 1,
+                      "dfsph.densityRelaxation", dfsph.densityRelaxation, "in (0, 1]");
+        check.require(dfsph.maxIterations >= 1 && dfsph.maxIterations <= 100000,
+                      "dfsph.maxIterations", dfsph.maxIterations, "1 to 100000");
+        check.require(dfsph.minTimeStep > 0 && check.finite(dfsph.minTimeStep), "dfsph.minTimeStep",
+                      dfsph.minTimeStep, "a finite value > 0 (s)");
+        check.require(dfsph.maxTimeStep >= dfsph.minTimeStep && check.finite(dfsph.maxTimeStep),
+                      "dfsph.maxTimeStep", dfsph.maxTimeStep,
+                      "finite and >= dfsph.minTimeStep (s)");
+    }
     check.require(maxSpeed >= 0 && check.finite(maxSpeed), "maxSpeed", maxSpeed,
                   ">= 0 (m/s; 0 = 20 x sound speed)");
 }

@@ -36,6 +36,10 @@ GhostSolver::GhostSolver(const GhostSettings& settings)
         mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
+    if (mSettings.pressure == PressureModel::Dfsph) {
+        mParticles.addScalarChannel(DENSITY_KAPPA);
+        mParticles.addScalarChannel(DIVERGENCE_KAPPA);
+    }
 }
 
 GhostSolver::~GhostSolver() = default;
@@ -574,6 +578,7 @@ SolverState GhostSolver::saveState() const
     state.reals["lennard_jones"] = double(mLennardJones);
     state.integers["solids"] = std::int64_t(mSolids.size());
     state.integers["emitters"] = std::int64_t(mEmitters.size());
+    state.integers["pressure_dfsph"] = mSettings.pressure == PressureModel::Dfsph;
     return state;
 }
 
@@ -590,6 +595,17 @@ void GhostSolver::restoreState(const SolverState& state)
         || !mEmitters.empty()) {
         throw ValueError("restoreState: call it on a freshly constructed solver, before adding "
                          "solids, emitters or liquid and before the first step");
+    }
+    // States from before the pressure setting are Tait states.
+    const auto dfsph = state.integers.find("pressure_dfsph");
+    const PressureModel saved = dfsph != state.integers.end() && dfsph->second != 0
+                                    ? PressureModel::Dfsph
+                                    : PressureModel::Tait;
+    if (saved != mSettings.pressure) {
+        throw ValueError(msg("restoreState: the state was saved with settings.pressure = '",
+                             pressureName(saved), "', this run has '",
+                             pressureName(mSettings.pressure),
+                             "'; resume with the pressure model the run started with"));
     }
     // Read every key first, so a state missing one leaves the solver untouched.
     const sph::RunCounters run = sph::RunCounters::load(state);
@@ -633,6 +649,10 @@ void GhostSolver::restoreState(const SolverState& state)
         mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
+    if (mSettings.pressure == PressureModel::Dfsph) {
+        mParticles.addScalarChannel(DENSITY_KAPPA);
+        mParticles.addScalarChannel(DIVERGENCE_KAPPA);
+    }
     mRun = run;
     mMass = Real(mass);
     mLennardJones = Real(lennardJones);
@@ -669,6 +689,15 @@ Real GhostSolver::stableTimeStep() const
         if (mParticles.kinds()[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
     }
     const Real h = mSettings.spacing;
+    if (mSettings.pressure == PressureModel::Dfsph) {
+        // The implicit pressure has no sound speed to resolve: dt <= cfl h / |v|max
+        // ([BK15] Sec. 4.4), the force limit, and [minTimeStep, maxTimeStep].
+        const DfsphSettings& d = mSettings.dfsph;
+        Real dt = vmax > Real(0) ? mSettings.cflNumber * h / vmax : d.maxTimeStep;
+        const Real a = std::max(mRun.maxAcceleration, mSettings.gravity.length());
+        if (a > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / a));
+        return std::clamp(dt, d.minTimeStep, d.maxTimeStep);
+    }
     Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
     // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration
     // of the last step (gravity before the first), which covers stiff Lennard-Jones walls.

@@ -363,8 +363,22 @@ void GhostSolver::stepGhost(Real dt)
         512);
     mRun.maxAcceleration = *std::max_element(accel.begin(), accel.end());
     mTimings.pressureForce += secondsSince(t0);
+    finishGhostStep(dt, gradMass);
+}
 
-    t0 = std::chrono::steady_clock::now();
+void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
+{
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& rho = mParticles.densities();
+    const auto& kind = mParticles.kinds();
+    auto& v = mParticles.velocities();
+    const auto& vstar = mParticles.vectorChannel(VSTAR);
+    const Real M = mMass;
+    const bool shifting = !gradMass.empty();
+    mScratch.resize(n);
     extrapolateSolidVelocity();
 
     // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid
@@ -497,8 +511,9 @@ void GhostSolver::step(Real dt)
         emit();
         mTimings.emission += secondsSince(t0);
     }
-    if (mSettings.method == Method::Ghost) stepGhost(dt);
-    else stepBasic(dt);
+    if (mSettings.method == Method::Basic) stepBasic(dt);
+    else if (mSettings.pressure == PressureModel::Dfsph) stepDfsph(dt);
+    else stepGhost(dt);
 
     const double t1 = mRun.time + double(dt);
     moveSolids(t1);

@@ -24,5 +24,21 @@ inline openvdb::FloatGrid::Ptr openTankGrid(sph::Real a, sph::Real top, double w
     return sph::levelSetFromSdf(sdf, bounds, voxel);
 }
 
+/// Closed box container: walls `wall` (m) thick around the inside [lo, hi], at voxels of
+/// `voxel` (m).
+inline openvdb::FloatGrid::Ptr closedTankGrid(const sph::Vec3& lo, const sph::Vec3& hi, double wall,
+                                              sph::Real voxel)
+{
+    const openvdb::Vec3d innerLo(lo), innerHi(hi);
+    const openvdb::Vec3d outerLo = innerLo - openvdb::Vec3d(wall),
+                         outerHi = innerHi + openvdb::Vec3d(wall);
+    auto sdf = [&](const openvdb::Vec3d& x) {
+        return std::max(sph::boxSignedDistance(x, outerLo, outerHi),
+                        -sph::boxSignedDistance(x, innerLo, innerHi));
+    };
+    const sph::Aabb bounds{sph::Vec3(outerLo), sph::Vec3(outerHi)};
+    return sph::levelSetFromSdf(sdf, bounds, voxel);
+}
+
 } // namespace testing
 } // namespace ghostfx

@@ -26,6 +26,43 @@ const char* methodName(Method method);
 /// Parse a method name; throws ValueError listing the valid names.
 Method methodFromName(const std::string& name);
 
+/// How the liquid's pressure is found. Chosen by name in scenes (settings.pressure).
+enum class PressureModel {
+    Tait, ///< [SB12] Sec. 3: weakly compressible, p = k ((rho / rho0)^7 - 1), acoustic time steps
+    Dfsph ///< divergence-free SPH (Bender and Koschier 2015, 2017): an implicit solve that holds
+          ///< the density within a set error, time steps bound by the flow speed
+};
+
+/// "tait" or "dfsph".
+const char* pressureName(PressureModel model);
+/// Parse a pressure model name; throws ValueError listing the valid names.
+PressureModel pressureFromName(const std::string& name);
+
+/// The implicit pressure solve of PressureModel::Dfsph ([BK15] Algorithms 2 and 3).
+struct DfsphSettings
+{
+    /// The constant-density solve stops when the mean |rho* - target| / rho0 of the liquid is
+    /// at most this (a fraction: 1e-3 = 0.1 %), rho* the density the step's velocities lead to
+    /// and target = rho0 + (1 - densityRelaxation) (rho - rho0).
+    Real densityError = Real(1e-3);
+    /// The divergence solve stops when the mean |D rho / Dt| dt / rho0 of the liquid, the
+    /// density change the velocity field would make in one step, is at most this ([BK17]: 0.1 %).
+    Real divergenceError = Real(1e-3);
+    /// Share beta of the density error rho - rho0 the density solve removes in one step
+    /// (Asai et al. 2012's relaxed density invariance; the velocity divergence is removed in
+    /// full). 1 is [BK15]'s solve; above about 0.05 the few-percent errors of sampled and
+    /// emitted particles become velocity kicks that grow (bench/RESULTS.md, "DFSPH").
+    Real densityRelaxation = Real(0.05);
+    /// Iteration cap of each solve; a solve that reaches it is counted as unconverged
+    /// (GhostSolver::pressureSolveStats) and the step goes on with the velocity it reached.
+    int maxIterations = 100;
+    /// CFL steps (substeps 0): dt = cfl h / |v|max, limited to [minTimeStep, maxTimeStep] (s).
+    Real minTimeStep = Real(1e-5);
+    Real maxTimeStep = Real(5e-3);
+    /// Start each solve from the last step's pressure ([BK15] Sec. 4.3).
+    bool warmStart = true;
+};
+
 /// Boundary condition at solids for Ghost SPH ([SB12] Sec. 4.4).
 enum class SolidSlip {
     Free,  ///< Eq. 3: normal velocity of the solid + tangential velocity of the nearest liquid
@@ -35,6 +72,9 @@ enum class SolidSlip {
 struct GhostSettings
 {
     Method method = Method::Ghost;
+    /// The pressure model of the Ghost method (Basic SPH is Tait only, as [SB12] defines it).
+    PressureModel pressure = PressureModel::Tait;
+    DfsphSettings dfsph;
 
     // Discretisation ---------------------------------------------------------------------------
     Real spacing = Real(0.01);    ///< particle spacing h (m)

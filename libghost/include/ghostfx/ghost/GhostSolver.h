@@ -78,6 +78,20 @@ struct PhaseTimings
     std::uint64_t steps = 0;
 };
 
+/// Work of the implicit pressure solves (settings.pressure = dfsph), accumulated since the last
+/// resetTimings(), with the last step's figures.
+struct PressureSolveStats
+{
+    std::uint64_t steps = 0;                ///< steps solved
+    std::uint64_t densityIterations = 0;    ///< constant-density iterations, all steps
+    std::uint64_t divergenceIterations = 0; ///< divergence iterations, all steps
+    std::uint64_t unconverged = 0;          ///< solves that reached DfsphSettings::maxIterations
+    int lastDensityIterations = 0, lastDivergenceIterations = 0;
+    double lastDensityError = 0; ///< mean |rho* / rho0 - 1| the last density solve reached
+    double lastDivergenceError =
+        0; ///< mean |D rho / Dt| dt / rho0 the last divergence solve reached
+};
+
 class GhostSolver
 {
 public:
@@ -189,7 +203,13 @@ public:
     int frame() const { return mRun.frame; }
 
     const PhaseTimings& timings() const { return mTimings; }
-    void resetTimings() { mTimings = PhaseTimings(); }
+    void resetTimings()
+    {
+        mTimings = PhaseTimings();
+        mSolveStats = PressureSolveStats();
+    }
+    /// The implicit pressure solves' iterations and errors (settings.pressure = dfsph).
+    const PressureSolveStats& pressureSolveStats() const { return mSolveStats; }
     /// Mean number of neighbours per liquid particle in the last density pass (self included).
     double meanNeighbors() const { return mRun.meanNeighbors; }
     /// Liquid-neighbour pairs in the last neighbour search, solid neighbours included.
@@ -243,6 +263,21 @@ private:
     void relaxInitialLiquid();
     void extrapolateSolidVelocity();
     void stepGhost(Real dt);
+    /// Algorithm 3 lines 15-28 after the pressure: ghost solid velocity, XSPH, air velocity,
+    /// positions and (with gradMass) particle shifting. Reads VSTAR.
+    void finishGhostStep(Real dt, const std::vector<Vec3>& gradMass);
+    /// The Ghost method with the DFSPH pressure solves (GhostDfsph.cc).
+    void stepDfsph(Real dt);
+    /// DFSPH factor 1 / (|sum_j m_j grad W_ij|^2 + sum_liquid j |m_j grad W_ij|^2), liquid
+    /// and solid neighbours, of each liquid particle into mAlpha, and with gradMass the sum
+    /// of m_j grad W_ij over every neighbour (particle shifting).
+    void computeDfsphFactors(std::vector<Vec3>* gradMass);
+    /// One DFSPH solve on the VSTAR velocities (preconditioned conjugate gradients): the
+    /// density solve (density = true) drives rho + dt D rho / Dt to rho0, the divergence solve
+    /// D rho / Dt to 0. `total` is the
+    /// per-particle channel of accumulated pressure terms (warm start in, result out).
+    /// Returns the iterations; sets `error` to the mean error reached.
+    int solvePressure(Real dt, bool density, std::vector<Real>& total, double& error);
     void stepBasic(Real dt);
     void moveSolids(double time);
     void projectOutOfSolids(Real dt);
@@ -268,6 +303,10 @@ private:
     bool mProjectAll = true; ///< a solid changed shape: test every liquid particle for collision
     sph::RunCounters mRun;   ///< clock and counters (maxAcceleration: of the liquid)
     PhaseTimings mTimings;
+    PressureSolveStats mSolveStats;
+    /// DFSPH: each liquid particle's inverse diagonal (0: spray, not solved), and each
+    /// particle's mass if liquid, else 0.
+    std::vector<Real> mAlpha, mLiquidMass;
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;

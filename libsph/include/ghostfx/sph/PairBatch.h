@@ -107,6 +107,30 @@ struct PairBatch
         return total;
     }
 
+    /// sum_k a[k] (vi - values[j[k]]) . (x_i - x_j) over the batch, as in sum(): with a[k] =
+    /// m_j gradFactor(r), the rate of density change sum_j m_j (v_i - v_j) . grad W_ij.
+    Real sumScaledApproach(const Real* a, const Vec3* values, const Vec3& vi) const
+    {
+        Real lane[LANES] = {};
+        int k = 0;
+        for (; k + LANES <= n; k += LANES) {
+            for (int l = 0; l < LANES; ++l) {
+                const Vec3& v = values[j[k + l]];
+                lane[l] += a[k + l]
+                           * ((vi[0] - v[0]) * dx[k + l] + (vi[1] - v[1]) * dy[k + l]
+                              + (vi[2] - v[2]) * dz[k + l]);
+            }
+        }
+        for (int l = 0; k < n; ++k, ++l) {
+            const Vec3& v = values[j[k]];
+            lane[l] +=
+                a[k] * ((vi[0] - v[0]) * dx[k] + (vi[1] - v[1]) * dy[k] + (vi[2] - v[2]) * dz[k]);
+        }
+        Real total = 0;
+        for (int l = 0; l < LANES; ++l) total += lane[l];
+        return total;
+    }
+
     /// sum_k a[k] (x_i - x_j) over the batch, each component as in sum().
     Vec3 sumScaledOffsets(const Real* a) const
     {

@@ -1,0 +1,386 @@
+/// @file   GhostDfsph.cc
+/// @brief  Ghost SPH with an implicit pressure: the divergence-free SPH solves of Bender and
+///         Koschier ([BK15] "Divergence-Free Smoothed Particle Hydrodynamics", SCA 2015;
+///         [BK17] the TVCG 2017 version) over [SB12]'s ghost air and ghost solids.
+/// @details One step, with one neighbour search (the lists of GhostStep.cc):
+///           1. density (Eq. 1, every kind of neighbour) and the factor alpha_i of each liquid
+///              particle;
+///           2. the divergence solve on the velocities the last step left ([BK15] Algorithm 2,
+///              moved from the end of the last step to the start of this one, where the new
+///              neighbourhood is known: the same sequence with one search);
+///           3. v* = v + dt g, then the constant-density solve ([BK15] Algorithm 3) on v*;
+///           4. [SB12] Algorithm 3 from line 15 on, unchanged: Eq. 3 ghost solid velocities,
+///              XSPH, air velocities, positions.
+///
+///          Both solves find pressure terms k_i = p_i / rho_i^2 (m^5 / (kg s^2)) whose velocity
+///          change is the symmetric pressure force of [SB12]'s Tait step,
+///              v_i -= dt (G k)_i,   (G k)_i = sum_liquid j m_j (k_i + k_j) grad W_ij
+///                                             + sum_solid s M k_i grad W_is,
+///          such that the rate of density change (D v)_i = sum_j m_j (v_i - v_j) . grad W_ij
+///          meets the solve's target. D G is symmetric and positive semi-definite (for equal
+///          masses sum_i k_i (D u)_i = sum_i u_i . (G k)_i when solids are held still), so the
+///          solve is preconditioned conjugate gradients with [BK15]'s alpha_i as the inverse
+///          diagonal. [BK15]'s Jacobi iteration (k_i = alpha_i e_i / dt^2) diverges at [SB12]'s
+///          3 h support: with about 110 neighbours the off-diagonal coupling outweighs the
+///          diagonal (measured: the error grew 4.4 x per iteration on a sampled ball).
+///
+///          How the ghosts take part (each choice measured: bench/RESULTS.md, "DFSPH"):
+///           - ghost air gives a surface particle its full density (its mass is in rho_i) at
+///             zero pressure (k = 0), and moves with the liquid: it adds nothing to the rate of
+///             density change or to the forces. So no density clamping and no surface special
+///             case: a surface particle has the error of any other. Air held still in the solve
+///             walls the liquid in (a falling ball's solve pressed it against its own air); air
+///             following its nearest liquid particle makes an isolated particle's density
+///             unchangeable (the system singular).
+///           - a ghost solid adds its mass to rho_i and pushes with the liquid particle's own
+///             pressure term (k_i: the liquid's pressure mirrored onto the wall, in the form
+///             that keeps D G symmetric); in D it moves with the solid's velocity (its normal
+///             velocity is what the wall imposes). Taking [SB12]'s Eq. 3 velocity there (the
+///             tangential velocity of the nearest liquid) fed the liquid's corrections back
+///             into the walls' velocities and a still tank blew up at the corners.
+///           - the density-invariance target is relaxed (Asai et al. 2012's stabilised
+///             incompressible SPH): the density solve asks for rho + dt D rho / Dt = rho0 +
+///             (1 - beta) (rho - rho0), beta = DfsphSettings::densityRelaxation per step, while
+///             the divergence solve asks for D rho / Dt = 0 in full. The Poisson samples, the
+///             resampled air and the emitters' new particles carry density errors of a few
+///             percent; asking each step to remove them in full (beta = 1) turns them into
+///             velocity kicks of error x h / dt that grew without bound in every violent test.
+///           - a liquid particle with fewer than MIN_LIQUID_NEIGHBOURS liquid neighbours is
+///             spray: it has no liquid to push against and takes no part in the solve.
+#include "ghostfx/ghost/GhostSolver.h"
+
+#include "GhostInternal.h"
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/PairBatch.h>
+#include <ghostfx/sph/Parallel.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace ghostfx {
+namespace ghost {
+
+using namespace sph;
+using namespace detail;
+
+namespace {
+
+/// Liquid neighbours (self included) below which a liquid particle is spray (about a tenth of
+/// a full neighbourhood at [SB12]'s 3 h support).
+constexpr int MIN_LIQUID_NEIGHBOURS = 10;
+
+} // namespace
+
+void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
+{
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& kind = mParticles.kinds();
+    const Real M = mMass;
+    mAlpha.assign(n, Real(0));
+    mLiquidMass.resize(n);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t j) { mLiquidMass[j] = kind[j] == ParticleKind::Liquid ? M : Real(0); },
+        4096);
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) continue;
+            const Vec3 xi = x[i];
+            Vec3 sum(0), all(0);
+            Real squares = 0;
+            int liquidNeighbours = 0;
+            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.g[k] = kernel.gradFactor(b.r[k]);
+                for (int k = 0; k < b.n; ++k) b.f[k] = mLiquidMass[b.j[k]] * b.g[k];
+                sum += b.sumScaledOffsets(b.f);
+                for (int k = 0; k < b.n; ++k) {
+                    liquidNeighbours += mLiquidMass[b.j[k]] > Real(0);
+                    b.f[k] = sqr(b.f[k] * b.r[k]);
+                }
+                squares += b.sum(b.f);
+                if (gradMass) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * b.g[k];
+                    all += b.sumScaledOffsets(b.f);
+                }
+            });
+            Vec3 solid(0);
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
+                                   [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = M * kernel.gradFactor(b.r[k]);
+                    solid += b.sumScaledOffsets(b.f);
+                });
+            }
+            // The particle's own pressure term moves it by its liquid and solid gradient sums
+            // and each liquid neighbour by its own term.
+            const Real a = (sum + solid).lengthSqr() + squares;
+            mAlpha[i] =
+                a > Real(0) && liquidNeighbours >= MIN_LIQUID_NEIGHBOURS ? Real(1) / a : Real(0);
+            if (gradMass) (*gradMass)[i] = all + solid;
+        }
+        },
+        512);
+}
+
+int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, double& error)
+{
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& rho = mParticles.densities();
+    auto& w = mParticles.vectorChannel(VSTAR);
+    const Real M = mMass, rho0 = mSettings.restDensity;
+    const DfsphSettings& opt = mSettings.dfsph;
+    const double limit = double(density ? opt.densityError : opt.divergenceError);
+    const Real beta = density ? opt.densityRelaxation : Real(0);
+    const SolidBlock* blocks[2] = {&mStatic, &mMoving};
+    // The particles in the solve: liquid that is not spray.
+    auto solved = [&](std::size_t i) { return mAlpha[i] > Real(0); };
+    const std::vector<Real>& lm = mLiquidMass;
+
+    // G k (see the file comment), zero for air and spray.
+    std::vector<Vec3> u(n, Vec3(0));
+    auto gradient = [&](const std::vector<Real>& k) {
+        forRangeWithBatch(
+            n, mKernel,
+            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (lm[i] == Real(0)) continue;
+                const Vec3 xi = x[i];
+                const Real ki = k[i];
+                Vec3 sum(0), solid(0);
+                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * (ki + k[b.j[c]]);
+                    for (int c = 0; c < b.n; ++c) b.f[c] *= kernel.gradFactor(b.r[c]);
+                    sum += b.sumScaledOffsets(b.f);
+                });
+                for (const SolidBlock* block : blocks) {
+                    batch.forEachBatch(xi, block->block.particles().positions().data(),
+                                       block->lists[i], [&](PairBatch& b) {
+                                           for (int c = 0; c < b.n; ++c)
+                                               b.f[c] = M * kernel.gradFactor(b.r[c]);
+                                           solid += b.sumScaledOffsets(b.f);
+                                       });
+                }
+                u[i] = sum + ki * solid;
+            }
+            },
+            512);
+    };
+    // D v for the solved particles: liquid velocities `vel`, solids at their own velocity
+    // (`solidMoves`) or still.
+    std::vector<Real> rate(n, Real(0));
+    auto divergence = [&](const std::vector<Vec3>& vel, bool solidMoves) {
+        forRangeWithBatch(
+            n, mKernel,
+            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (!solved(i)) continue;
+                const Vec3 xi = x[i], vi = vel[i];
+                Real sum = 0;
+                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
+                    sum += b.sumScaledApproach(b.f, vel.data(), vi);
+                });
+                for (const SolidBlock* block : blocks) {
+                    const Vec3* vs = block->block.particles().velocities().data();
+                    batch.forEachBatch(xi, block->block.particles().positions().data(),
+                                       block->lists[i], [&](PairBatch& b) {
+                                           for (int c = 0; c < b.n; ++c)
+                                               b.f[c] = M * kernel.gradFactor(b.r[c]);
+                                           if (solidMoves) sum += b.sumScaledApproach(b.f, vs, vi);
+                                           else sum += vi.dot(b.sumScaledOffsets(b.f));
+                                       });
+                }
+                rate[i] = sum;
+            }
+            },
+            512);
+    };
+    auto dot = [&](const std::vector<Real>& a, const std::vector<Real>& b) {
+        return parallel::sum(0, n, [&](std::size_t i) { return double(a[i]) * double(b[i]); });
+    };
+    const double count = parallel::sum(0, n, [&](std::size_t i) { return solved(i) ? 1.0 : 0.0; });
+    const Real dt2 = dt * dt;
+    // Mean |e| / rho0 over the solved particles of residuals r = e / dt^2.
+    auto meanError = [&](const std::vector<Real>& r) {
+        const double sum =
+            parallel::sum(0, n, [&](std::size_t i) { return double(std::abs(r[i])); });
+        return count > 0 ? sum * double(dt2) / count / double(rho0) : 0.0;
+    };
+
+    // Warm start: the last step's pressure terms first ([BK15] Sec. 4.3).
+    std::vector<Real> k(n, Real(0));
+    if (opt.warmStart) {
+        parallel::forEach(
+            0, n, [&](std::size_t i) { k[i] = solved(i) ? total[i] : Real(0); }, 4096);
+        gradient(k);
+        parallel::forEach(
+            0, n, [&](std::size_t i) { w[i] -= dt * u[i]; }, 4096);
+    }
+    parallel::forEach(
+        0, n, [&](std::size_t i) { total[i] = solved(i) && opt.warmStart ? total[i] : Real(0); },
+        4096);
+
+    // The error the velocities leave: beta (rho - rho0) + dt D rho / Dt for the density solve,
+    // dt D rho / Dt for the divergence solve.
+    divergence(w, true);
+    std::vector<Real> r(n, Real(0)), z(n, Real(0)), p(n, Real(0)), q(n, Real(0));
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+        if (solved(i)) r[i] = (beta * (rho[i] - rho0) + dt * rate[i]) / dt2;
+        },
+        4096);
+    error = meanError(r);
+
+    // Preconditioned conjugate gradients on D G k = r.
+    std::fill(k.begin(), k.end(), Real(0));
+    int iteration = 0;
+    if (!(error <= limit)) {
+        parallel::forEach(
+            0, n,
+            [&](std::size_t i) {
+            z[i] = mAlpha[i] * r[i];
+            p[i] = z[i];
+            },
+            4096);
+        double rz = dot(r, z);
+        while (iteration < opt.maxIterations) {
+            ++iteration;
+            gradient(p);
+            divergence(u, false);
+            parallel::forEach(
+                0, n, [&](std::size_t i) { q[i] = solved(i) ? rate[i] : Real(0); }, 4096);
+            const double pq = dot(p, q);
+            if (!(pq > 0)) break; // what is left lies where G has no effect
+            const Real step = Real(rz / pq);
+            parallel::forEach(
+                0, n,
+                [&](std::size_t i) {
+                k[i] += step * p[i];
+                r[i] -= step * q[i];
+                },
+                4096);
+            error = meanError(r);
+            if (!std::isfinite(error)) {
+                throw NumericalError(msg("liquid solver at frame ", mRun.frame, ", step ",
+                                         mRun.step, " (t = ", mRun.time, " s): the DFSPH ",
+                                         density ? "density" : "divergence",
+                                         " solve gave a non-finite error at iteration ", iteration,
+                                         "; reduce the time step (dfsph.max_dt, cfl)"));
+            }
+            if (error <= limit) break;
+            parallel::forEach(
+                0, n, [&](std::size_t i) { z[i] = mAlpha[i] * r[i]; }, 4096);
+            const double rzNext = dot(r, z);
+            const Real direction = Real(rzNext / rz);
+            rz = rzNext;
+            parallel::forEach(
+                0, n, [&](std::size_t i) { p[i] = z[i] + direction * p[i]; }, 4096);
+        }
+        gradient(k);
+        parallel::forEach(
+            0, n,
+            [&](std::size_t i) {
+            w[i] -= dt * u[i];
+            total[i] += k[i];
+            },
+            4096);
+    }
+    if (!(error <= limit)) ++mSolveStats.unconverged;
+    return iteration;
+}
+
+void GhostSolver::stepDfsph(Real dt)
+{
+    // Line 1 and the density of lines 2-7, as in the Tait step (GhostStep.cc).
+    prepareSolidBlocks();
+    fadeAir();
+    auto t0 = std::chrono::steady_clock::now();
+    searchNeighbors();
+    const double search = secondsSince(t0);
+    mTimings.sortAndSearch += search;
+    if (mRun.step > 0) resampleAir(int(mRun.step % std::uint64_t(mSettings.airResampleSteps)));
+    t0 = std::chrono::steady_clock::now();
+    computeDensity();
+    const bool shifting = mSettings.shifting() > Real(0);
+    std::vector<Vec3> gradMass(shifting ? mParticles.size() : 0, Vec3(0));
+    computeDfsphFactors(shifting ? &gradMass : nullptr);
+    mTimings.neighborsAndDensity += search + secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    const std::size_t n = mParticles.size();
+    const auto& kind = mParticles.kinds();
+    const auto& v = mParticles.velocities();
+    auto& w = mParticles.vectorChannel(VSTAR);
+    auto& kappaDensity = mParticles.scalarChannel(DENSITY_KAPPA);
+    auto& kappaDivergence = mParticles.scalarChannel(DIVERGENCE_KAPPA);
+
+    // The divergence solve: the velocities the last step left, made divergence-free at the
+    // positions they led to.
+    parallel::forEach(
+        0, n, [&](std::size_t i) { w[i] = v[i]; }, 4096);
+    double divergenceError = 0;
+    const int divergenceIterations = solvePressure(dt, false, kappaDivergence, divergenceError);
+
+    // Lines 11-14 with the implicit pressure: v* = v + dt g for liquid and air (air falls with
+    // the liquid it surrounds), then the constant-density solve on v*.
+    const Vec3 g = mSettings.gravity;
+    std::vector<Vec3> start(n);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+        if (kind[i] == ParticleKind::Liquid) start[i] = w[i];
+        w[i] += dt * g;
+        },
+        4096);
+    double densityError = 0;
+    const int densityIterations = solvePressure(dt, true, kappaDensity, densityError);
+
+    // Pressure p = k rho^2 for the output and the ghost solids; the acceleration the pressure
+    // and gravity gave (the CFL force limit).
+    const auto& rho = mParticles.densities();
+    auto& p = mParticles.pressures();
+    std::vector<Real> accel(n, Real(0));
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Liquid) {
+            p[i] = 0;
+            return;
+        }
+        p[i] = kappaDensity[i] * sqr(rho[i]);
+        accel[i] = (w[i] - start[i]).length() / dt;
+        },
+        4096);
+    mRun.maxAcceleration = *std::max_element(accel.begin(), accel.end());
+    for (SolidBlock* b : {&mStatic, &mMoving}) {
+        parallel::forEach(
+            0, b->touched.size(),
+            [&](std::size_t t) {
+            const Index s = b->touched[t];
+            const Index j = nearestIndex(b->nearest[s]);
+            b->p[s] = p[j];
+            b->pOverRho2[s] = kappaDensity[j];
+            },
+            1024);
+    }
+    ++mSolveStats.steps;
+    mSolveStats.densityIterations += std::uint64_t(densityIterations);
+    mSolveStats.divergenceIterations += std::uint64_t(divergenceIterations);
+    mSolveStats.lastDensityIterations = densityIterations;
+    mSolveStats.lastDivergenceIterations = divergenceIterations;
+    mSolveStats.lastDensityError = densityError;
+    mSolveStats.lastDivergenceError = divergenceError;
+    mTimings.pressureForce += secondsSince(t0);
+
+    finishGhostStep(dt, gradMass);
+}
+
+} // namespace ghost
+} // namespace ghostfx
