@@ -50,19 +50,20 @@ constexpr double PAPER_DT = 1.0 / (30.0 * 20.0);
 
 struct Options
 {
-    double damLiquid = 100000;    ///< dam break: target liquid particle count
-    double tankFloor = 1;         ///< dam break: tank floor area as a multiple of the default
-    double sphereLiquid = 20000;  ///< sphere scene: target liquid particle count
-    double sphereSpacing = 0.01;  ///< sphere scene: h (m)
-    int steps = 30;               ///< measured steps
-    int warmup = 20;              ///< steps before the measurement (>= 1)
-    double cfl = 0;               ///< > 0: CFL-limited dt with this number instead of PAPER_DT
-    double stiffness = 0;         ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
-    double shifting = -1;         ///< >= 0: particle shifting coefficient instead of the default
-    double lennardJones = 0;      ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
-    int threads = 0;              ///< TBB threads, 0 = all
-    std::string scenes = "all";   ///< dam, sphere or all
-    std::string methods = "both"; ///< ghost, basic or both
+    double damLiquid = 100000;     ///< dam break: target liquid particle count
+    double tankFloor = 1;          ///< dam break: tank floor area as a multiple of the default
+    double sphereLiquid = 20000;   ///< sphere scene: target liquid particle count
+    double sphereSpacing = 0.01;   ///< sphere scene: h (m)
+    int steps = 30;                ///< measured steps
+    int warmup = 20;               ///< steps before the measurement (>= 1)
+    double cfl = 0;                ///< > 0: CFL-limited dt with this number instead of PAPER_DT
+    double stiffness = 0;          ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
+    double shifting = -1;          ///< >= 0: particle shifting coefficient instead of the default
+    double lennardJones = 0;       ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
+    int threads = 0;               ///< TBB threads, 0 = all
+    std::string scenes = "all";    ///< dam, sphere or all
+    std::string methods = "both";  ///< ghost, basic or both
+    std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     std::uint64_t seed = 1;
 };
 
@@ -155,6 +156,8 @@ struct RunResult
 {
     std::string scene;
     Method method = Method::Ghost;
+    PressureModel pressure = PressureModel::Tait;
+    PressureSolveStats solve; ///< DFSPH iterations over the measured steps
     bool ok = false;
     std::string error;
     std::size_t liquid = 0, air = 0, solid = 0;                  ///< at the end of the measurement
@@ -178,6 +181,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
 {
     out.scene = scene.name;
     out.method = method;
+    out.pressure = solver.settings().pressure;
     double sum = 0, lo = 1e30, hi = 0, nbrs = 0, simulated = 0;
     std::vector<double> times;
     bool measuring = false;
@@ -185,7 +189,9 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
         if (solver.count(ParticleKind::Liquid) == 0) {
             solver.addLiquidParticles(liquidPositions, scene.liquidVelocity);
         }
-        auto nextDt = [&]() { return opt.cfl > 0 ? solver.stableTimeStep() : Real(PAPER_DT); };
+        // DFSPH steps are bound by the flow speed: always CFL steps (its point).
+        const bool cflSteps = opt.cfl > 0 || solver.settings().pressure == PressureModel::Dfsph;
+        auto nextDt = [&]() { return cflSteps ? solver.stableTimeStep() : Real(PAPER_DT); };
 
         // Warm-up; the first step also builds the air layer and scales the mass (Sec. 4.6).
         auto t0 = std::chrono::steady_clock::now();
@@ -223,6 +229,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
         out.dt = simulated / out.steps;
         out.meanNeighbors = nbrs / out.steps;
         out.phases = solver.timings();
+        out.solve = solver.pressureSolveStats();
     }
 
     const ParticleSet& p = solver.particles();
@@ -247,7 +254,8 @@ double percent(double part, double whole) { return whole > 0 ? 100 * part / whol
 
 void printRun(const RunResult& r)
 {
-    std::printf("\n--- %s, %s ---\n", r.scene.c_str(), methodName(r.method));
+    std::printf("\n--- %s, %s, %s pressure ---\n", r.scene.c_str(), methodName(r.method),
+                pressureName(r.pressure));
     if (!r.ok) std::printf("  FAILED: %s\n", r.error.c_str());
     std::printf("  particles: liquid %zu, ghost air %zu (%.0f %%), %s %zu (%.0f %%), total %zu\n",
                 r.liquid, r.air, percent(double(r.air), double(r.liquid)),
@@ -303,6 +311,14 @@ void printRun(const RunResult& r)
     std::printf("  mean neighbours %.1f; %.2f ns per particle-neighbour pair; %.1f wall s per "
                 "simulated s\n",
                 r.meanNeighbors, 1e9 * r.meanStep / pairs, r.meanStep / r.dt);
+    if (r.pressure == PressureModel::Dfsph) {
+        const PressureSolveStats& st = r.solve;
+        std::printf("  DFSPH: %.1f density + %.1f divergence iterations per step, last errors "
+                    "%.2e / %.2e, %llu unconverged solves\n",
+                    double(st.densityIterations) / double(st.steps),
+                    double(st.divergenceIterations) / double(st.steps), st.lastDensityError,
+                    st.lastDivergenceError, static_cast<unsigned long long>(st.unconverged));
+    }
 }
 
 std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
@@ -316,6 +332,7 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     if (opt.stiffness > 0) settings.stiffness = Real(opt.stiffness);
     if (opt.shifting >= 0) settings.shiftingCoefficient = Real(opt.shifting);
     if (opt.lennardJones > 0) settings.lennardJonesStrength = Real(opt.lennardJones);
+    const PressureModel pressure = pressureFromName(opt.pressure);
 
     std::vector<RunResult> results;
     std::vector<Vec3> liquid;
@@ -323,6 +340,7 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     for (const Method method : {Method::Ghost, Method::Basic}) {
         if (opt.methods != "both" && opt.methods != methodName(method)) continue;
         settings.method = method;
+        settings.pressure = method == Method::Ghost ? pressure : PressureModel::Tait;
         GhostSolver solver(settings);
         RunResult r;
         auto t0 = std::chrono::steady_clock::now();
@@ -391,6 +409,11 @@ int main(int argc, char** argv)
     app.add_option("--scene", opt.scenes, "dam, sphere or all")
         ->capture_default_str()
         ->check(CLI::IsMember({"dam", "sphere", "all"}));
+    app.add_option("--pressure", opt.pressure,
+                   "Ghost SPH pressure: tait ([SB12]) or dfsph (implicit, CFL steps on the flow "
+                   "speed)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"tait", "dfsph"}));
     app.add_option("--method", opt.methods, "ghost, basic or both")
         ->capture_default_str()
         ->check(CLI::IsMember({"ghost", "basic", "both"}));

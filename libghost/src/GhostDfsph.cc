@@ -80,6 +80,7 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
     const auto& kind = mParticles.kinds();
     const Real M = mMass;
     mAlpha.assign(n, Real(0));
+    mSolidGradient.assign(n, Vec3(0));
     mLiquidMass.resize(n);
     parallel::forEach(
         0, n,
@@ -121,6 +122,7 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
             const Real a = (sum + solid).lengthSqr() + squares;
             mAlpha[i] =
                 a > Real(0) && liquidNeighbours >= MIN_LIQUID_NEIGHBOURS ? Real(1) / a : Real(0);
+            mSolidGradient[i] = solid;
             if (gradMass) (*gradMass)[i] = all + solid;
         }
         },
@@ -137,7 +139,6 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     const DfsphSettings& opt = mSettings.dfsph;
     const double limit = double(density ? opt.densityError : opt.divergenceError);
     const Real beta = density ? opt.densityRelaxation : Real(0);
-    const SolidBlock* blocks[2] = {&mStatic, &mMoving};
     // The particles in the solve: liquid that is not spray.
     auto solved = [&](std::size_t i) { return mAlpha[i] > Real(0); };
     const std::vector<Real>& lm = mLiquidMass;
@@ -152,21 +153,14 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
                 if (lm[i] == Real(0)) continue;
                 const Vec3 xi = x[i];
                 const Real ki = k[i];
-                Vec3 sum(0), solid(0);
+                Vec3 sum(0);
                 batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
                     for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * (ki + k[b.j[c]]);
                     for (int c = 0; c < b.n; ++c) b.f[c] *= kernel.gradFactor(b.r[c]);
                     sum += b.sumScaledOffsets(b.f);
                 });
-                for (const SolidBlock* block : blocks) {
-                    batch.forEachBatch(xi, block->block.particles().positions().data(),
-                                       block->lists[i], [&](PairBatch& b) {
-                                           for (int c = 0; c < b.n; ++c)
-                                               b.f[c] = M * kernel.gradFactor(b.r[c]);
-                                           solid += b.sumScaledOffsets(b.f);
-                                       });
-                }
-                u[i] = sum + ki * solid;
+                // The solids' part, k_i sum_s M grad W_is, from the step's sum.
+                u[i] = sum + ki * mSolidGradient[i];
             }
             },
             512);
@@ -174,6 +168,9 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // D v for the solved particles: liquid velocities `vel`, solids at their own velocity
     // (`solidMoves`) or still.
     std::vector<Real> rate(n, Real(0));
+    // sum_s M (v_i - v_s) . grad W_is = v_i . (the step's solid gradient sum) - the moving
+    // block's sum_s M v_s . grad W_is (static solids have v_s = 0).
+    const bool movingSolids = !mMoving.block.empty();
     auto divergence = [&](const std::vector<Vec3>& vel, bool solidMoves) {
         forRangeWithBatch(
             n, mKernel,
@@ -181,20 +178,18 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
             for (std::size_t i = lo; i < hi; ++i) {
                 if (!solved(i)) continue;
                 const Vec3 xi = x[i], vi = vel[i];
-                Real sum = 0;
+                Real sum = vi.dot(mSolidGradient[i]);
                 batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
                     for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
                     sum += b.sumScaledApproach(b.f, vel.data(), vi);
                 });
-                for (const SolidBlock* block : blocks) {
-                    const Vec3* vs = block->block.particles().velocities().data();
-                    batch.forEachBatch(xi, block->block.particles().positions().data(),
-                                       block->lists[i], [&](PairBatch& b) {
-                                           for (int c = 0; c < b.n; ++c)
-                                               b.f[c] = M * kernel.gradFactor(b.r[c]);
-                                           if (solidMoves) sum += b.sumScaledApproach(b.f, vs, vi);
-                                           else sum += vi.dot(b.sumScaledOffsets(b.f));
-                                       });
+                if (solidMoves && movingSolids) {
+                    const ParticleSet& set = mMoving.block.particles();
+                    batch.forEachBatch(xi, set.positions().data(), mMoving.lists[i],
+                                       [&](PairBatch& b) {
+                        for (int c = 0; c < b.n; ++c) b.f[c] = M * kernel.gradFactor(b.r[c]);
+                        sum -= b.sumScaledApproach(b.f, set.velocities().data(), Vec3(0));
+                    });
                 }
                 rate[i] = sum;
             }
@@ -215,7 +210,11 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
 
     // Warm start: the last step's pressure terms first ([BK15] Sec. 4.3).
     std::vector<Real> k(n, Real(0));
-    if (opt.warmStart) {
+    // (Nothing to apply on the first step, or after a restart from rest.)
+    const bool warm = opt.warmStart && parallel::sum(0, n, [&](std::size_t i) {
+                                           return solved(i) && total[i] != Real(0) ? 1.0 : 0.0;
+                                       }) > 0;
+    if (warm) {
         parallel::forEach(
             0, n, [&](std::size_t i) { k[i] = solved(i) ? total[i] : Real(0); }, 4096);
         gradient(k);
@@ -230,6 +229,7 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // dt D rho / Dt for the divergence solve.
     divergence(w, true);
     std::vector<Real> r(n, Real(0)), z(n, Real(0)), p(n, Real(0)), q(n, Real(0));
+    std::vector<Vec3> change(n, Vec3(0)); // G k
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
@@ -259,11 +259,13 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
             const double pq = dot(p, q);
             if (!(pq > 0)) break; // what is left lies where G has no effect
             const Real step = Real(rz / pq);
+            // G k accumulates with k (G is linear): no gradient pass after the loop.
             parallel::forEach(
                 0, n,
                 [&](std::size_t i) {
                 k[i] += step * p[i];
                 r[i] -= step * q[i];
+                change[i] += step * u[i];
                 },
                 4096);
             error = meanError(r);
@@ -283,11 +285,10 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
             parallel::forEach(
                 0, n, [&](std::size_t i) { p[i] = z[i] + direction * p[i]; }, 4096);
         }
-        gradient(k);
         parallel::forEach(
             0, n,
             [&](std::size_t i) {
-            w[i] -= dt * u[i];
+            w[i] -= dt * change[i];
             total[i] += k[i];
             },
             4096);

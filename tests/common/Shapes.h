@@ -40,5 +40,22 @@ inline openvdb::FloatGrid::Ptr closedTankGrid(const sph::Vec3& lo, const sph::Ve
     return sph::levelSetFromSdf(sdf, bounds, voxel);
 }
 
+/// An upside-down cup: a ceiling at y = 0 with side walls 4 cm thick around
+/// [-0.06, 0.06]^2 reaching down to y = -0.1, open at the bottom, at voxels of spacing / 2.
+inline openvdb::FloatGrid::Ptr invertedCupGrid(sph::Real spacing)
+{
+    using sph::Real;
+    const double a = 0.06, wall = 0.04;
+    auto sdf = [&](const openvdb::Vec3d& x) {
+        const double outside =
+            sph::boxSignedDistance(x, {-a - wall, -0.1, -a - wall}, {a + wall, wall, a + wall});
+        return std::max(outside, -sph::boxSignedDistance(x, {-a, -1.0, -a}, {a, 0.0, a}));
+    };
+    return sph::levelSetFromSdf(sdf,
+                                sph::Aabb{sph::Vec3(Real(-a - wall), Real(-0.1), Real(-a - wall)),
+                                          sph::Vec3(Real(a + wall), Real(wall), Real(a + wall))},
+                                spacing / 2);
+}
+
 } // namespace testing
 } // namespace ghostfx

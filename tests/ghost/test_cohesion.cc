@@ -6,6 +6,8 @@
 #include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 
+#include "common/Shapes.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,22 +21,6 @@ using namespace ghostfx::ghost;
 namespace {
 
 constexpr Real H = Real(0.01);
-
-/// An upside-down cup: a ceiling at y = 0 with side walls around [-0.06, 0.06]^2 reaching down
-/// to y = -0.1, open at the bottom, walls 4 h thick.
-openvdb::FloatGrid::Ptr invertedCup()
-{
-    const double a = 0.06, wall = 0.04;
-    auto sdf = [&](const openvdb::Vec3d& x) {
-        const double outside =
-            boxSignedDistance(x, {-a - wall, -0.1, -a - wall}, {a + wall, wall, a + wall});
-        return std::max(outside, -boxSignedDistance(x, {-a, -1.0, -a}, {a, 0.0, a}));
-    };
-    return levelSetFromSdf(sdf,
-                           Aabb{Vec3(Real(-a - wall), Real(-0.1), Real(-a - wall)),
-                                Vec3(Real(a + wall), Real(wall), Real(a + wall))},
-                           H / 2);
-}
 
 /// Drop (m) of the liquid's top layer (the highest 10 % of its particles) after 0.1 s.
 double hangingDrop(Method method)
@@ -50,7 +36,7 @@ double hangingDrop(Method method)
     s.frameRate = Real(30);
     s.substeps = 133;
     GhostSolver solver(s);
-    solver.addSolid(makeLevelSet(invertedCup(), "cup"));
+    solver.addSolid(makeLevelSet(ghostfx::testing::invertedCupGrid(H), "cup"));
     // A 4 cm slab filling the top of the cup: hydrostatic tension at the top -rho0 g d =
     // -390 Pa, well within what the Tait equation holds (down to -k = -2000 Pa).
     solver.addLiquid(makeLevelSet(

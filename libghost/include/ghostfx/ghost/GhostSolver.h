@@ -307,6 +307,7 @@ private:
     /// DFSPH: each liquid particle's inverse diagonal (0: spray, not solved), and each
     /// particle's mass if liquid, else 0.
     std::vector<Real> mAlpha, mLiquidMass;
+    std::vector<Vec3> mSolidGradient; ///< DFSPH: sum_solid M grad W_is of each liquid particle
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;
