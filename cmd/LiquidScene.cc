@@ -26,6 +26,11 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.supportFactor = Real(s.inRange("kernel_support", g.supportFactor, 1.5, 5));
     g.restDensity = Real(s.positive("rest_density", g.restDensity));
     g.pressure = ghost::pressureFromName(s.choice("pressure", "tait", {"tait", "dfsph"}));
+    if (g.pressure == ghost::PressureModel::Dfsph && method == ghost::Method::Basic) {
+        s.failValue("pressure", "expected 'tait' with method 'basic' ([SB12]'s weakly "
+                                "compressible baseline has no air for a pressure solve's free "
+                                "surface)");
+    }
     if (s.has("dfsph")) {
         const vdbio::JsonObject d = s.object("dfsph");
         ghost::DfsphSettings& o = g.dfsph;

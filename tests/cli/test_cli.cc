@@ -252,6 +252,14 @@ TEST_F(Cli, BadInputGetsOneClearLine)
         {" -D settings.shifting=50", "settings.shifting = 50: expected a number in [0, 20]"},
         {" -D settings.initial_relaxation=2.5",
          "settings.initial_relaxation = 2.5: expected a whole number of passes, 0 to 1000"},
+        {" -D settings.pressure=iisph",
+         "settings.pressure = \"iisph\": expected one of 'tait', 'dfsph' (did you mean 'dfsph'?)"},
+        {" -D settings.dfsph.density_eror=0.01",
+         "settings.dfsph.density_eror: unknown key (did you mean 'density_error'?)"},
+        {" -D settings.dfsph.density_relaxation=0", "settings.dfsph.density_relaxation = 0: "
+                                                    "expected a number in [1e-06, 1]"},
+        {" -D settings.method=basic -D settings.pressure=dfsph",
+         "settings.pressure = \"dfsph\": expected 'tait' with method 'basic'"},
         {" -D settings.method=gas", "liquids: a 'gas' scene simulates gas only: liquids, emitters "
                                     "and heaters need a liquid method ('ghost' or 'basic'"},
         {" -D settings.gas.kappa=2",
