@@ -344,12 +344,18 @@ TEST(Dfsph, ZeroGravityCubeKeepsItsShape)
 {
     // [SB12] Fig. 4's test (test_hydrostatic_cube.cc): a 20 cm cube of liquid at 2.5 cm
     // spacing without gravity, 2 s. With ghost air around it the surface particles have a full
-    // neighbourhood and nothing pulls the cube apart or into a ball. Bounds as the Tait test's:
-    // radius of gyration within 4 %, speeds over the second second below 0.6 m/s.
+    // neighbourhood and nothing pulls the cube apart or into a ball. The cube starts from the
+    // raw Poisson samples (no initial relaxation): their density errors of a few percent are
+    // what the solve has to settle (from a relaxed start, beta times the error is below the
+    // solve's limit and, in the double build, nothing moves at all). Bounds as the Tait
+    // test's: radius of gyration within 4 %, speeds over the second second below 0.6 m/s
+    // (measured +1.81 %, 0.053 m/s float, +1.78 %, 0.057 m/s double; Tait from the same
+    // samples through the command line: +5.1 %, 5.4 m/s).
     GhostSettings s = dfsphSettings();
     s.spacing = Real(0.025);
     s.gravity = Vec3(0);
     s.seed = 1;
+    s.initialRelaxation = 0;
     GhostSolver solver(s);
     solver.addLiquid(makeLevelSet(makeBoxLevelSet(Vec3(0), Vec3(Real(0.2)), Real(0.0125)), "cube"));
     auto gyration = [&]() {
