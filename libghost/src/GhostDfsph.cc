@@ -300,19 +300,12 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
 void GhostSolver::stepDfsph(Real dt)
 {
     // Line 1 and the density of lines 2-7, as in the Tait step (GhostStep.cc).
-    prepareSolidBlocks();
-    fadeAir();
+    searchAndDensity();
     auto t0 = std::chrono::steady_clock::now();
-    searchNeighbors();
-    const double search = secondsSince(t0);
-    mTimings.sortAndSearch += search;
-    if (mRun.step > 0) resampleAir(int(mRun.step % std::uint64_t(mSettings.airResampleSteps)));
-    t0 = std::chrono::steady_clock::now();
-    computeDensity();
     const bool shifting = mSettings.shifting() > Real(0);
     std::vector<Vec3> gradMass(shifting ? mParticles.size() : 0, Vec3(0));
     computeDfsphFactors(shifting ? &gradMass : nullptr);
-    mTimings.neighborsAndDensity += search + secondsSince(t0);
+    mTimings.neighborsAndDensity += secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
     const std::size_t n = mParticles.size();

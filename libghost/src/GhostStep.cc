@@ -283,7 +283,7 @@ void GhostSolver::extrapolateSolidVelocity()
     }
 }
 
-void GhostSolver::stepGhost(Real dt)
+void GhostSolver::searchAndDensity()
 {
     // Line 1: resample the air every airResampleSteps steps (the first step always has air),
     // then move every fading air particle's weight one step towards its target.
@@ -300,6 +300,11 @@ void GhostSolver::stepGhost(Real dt)
     t0 = std::chrono::steady_clock::now();
     computeDensity();
     mTimings.neighborsAndDensity += search + secondsSince(t0);
+}
+
+void GhostSolver::stepGhost(Real dt)
+{
+    searchAndDensity();
 
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
@@ -314,7 +319,7 @@ void GhostSolver::stepGhost(Real dt)
 
     // Lines 11-14: liquid acceleration from gravity and Monaghan's symmetric pressure gradient
     // over every neighbour, v* = v + dt a.
-    t0 = std::chrono::steady_clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     mScratch.resize(n);
     parallel::forEach(
         0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);

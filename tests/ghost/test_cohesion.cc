@@ -6,6 +6,7 @@
 #include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 
+#include "common/LiquidMeasures.h"
 #include "common/Shapes.h"
 
 #include <gtest/gtest.h>
@@ -41,19 +42,7 @@ double hangingDrop(Method method)
     // -390 Pa, well within what the Tait equation holds (down to -k = -2000 Pa).
     solver.addLiquid(makeLevelSet(
         makeBoxLevelSet(Vec3(-0.06f, -0.04f, -0.06f), Vec3(0.06f, 0, 0.06f), H / 2), "slab"));
-    auto topLayer = [&] {
-        std::vector<double> y;
-        for (std::size_t i = 0; i < solver.particles().size(); ++i) {
-            if (solver.particles().kinds()[i] == ParticleKind::Liquid) {
-                y.push_back(solver.particles().positions()[i][1]);
-            }
-        }
-        const std::size_t top = std::max<std::size_t>(1, y.size() / 10);
-        std::nth_element(y.begin(), y.begin() + top, y.end(), std::greater<double>());
-        double sum = 0;
-        for (std::size_t k = 0; k < top; ++k) sum += y[k];
-        return sum / double(top);
-    };
+    auto topLayer = [&] { return ghostfx::testing::topLayerHeight(solver.particles()); };
     const double start = topLayer();
     for (int f = 0; f < 3; ++f) solver.advanceFrame(); // 0.1 s at 30 frames/s
     const double drop = start - topLayer();

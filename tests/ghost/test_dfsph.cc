@@ -8,6 +8,7 @@
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
 
+#include "common/LiquidMeasures.h"
 #include "common/ResumeScene.h"
 #include "common/Shapes.h"
 #include "common/StateDiff.h"
@@ -25,6 +26,8 @@
 using namespace ghostfx;
 using namespace ghostfx::sph;
 using namespace ghostfx::ghost;
+using ghostfx::testing::liquidCentre;
+using ghostfx::testing::liquidMass;
 
 namespace {
 
@@ -38,27 +41,6 @@ GhostSettings dfsphSettings()
     s.pressure = PressureModel::Dfsph;
     s.substeps = 0; // CFL steps on the flow speed
     return s;
-}
-
-double liquidMass(const ParticleSet& p)
-{
-    double m = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] == ParticleKind::Liquid) m += p.masses()[i];
-    }
-    return m;
-}
-
-Vec3d liquidCentre(const ParticleSet& p)
-{
-    Vec3d c(0);
-    double n = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] != ParticleKind::Liquid) continue;
-        c += Vec3d(p.positions()[i]);
-        n += 1;
-    }
-    return c / n;
 }
 
 /// A water block collapsing in a closed box: the violent case of the extremes below.
@@ -405,18 +387,7 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
     solver.addSolid(makeLevelSet(ghostfx::testing::invertedCupGrid(H), "cup"));
     solver.addLiquid(makeLevelSet(
         makeBoxLevelSet(Vec3(-0.06f, -0.04f, -0.06f), Vec3(0.06f, 0, 0.06f), H / 2), "slab"));
-    auto topLayer = [&] {
-        std::vector<double> y;
-        for (std::size_t i = 0; i < solver.particles().size(); ++i) {
-            if (solver.particles().kinds()[i] == ParticleKind::Liquid)
-                y.push_back(solver.particles().positions()[i][1]);
-        }
-        const std::size_t top = std::max<std::size_t>(1, y.size() / 10);
-        std::nth_element(y.begin(), y.begin() + top, y.end(), std::greater<double>());
-        double sum = 0;
-        for (std::size_t k = 0; k < top; ++k) sum += y[k];
-        return sum / double(top);
-    };
+    auto topLayer = [&] { return ghostfx::testing::topLayerHeight(solver.particles()); };
     const double start = topLayer();
     while (solver.time() < 0.1) solver.step(solver.stableTimeStep());
     const double drop = start - topLayer(), freeFall = 0.5 * 9.81 * 0.1 * 0.1;

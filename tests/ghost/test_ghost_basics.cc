@@ -6,6 +6,8 @@
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
 
+#include "common/LiquidMeasures.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -14,6 +16,8 @@
 using namespace ghostfx;
 using namespace ghostfx::sph;
 using namespace ghostfx::ghost;
+using ghostfx::testing::liquidCentre;
+using ghostfx::testing::liquidMass;
 
 namespace {
 
@@ -31,27 +35,6 @@ GhostSettings baseSettings(Method method = Method::Ghost)
 LevelSet ball(const Vec3& center, Real radius)
 {
     return makeLevelSet(makeSphereLevelSet(center, radius, H / 2), "ball");
-}
-
-Vec3d liquidCentre(const ParticleSet& p)
-{
-    Vec3d c(0);
-    double n = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] != ParticleKind::Liquid) continue;
-        c += Vec3d(p.positions()[i]);
-        n += 1;
-    }
-    return c / n;
-}
-
-double liquidMass(const ParticleSet& p)
-{
-    double m = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] == ParticleKind::Liquid) m += p.masses()[i];
-    }
-    return m;
 }
 
 } // namespace

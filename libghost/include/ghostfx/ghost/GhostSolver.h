@@ -262,6 +262,8 @@ private:
     /// initialRelaxation), recording the density error before and after.
     void relaxInitialLiquid();
     void extrapolateSolidVelocity();
+    /// Algorithm 3 lines 1-7: air fading, the search, air resampling and the density.
+    void searchAndDensity();
     void stepGhost(Real dt);
     /// Algorithm 3 lines 15-28 after the pressure: ghost solid velocity, XSPH, air velocity,
     /// positions and (with gradMass) particle shifting. Reads VSTAR.
