@@ -45,8 +45,9 @@
 ///             resampled air and the emitters' new particles carry density errors of a few
 ///             percent; asking each step to remove them in full (beta = 1) turns them into
 ///             velocity kicks of error x h / dt that grew without bound in every violent test.
-///           - a liquid particle with fewer than MIN_LIQUID_NEIGHBOURS liquid neighbours is
-///             spray: it has no liquid to push against and takes no part in the solve.
+///           - a liquid particle with fewer than MIN_NEIGHBOURS liquid and solid neighbours is
+///             spray (a thin stream's edge, a drop): too little to push against; it takes no
+///             part in the solve.
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "GhostInternal.h"
@@ -66,9 +67,11 @@ using namespace detail;
 
 namespace {
 
-/// Liquid neighbours (self included) below which a liquid particle is spray (about a tenth of
-/// a full neighbourhood at [SB12]'s 3 h support).
-constexpr int MIN_LIQUID_NEIGHBOURS = 10;
+/// Liquid and solid neighbours (self included) below which a liquid particle is spray, about a
+/// fifth of a full neighbourhood at [SB12]'s 3 h support. Measured: with 10 (liquid only) the
+/// tomato's stream blew up at frame 8; with 20 liquid only, the still tank's corner particles
+/// went unsolved and were pushed into the walls; 20 with the solids holds both.
+constexpr int MIN_NEIGHBOURS = 20;
 
 } // namespace
 
@@ -117,11 +120,13 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
                     solid += b.sumScaledOffsets(b.f);
                 });
             }
+            const int solidNeighbours = int(mStatic.lists[i].size() + mMoving.lists[i].size());
             // The particle's own pressure term moves it by its liquid and solid gradient sums
             // and each liquid neighbour by its own term.
             const Real a = (sum + solid).lengthSqr() + squares;
-            mAlpha[i] =
-                a > Real(0) && liquidNeighbours >= MIN_LIQUID_NEIGHBOURS ? Real(1) / a : Real(0);
+            mAlpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= MIN_NEIGHBOURS
+                            ? Real(1) / a
+                            : Real(0);
             mSolidGradient[i] = solid;
             if (gradMass) (*gradMass)[i] = all + solid;
         }
