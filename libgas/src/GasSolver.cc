@@ -34,6 +34,19 @@ inline void accumulate(Vec3d& sum, const Vec3& v) { sum += Vec3d(v[0], v[1], v[2
 /// Pair support radius: symmetric in i and j, so every pair term is antisymmetric.
 inline Real pairSupport(Real hi, Real hj) { return Real(0.5) * (hi + hj); }
 
+/// Call fn(j, x_i - x_j, r) for each entry j of particle i's neighbour list (i itself included,
+/// at r = 0), in the list's fixed order.
+template <typename Fn>
+inline void forEachListed(const NeighborLists& lists, const std::vector<Vec3>& x, std::size_t i,
+                          Fn&& fn)
+{
+    const Vec3 xi = x[i];
+    for (const Index j : lists[i]) {
+        const Vec3 xij = xi - x[j];
+        fn(j, xij, xij.length());
+    }
+}
+
 /// gamma^2 of Eq. 15 as a fraction of the squared pair support ([RYY15]: "gamma^2 << 1"; the
 /// usual SPH choice 0.01 h^2 keeps it small against the smallest inter-particle distance).
 constexpr Real DIFFUSION_GAMMA2 = Real(0.01);
@@ -566,11 +579,19 @@ void GasSolver::sortParticles()
     for (Real hi : h) maxH = std::max(maxH, hi);
     if (!(mGrid.cellSize() == maxH)) mGrid = NeighborGrid(maxH);
     mGrid.sortParticles(mParticles);
+    // One search per step: every gas particle's neighbours, reused by density and forces.
+    const std::size_t n = mParticles.size();
+    const auto& kind = mParticles.kinds();
+    mQueryMask.resize(n);
+    parallel::forEach(
+        0, n, [&](std::size_t i) { mQueryMask[i] = kind[i] == ParticleKind::Gas; }, 4096);
+    mLists.build(mGrid, mParticles.positions().data(), n, maxH, mQueryMask.data());
 }
 
 void GasSolver::computeDensity()
 {
     const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
     const auto& m = mParticles.masses();
     const auto& kind = mParticles.kinds();
     const auto& h = mParticles.scalarChannel(channel::SUPPORT);
@@ -591,7 +612,7 @@ void GasSolver::computeDensity()
         }
         double sum = 0;
         std::uint32_t count = 0;
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3&, Real r) {
+        forEachListed(mLists, x, i, [&](Index j, const Vec3&, Real r) {
             const Real R = pairSupport(h[i], h[j]);
             if (r >= R) return;
             sum += double(m[j]) * double(poly6W(r, R));
@@ -621,7 +642,7 @@ void GasSolver::computeDensity()
             return;
         }
         Vec3d nbar(0.0);
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
+        forEachListed(mLists, x, i, [&](Index j, const Vec3& xij, Real r) {
             if (j == i) return;
             const Real R = pairSupport(h[i], h[j]);
             if (r >= R) return;
@@ -687,7 +708,7 @@ void GasSolver::computeForcesAndIntegrate(Real dt)
         const Vec3 vi = v[i];
         Vec3d Fp(0.0), nI(0.0), Fv(0.0), vortex(0.0), stretch(0.0);
         double heat = 0;
-        mGrid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
+        forEachListed(mLists, x, i, [&](Index j, const Vec3& xij, Real r) {
             if (j == i) return;
             const Real R = pairSupport(h[i], h[j]);
             if (r >= R) return;

@@ -40,6 +40,7 @@
 #include <ghostfx/gas/GasSettings.h>
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborGrid.h>
+#include <ghostfx/sph/NeighborLists.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
@@ -240,6 +241,10 @@ private:
     Vec3 mBuoyancyDir;
     ParticleSet mParticles;
     sph::NeighborGrid mGrid;
+    /// Each gas particle's neighbours (gas and boundary) within the grid's cell size, searched
+    /// once per step in sortParticles() and read by the density and force passes.
+    sph::NeighborLists mLists;
+    std::vector<std::uint8_t> mQueryMask; ///< 1 for gas particles: the queries of mLists
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Source>> mSources;
     std::vector<Vec3> mNbar;             ///< n_bar_i with uncorrected densities (Eq. 5), per step
