@@ -542,6 +542,8 @@ void GasSolver::emit(Real dt)
             } else {
                 PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
                 ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
+                // [SB12] Sec. 4.5.2: emission during the run takes 8 attempts per seed, not 30.
+                ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
                 auto accept = [&](const Vec3& x) { return inside(x) && !blockedBySolid(x); };
                 fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
             }
