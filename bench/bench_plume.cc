@@ -108,8 +108,8 @@ int main(int argc, char** argv)
             warmTime += double(dt);
             ++warm;
         }
-        std::printf("warm-up: %d steps, %.3f s simulated in %.1f s wall, gas %zu\n", warm,
-                    warmTime, now() - t0, fast.visibleGasCount());
+        std::printf("warm-up: %d steps, %.3f s simulated in %.1f s wall, gas %zu\n", warm, warmTime,
+                    now() - t0, fast.visibleGasCount());
 
         fast.resetTimings();
         t0 = now();

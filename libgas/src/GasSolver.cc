@@ -582,12 +582,56 @@ void GasSolver::sortParticles()
     if (!(mGrid.cellSize() == maxH)) mGrid = NeighborGrid(maxH);
     mGrid.sortParticles(mParticles);
     // One search per step: every gas particle's neighbours, reused by density and forces.
+    // A pair interacts within the mean of its two supports, so particle i searches
+    // (h_i + h_max) / 2: a small newborn vapour particle among large ones does not list the
+    // whole cell of the largest support.
     const std::size_t n = mParticles.size();
     const auto& kind = mParticles.kinds();
     mQueryMask.resize(n);
+    mQueryRadius.resize(n);
+    bool uniform = true;
+    for (std::size_t i = 0; i < n && uniform; ++i)
+        uniform = kind[i] != ParticleKind::Gas || h[i] == maxH;
     parallel::forEach(
-        0, n, [&](std::size_t i) { mQueryMask[i] = kind[i] == ParticleKind::Gas; }, 4096);
-    mLists.build(mGrid, mParticles.positions().data(), n, maxH, mQueryMask.data());
+        0, n,
+        [&](std::size_t i) {
+        mQueryMask[i] = kind[i] == ParticleKind::Gas;
+        mQueryRadius[i] = pairSupport(h[i], maxH);
+        },
+        4096);
+    mLists.build(mGrid, mParticles.positions().data(), n, maxH, mQueryMask.data(),
+                 uniform ? nullptr : mQueryRadius.data());
+}
+
+void GasSolver::expandSupports()
+{
+    // A particle born denser than the gas (boiled vapour, [RYY15] Sec. 4.2: "the smoothing
+    // radius of these gas particles is also enlarged in this process, matching their expansion
+    // in effective volume") starts with h sized for its birth density and grows h as it
+    // expands: h_i = h_rest(m_i) (rho0 / rho_bar_i)^(1/3), which keeps the neighbour count of a
+    // gas at rest at any density, never shrinking and never beyond h_rest(m_i). Particles at
+    // their rest support (all others) are untouched.
+    const std::size_t n = mParticles.size();
+    const auto& m = mParticles.masses();
+    const auto& kind = mParticles.kinds();
+    const auto& rhoBar = mParticles.scalarChannel(channel::DENSITY_UNCORRECTED);
+    auto& h = mParticles.scalarChannel(channel::SUPPORT);
+    const double rho0 = double(mSettings.restDensity);
+    const double hSettings = double(mSettings.supportRadius());
+    const double mRef = double(mMass);
+    const std::size_t listed = std::min(n, rhoBar.size());
+    parallel::forEach(
+        0, listed,
+        [&](std::size_t i) {
+        if (kind[i] != ParticleKind::Gas) return;
+        // The support a particle of this mass has at rest (as PhaseTransition sizes vapour).
+        const Real hRest = Real(hSettings * std::cbrt(double(m[i]) / mRef));
+        if (!(h[i] < hRest)) return;
+        const double ratio = rhoBar[i] > Real(0) ? rho0 / double(rhoBar[i]) : 1.0;
+        const Real grown = Real(double(hRest) * std::cbrt(std::min(1.0, ratio)));
+        h[i] = std::min(hRest, std::max(h[i], grown));
+        },
+        1024);
 }
 
 void GasSolver::computeDensity()
@@ -988,6 +1032,7 @@ void GasSolver::step(Real dt)
     mTimings.density += secondsSince(t0);
     t0 = std::chrono::steady_clock::now();
     computeForcesAndIntegrate(dt);
+    expandSupports();
     mTimings.forces += secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();

@@ -273,9 +273,15 @@ std::size_t PhaseTransition::transfer(Real dt)
     mBoiled += boil.size();
     mEvaporated += evapIds.size();
 
-    // Hand every gas daughter to the gas solver with its exact mass; its support radius is the
-    // one a gas particle of that mass has at the gas rest density (volume expansion, Sec. 4.2).
-    const Real hGas = mGas.settings().supportRadius();
+    // Hand every gas daughter to the gas solver with its exact mass. Its support radius is the
+    // one a gas particle of that mass has at its birth density, the liquid's: h_rest(m)
+    // (rho0_gas / rho0_liquid)^(1/3), so a newborn vapour particle has the neighbour count of
+    // a gas at rest (Sec. 4.2's volume expansion then grows h back to h_rest(m) as the vapour
+    // expands, GasSolver::expandSupports). Sized for the gas at rest instead, the daughters of
+    // a boiling layer, packed at the liquid's density, had about 1,300 neighbours each.
+    const double birth =
+        std::cbrt(double(mGas.settings().restDensity) / double(mLiquid.restDensity()));
+    const double hGas = double(mGas.settings().supportRadius());
     const double mGasRef = double(mGas.referenceParticleMass());
     const auto& Tc = p.scalarChannel(TEMPERATURE);
     std::vector<Vec3> xs, vs;
@@ -288,7 +294,8 @@ std::size_t PhaseTransition::transfer(Real dt)
         vs.push_back(p.velocities()[i]);
         Ts.push_back(Tc[i]);
         ms.push_back(p.masses()[i]);
-        hs.push_back(Real(double(hGas) * std::cbrt(double(p.masses()[i]) / mGasRef)));
+        const double hRest = hGas * std::cbrt(double(p.masses()[i]) / mGasRef);
+        hs.push_back(Real(hRest * std::min(1.0, birth)));
         mVapourMass += double(p.masses()[i]);
     }
     p.removeIf(remove);

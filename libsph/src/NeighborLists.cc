@@ -147,7 +147,7 @@ struct Stencil
 } // namespace
 
 void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
-                          Real radius, const std::uint8_t* wanted)
+                          Real radius, const std::uint8_t* wanted, const Real* queryRadius)
 {
     if (!(radius > Real(0)) || radius > targets.cellSize()) {
         throw ValueError(msg("neighbour lists: radius ", radius,
@@ -158,7 +158,7 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
     const std::size_t chunks = (count + CHUNK - 1) / CHUNK;
     mEnd.resize(count);
     if (mChunks.size() < chunks) mChunks.resize(chunks);
-    const Real radius2 = radius * radius;
+    const Real radiusSquared = radius * radius;
     const Real cellSize = targets.cellSize();
     const Real* X = targets.sortedX();
     const Real* Y = targets.sortedY();
@@ -182,6 +182,11 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
                 continue;
             }
             const Vec3& x = queries[q];
+            Real radius2 = radiusSquared;
+            if (queryRadius) {
+                const Real rq = std::min(queryRadius[q], radius);
+                radius2 = rq > Real(0) ? rq * rq : Real(0);
+            }
             const NeighborGrid::Cell c = targets.cellOf(x);
             if (c != stencil.centre) stencil.lookUp(targets, c);
             // Squared distance from x to the slab of each neighbouring cell, per axis: 0 for its

@@ -93,6 +93,33 @@ TEST(NeighborLists, MatchBruteForceForUnsortedTargetsMasksAndSmallerRadii)
     }
 }
 
+TEST(NeighborLists, PerQueryRadiiMatchBruteForceOnBothSearchPaths)
+{
+    // Particles with their own support radius (the gas's expanding vapour): each query searches
+    // its own radius, capped at the lists' radius.
+    const Real cell = Real(0.05);
+    const std::vector<Vec3> targets = randomPoints(4000, Real(0.4), 3);
+    const std::vector<Vec3> queries = randomPoints(1200, Real(0.4), 4);
+    std::vector<Real> radii(queries.size());
+    for (std::size_t q = 0; q < radii.size(); ++q) {
+        radii[q] = cell * Real(0.1 + 1.2 * double(q % 13) / 12.0); // 0.1 to 1.3 cells
+    }
+    NeighborGrid grid(cell);
+    grid.build(targets);
+    for (bool wide : {false, true}) {
+        SCOPED_TRACE(::testing::Message() << "AVX2 path " << wide);
+        const bool before = NeighborLists::wideSimd();
+        NeighborLists::setWideSimd(wide);
+        NeighborLists lists;
+        lists.build(grid, queries.data(), queries.size(), cell, nullptr, radii.data());
+        NeighborLists::setWideSimd(before);
+        for (std::size_t q = 0; q < queries.size(); ++q) {
+            ASSERT_EQ(sorted(lists[q]), bruteForce(queries[q], targets, std::min(radii[q], cell)))
+                << "query " << q << ", radius " << radii[q];
+        }
+    }
+}
+
 TEST(NeighborLists, SortedSetAgainstItselfHoldsEachParticleAndIsTheSameOnBothSearchPaths)
 {
     // As the solver uses them: a set sorted by the grid, queried with its own positions.

@@ -227,6 +227,9 @@ private:
     void sortParticles();
     void computeDensity();
     void computeForcesAndIntegrate(Real dt);
+    /// Grow the support of particles born denser than the gas (added with an h below the one
+    /// their mass has at rest: vapour born at the liquid's density) as they expand.
+    void expandSupports();
     void moveSolids(double t1);
     void projectOutOfSolids(Real dt);
     void applyDomain();
@@ -245,6 +248,7 @@ private:
     /// once per step in sortParticles() and read by the density and force passes.
     sph::NeighborLists mLists;
     std::vector<std::uint8_t> mQueryMask; ///< 1 for gas particles: the queries of mLists
+    std::vector<Real> mQueryRadius;       ///< search radius per particle: (h_i + h_max) / 2
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Source>> mSources;
     std::vector<Vec3> mNbar;             ///< n_bar_i with uncorrected densities (Eq. 5), per step

@@ -49,8 +49,10 @@ public:
     /// Build the lists of the particles of `targets` closer than `radius` (m, at most the
     /// grid's cell size) to each of `count` query points. Queries with `wanted[q] == 0` get an
     /// empty list (`wanted` may be null: every query is wanted). Sorted queries run fastest.
+    /// `queryRadius` (optional, m): a smaller radius per query (capped at `radius`), for
+    /// particles with their own support radius.
     void build(const NeighborGrid& targets, const Vec3* queries, std::size_t count, Real radius,
-               const std::uint8_t* wanted = nullptr);
+               const std::uint8_t* wanted = nullptr, const Real* queryRadius = nullptr);
 
     /// Number of query points of the last build.
     std::size_t size() const { return mEnd.size(); }
