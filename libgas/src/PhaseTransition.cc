@@ -133,7 +133,8 @@ void PhaseTransition::addHeater(const sph::LevelSet& shape, Real temperature)
                              " m), beyond which phi is clamped: widen the band or reduce "
                              "heaterBand"));
     }
-    mHeaters.push_back(Heater{shape, temperature});
+    mHeaters.push_back(
+        Heater{shape, temperature, shape.bounds().padded(Real(2) * shape.voxelSize())});
 }
 
 void PhaseTransition::setLiquidTemperature(Real temperature)
@@ -158,8 +159,12 @@ void PhaseTransition::heat(Real dt)
     const Real R = mLiquid.supportRadius();
     const Real rho0 = mLiquid.restDensity();
     const sph::CubicSplineKernel kernel(R);
+    // One vectorised search into lists (the liquid solver left its particles sorted by cell).
     sph::NeighborGrid grid(R);
     grid.build(p.positions());
+    mHeatQueries.resize(n);
+    for (std::size_t i = 0; i < n; ++i) mHeatQueries[i] = p.kinds()[i] == ParticleKind::Liquid;
+    mHeatLists.build(grid, p.positions().data(), n, R, mHeatQueries.data());
 
     const auto& x = p.positions();
     const auto& m = p.masses();
@@ -181,19 +186,25 @@ void PhaseTransition::heat(Real dt)
         double dTdt = 0;
         Vec3d colour(
             0.0); // colour-field gradient sum_j V_j gradW_ij: ~0 inside, large at a surface
-        grid.forEachNeighbor(Index(i), [&](Index j, const Vec3& xij, Real r) {
+        for (const Index j : mHeatLists[i]) {
+            const Vec3 xij = x[i] - x[j];
+            const Real r = xij.length();
             const ParticleKind kj = kind[j];
             const bool liquidJ = kj == ParticleKind::Liquid;
-            if (!liquidJ && !isSolidKind(kj)) return;
+            if (!liquidJ && !isSolidKind(kj)) continue;
             const Real rhoJ = density(j);
-            colour += Vec3d(kernel.gradW(xij, r) * (m[j] / rhoJ));
-            if (!liquidJ || j == i || Dc == Real(0)) return;
+            const Vec3 gradW = kernel.gradW(xij, r);
+            colour += Vec3d(gradW * (m[j] / rhoJ));
+            if (!liquidJ || j == i || Dc == Real(0)) continue;
             // Eq. 15: dT_i/dt = sum_j m_j / (rho_i rho_j) D_c (T_i - T_j) x_ij.gradW_ij /
             // (r^2 + gamma^2); x_ij.gradW_ij < 0, so heat flows from hot to cold.
-            const Real xg = xij.dot(kernel.gradW(xij, r));
+            const Real xg = xij.dot(gradW);
             dTdt += double(m[j] / (rhoI * rhoJ) * Dc * (T[i] - T[j]) * xg / (r * r + gamma2));
-        });
+        }
         for (const Heater& h : mHeaters) {
+            // Beyond the level set's active box phi is the background, at least its band
+            // width, which addHeater() checked is more than heaterBand: no lookup needed.
+            if (!h.reach.contains(x[i])) continue;
             if (h.shape.phi(x[i]) < band)
                 dTdt += double((h.temperature - T[i]) / mSettings.heatingTime);
         }

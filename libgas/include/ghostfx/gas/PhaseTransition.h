@@ -64,6 +64,7 @@
 #include <ghostfx/gas/SplitMerge.h>
 #include <ghostfx/gas/SplitPatterns.h>
 #include <ghostfx/sph/LevelSet.h>
+#include <ghostfx/sph/NeighborLists.h>
 #include <ghostfx/sph/ParticleSet.h>
 
 #include <cstdint>
@@ -231,6 +232,8 @@ private:
     {
         sph::LevelSet shape;
         Real temperature;
+        /// The level set's active box padded by two voxels: outside it phi is the background.
+        sph::Aabb reach;
     };
 
     void ensureChannels();
@@ -245,6 +248,10 @@ private:
     PhaseSettings mSettings;
     std::vector<Heater> mHeaters;
     std::vector<std::uint8_t> mSurface; ///< per liquid-set index, from the last heat pass
+    /// The heat pass's search over the liquid set: one grid and one list per liquid particle,
+    /// kept between steps for their capacity.
+    sph::NeighborLists mHeatLists;
+    std::vector<std::uint8_t> mHeatQueries;
     SplitPattern mBoilPattern, mEvapPattern;
     MergeSettings mMerge;
     std::size_t mBoiled = 0, mEvaporated = 0, mMerges = 0, mVapourCreated = 0;
