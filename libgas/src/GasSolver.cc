@@ -501,9 +501,11 @@ void GasSolver::emit(Real dt)
         const Aabb near = box.padded(R);
 
         std::size_t added = 0;
+        const std::vector<Real>* air = nullptr;
         if (mSettings.method == Method::Ambient) {
             // The standard approach marks the air passing through the source as visible gas.
             auto& ambient = mParticles.scalarChannel(channel::AMBIENT);
+            air = &ambient;
             for (std::size_t i = 0; i < mParticles.size() && added < allowed; ++i) {
                 if (mParticles.kinds()[i] != ParticleKind::Gas || ambient[i] == Real(0)) continue;
                 const Vec3& x = mParticles.positions()[i];
@@ -512,50 +514,55 @@ void GasSolver::emit(Real dt)
                 mParticles.velocities()[i] = par.velocity;
                 ++added;
             }
-        } else {
-            std::vector<Vec3> seeds, obstacles;
-            for (std::size_t i = 0; i < mParticles.size(); ++i) {
-                const Vec3& x = mParticles.positions()[i];
-                if (!near.contains(x)) continue;
-                if (mParticles.kinds()[i] == ParticleKind::Gas && box.contains(x) && inside(x)) {
-                    seeds.push_back(x);
-                } else {
-                    obstacles.push_back(x);
-                }
-            }
-            const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
-            std::vector<Vec3> fresh;
-            if (seeds.empty()) {
-                // Nothing to grow from: fill the source like a block of gas.
-                NeighborGrid grid(r);
-                grid.build(obstacles);
-                for (const Vec3& xl :
-                     sampleShape(src.shape, mSettings.seed + 31337ULL * (e + 1) + mRun.step)) {
-                    const Vec3 x = xf.toWorld(xl);
-                    bool clear = !blockedBySolid(x);
-                    if (clear && !obstacles.empty()) {
-                        grid.forEachInRadius(x, r,
-                                             [&](Index, const Vec3&, Real) { clear = false; });
-                    }
-                    if (clear) fresh.push_back(x);
-                }
-            } else {
-                PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-                ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
-                // [SB12] Sec. 4.5.2: emission during the run takes 8 attempts per seed, not 30.
-                ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
-                auto accept = [&](const Vec3& x) { return inside(x) && !blockedBySolid(x); };
-                fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
-            }
-            if (fresh.size() > allowed) fresh.resize(allowed);
-            if (!fresh.empty()) {
-                const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Gas);
-                for (std::size_t i = first; i < mParticles.size(); ++i) {
-                    mParticles.velocities()[i] = par.velocity;
-                }
-            }
-            added = fresh.size();
         }
+        // Then the free room in the source is filled with new gas, in every method, so the
+        // baseline emits what the fast solver emits: its air, once converted, rises out of the
+        // source as the fast solver's gas does, and the room it leaves is not always refilled
+        // by air in time (the shipped plume's baseline stopped emitting at 143 particles).
+        std::vector<Vec3> seeds, obstacles;
+        for (std::size_t i = 0; i < mParticles.size(); ++i) {
+            const Vec3& x = mParticles.positions()[i];
+            if (!near.contains(x)) continue;
+            const bool visible =
+                mParticles.kinds()[i] == ParticleKind::Gas && !(air && (*air)[i] != Real(0));
+            if (visible && box.contains(x) && inside(x)) {
+                seeds.push_back(x);
+            } else {
+                obstacles.push_back(x);
+            }
+        }
+        const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
+        std::vector<Vec3> fresh;
+        if (seeds.empty()) {
+            // Nothing to grow from: fill the source like a block of gas.
+            NeighborGrid grid(r);
+            grid.build(obstacles);
+            for (const Vec3& xl :
+                 sampleShape(src.shape, mSettings.seed + 31337ULL * (e + 1) + mRun.step)) {
+                const Vec3 x = xf.toWorld(xl);
+                bool clear = !blockedBySolid(x);
+                if (clear && !obstacles.empty()) {
+                    grid.forEachInRadius(x, r, [&](Index, const Vec3&, Real) { clear = false; });
+                }
+                if (clear) fresh.push_back(x);
+            }
+        } else {
+            PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+            ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
+            // [SB12] Sec. 4.5.2: emission during the run takes 8 attempts per seed, not 30.
+            ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
+            auto accept = [&](const Vec3& x) { return inside(x) && !blockedBySolid(x); };
+            fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
+        }
+        const std::size_t room = allowed - added;
+        if (fresh.size() > room) fresh.resize(room);
+        if (!fresh.empty()) {
+            const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Gas);
+            for (std::size_t i = first; i < mParticles.size(); ++i) {
+                mParticles.velocities()[i] = par.velocity;
+            }
+        }
+        added += fresh.size();
         if (par.rate > Real(0)) src.budget -= double(added);
         mRun.emitted += added;
         // The source is a heater: visible gas inside it is held at the source temperature.

@@ -242,9 +242,10 @@ TEST(GasTemperature, HotBlobRisesColdStaysAndDiffusionConservesHeat)
                     c1[2] - c0[2]);
     }
     // Hot: a = C_b dT = 3.35 m/s^2 at first; the boundary damping (Eq. 14, terminal speed
-    // C_b dT / C_d = 3.35 m/s on the surface) and radiation (Eq. 16) slow it. Measured 1.33 m;
-    // free fall upwards would give 1.7 m. Bound: more than 0.5 m, less than 1.7 m.
-    EXPECT_GT(rise[1], 0.5);
+    // C_b dT / C_d = 0.48 m/s on the surface at the default C_d = 7 /s) and radiation (Eq. 16)
+    // slow it. Measured 0.50 m (1.33 m with C_d = 1); free fall upwards would give 1.7 m.
+    // Bound: more than 0.3 m (about twice the blob's diameter), less than 1.7 m.
+    EXPECT_GT(rise[1], 0.3);
     EXPECT_LT(rise[1], 1.7);
     // Without buoyancy nothing moves it: measured below 1 mm; bound 5 mm.
     EXPECT_LT(std::abs(rise[0]), 0.005);
@@ -307,10 +308,10 @@ TEST(GasPlume, AmbientBaselineAndFastSolverRiseAlikeWithFarFewerParticles)
         gs.diffusion = 0;
         gs.radiationTime = 0;
         // A thin gas (mu 0.002 Pa s); the fast solver stands in for the air's drag with the
-        // damping of Eq. 14, a user coefficient ([RYY15] gives no value): C_d = 7 /s matches the
-        // baseline here (measured: C_d = 5 rises 1.25x, 10 rises 0.85x the baseline's height).
+        // damping of Eq. 14, a user coefficient ([RYY15] gives no value): the default C_d = 7 /s
+        // matches the baseline here (measured: C_d = 5 rises 1.25x, 10 rises 0.85x the
+        // baseline's height).
         gs.viscosity = Real(0.002);
-        gs.damping = Real(7);
         GasSolver solver(gs);
         GasSource src;
         src.temperature = TAMB + Real(100);
