@@ -151,11 +151,15 @@ void GasSolver::sampleSolid(std::size_t solidIndex)
                              "placement at t = ",
                              mRun.time, " s"));
     }
-    // [RYY15] Sec. 3.3: rigid boundaries are boundary particles. Sampled like the liquid's
-    // solids ([SB12] Sec. 4.5) in a band one kernel radius deep, so a gas particle at the wall
-    // sees a full neighbourhood of gas and boundary particles.
+    // [RYY15] Sec. 3.3: rigid boundaries are boundary particles, sampled in a band one kernel
+    // radius deep, so a gas particle at the wall sees a full neighbourhood of gas and boundary
+    // particles. Sampled as the gas itself is ([SB12] Sec. 4.5 without the relaxation sweeps,
+    // sampleShape): the same packing as the block that sets the particle mass, so a wall sums
+    // to the gas's own rest density, at a fraction of the relaxation's cost.
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.bandDepth = mSettings.supportRadius();
+    ps.surfaceRelaxSweeps = 0;
+    ps.volumeRelaxSweeps = 0;
     ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step;
     const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(body.shape);
 
