@@ -217,9 +217,10 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
         if (media.max().x() >= media.min().x()) {
             const openvdb::Vec3d centre = media.getCenter();
             const openvdb::Vec3d local = layer.rotation.transpose() * (centre - layer.translation);
-            const openvdb::CoordBBox ibox = layer.grid->evalActiveVoxelBoundingBox();
-            const openvdb::BBoxd box(layer.grid->indexToWorld(ibox.min()),
-                                     layer.grid->indexToWorld(ibox.max()));
+            // The level set keeps its active box (walking a large solid's tree every frame cost
+            // more than drawing it).
+            const sph::Aabb b = shape.bounds();
+            const openvdb::BBoxd box(openvdb::Vec3d(b.min), openvdb::Vec3d(b.max));
             layer.cutaway = box.isInside(local) && shape.phi(sph::Vec3(local)) > 0;
         }
         layers.push_back(layer);

@@ -40,11 +40,11 @@ constexpr double FOG_STEP_VOXELS = 2.0;
 /// Fog: the light a voxel scatters towards the camera, as a share of its albedo (no shadows).
 constexpr float FOG_SHADE = 0.85f;
 
-/// The box of a layer's active voxels (their extent, every corner through the grid's transform
-/// and then, with `placed`, the layer's placement); empty for an empty grid.
-openvdb::BBoxd layerBox(const PreviewLayer& layer, bool placed)
+/// The box of a layer's active voxels `ibox` (the grid's active voxel box: their extent, every
+/// corner through the grid's transform and then, with `placed`, the layer's placement); empty
+/// for an empty grid.
+openvdb::BBoxd layerBox(const PreviewLayer& layer, const openvdb::CoordBBox& ibox, bool placed)
 {
-    const openvdb::CoordBBox ibox = layer.grid->evalActiveVoxelBoundingBox();
     openvdb::BBoxd box;
     if (ibox.empty()) return box;
     const Vec3d lo = ibox.min().asVec3d() - Vec3d(0.5), hi = ibox.max().asVec3d() + Vec3d(0.5);
@@ -139,9 +139,21 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
     const bool frameLayers = !(bounds.max().x() > bounds.min().x());
     openvdb::BBoxd frame = frameLayers ? openvdb::BBoxd() : bounds;
     for (const PreviewLayer& l : layers) {
-        localBoxes.push_back(layerBox(l, false));
+        // The active voxel box walks the whole tree: a fixed layer's is kept in the cache.
+        openvdb::CoordBBox ibox;
+        bool known = false;
+        if (cache && l.fixed) {
+            for (const auto& [grid, box] : cache->activeBoxes) {
+                if (grid == l.grid.get()) ibox = box, known = true;
+            }
+        }
+        if (!known) {
+            ibox = l.grid->evalActiveVoxelBoundingBox();
+            if (cache && l.fixed) cache->activeBoxes.emplace_back(l.grid.get(), ibox);
+        }
+        localBoxes.push_back(layerBox(l, ibox, false));
         voxel.push_back(l.grid->voxelSize()[0]);
-        const openvdb::BBoxd placed = layerBox(l, true);
+        const openvdb::BBoxd placed = layerBox(l, ibox, true);
         if (frameLayers && !isEmpty(placed)) frame.expand(placed);
     }
     if (isEmpty(frame)) {
@@ -163,6 +175,7 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                                setup.up.x(),          setup.up.y(),     setup.up.z(),
                                setup.nearPlane,       setup.farPlane,   double(film.width()),
                                double(film.height()), double(n)};
+    for (float c : options.background) key.push_back(double(c));
     std::vector<const void*> fixedGrids;
     for (std::size_t k = 0; k < n; ++k) {
         fixed[k] = layers[k].fixed && layers[k].kind == PreviewLayer::Kind::Surface;
@@ -184,8 +197,74 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
         cache->t.assign(pixelCount, std::numeric_limits<double>::max());
         cache->layer.assign(pixelCount, std::uint32_t(n));
         cache->normal.assign(pixelCount, Vec3d(0.0));
+        cache->direction.assign(pixelCount, openvdb::Vec3f(0.0f));
+        cache->base.assign(pixelCount, {0.0f, 0.0f, 0.0f, 0.0f});
     }
+    // A kept pixel whose ray cannot meet any other layer is the fixed layers' colour, copied
+    // without casting its ray: when no surface layer moves, and the ray's line misses every fog
+    // layer's box (grown by a rounding margin, so a ray the full test would count as a hit is
+    // never skipped). The picture is the same (ScenePreview tests).
+    bool copyable = reuse;
+    for (std::size_t k = 0; k < n; ++k) {
+        if (layers[k].kind == PreviewLayer::Kind::Surface && !fixed[k]) copyable = false;
+    }
+    struct FogBox
+    {
+        openvdb::math::Mat3d back; ///< world to layer rotation
+        Vec3d eye;                 ///< the camera in the layer's frame
+        Vec3d lo, hi;              ///< the layer's box, grown by a margin
+    };
+    std::vector<FogBox> fogBoxes;
+    for (std::size_t k = 0; copyable && k < n; ++k) {
+        if (layers[k].kind == PreviewLayer::Kind::Surface || isEmpty(localBoxes[k])) continue;
+        FogBox f;
+        f.back = layers[k].rotation.transpose();
+        f.eye = f.back * (setup.eye - layers[k].translation);
+        const Vec3d size = localBoxes[k].max() - localBoxes[k].min();
+        const double margin = 1e-6 * (size.length() + f.eye.length()) + 1e-9;
+        f.lo = localBoxes[k].min() - Vec3d(margin);
+        f.hi = localBoxes[k].max() + Vec3d(margin);
+        fogBoxes.push_back(f);
+    }
+    auto missesFog = [&](const openvdb::Vec3f& dirF) {
+        const Vec3d dir(dirF.x(), dirF.y(), dirF.z());
+        for (const FogBox& f : fogBoxes) {
+            const Vec3d d = f.back * dir;
+            double tmin = 0, tmax = std::numeric_limits<double>::max();
+            for (int a = 0; a < 3; ++a) {
+                if (std::abs(d[a]) < 1e-12) {
+                    if (f.eye[a] < f.lo[a] || f.eye[a] > f.hi[a]) tmax = -1;
+                    continue;
+                }
+                double t1 = (f.lo[a] - f.eye[a]) / d[a], t2 = (f.hi[a] - f.eye[a]) / d[a];
+                if (t1 > t2) std::swap(t1, t2);
+                tmin = std::max(tmin, t1);
+                tmax = std::min(tmax, t2);
+            }
+            // The stored direction is a float copy: a line that passes within the margin
+            // counts as a hit.
+            if (tmax >= tmin * (1 - 1e-6) - 1e-9) return false;
+        }
+        return true;
+    };
     if (cache) ++(reuse ? cache->reused : cache->computed);
+    // The colour of a pixel with only its fixed-layer hit and no fog, over the background: the
+    // same arithmetic as the full path below with transmittance 1, so a copied pixel is
+    // bit-identical to one traced.
+    auto fixedColour = [&](std::size_t hitLayer, const Vec3d& hitNormal, const Vec3d& dir) {
+        float r = 0, g = 0, b = 0, surfaceAlpha = 0;
+        if (hitLayer < n) {
+            const float shade = detail::keyLightShade(setup, hitNormal, dir);
+            const auto& a = layers[hitLayer].albedo;
+            r = a[0] * shade, g = a[1] * shade, b = a[2] * shade, surfaceAlpha = 1;
+        }
+        const float tr = 1.0f, fr = 0.0f, fg = 0.0f, fb = 0.0f;
+        const float behind = tr * (1 - surfaceAlpha);
+        const auto& bg = options.background;
+        return std::array<float, 4>{
+            fr + tr * r + behind * bg[0] * bg[3], fg + tr * g + behind * bg[1] * bg[3],
+            fb + tr * b + behind * bg[2] * bg[3], (1 - tr) + tr * surfaceAlpha + behind * bg[3]};
+    };
     std::vector<std::atomic<std::size_t>> pixels(n);
     for (auto& p : pixels) p = 0;
     const auto t0 = std::chrono::steady_clock::now();
@@ -194,6 +273,13 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
         std::vector<std::size_t> counts(n, 0);
         for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
             for (std::size_t x = 0; x < film.width(); ++x) {
+                const std::size_t pixel = y * film.width() + x;
+                if (copyable && missesFog(cache->direction[pixel])) {
+                    const auto& c = cache->base[pixel];
+                    film.pixel(x, y) = Film::RGBA(c[0], c[1], c[2], c[3]);
+                    if (cache->layer[pixel] < n) ++counts[cache->layer[pixel]];
+                    continue;
+                }
                 const Ray ray = camera.getRay(x, y);
                 // The nearest surface: the fixed layers' hit (kept, or computed and stored),
                 // then the other surface layers.
@@ -229,7 +315,6 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                         }
                     }
                 };
-                const std::size_t pixel = y * film.width() + x;
                 if (reuse) {
                     nearest = cache->t[pixel];
                     hitLayer = cache->layer[pixel];
@@ -240,6 +325,8 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
                         cache->t[pixel] = nearest;
                         cache->layer[pixel] = std::uint32_t(hitLayer);
                         cache->normal[pixel] = hitNormal;
+                        cache->direction[pixel] = openvdb::Vec3f(ray.dir());
+                        cache->base[pixel] = fixedColour(hitLayer, hitNormal, ray.dir());
                     }
                 }
                 nearestOf(false);

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ghostfx {
@@ -50,11 +51,17 @@ struct PreviewLayer
 /// A preview drawn with a cache is identical to one drawn without.
 struct PreviewCache
 {
-    std::vector<double> key;              ///< camera, image size and fixed layers' placements
-    std::vector<const void*> grids;       ///< the fixed layers' grids
-    std::vector<double> t;                ///< per pixel: distance to the nearest fixed-layer hit
-    std::vector<std::uint32_t> layer;     ///< per pixel: its layer index, or the layer count
-    std::vector<openvdb::Vec3d> normal;   ///< per pixel: its world normal
+    std::vector<double> key;            ///< camera, image size and fixed layers' placements
+    std::vector<const void*> grids;     ///< the fixed layers' grids
+    std::vector<double> t;              ///< per pixel: distance to the nearest fixed-layer hit
+    std::vector<std::uint32_t> layer;   ///< per pixel: its layer index, or the layer count
+    std::vector<openvdb::Vec3d> normal; ///< per pixel: its world normal
+    /// Per pixel: the camera ray's direction (world) and the colour of the fixed layers alone
+    /// over the background, so a pixel whose ray misses every other layer is copied.
+    std::vector<openvdb::Vec3f> direction;
+    std::vector<std::array<float, 4>> base;
+    /// The active voxel boxes of the fixed layers' grids (index space), by grid.
+    std::vector<std::pair<const void*, openvdb::CoordBBox>> activeBoxes;
     std::size_t reused = 0, computed = 0; ///< previews that used the hits, that computed them
 };
 
