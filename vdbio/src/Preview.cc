@@ -16,6 +16,8 @@
 
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfRgbaFile.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -191,13 +193,17 @@ void writeExr(const Film& film, const std::string& exrPath)
         return;
     }
     const int width = int(film.width()), height = int(film.height());
+    // Float to half by rows in parallel (a serial loop was a third of writing a preview).
     std::vector<Imf::Rgba> pixels(std::size_t(width) * std::size_t(height));
-    for (int y = 0; y < height; ++y) {
-        for (int x = 0; x < width; ++x) {
-            const Film::RGBA& p = film.pixel(std::size_t(x), std::size_t(y));
-            pixels[std::size_t(y) * width + x] = Imf::Rgba(p.r, p.g, p.b, p.a);
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, 16),
+                      [&](const tbb::blocked_range<int>& rows) {
+        for (int y = rows.begin(); y < rows.end(); ++y) {
+            for (int x = 0; x < width; ++x) {
+                const Film::RGBA& p = film.pixel(std::size_t(x), std::size_t(y));
+                pixels[std::size_t(y) * width + x] = Imf::Rgba(p.r, p.g, p.b, p.a);
+            }
         }
-    }
+    });
     writeAtomically(exrPath, [&](const std::string& tmp) {
         try {
             // RLE: a preview is mostly flat background and smooth shading, which runs of equal
