@@ -22,6 +22,8 @@
 ///          Run: build/bench/bench_gas [--spacing 0.005] [--steps 20] [--baseline-steps 3]
 #include "GhostLiquidSide.h"
 
+#include "GasCopy.h"
+
 #include <ghostfx/gas/GasSolver.h>
 #include <ghostfx/gas/PhaseTransition.h>
 #include <ghostfx/ghost/GhostSolver.h>
@@ -164,22 +166,7 @@ int main(int argc, char** argv)
         const Real half = Real(0.5 * domain);
         bs.domain = Aabb{Vec3(-half, Real(-wall), -half), Vec3(half, Real(height), half)};
         gas::GasSolver ambientGas(bs);
-        {
-            const ParticleSet& g = fastGas.particles();
-            std::vector<Vec3> x, v;
-            std::vector<Real> T, m, h;
-            const auto& gT = g.scalarChannel(gas::channel::TEMPERATURE);
-            const auto& gh = g.scalarChannel(gas::channel::SUPPORT);
-            for (std::size_t i = 0; i < g.size(); ++i) {
-                if (g.kinds()[i] != ParticleKind::Gas) continue;
-                x.push_back(g.positions()[i]);
-                v.push_back(g.velocities()[i]);
-                T.push_back(gT[i]);
-                m.push_back(g.masses()[i]);
-                h.push_back(gh[i]);
-            }
-            ambientGas.addGasParticles(x, v, T, m, h);
-        }
+        bench::copyGas(fastGas, ambientGas);
         gas::PhaseTransition baseline(ambientGas, side, ps);
         baseline.addHeater(plate, Real(heater));
         t0 = now();

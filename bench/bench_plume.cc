@@ -13,6 +13,8 @@
 ///             `--ambient-steps` steps at the fast run's last dt are timed.
 ///
 ///          Run: build/bench/bench_plume [--spacing 0.0125] [--gas 9000] [--steps 200]
+#include "GasCopy.h"
+
 #include <ghostfx/gas/GasSolver.h>
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
@@ -125,22 +127,7 @@ int main(int argc, char** argv)
         bs.method = gas::Method::Ambient;
         gas::GasSolver ambient(bs);
         addScene(ambient, s.spacing);
-        {
-            const ParticleSet& g = fast.particles();
-            std::vector<Vec3> x, v;
-            std::vector<Real> T, m, h;
-            const auto& gT = g.scalarChannel(gas::channel::TEMPERATURE);
-            const auto& gh = g.scalarChannel(gas::channel::SUPPORT);
-            for (std::size_t i = 0; i < g.size(); ++i) {
-                if (g.kinds()[i] != ParticleKind::Gas) continue;
-                x.push_back(g.positions()[i]);
-                v.push_back(g.velocities()[i]);
-                T.push_back(gT[i]);
-                m.push_back(g.masses()[i]);
-                h.push_back(gh[i]);
-            }
-            ambient.addGasParticles(x, v, T, m, h);
-        }
+        bench::copyGas(fast, ambient);
         t0 = now();
         ambient.step(dt); // fills the box with air (not timed)
         std::printf("ambient set-up step (air fill): %.1f s, air %zu\n", now() - t0,
