@@ -39,10 +39,35 @@ struct LevelSet::Impl
 
     Accessor& accessor() const { return accessors.local(); }
 
+    /// The values at the eight voxels c + {0,1}^3, as BoxSampler::getValues reads them. When
+    /// all eight lie in one leaf node (7 times in 8 per axis) they are read straight from its
+    /// buffer: the accessor's own per-voxel path checks its caches eight times and costs as
+    /// much as the rest of a lookup.
+    static void corners(Accessor& acc, const openvdb::Coord& c, float (&f)[2][2][2])
+    {
+        using Leaf = openvdb::FloatTree::LeafNodeType;
+        constexpr int LAST = int(Leaf::DIM) - 1;
+        if ((c.x() & LAST) != LAST && (c.y() & LAST) != LAST && (c.z() & LAST) != LAST) {
+            if (const Leaf* leaf = acc.probeConstLeaf(c)) {
+                const float* v = leaf->buffer().data() + Leaf::coordToOffset(c);
+                constexpr int X = 1 << (2 * Leaf::LOG2DIM), Y = 1 << Leaf::LOG2DIM;
+                for (int a = 0; a < 2; ++a)
+                    for (int b = 0; b < 2; ++b)
+                        for (int d = 0; d < 2; ++d) f[a][b][d] = v[a * X + b * Y + d];
+                return;
+            }
+        }
+        openvdb::tools::BoxSampler::getValues(f, acc, c);
+    }
+
+    /// BoxSampler::sample (the same interpolation, so the same value), with corners() above.
     Real sample(const Vec3& x) const
     {
-        const openvdb::Vec3d ijk = grid->transform().worldToIndex(openvdb::Vec3d(x[0], x[1], x[2]));
-        return Real(openvdb::tools::BoxSampler::sample(accessor(), ijk));
+        const openvdb::Vec3d ijk = map->applyInverseMap(openvdb::Vec3d(x[0], x[1], x[2]));
+        const openvdb::Vec3i i = openvdb::tools::local_util::floorVec3(ijk);
+        float f[2][2][2];
+        corners(accessor(), openvdb::Coord(i), f);
+        return Real(openvdb::tools::BoxSampler::trilinearInterpolation(f, ijk - i));
     }
 
     openvdb::FloatGrid::ConstPtr grid;
@@ -85,15 +110,15 @@ Vec3 LevelSet::gradient(const Vec3& x) const
 
 Real LevelSet::phiAndGradient(const Vec3& x, Vec3& grad) const
 {
-    const auto& xf = mImpl->grid->transform();
-    const openvdb::Vec3d ijk = xf.worldToIndex(openvdb::Vec3d(x[0], x[1], x[2]));
+    const openvdb::Vec3d ijk = mImpl->map->applyInverseMap(openvdb::Vec3d(x[0], x[1], x[2]));
     const openvdb::Coord c = openvdb::Coord::floor(ijk);
     const double u = ijk.x() - c.x(), v = ijk.y() - c.y(), w = ijk.z() - c.z();
-    auto& acc = mImpl->accessor();
+    float values[2][2][2];
+    Impl::corners(mImpl->accessor(), c, values);
     double f[2][2][2];
     for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b)
-            for (int d = 0; d < 2; ++d) f[a][b][d] = acc.getValue(c.offsetBy(a, b, d));
+            for (int d = 0; d < 2; ++d) f[a][b][d] = values[a][b][d];
     // Bilinear blends on each pair of opposite faces give value and partial derivatives.
     auto lerp = [](double p, double q, double t) { return p + (q - p) * t; };
     const double x00 = lerp(f[0][0][0], f[1][0][0], u), x10 = lerp(f[0][1][0], f[1][1][0], u);
