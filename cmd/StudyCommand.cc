@@ -1,13 +1,19 @@
 /// @file   StudyCommand.cc
 /// @brief  `ghostfx study`: one scene over a sweep of settings, cost against error.
 /// @details The study file names a scene, the keys to sweep (any scene key, as for `-D`), the
-///          metrics to measure and where to write. Each case runs in a child process of its own
-///          (the same program, `ghostfx study FILE --case K`), which gives every case a clean
-///          peak-memory figure from the kernel, lets a case that blows up or runs out of time be
-///          recorded as such instead of ending the study, and lets a case run on another build
-///          (a double-precision one). The parent writes the table (CSV) after every case, and at
-///          the end the observed convergence order and a plot of error against cost with the
-///          Pareto front. Format and metric definitions: docs/study.md.
+///          metrics to measure and where to write. A study is three pieces, which a farm runs
+///          as separate jobs and a local run runs in turn:
+///          - the cases (`--list`): every combination of the sweep, numbered from 0;
+///          - one case (`--case K`): runs the scene with case K's settings and writes its row
+///            file, `runs/case_KK.json` in the output folder (status, cost, metric values and
+///            traces), in a process of its own: a clean peak-memory figure, a case that blows
+///            up is recorded as such, and a case may run on another build (double precision);
+///          - the collection (`--collect`): reads every row file and writes the table (CSV and
+///            Markdown), the observed convergence order and a plot of error against cost with
+///            the Pareto front.
+///          Without a flag the study runs each case as a child process and collects after every
+///          case; `--emit slurm` writes an `sbatch --array` job script for the same `--case K`
+///          commands. Format and metric definitions: docs/study.md.
 #include "Command.h"
 #include "LiquidScene.h"
 #include "Simulation.h"
@@ -394,11 +400,110 @@ Json runCase(const StudySpec& spec, std::size_t index)
 
 struct CaseOutcome
 {
-    std::string status = "not run"; ///< ok, failed, unstable, timeout
+    std::string status = "missing"; ///< ok, failed, unstable, timeout, missing
     std::string note;
     std::map<std::string, double> numbers;
     std::map<std::string, std::vector<double>> traces;
 };
+
+struct StudyOptions
+{
+    std::string study;
+    std::string out;
+    int threads = 0;
+    bool quiet = false;
+    int caseIndex = -1;
+    bool list = false;
+    bool collect = false;
+    std::string emit;
+    bool replot = false;
+};
+
+std::string outputFolder(const StudyOptions& o, const StudySpec& spec)
+{
+    return o.out.empty() ? spec.directory : o.out;
+}
+
+/// The row file of case k: runs/case_07.json (two digits at least, so they list in order).
+std::string rowPath(const std::string& folder, std::size_t k)
+{
+    return (fs::path(folder) / "runs" / msg("case_", k < 10 ? "0" : "", k, ".json")).string();
+}
+
+std::string logPath(const std::string& folder, std::size_t k)
+{
+    return fs::path(rowPath(folder, k)).replace_extension(".log").string();
+}
+
+/// Peak resident memory (MB) of this process (RUSAGE_SELF) or of its waited-for children.
+double peakRssMb(int who)
+{
+    struct rusage u
+    {};
+    ::getrusage(who, &u);
+    return double(u.ru_maxrss) / 1024.0; // Linux: kilobytes
+}
+
+/// Write a case's result as its row file, tagged with the case it answers: --collect refuses a
+/// row whose label is not the study's case of that number (the study changed since it ran).
+void writeRow(const StudySpec& spec, std::size_t k, Json result, const std::string& path)
+{
+    result["case"] = k;
+    result["label"] = spec.cases[k].label;
+    vdbio::writeAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp);
+        out << result.dump(1);
+        if (!out) throw IoError(msg("study row '", path, "': write failed"));
+    });
+}
+
+/// Case k's outcome from its row file; status "missing" when there is none (the job has not
+/// run, or was killed before it could write).
+CaseOutcome readRow(const StudySpec& spec, std::size_t k, const std::string& path)
+{
+    CaseOutcome o;
+    std::ifstream in(path);
+    if (!in) {
+        o.status = "missing";
+        o.note = msg("no row file ", fs::path(path).filename().string(),
+                     ": the case has not run, or its job ended before writing it");
+        return o;
+    }
+    Json result;
+    try {
+        in >> result;
+    } catch (const Json::exception& e) {
+        throw SceneError(msg("study row '", path, "': not valid JSON (", e.what(), ")"));
+    }
+    if (!result.is_object() || !result.contains("label") || !result["label"].is_string()
+        || !result.contains("status") || !result["status"].is_string()) {
+        throw SceneError(msg("study row '", path,
+                             "': expected an object with \"label\" and \"status\" (a row file "
+                             "written by ghostfx study --case)"));
+    }
+    if (result["label"] != spec.cases[k].label) {
+        throw SceneError(
+            msg("study row '", path, "': holds case '", result["label"].get<std::string>(),
+                "', but case ", k, " of study '", spec.file, "' is '", spec.cases[k].label,
+                "': the study changed since the case ran (run it again: --case ", k, ")"));
+    }
+    o.status = result["status"].get<std::string>();
+    o.note = result.value("error", result.value("counts", ""));
+    for (const char* group : {"cost", "values"}) {
+        if (!result.contains(group)) continue;
+        for (auto it = result[group].begin(); it != result[group].end(); ++it) {
+            o.numbers[it.key()] = it.value().is_number() ? it.value().get<double>() : NAN;
+        }
+    }
+    if (result.contains("traces")) {
+        for (auto it = result["traces"].begin(); it != result["traces"].end(); ++it) {
+            std::vector<double> t;
+            for (const Json& v : it.value()) t.push_back(v.is_number() ? v.get<double>() : NAN);
+            o.traces[it.key()] = std::move(t);
+        }
+    }
+    return o;
+}
 
 /// This program, for the child runs. /proc/self/exe names the running image itself, so a study
 /// keeps working while its program file is rebuilt or replaced under it.
@@ -422,16 +527,20 @@ std::string lastLine(const std::string& path)
     return last;
 }
 
+/// Run case `index` as a child process (`ghostfx study FILE --case K --out FOLDER`) and read
+/// its row file. A child that is killed (max_seconds_per_run, a signal) or dies without writing
+/// its row gets a row written here, so that --collect sees what this run saw.
 CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string& program,
-                     int threads, const std::string& resultPath, const std::string& logPath)
+                     int threads, const std::string& folder)
 {
+    const std::string row = rowPath(folder, index), log = logPath(folder, index);
     std::vector<std::string> args = {program,
                                      "study",
                                      spec.file,
                                      "--case",
                                      std::to_string(index),
-                                     "--result",
-                                     resultPath,
+                                     "--out",
+                                     folder,
                                      "--threads",
                                      std::to_string(threads)};
     std::vector<char*> argv;
@@ -440,11 +549,11 @@ CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string
 
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, logPath.c_str(),
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
     std::error_code ec;
-    fs::remove(resultPath, ec);
+    fs::remove(row, ec);
     pid_t pid = 0;
     const int err = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
@@ -471,44 +580,17 @@ CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
 
-    CaseOutcome o;
-    o.numbers["peak_rss_mb"] = double(usage.ru_maxrss) / 1024.0; // Linux: kilobytes
-    if (timedOut) {
-        o.status = "timeout";
-        o.note = msg("stopped after max_seconds_per_run = ", spec.maxSecondsPerRun, " s");
-        return o;
+    if (timedOut || !fs::exists(row)) {
+        Json result;
+        result["status"] = timedOut ? "timeout" : "failed";
+        result["error"] =
+            timedOut ? msg("stopped after max_seconds_per_run = ", spec.maxSecondsPerRun, " s")
+            : WIFSIGNALED(status) ? msg("killed by signal ", WTERMSIG(status))
+                                  : lastLine(log);
+        result["cost"]["peak_rss_mb"] = double(usage.ru_maxrss) / 1024.0; // Linux: kilobytes
+        writeRow(spec, index, result, row);
     }
-    std::ifstream in(resultPath);
-    Json result;
-    if (in) {
-        try {
-            in >> result;
-        } catch (const Json::exception&) {
-            result = Json();
-        }
-    }
-    if (!result.is_object()) {
-        o.status = "failed";
-        o.note =
-            WIFSIGNALED(status) ? msg("killed by signal ", WTERMSIG(status)) : lastLine(logPath);
-        return o;
-    }
-    o.status = result.value("status", "failed");
-    o.note = result.value("error", result.value("counts", ""));
-    for (const char* group : {"cost", "values"}) {
-        if (!result.contains(group)) continue;
-        for (auto it = result[group].begin(); it != result[group].end(); ++it) {
-            o.numbers[it.key()] = it.value().is_number() ? it.value().get<double>() : NAN;
-        }
-    }
-    if (result.contains("traces")) {
-        for (auto it = result["traces"].begin(); it != result["traces"].end(); ++it) {
-            std::vector<double> t;
-            for (const Json& v : it.value()) t.push_back(v.is_number() ? v.get<double>() : NAN);
-            o.traces[it.key()] = std::move(t);
-        }
-    }
-    return o;
+    return readRow(spec, index, row);
 }
 
 /// Trace errors against the reference run (which is case 0).
@@ -744,17 +826,6 @@ std::vector<PlotPoint> plotPoints(const StudySpec& spec, const std::vector<CaseO
     return points;
 }
 
-struct StudyOptions
-{
-    std::string study;
-    std::string out;
-    int threads = 0;
-    bool quiet = false;
-    int caseIndex = -1;
-    std::string result;
-    bool replot = false;
-};
-
 /// Read a study table back (for --replot): numbers by column, status and note, row by row.
 std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& path)
 {
@@ -813,6 +884,9 @@ int runStudyCase(const StudyOptions& o, const StudySpec& spec)
         throw ValueError(
             msg("--case ", o.caseIndex, ": the study has cases 0-", spec.cases.size() - 1));
     }
+    const std::string folder = outputFolder(o, spec);
+    vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
+    const std::string path = rowPath(folder, std::size_t(o.caseIndex));
     parallel::ThreadLimit threadLimit(o.threads);
     Json result;
     int code = 0;
@@ -825,13 +899,8 @@ int runStudyCase(const StudyOptions& o, const StudySpec& spec)
         result = {{"status", "failed"}, {"error", e.what()}};
         code = 1;
     }
-    if (!o.result.empty()) {
-        vdbio::writeAtomically(o.result, [&](const std::string& tmp) {
-            std::ofstream out(tmp);
-            out << result.dump(1);
-            if (!out) throw IoError(msg("study result '", o.result, "': write failed"));
-        });
-    }
+    result["cost"]["peak_rss_mb"] = peakRssMb(RUSAGE_SELF);
+    writeRow(spec, std::size_t(o.caseIndex), result, path);
     if (code != 0)
         std::fprintf(stderr, "ghostfx study: case %d %s: %s\n", o.caseIndex,
                      result["status"].get<std::string>().c_str(),
@@ -878,19 +947,11 @@ int finishStudy(const StudyOptions& o, const StudySpec& spec,
     return 0;
 }
 
-int runStudy(const StudyOptions& o)
+/// Check every case before anything runs: a program for its precision, its scene and settings.
+void checkCases(const StudySpec& spec)
 {
-    const StudySpec spec = readStudy(o.study);
-    if (o.caseIndex >= 0) return runStudyCase(o, spec);
-    if (o.replot) {
-        const std::string folder = o.out.empty() ? spec.directory : o.out;
-        const std::vector<CaseOutcome> outcomes =
-            readTable(spec, (fs::path(folder) / spec.table).string());
-        return finishStudy(o, spec, outcomes, folder);
-    }
-
-    // Cases of the other precision run on the program named for it (checked by the parent only:
-    // a child of the other build sees this build's cases as "other").
+    // Cases of the other precision run on the program named for it (checked here only: a child
+    // of the other build sees this build's cases as "other").
     for (const StudyCase& c : spec.cases) {
         if (c.precision != BUILD_PRECISION && !spec.executables.count(c.precision)) {
             throw SceneError(msg("study '", spec.file, "': executables: case '", c.label,
@@ -899,7 +960,6 @@ int runStudy(const StudyOptions& o)
                                  c.precision, "\": \"build-", c.precision, "/cmd/ghostfx\" }"));
         }
     }
-    // Every case's scene and settings are checked before anything runs.
     for (const StudyCase& c : spec.cases) {
         try {
             const vdbio::Scene scene = vdbio::readScene(spec.scene, c.overrides);
@@ -908,28 +968,222 @@ int runStudy(const StudyOptions& o)
             throw SceneError(msg("study '", spec.file, "': case '", c.label, "': ", e.what()));
         }
     }
-    const std::string folder = o.out.empty() ? spec.directory : o.out;
+}
+
+/// The program that runs case c: this one, or the study's executable for c's precision.
+std::string programFor(const StudySpec& spec, const StudyCase& c, const std::string& self)
+{
+    return c.precision == BUILD_PRECISION ? self : spec.executables.at(c.precision);
+}
+
+/// A word for the shell, in single quotes.
+std::string shellQuoted(const std::string& s)
+{
+    std::string q = "'";
+    for (char ch : s) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return q + "'";
+}
+
+/// The command a farm runs for case k: absolute paths, since a farm job starts elsewhere.
+std::string caseCommand(const StudySpec& spec, std::size_t k, const std::string& program,
+                        const std::string& folder, const std::string& threads)
+{
+    return msg(shellQuoted(program), " study ", shellQuoted(fs::absolute(spec.file).string()),
+               " --case ", k, " --out ", shellQuoted(fs::absolute(folder).string()), " --threads ",
+               threads);
+}
+
+/// This program's own file (not /proc/self/exe: a farm node runs the command elsewhere).
+std::string selfPath()
+{
+    std::error_code ec;
+    const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) throw IoError(msg("ghostfx study: cannot find its own program file: ", ec.message()));
+    return p.string();
+}
+
+/// Read every row file, compare with the reference, write the table: the collection step.
+std::vector<CaseOutcome> collectRows(const StudySpec& spec, const std::string& folder)
+{
+    std::vector<CaseOutcome> outcomes;
+    for (std::size_t k = 0; k < spec.cases.size(); ++k)
+        outcomes.push_back(readRow(spec, k, rowPath(folder, k)));
+    compareWithReference(spec, outcomes);
+    writeTable(spec, outcomes, (fs::path(folder) / spec.table).string());
+    return outcomes;
+}
+
+int listCases(const StudyOptions& o, const StudySpec& spec)
+{
+    checkCases(spec);
+    const std::string folder = outputFolder(o, spec), self = selfPath();
+    const std::string collect =
+        msg("ghostfx study ", spec.file, " --collect", o.out.empty() ? "" : " --out " + o.out);
+    std::printf("# case\tlabel\tcommand (study '%s': %zu cases; then: %s)\n", spec.file.c_str(),
+                spec.cases.size(), collect.c_str());
+    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
+        const StudyCase& c = spec.cases[k];
+        std::printf(
+            "%zu\t%s\t%s\n", k, c.label.empty() ? "base scene" : c.label.c_str(),
+            caseCommand(spec, k, programFor(spec, c, self), folder, std::to_string(o.threads))
+                .c_str());
+    }
+    return 0;
+}
+
+/// `--emit slurm`: an array job of the cases, a collect job, and a script that submits both
+/// (the collect job waits for every case to end, whether it succeeded or not).
+int emitSlurm(const StudyOptions& o, const StudySpec& spec)
+{
+    checkCases(spec);
+    const std::string folder = fs::absolute(outputFolder(o, spec)).lexically_normal().string();
+    const std::string slurm = (fs::path(folder) / "slurm").string();
+    vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
+    vdbio::ensureWritableDirectory(slurm);
+    const std::string self = selfPath(), name = "ghostfx-" + fs::path(spec.file).stem().string();
+    const int cpus = std::max(1, o.threads);
+    auto write = [](const std::string& path, const std::string& text) {
+        vdbio::writeAtomically(path, [&](const std::string& tmp) {
+            std::ofstream out(tmp);
+            out << text;
+            if (!out) throw IoError(msg("job script '", path, "': write failed"));
+        });
+        fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+    };
+
+    std::string cases = msg(
+        "#!/bin/bash\n"
+        "# ghostfx study '",
+        spec.file, "': one array task per case (", "ghostfx study --emit slurm; docs/study.md).\n",
+        "#SBATCH --job-name=", name, "\n#SBATCH --array=0-", spec.cases.size() - 1,
+        "\n#SBATCH --cpus-per-task=", cpus, "\n#SBATCH --output=", slurm, "/case_%a.slurm.out\n");
+    if (spec.maxSecondsPerRun > 0) {
+        // max_seconds_per_run, rounded up to whole minutes, as the task's time limit.
+        cases += msg("#SBATCH --time=", int(std::ceil(spec.maxSecondsPerRun / 60.0)), "\n");
+    }
+    cases += "set -u\n"
+             "threads=${SLURM_CPUS_PER_TASK:-"
+             + std::to_string(cpus)
+             + "}\n"
+               "case \"${SLURM_ARRAY_TASK_ID:?run this script with sbatch (an array job)}\" in\n";
+    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
+        cases +=
+            msg("  ", k, ") exec ",
+                caseCommand(spec, k, programFor(spec, spec.cases[k], self), folder, "\"$threads\""),
+                " > ", shellQuoted(logPath(folder, k)), " 2>&1 ;;\n");
+    }
+    cases += "  *) echo \"no case $SLURM_ARRAY_TASK_ID in this study\" >&2; exit 1 ;;\nesac\n";
+    write((fs::path(slurm) / "cases.sbatch").string(), cases);
+
+    write((fs::path(slurm) / "collect.sbatch").string(),
+          msg("#!/bin/bash\n# ghostfx study '", spec.file,
+              "': the table, convergence and plot from every case's row file.\n"
+              "#SBATCH --job-name=",
+              name, "-collect\n#SBATCH --cpus-per-task=1\n#SBATCH --output=", slurm,
+              "/collect.slurm.out\nexec ", shellQuoted(self), " study ",
+              shellQuoted(fs::absolute(spec.file).string()), " --collect --out ",
+              shellQuoted(folder), "\n"));
+
+    write((fs::path(slurm) / "submit.sh").string(),
+          msg("#!/bin/sh\n"
+              "# Submit the study's cases as an array job and the collection after them.\n"
+              "# Options go to both sbatch calls: ./submit.sh --partition=sim --mem=8G\n"
+              "set -e\n"
+              "cd ",
+              shellQuoted(slurm),
+              "\n"
+              "array=$(sbatch --parsable \"$@\" cases.sbatch)\n"
+              "array=${array%%;*}\n"
+              "collect=$(sbatch --parsable --dependency=afterany:\"$array\" \"$@\" "
+              "collect.sbatch)\n"
+              "echo \"cases: job $array (",
+              spec.cases.size(), " tasks); collect: job ${collect%%;*}\"\n"));
+
+    if (!o.quiet) {
+        std::fprintf(stderr,
+                     "ghostfx study '%s': %zu cases; Slurm scripts in '%s' (cases.sbatch, "
+                     "collect.sbatch); submit with: %s/submit.sh\n",
+                     spec.file.c_str(), spec.cases.size(), slurm.c_str(), slurm.c_str());
+    }
+    return 0;
+}
+
+int collectStudy(const StudyOptions& o, const StudySpec& spec)
+{
+    const std::string folder = outputFolder(o, spec);
+    if (!fs::is_directory(fs::path(folder) / "runs")) {
+        throw IoError(msg("study '", spec.file, "': no folder '",
+                          (fs::path(folder) / "runs").string(),
+                          "' (run the cases first: ghostfx study ", spec.file, " --list)"));
+    }
+    const std::vector<CaseOutcome> outcomes = collectRows(spec, folder);
+    std::map<std::string, std::vector<std::size_t>> byStatus;
+    for (std::size_t k = 0; k < outcomes.size(); ++k) byStatus[outcomes[k].status].push_back(k);
+    std::string summary;
+    for (const auto& [status, cases] : byStatus) {
+        summary += msg(summary.empty() ? "" : ", ", cases.size(), " ", status);
+        if (status != "ok") {
+            summary += " (cases";
+            for (std::size_t k : cases) summary += msg(" ", k);
+            summary += ")";
+        }
+    }
+    if (!o.quiet) {
+        std::fprintf(stderr, "ghostfx study '%s': collected %zu cases: %s\n", spec.file.c_str(),
+                     outcomes.size(), summary.c_str());
+    }
+    if (byStatus.count("missing")) {
+        std::fprintf(stderr,
+                     "ghostfx study: warning: %zu of %zu cases have no row file yet; their rows "
+                     "say \"missing\" (run them, then --collect again)\n",
+                     byStatus["missing"].size(), outcomes.size());
+    }
+    return finishStudy(o, spec, outcomes, folder);
+}
+
+int runStudy(const StudyOptions& o)
+{
+    const StudySpec spec = readStudy(o.study);
+    if (int(o.caseIndex >= 0) + int(o.list) + int(o.collect) + int(!o.emit.empty()) + int(o.replot)
+        > 1) {
+        throw ValueError(msg("study '", o.study,
+                             "': --case, --list, --collect, --emit and --replot are separate "
+                             "steps: give one of them"));
+    }
+    if (o.caseIndex >= 0) return runStudyCase(o, spec);
+    if (o.list) return listCases(o, spec);
+    if (o.collect) return collectStudy(o, spec);
+    if (!o.emit.empty()) return emitSlurm(o, spec);
+    if (o.replot) {
+        const std::string folder = outputFolder(o, spec);
+        const std::vector<CaseOutcome> outcomes =
+            readTable(spec, (fs::path(folder) / spec.table).string());
+        return finishStudy(o, spec, outcomes, folder);
+    }
+
+    // Local: each case as a child process, collected after every case.
+    checkCases(spec);
+    const std::string folder = outputFolder(o, spec);
     vdbio::ensureWritableDirectory(folder);
     vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
     const std::string self = selfExecutable();
-    const std::string table = (fs::path(folder) / spec.table).string();
     auto say = [&](const std::string& line) {
         if (!o.quiet) std::fprintf(stderr, "%s\n", line.c_str());
     };
     say(msg("ghostfx study '", spec.file, "': scene '", spec.scene, "', ", spec.cases.size(),
             " runs, ", spec.metrics.size(), " metrics, output in '", folder, "'"));
 
-    std::vector<CaseOutcome> outcomes(spec.cases.size());
+    // Rows of an earlier run would be collected as this run's until their case runs again.
+    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
+        std::error_code ec;
+        fs::remove(rowPath(folder, k), ec);
+    }
+    std::vector<CaseOutcome> outcomes;
     for (std::size_t k = 0; k < spec.cases.size(); ++k) {
         const StudyCase& c = spec.cases[k];
-        const std::string program =
-            c.precision == BUILD_PRECISION ? self : spec.executables.at(c.precision);
-        const std::string stem =
-            (fs::path(folder) / "runs" / msg("case_", k < 10 ? "0" : "", k)).string();
         const auto start = Clock::now();
-        outcomes[k] = runChild(spec, k, program, o.threads, stem + ".json", stem + ".log");
-        compareWithReference(spec, outcomes);
-        writeTable(spec, outcomes, table);
+        runChild(spec, k, programFor(spec, c, self), o.threads, folder);
+        outcomes = collectRows(spec, folder);
         const CaseOutcome& r = outcomes[k];
         std::string line = msg("[", k + 1, "/", spec.cases.size(), "] ",
                                c.label.empty() ? "base scene" : c.label, ": ", r.status);
@@ -942,7 +1196,7 @@ int runStudy(const StudyOptions& o)
         } else {
             line +=
                 msg(" after ", number(std::chrono::duration<double>(Clock::now() - start).count()),
-                    " s: ", r.note, " (log: ", stem, ".log)");
+                    " s: ", r.note, " (log: ", logPath(folder, k), ")");
         }
         say(line);
     }
@@ -965,9 +1219,18 @@ Command addStudyCommand(CLI::App& parent)
     c->add_flag("--replot", o->replot,
                 "only redraw the plot and convergence table from the study's existing table "
                 "(after changing \"plot\" or \"convergence\")");
-    // Internal: how the study runs one case in a child process.
-    c->add_option("--case", o->caseIndex)->group("");
-    c->add_option("--result", o->result)->group("");
+    c->add_flag("--list", o->list,
+                "print the cases, one per line: number, label and the command that runs it");
+    c->add_option("--case", o->caseIndex,
+                  "run case K only and write its row file (runs/case_KK.json in the output "
+                  "folder): one farm job")
+        ->check(CLI::NonNegativeNumber);
+    c->add_flag("--collect", o->collect,
+                "build the table, convergence and plot from the cases' row files");
+    c->add_option("--emit", o->emit,
+                  "write job scripts for a farm into the output folder: slurm (an sbatch "
+                  "--array job, a collect job and submit.sh)")
+        ->check(CLI::IsMember({"slurm"}));
     return {c, [o] { return runStudy(*o); }};
 }
 

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
@@ -342,4 +343,102 @@ TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
     // Single particles scatter more than the layer means: the noise bounds the profile error.
     EXPECT_GE(num(rows[0], "hydrostatic_pressure_noise"),
               num(rows[0], "hydrostatic_pressure_error"));
+}
+
+TEST_F(Study, CasesRunAsSeparateJobsInAnyOrderThenCollectGiveTheLocalTable)
+{
+    // Four cases and a reference (so the collection also computes trace errors), run once
+    // locally and once as a farm would: each case its own process, in a shuffled order, through
+    // the emitted Slurm array script (run here with bash, as sbatch would, one task id at a time).
+    Json s = baseStudy();
+    s["metrics"] = Json::array(
+        {"free_fall", "density_error",
+         Json{{"metric", "surge_front"}, {"direction", {0, -1, 0}}, {"percentile", 100}}});
+    s["sweep"]["settings.substeps"] = {5, 10};
+    s["sweep"]["settings.method"] = {"ghost", "basic"};
+    s["reference"]["settings.substeps"] = 20;
+    s["max_seconds_per_run"] = 600;
+    const std::string study = writeStudy(s).string();
+    const fs::path local = mDir / "local", farm = mDir / "farm";
+    const Result r = run("study " + study + " --threads 1 --out " + local.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    // One array task, as Slurm would start it.
+    auto task = [&](int id) {
+        const std::string command = "env SLURM_ARRAY_TASK_ID=" + std::to_string(id) + " bash "
+                                    + (farm / "slurm" / "cases.sbatch").string();
+        const int status = std::system(command.c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    };
+
+    // --list: a header line, then one line per case with the command that runs it.
+    const Result listed = run("study " + study + " --list --threads 1 --out " + farm.string()
+                              + " > " + (mDir / "list.txt").string());
+    ASSERT_EQ(listed.code, 0) << listed.err;
+    std::istringstream list(slurp(mDir / "list.txt"));
+    std::string line;
+    std::vector<std::string> lines;
+    while (std::getline(list, line)) lines.push_back(line);
+    ASSERT_EQ(lines.size(), 6u) << slurp(mDir / "list.txt");
+    EXPECT_EQ(lines[1].rfind("0\treference settings.substeps=20\t", 0), 0u) << lines[1];
+    for (std::size_t k = 1; k < lines.size(); ++k) {
+        EXPECT_NE(lines[k].find(" --case " + std::to_string(k - 1) + " --out "), std::string::npos)
+            << lines[k];
+    }
+
+    // --emit slurm: the array script covers the five cases, with the run's time limit.
+    const Result emitted =
+        run("study " + study + " --emit slurm --threads 1 --out " + farm.string());
+    ASSERT_EQ(emitted.code, 0) << emitted.err;
+    const std::string script = slurp(farm / "slurm" / "cases.sbatch");
+    EXPECT_NE(script.find("#SBATCH --array=0-4\n"), std::string::npos) << script;
+    EXPECT_NE(script.find("#SBATCH --time=10\n"), std::string::npos) << script;
+    EXPECT_TRUE(fs::exists(farm / "slurm" / "collect.sbatch"));
+    EXPECT_TRUE(fs::exists(farm / "slurm" / "submit.sh"));
+
+    // Half the cases, then --collect: the rest are reported missing, and the table says so.
+    for (int id : {3, 0}) ASSERT_EQ(task(id), 0) << "task " << id;
+    const Result partial = run("study " + study + " --collect --out " + farm.string());
+    ASSERT_EQ(partial.code, 0) << partial.err;
+    EXPECT_NE(partial.err.find("3 of 5 cases have no row file yet"), std::string::npos)
+        << partial.err;
+    EXPECT_EQ(readCsv(farm / "study.csv").at(1).at("status"), "missing");
+
+    for (int id : {4, 1, 2}) ASSERT_EQ(task(id), 0) << "task " << id;
+    const Result collected = run("study " + study + " --collect --out " + farm.string());
+    ASSERT_EQ(collected.code, 0) << collected.err;
+    EXPECT_NE(collected.err.find("collected 5 cases: 5 ok"), std::string::npos) << collected.err;
+    EXPECT_TRUE(fs::exists(farm / "study.png"));
+
+    // The same table: every column but the measured times and memory is equal, digit for digit
+    // (one thread per case, so each case is the same deterministic run wherever it ran).
+    const auto a = readCsv(local / "study.csv"), b = readCsv(farm / "study.csv");
+    ASSERT_EQ(a.size(), 5u);
+    ASSERT_EQ(b.size(), a.size());
+    const std::set<std::string> timed = {
+        "setup_s",          "wall_s",     "wall_per_sim_second", "cpu_s", "cpu_per_sim_second",
+        "steps_per_second", "peak_rss_mb"};
+    for (std::size_t k = 0; k < a.size(); ++k) {
+        ASSERT_EQ(a[k].size(), b[k].size());
+        EXPECT_EQ(a[k].at("status"), "ok") << a[k].at("note");
+        for (const auto& [column, value] : a[k]) {
+            if (timed.count(column)) {
+                EXPECT_GT(num(b[k], column), 0) << column;
+                continue;
+            }
+            EXPECT_EQ(b[k].at(column), value) << "case " << k << ", " << column;
+        }
+    }
+    EXPECT_GT(num(b[1], "surge_front_error_m"), 0);
+    EXPECT_EQ(slurp(farm / "convergence.csv"), slurp(local / "convergence.csv"));
+
+    // A row from another version of the study is refused, naming the file and both cases.
+    s["sweep"]["settings.substeps"] = {5, 40};
+    writeStudy(s);
+    const Result changed = run("study " + study + " --collect --out " + farm.string());
+    EXPECT_EQ(changed.code, 1);
+    EXPECT_NE(changed.err.find("case_02.json': holds case 'settings.method=ghost "
+                               "settings.substeps=10', but case 2 of study"),
+              std::string::npos)
+        << changed.err;
+    EXPECT_NE(changed.err.find("the study changed since the case ran"), std::string::npos);
 }
