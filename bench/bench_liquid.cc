@@ -22,6 +22,7 @@
 ///
 ///          Run: build/bench/bench_liquid [--liquid 100000] [--steps 30] [--warmup 20]
 #include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/sph/DomainDecomposition.h>
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
@@ -34,6 +35,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -65,6 +67,7 @@ struct Options
     std::string methods = "both";  ///< ghost, basic or both
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     std::uint64_t seed = 1;
+    bool halo = false; ///< print the halos of domain decompositions of the state
 };
 
 double seconds(std::chrono::steady_clock::time_point start)
@@ -173,6 +176,67 @@ struct RunResult
     int steps = 0;               ///< measured steps completed
 };
 
+/// The halos that a domain decomposition of the solver's present state would exchange, for
+/// slabs and recursive bisection over 2 to 1,024 parts (the scaling model of bench/RESULTS.md,
+/// "One simulation over many ranks"). A part owns the liquid and air in its region (what it
+/// computes); its halo is the liquid and air of other parts within a support radius R of its
+/// region (copies it receives every step); its solid particles are those in or within R of
+/// its region (sampled locally, never exchanged).
+void printHalo(const GhostSolver& solver, const std::string& when)
+{
+    const ParticleSet& p = solver.particles();
+    std::vector<Vec3> fluid;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const ParticleKind k = p.kinds()[i];
+        if (k == ParticleKind::Liquid || k == ParticleKind::GhostAir)
+            fluid.push_back(p.positions()[i]);
+    }
+    const ParticleSet solidSet = solver.solidParticles();
+    const std::vector<Vec3>& solids = solidSet.positions();
+    const Real R = solver.settings().supportRadius();
+    std::printf("\n  halo %s: %zu liquid and air, %zu solid particles, R = %.5f m\n"
+                "| scheme | parts | owned per part | imbalance | halo / owned (all parts) | "
+                "halo / owned (worst part) | parts sending to a part (mean / max) | solid per "
+                "part / all solid |\n|---|---|---|---|---|---|---|---|\n",
+                when.c_str(), fluid.size(), solids.size(), double(R));
+    for (const DecompositionScheme scheme :
+         {DecompositionScheme::Slabs, DecompositionScheme::Bisection}) {
+        for (int parts = 2; parts <= 1024 && std::size_t(parts) <= fluid.size(); parts *= 2) {
+            const DomainDecomposition d = DomainDecomposition::balanced(fluid, parts, scheme);
+            std::vector<std::size_t> owned(std::size_t(parts), 0), halo(owned), solid(owned);
+            std::vector<std::set<int>> sources(owned.size());
+            for (const Vec3& x : fluid) {
+                const int own = d.owner(x);
+                ++owned[std::size_t(own)];
+                d.forEachHaloPart(x, R, [&](int q) {
+                    ++halo[std::size_t(q)];
+                    sources[std::size_t(q)].insert(own);
+                });
+            }
+            for (const Vec3& x : solids) {
+                ++solid[std::size_t(d.owner(x))];
+                d.forEachHaloPart(x, R, [&](int q) { ++solid[std::size_t(q)]; });
+            }
+            double totalHalo = 0, totalOwned = 0, worst = 0, totalSolid = 0, sourceSum = 0;
+            std::size_t sourceMax = 0;
+            for (std::size_t k = 0; k < owned.size(); ++k) {
+                totalHalo += double(halo[k]);
+                totalOwned += double(owned[k]);
+                totalSolid += double(solid[k]);
+                if (owned[k] > 0) worst = std::max(worst, double(halo[k]) / double(owned[k]));
+                sourceSum += double(sources[k].size());
+                sourceMax = std::max(sourceMax, sources[k].size());
+            }
+            std::printf("| %s | %d | %.0f | %.3f | %.3f | %.3f | %.1f / %zu | %.0f / %.3f |\n",
+                        scheme == DecompositionScheme::Slabs ? "slabs" : "bisection", parts,
+                        totalOwned / parts, DomainDecomposition::imbalance(owned),
+                        totalHalo / totalOwned, worst, sourceSum / parts, sourceMax,
+                        totalSolid / parts,
+                        solids.empty() ? 0.0 : totalSolid / parts / double(solids.size()));
+        }
+    }
+}
+
 /// Warm up and measure `solver` (its solid already added). The liquid is `liquidPositions`
 /// (sampled once per scene) unless the solver already holds liquid. A NumericalError (blow-up)
 /// ends the run and is recorded in `out`; the state at the end is recorded either way.
@@ -197,6 +261,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
         auto t0 = std::chrono::steady_clock::now();
         solver.step(nextDt());
         out.firstStep = seconds(t0);
+        if (opt.halo) printHalo(solver, "after the first step (the liquid at rest, with its air)");
         for (int s = 1; s < opt.warmup; ++s) solver.step(nextDt());
 
         solver.resetTimings();
@@ -232,6 +297,10 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
         out.solve = solver.pressureSolveStats();
     }
 
+    if (opt.halo && out.steps > 0) {
+        printHalo(solver, msg("at the end (t = ", solver.time(), " s, after ", solver.stepCount(),
+                              " steps)"));
+    }
     const ParticleSet& p = solver.particles();
     const Real rho0 = solver.settings().restDensity;
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -418,6 +487,9 @@ int main(int argc, char** argv)
         ->capture_default_str()
         ->check(CLI::IsMember({"ghost", "basic", "both"}));
     app.add_option("--seed", opt.seed, "random seed of all sampling")->capture_default_str();
+    app.add_flag("--halo", opt.halo,
+                 "print the halos of slab and bisection decompositions into 2-1024 parts, "
+                 "after the first step and at the end (the multi-rank scaling model)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
