@@ -169,7 +169,10 @@ struct RunResult
     double dt = 0;                                                 ///< mean dt (s)
     PhaseTimings phases;
     double meanNeighbors = 0;
-    double maxSpeed = 0, maxDensityRatio = 0; ///< at the end (m/s, rho / rho0)
+    double maxSpeed = 0, maxDensityRatio = 0;       ///< at the end (m/s, rho / rho0)
+    double spacing = 0;                             ///< h (m)
+    Vec3 fastest{0};                                ///< where the fastest liquid particle is
+    double fastestPhi = 0, fastestDensityRatio = 0; ///< its distance to the solid, rho / rho0
     std::size_t escaped = 0, insideSolid = 0;
     std::size_t memoryBytes = 0; ///< the solver's memoryBytes() at the end
     std::size_t listBytes = 0;   ///< of which neighbour lists
@@ -244,6 +247,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
                GhostSolver& solver, const Options& opt, RunResult& out)
 {
     out.scene = scene.name;
+    out.spacing = scene.spacing;
     out.method = method;
     out.pressure = solver.settings().pressure;
     double sum = 0, lo = 1e30, hi = 0, nbrs = 0, simulated = 0;
@@ -306,7 +310,13 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
     for (std::size_t i = 0; i < p.size(); ++i) {
         if (p.kinds()[i] != ParticleKind::Liquid) continue;
         const Vec3& x = p.positions()[i];
-        out.maxSpeed = std::max(out.maxSpeed, double(p.velocities()[i].length()));
+        const double speed = p.velocities()[i].length();
+        if (speed > out.maxSpeed) {
+            out.maxSpeed = speed;
+            out.fastest = x;
+            out.fastestPhi = scene.solid.phi(x);
+            out.fastestDensityRatio = p.densities()[i] / rho0;
+        }
         out.maxDensityRatio = std::max(out.maxDensityRatio, double(p.densities()[i] / rho0));
         if (!scene.container.contains(x)) ++out.escaped;
         if (scene.solid.phi(x) < -Real(0.01) * scene.spacing) ++out.insideSolid;
@@ -341,6 +351,10 @@ void printRun(const RunResult& r)
     std::printf("  state at the end: max liquid speed %.3f m/s, max rho/rho0 %.3f, %zu liquid "
                 "outside the container, %zu inside the solid\n",
                 r.maxSpeed, r.maxDensityRatio, r.escaped, r.insideSolid);
+    std::printf("  fastest liquid particle: at (%.4f, %.4f, %.4f) m, %.2f h from the solid, "
+                "rho/rho0 %.3f\n",
+                double(r.fastest[0]), double(r.fastest[1]), double(r.fastest[2]),
+                r.fastestPhi / double(r.spacing), r.fastestDensityRatio);
     if (r.steps == 0) return;
     if (!r.ok) {
         // The phases of the failed step are in r.phases but its total is not: no breakdown.
