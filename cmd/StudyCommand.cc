@@ -988,9 +988,12 @@ std::string shellQuoted(const std::string& s)
 std::string caseCommand(const StudySpec& spec, std::size_t k, const std::string& program,
                         const std::string& folder, const std::string& threads)
 {
-    return msg(shellQuoted(program), " study ", shellQuoted(fs::absolute(spec.file).string()),
-               " --case ", k, " --out ", shellQuoted(fs::absolute(folder).string()), " --threads ",
-               threads);
+    // A relative program (an "executables" entry such as build-double/cmd/ghostfx) is taken
+    // from where the study was listed; a bare name is left to the farm node's PATH.
+    const bool path = program.find('/') != std::string::npos;
+    return msg(shellQuoted(path ? fs::absolute(program).lexically_normal().string() : program),
+               " study ", shellQuoted(fs::absolute(spec.file).string()), " --case ", k, " --out ",
+               shellQuoted(fs::absolute(folder).string()), " --threads ", threads);
 }
 
 /// This program's own file (not /proc/self/exe: a farm node runs the command elsewhere).
