@@ -134,13 +134,20 @@ void GhostSolver::resampleAir(int phase)
     //    only, so escaped spray neither attracts air nor stretches the sampling region.
     std::vector<Real> indicator(n, std::numeric_limits<Real>::max());
     std::vector<std::uint8_t> body(n, 0);
+    // Halo copies (other processes' particles, with no lists of their own): their liquid counts
+    // as body, never as a seed; their air is an obstacle whose fate its owner decides.
+    const Real* halo = haloFlags();
+    auto owned = [halo](std::size_t i) { return !halo || halo[i] == Real(0); };
+    if (halo) {
+        for (std::size_t i = 0; i < n; ++i) body[i] = !owned(i) && kind[i] == ParticleKind::Liquid;
+    }
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
             // Only the liquid within a kernel radius of the region is asked about, and only the
             // seeding candidates need the indicator.
-            if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)) continue;
+            if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY) || !owned(i)) continue;
             for (Index j : mFluidLists[i]) {
                 if (j != i && kind[j] == ParticleKind::Liquid) {
                     body[i] = 1;
@@ -245,7 +252,8 @@ void GhostSolver::resampleAir(int phase)
     auto& target = mParticles.scalarChannel(AIR_TARGET);
     std::vector<std::uint8_t> keep(n, 0);
     parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0) || !(zone[i] & IN_REGION))
+        if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0) || !(zone[i] & IN_REGION)
+            || !owned(i))
             return;
         Real d = -1;
         keep[i] = nearBody(x[i], &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x[i])
@@ -293,7 +301,7 @@ void GhostSolver::resampleAir(int phase)
     for (std::size_t i = 0; i < n; ++i) {
         if (!(zone[i] & NEAR_SEEDING)) continue;
         if (kind[i] == ParticleKind::GhostAir) {
-            if (!(zone[i] & IN_REGION)) {
+            if (!(zone[i] & IN_REGION) || !owned(i)) {
                 if (target[i] != Real(0)) obstacles.push_back(x[i]);
             } else if (keep[i]) {
                 seeds.push_back(x[i]);
@@ -315,7 +323,8 @@ void GhostSolver::resampleAir(int phase)
     }
 
     auto accept = [&](const Vec3& q) {
-        return inPhase(q) && nearBody(q) != INVALID_INDEX && !insideSolid(q) && !insideLiquid(q);
+        return inPhase(q) && (!mExchange || mExchange->owns(q)) && nearBody(q) != INVALID_INDEX
+               && !insideSolid(q) && !insideLiquid(q);
     };
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
@@ -353,7 +362,7 @@ void GhostSolver::resampleAir(int phase)
             0, xs.size(),
             [&](std::size_t i) {
             if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
-            if (i < n && !(zone[i] & IN_REGION)) return;
+            if (i < n && (!(zone[i] & IN_REGION) || !owned(i))) return;
             // The liquid and the living air of the step's grid, and the new air.
             Real sigma = 0;
             mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {

@@ -64,6 +64,41 @@ void GhostSolver::setParticleMass(Real mass)
 
 void GhostSolver::setStepObserver(StepObserver observer) { mObserver = std::move(observer); }
 
+void GhostSolver::setExchange(sph::ParticleExchange* exchange)
+{
+    if (!exchange || exchange->ranks() == 1) {
+        mExchange = nullptr;
+        return;
+    }
+    auto refuse = [](const std::string& what) {
+        throw ValueError(msg("liquid solver over several processes: ", what,
+                             " is not supported yet (supported: method ghost, pressure tait, "
+                             "static solids, no emitters)"));
+    };
+    if (mSettings.method != Method::Ghost) refuse("method basic");
+    if (mSettings.pressure != PressureModel::Tait) refuse("pressure dfsph");
+    if (!mEmitters.empty()) refuse("an emitter");
+    for (const auto& solid : mSolids) {
+        if (solid->moving) refuse(msg("the moving solid '", solid->shape.name(), "'"));
+    }
+    if (!mRun.initialized) refuse("sharing before prepare()");
+    // Keep what this process owns; every process has the same particles here.
+    std::vector<std::uint8_t> remove(mParticles.size(), 0);
+    for (std::size_t i = 0; i < remove.size(); ++i)
+        remove[i] = !exchange->owns(mParticles.positions()[i]);
+    mParticles.removeIf(remove);
+    mParticles.addScalarChannel(HALO_CHANNEL, Real(0));
+    // New particles (air) take ids congruent to this rank modulo the rank count, above every
+    // id any process holds now (the same counters everywhere: the set-up was the same).
+    ParticleId next = mParticles.nextId();
+    for (const SolidBlock* b : {&mStatic, &mMoving})
+        next = std::max(next, b->block.particles().nextId());
+    const ParticleId ranks = exchange->ranks();
+    next = (next + ranks - 1) / ranks * ranks + exchange->rank();
+    mParticles.setIdSequence(next, ranks);
+    mExchange = exchange;
+}
+
 // Solids ------------------------------------------------------------------------------------------
 
 void GhostSolver::addSolid(const LevelSet& solid, const Vec3& velocity)
@@ -688,6 +723,9 @@ Real GhostSolver::stableTimeStep() const
     for (std::size_t i = 0; i < v.size(); ++i) {
         if (mParticles.kinds()[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
     }
+    // Every process takes the same step: the fastest liquid of them all (between steps a
+    // process holds no halo copies).
+    if (mExchange) vmax = Real(mExchange->maxOf(double(vmax)));
     const Real h = mSettings.spacing;
     if (mSettings.pressure == PressureModel::Dfsph) {
         // The implicit pressure has no sound speed to resolve: dt <= cfl h / |v|max

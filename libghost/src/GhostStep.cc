@@ -75,11 +75,17 @@ void GhostSolver::searchNeighbors()
     const auto& kind = mParticles.kinds();
     mQueryMask.resize(n);
     mLiquidMask.resize(n);
+    // Halo copies (other processes' particles) are neighbours, never queries.
+    const Real* halo = haloFlags();
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
+        const bool own = !halo || halo[i] == Real(0);
+        // Halo liquid searches the solid blocks too: a ghost solid's nearest liquid particle
+        // (lines 5-7) may be across the cut.
         mLiquidMask[i] = kind[i] == ParticleKind::Liquid;
-        mQueryMask[i] = mLiquidMask[i] || kind[i] == ParticleKind::GhostAir;
+        mQueryMask[i] =
+            own && (kind[i] == ParticleKind::Liquid || kind[i] == ParticleKind::GhostAir);
         },
         4096);
     const Real R = mSettings.supportRadius();
@@ -105,6 +111,7 @@ void GhostSolver::computeDensity()
     // Ghost SPH also finds each solid particle's nearest liquid particle (lines 5-7).
     std::vector<std::uint32_t> neighbours(n, 0);
     std::mutex touchedMutex;
+    const Real* halo = haloFlags();
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
@@ -112,6 +119,20 @@ void GhostSolver::computeDensity()
         for (std::size_t i = lo; i < hi; ++i) {
             if (kind[i] != ParticleKind::Liquid) {
                 rho[i] = rho0;
+                continue;
+            }
+            if (halo && halo[i] != Real(0)) {
+                // A halo copy: its density comes from its owner (refresh below); it only
+                // offers itself as the nearest liquid particle of the solid particles it sees.
+                for (int k = 0; k < 2; ++k) {
+                    SolidBlock& block = *blocks[k];
+                    const Vec3* xs = block.block.particles().positions().data();
+                    for (Index j : block.lists[i]) {
+                        const Real r = (x[i] - xs[j]).length();
+                        if (atomicMin(&block.nearest[j], nearestKey(r, Index(i))))
+                            firstTouch[k].push_back(j);
+                    }
+                }
                 continue;
             }
             const Vec3 xi = x[i];
@@ -152,8 +173,9 @@ void GhostSolver::computeDensity()
         }
         },
         512);
-    const double liquidCount = parallel::sum(
-        0, n, [&](std::size_t i) { return kind[i] == ParticleKind::Liquid ? 1.0 : 0.0; });
+    const double liquidCount = parallel::sum(0, n, [&](std::size_t i) {
+        return kind[i] == ParticleKind::Liquid && !(halo && halo[i] != Real(0)) ? 1.0 : 0.0;
+    });
     const double pairs = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); });
     mRun.meanNeighbors = pairs / std::max(1.0, liquidCount);
     mPairCount = std::size_t(pairs);
@@ -162,6 +184,11 @@ void GhostSolver::computeDensity()
     auto& p = mParticles.pressures();
     parallel::forEach(
         0, n, [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, mSettings.stiffness); }, 2048);
+    if (mExchange) {
+        const auto t = std::chrono::steady_clock::now();
+        mExchange->refresh(mParticles, {"density", "pressure"});
+        mTimings.exchange += secondsSince(t);
+    }
 
     // Lines 5-7: a ghost solid takes the density (and so the pressure) of its nearest liquid
     // particle. The order of `touched` depends on the threads; nothing below depends on it.
@@ -291,6 +318,11 @@ void GhostSolver::searchAndDensity()
     // sampled after the search (reusing it) with weight 0, so it has no part in this step's sums.
     prepareSolidBlocks();
     fadeAir();
+    if (mExchange) {
+        const auto t = std::chrono::steady_clock::now();
+        mExchange->exchange(mParticles, mSettings.supportRadius());
+        mTimings.exchange += secondsSince(t);
+    }
 
     auto t0 = std::chrono::steady_clock::now();
     searchNeighbors();
@@ -327,12 +359,13 @@ void GhostSolver::stepGhost(Real dt)
     // Particle shifting needs grad C = sum_j (m_j / rho0) grad W_ij over the same pairs.
     const bool shifting = mSettings.shifting() > Real(0);
     std::vector<Vec3> gradMass(shifting ? n : 0, Vec3(0));
+    const Real* halo = haloFlags();
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) {
-                vstar[i] = v[i];
+            if (kind[i] != ParticleKind::Liquid || (halo && halo[i] != Real(0))) {
+                vstar[i] = v[i]; // a halo copy's comes from its owner (refresh)
                 continue;
             }
             const Vec3 xi = x[i];
@@ -368,6 +401,12 @@ void GhostSolver::stepGhost(Real dt)
         512);
     mRun.maxAcceleration = *std::max_element(accel.begin(), accel.end());
     mTimings.pressureForce += secondsSince(t0);
+    if (mExchange) {
+        const auto t = std::chrono::steady_clock::now();
+        mRun.maxAcceleration = Real(mExchange->maxOf(double(mRun.maxAcceleration)));
+        mExchange->refresh(mParticles, {VSTAR});
+        mTimings.exchange += secondsSince(t);
+    }
     finishGhostStep(dt, gradMass);
 }
 
@@ -391,10 +430,13 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
     // eps m_j / rho_j of each neighbour is computed once (zero for air).
     // The wall drag is a rate (GhostSettings::solidEpsilonForStep), scaled by this step's dt
     // against the reference step at the liquid's largest speed.
+    const Real* halo = haloFlags();
+    auto owned = [halo](std::size_t i) { return !halo || halo[i] == Real(0); };
     Real vmax = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        if (kind[i] == ParticleKind::Liquid) vmax = std::max(vmax, v[i].length());
+        if (kind[i] == ParticleKind::Liquid && owned(i)) vmax = std::max(vmax, v[i].length());
     }
+    if (mExchange) vmax = Real(mExchange->maxOf(double(vmax)));
     const Real eps = mSettings.xsphEpsilonPerStep();
     const Real epsSolid = mSettings.solidEpsilonForStep(dt, vmax);
     parallel::forEach(
@@ -407,7 +449,7 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) continue;
+            if (kind[i] != ParticleKind::Liquid || !owned(i)) continue;
             const Vec3 xi = x[i], vi = vstar[i];
             // The particle itself adds w W(0) (v_i - v_i) = 0.
             Vec3 dv(0);
@@ -430,6 +472,13 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
         },
         512);
 
+    // Halo liquid's new velocities, for the air near the cut that takes one of them.
+    if (mExchange) {
+        const auto t = std::chrono::steady_clock::now();
+        mExchange->refresh(mParticles, {"velocity"});
+        mTimings.exchange += secondsSince(t);
+    }
+
     // Lines 22-25: air takes the new velocity of its nearest liquid particle (searched up to two
     // kernel radii: air advects between resamplings and may drift a little).
     // The nearest liquid entry of the air particle's list (within R), else a search to 2R.
@@ -439,7 +488,7 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
     parallel::forEach(
         0, std::min(n, listed),
         [&](std::size_t i) {
-        if (kind[i] != ParticleKind::GhostAir) return;
+        if (kind[i] != ParticleKind::GhostAir || !owned(i)) return;
         Index j = INVALID_INDEX;
         Real best2 = R * R;
         for (Index k : mFluidLists[i]) {
@@ -474,7 +523,7 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
             // drop outside the air layer) has no even spacing to move towards: not shifted.
             // Liquid inside an emitter keeps the emitter's packing: the volume rate is set by
             // how the emitter fills its shape.
-            if (kind[i] != ParticleKind::Liquid || rho[i] < completeDensity) return;
+            if (kind[i] != ParticleKind::Liquid || rho[i] < completeDensity || !owned(i)) return;
             for (const auto& em : mEmitters) {
                 if (em->shape.bounds().contains(x[i]) && em->shape.phi(x[i]) < Real(0)) return;
             }
@@ -525,6 +574,7 @@ void GhostSolver::step(Real dt)
     mRun.time = t1;
     ++mRun.step;
     projectOutOfSolids(dt);
+    if (mExchange) mExchange->dropHalo(mParticles);
     applyKillBox();
     checkBlowUp();
     mTimings.total += secondsSince(start);
@@ -561,8 +611,9 @@ void GhostSolver::projectOutOfSolids(Real dt)
     // by dt v, so it started at x - dt v.
     std::atomic<std::size_t> stuck{mParticles.size()};
     std::atomic<std::uint64_t> restored{0};
+    const Real* halo = haloFlags();
     parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Liquid) return;
+        if (kind[i] != ParticleKind::Liquid || (halo && halo[i] != Real(0))) return;
         const bool near = all || i >= listed || !mStatic.lists[i].empty()
                           || !mMoving.lists[i].empty()
                           || dt * (v[i].length() + solidSpeed) >= margin;
@@ -614,6 +665,14 @@ void GhostSolver::checkBlowUp() const
         },
         4096);
     const std::size_t i = bad.load();
+    // Over several processes every one must stop together (a process that throws alone would
+    // leave the others waiting in the next exchange).
+    if (mExchange && mExchange->maxOf(i == n ? 0.0 : 1.0) > 0 && i == n) {
+        throw NumericalError(msg("liquid solver blew up at frame ", mRun.frame, ", step ",
+                                 mRun.step, " (t = ", mRun.time,
+                                 " s) on another process (its own message says where); reduce "
+                                 "the time step (substeps / cflNumber) or the stiffness"));
+    }
     if (i == n) return;
     const char* kind = kindName(mParticles.kinds()[i]);
     if (!isFinite(x[i]) || !isFinite(v[i])) {

@@ -110,7 +110,10 @@ void ParticleSet::appendDefaults(std::size_t count)
     mDensities.resize(n, Real(0));
     mPressures.resize(n, Real(0));
     mKinds.resize(n, ParticleKind::Liquid);
-    for (std::size_t k = 0; k < count; ++k) mIds.push_back(mNextId++);
+    for (std::size_t k = 0; k < count; ++k) {
+        mIds.push_back(mNextId);
+        mNextId += mIdStride;
+    }
     for (auto& [name, ch] : mScalars) ch.data.resize(n, ch.defaultValue);
     for (auto& [name, ch] : mVectors) ch.data.resize(n, ch.defaultValue);
 }
@@ -203,7 +206,9 @@ void ParticleSet::append(const ParticleSet& other)
         if (it != other.mVectors.end()) cat(ch.data, it->second.data);
         else ch.data.resize(n + m, ch.defaultValue);
     }
-    mNextId = std::max(mNextId, other.mNextId);
+    // The larger counter, kept on this set's own sequence (setIdSequence).
+    if (other.mNextId > mNextId)
+        mNextId += (other.mNextId - mNextId + mIdStride - 1) / mIdStride * mIdStride;
 }
 
 ParticleSet ParticleSet::select(const std::vector<std::uint8_t>& keep) const
@@ -244,6 +249,15 @@ void ParticleSet::setNextId(ParticleId next)
                              maxId, ")"));
     }
     mNextId = next;
+}
+
+void ParticleSet::setIdSequence(ParticleId next, ParticleId stride)
+{
+    if (stride < 1) {
+        throw ValueError(msg("ParticleSet::setIdSequence: stride ", stride, ": expected >= 1"));
+    }
+    setNextId(next);
+    mIdStride = stride;
 }
 
 std::vector<Real>& ParticleSet::addScalarChannel(const std::string& name, Real value)

@@ -120,6 +120,35 @@ TEST(ParticleSet, AddAndAddBatchAssignConsecutiveIds)
     }
 }
 
+TEST(ParticleSet, IdSequenceWithAStrideKeepsProcessesApart)
+{
+    // Three processes of one simulation: each takes ids congruent to its rank modulo 3 above
+    // the shared ones, so what they add never collides, appends included.
+    std::vector<ParticleSet> sets(3);
+    for (int r = 0; r < 3; ++r) {
+        sets[std::size_t(r)].addBatch(std::vector<Vec3>(5, Vec3(0)), 1, ParticleKind::Liquid);
+        sets[std::size_t(r)].setIdSequence(6 + r, 3);
+        sets[std::size_t(r)].addBatch(std::vector<Vec3>(4, Vec3(0)), 1, ParticleKind::GhostAir);
+    }
+    std::vector<ParticleId> fresh;
+    for (int r = 0; r < 3; ++r) {
+        const auto& ids = sets[std::size_t(r)].ids();
+        for (std::size_t k = 5; k < ids.size(); ++k) {
+            EXPECT_EQ(ids[k] % 3, r);
+            fresh.push_back(ids[k]);
+        }
+    }
+    std::sort(fresh.begin(), fresh.end());
+    EXPECT_EQ(std::adjacent_find(fresh.begin(), fresh.end()), fresh.end());
+    // Appending another rank's particles (with a larger counter) keeps this rank's residue.
+    sets[0].append(sets[2]);
+    EXPECT_EQ(sets[0].nextId() % 3, 0);
+    EXPECT_GE(sets[0].nextId(), sets[2].nextId());
+    EXPECT_EQ(sets[0].idStride(), 3);
+    EXPECT_THROW(sets[1].setIdSequence(100, 0), ghostfx::ValueError);
+    EXPECT_THROW(sets[1].setIdSequence(3, 2), ghostfx::ValueError); // below an id in the set
+}
+
 TEST(ParticleSet, NamedChannelsGetTheirDefaultForNewParticles)
 {
     ParticleSet set;

@@ -41,6 +41,7 @@
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/NeighborLists.h>
+#include <ghostfx/sph/ParticleExchange.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
@@ -74,6 +75,7 @@ struct PhaseTimings
     double xsphAndBoundary = 0; ///< ghost velocities, XSPH, positions, collisions
     double airResampling = 0;   ///< ghost air sampling
     double emission = 0;        ///< emitter sampling
+    double exchange = 0;        ///< with other processes: migration, halos, reductions
     double total = 0;
     std::uint64_t steps = 0;
 };
@@ -158,6 +160,21 @@ public:
 
     /// Install (or, with an empty function, remove) the observer called after every step.
     void setStepObserver(StepObserver observer);
+
+    /// The first air layer, the mass scaling and the initial relaxation, which the first step
+    /// would otherwise make. Returns false while waiting for an emitter that starts later.
+    bool prepare() { return initialize(); }
+
+    /// Share this simulation with other processes (one MPI rank each): from now on this
+    /// solver owns and computes only the liquid and air in `exchange`'s region, receives halo
+    /// copies of its neighbours' particles every step and agrees with the others on the time
+    /// step and on blow-ups (sph::ParticleExchange). Call it on every process after the same
+    /// set-up and prepare(): the particles outside the region are dropped here, and new
+    /// particles take ids of this process's own sequence. Supported: Ghost SPH with the Tait
+    /// pressure and static solids, without emitters; anything else is refused with a
+    /// ValueError. The exchange must outlive the solver's steps.
+    void setExchange(sph::ParticleExchange* exchange);
+    sph::ParticleExchange* exchange() const { return mExchange; }
 
     /// Everything that decides how the run continues, as a SolverState with solver name
     /// methodName(method): all particles and channels, and
@@ -285,6 +302,11 @@ private:
     void projectOutOfSolids(Real dt);
     void checkBlowUp() const;
     Index nearestLiquid(const Vec3& x, Real maxRadius) const;
+    /// The halo flags of mParticles (HALO_CHANNEL) when shared with other processes, else null.
+    const Real* haloFlags() const
+    {
+        return mExchange ? mParticles.scalarChannel(sph::HALO_CHANNEL).data() : nullptr;
+    }
 
     GhostSettings mSettings;
     sph::CubicSplineKernel mKernel;
@@ -313,6 +335,7 @@ private:
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;
+    sph::ParticleExchange* mExchange = nullptr; ///< other processes of this simulation, if any
     bool mRestored = false;            ///< restoreState() was called: no liquid may be added
     std::size_t mRestoredSolids = 0;   ///< solids whose particles came with the restored state
     std::size_t mRestoredEmitters = 0; ///< emitters the restored run had

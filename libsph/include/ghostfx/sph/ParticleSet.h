@@ -74,6 +74,11 @@ public:
     ParticleId nextId() const { return mNextId; }
     /// Restore the id counter (checkpoint resume). Must exceed every id in the set.
     void setNextId(ParticleId next);
+    /// Hand out ids next, next + stride, next + 2 stride, ...: processes that share one
+    /// simulation each take their own residue modulo the process count, so the ids they give
+    /// new particles never collide. `next` must exceed every id in the set; stride >= 1.
+    void setIdSequence(ParticleId next, ParticleId stride);
+    ParticleId idStride() const { return mIdStride; }
 
     // Built-in channels ----------------------------------------------------------------------
     std::vector<Vec3>& positions() { return mPositions; } ///< x (m)
@@ -149,6 +154,7 @@ private:
     std::map<std::string, ScalarChannel> mScalars;
     std::map<std::string, VectorChannel> mVectors;
     ParticleId mNextId = 0;
+    ParticleId mIdStride = 1;
 };
 
 } // namespace sph

@@ -1,0 +1,92 @@
+/// @file   MpiExchange.h
+/// @brief  sph::ParticleExchange over MPI: one simulation spread over the ranks of a
+///         communicator, each owning the particles of one part of a DomainDecomposition.
+/// @details Every exchange is one MPI_Alltoall of byte counts and one MPI_Alltoallv of the
+///          bytes (only neighbouring parts send anything). Particles travel with every channel
+///          of their set (built-in, scalar and vector, by name), so a solver's own channels
+///          (air weights, v*) migrate with them. Halo copies are refreshed by id: the owner
+///          sends the values of the ids it sent at the last exchange, in the same order, and
+///          the receiver finds its copies of those ids; ids are unique across the ranks
+///          (GhostSolver::setExchange gives each rank its own id sequence).
+///          Rebalancing: when the owned counts' imbalance (largest over mean) passes
+///          `rebalanceAbove`, rebalance() (called by exchange()) rebuilds the decomposition from
+///          every rank's owned particles (gathered to all ranks: the cuts are then the same
+///          everywhere) and migrates accordingly.
+#pragma once
+
+#include <ghostfx/sph/DomainDecomposition.h>
+#include <ghostfx/sph/ParticleExchange.h>
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace ghostfx {
+namespace dist {
+
+/// MPI_Init on construction (unless already initialised), MPI_Finalize on destruction if
+/// this object initialised it. One per program, made before any other MPI use.
+class MpiSession
+{
+public:
+    MpiSession(int* argc, char*** argv);
+    ~MpiSession();
+    MpiSession(const MpiSession&) = delete;
+    MpiSession& operator=(const MpiSession&) = delete;
+    int rank() const;
+    int ranks() const;
+
+private:
+    bool mOwner = false;
+};
+
+/// Whether this program was started by an MPI launcher with more than one process (mpirun,
+/// srun): the environment says so before MPI_Init.
+int launcherRankCount();
+
+class MpiExchange : public sph::ParticleExchange
+{
+public:
+    /// Parts for the ranks of `comm`: `scheme` over `points` (the same on every rank).
+    MpiExchange(MPI_Comm comm, const std::vector<sph::Vec3>& points,
+                sph::DecompositionScheme scheme = sph::DecompositionScheme::Slabs);
+
+    int rank() const override { return mRank; }
+    int ranks() const override { return mRanks; }
+    bool owns(const sph::Vec3& x) const override { return mParts.owner(x) == mRank; }
+    void exchange(sph::ParticleSet& set, sph::Real width) override;
+    void refresh(sph::ParticleSet& set, const std::vector<std::string>& channels) override;
+    void dropHalo(sph::ParticleSet& set) override;
+    double maxOf(double value) override;
+    double minOf(double value) override;
+    double sumOf(double value) override;
+
+    const sph::DomainDecomposition& decomposition() const { return mParts; }
+    /// Rebuild the parts when the owned counts' largest over mean passes this (default
+    /// DomainDecomposition::REBALANCE_IMBALANCE; infinity: never).
+    void setRebalanceThreshold(double imbalance) { mRebalanceAbove = imbalance; }
+    std::uint64_t rebalances() const { return mRebalances; }
+    /// Particles migrated to other ranks and halo copies received, over all exchanges so far.
+    std::uint64_t migrated() const { return mMigrated; }
+    std::uint64_t haloReceived() const { return mHaloReceived; }
+
+private:
+    /// Send bytes[q] to every rank q, return what every rank sent here, by source rank.
+    std::vector<std::vector<char>> allToAll(const std::vector<std::vector<char>>& bytes) const;
+    void migrate(sph::ParticleSet& set);
+    void rebalanceIfNeeded(sph::ParticleSet& set);
+
+    MPI_Comm mComm;
+    int mRank = 0, mRanks = 1;
+    sph::DomainDecomposition mParts;
+    sph::DecompositionScheme mScheme;
+    double mRebalanceAbove = sph::DomainDecomposition::REBALANCE_IMBALANCE;
+    std::vector<std::vector<sph::ParticleId>> mSent;     ///< ids sent as halo, per rank
+    std::vector<std::vector<sph::ParticleId>> mReceived; ///< halo ids received, per rank
+    std::uint64_t mRebalances = 0, mMigrated = 0, mHaloReceived = 0;
+};
+
+} // namespace dist
+} // namespace ghostfx

@@ -1,0 +1,426 @@
+/// @file   MpiExchange.cc
+/// @brief  Particle migration, halo copies and reductions over MPI (see the header).
+#include "ghostfx/dist/MpiExchange.h"
+
+#include <ghostfx/sph/Exceptions.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <unordered_map>
+
+namespace ghostfx {
+namespace dist {
+
+using namespace sph;
+
+namespace {
+
+void check(int code, const char* what)
+{
+    if (code != MPI_SUCCESS) {
+        char text[MPI_MAX_ERROR_STRING];
+        int length = 0;
+        MPI_Error_string(code, text, &length);
+        throw Error(msg("MPI: ", what, " failed: ", std::string(text, std::size_t(length))));
+    }
+}
+
+// Byte packing of particle rows ----------------------------------------------------------------
+
+class Writer
+{
+public:
+    explicit Writer(std::vector<char>& out) : mOut(out) {}
+    template <typename T>
+    void put(const T& value)
+    {
+        const std::size_t at = mOut.size();
+        mOut.resize(at + sizeof(T));
+        std::memcpy(mOut.data() + at, &value, sizeof(T));
+    }
+    void put(const std::string& s)
+    {
+        put(std::uint32_t(s.size()));
+        mOut.insert(mOut.end(), s.begin(), s.end());
+    }
+
+private:
+    std::vector<char>& mOut;
+};
+
+class Reader
+{
+public:
+    explicit Reader(const std::vector<char>& in) : mIn(in) {}
+    template <typename T>
+    T get()
+    {
+        if (mAt + sizeof(T) > mIn.size()) throw Error("MPI exchange: message ends early");
+        T value;
+        std::memcpy(&value, mIn.data() + mAt, sizeof(T));
+        mAt += sizeof(T);
+        return value;
+    }
+    std::string getString()
+    {
+        const std::uint32_t n = get<std::uint32_t>();
+        if (mAt + n > mIn.size()) throw Error("MPI exchange: message ends early");
+        std::string s(mIn.data() + mAt, n);
+        mAt += n;
+        return s;
+    }
+    bool done() const { return mAt == mIn.size(); }
+
+private:
+    const std::vector<char>& mIn;
+    std::size_t mAt = 0;
+};
+
+/// Rows of `set` with every channel, by name, so the receiver needs no agreement on layout.
+void packRows(const ParticleSet& set, const std::vector<Index>& rows, std::vector<char>& out)
+{
+    Writer w(out);
+    w.put(std::uint64_t(rows.size()));
+    for (Index i : rows) {
+        w.put(set.positions()[i]);
+        w.put(set.velocities()[i]);
+        w.put(set.masses()[i]);
+        w.put(set.densities()[i]);
+        w.put(set.pressures()[i]);
+        w.put(std::uint8_t(set.kinds()[i]));
+        w.put(set.ids()[i]);
+    }
+    const std::vector<std::string> scalars = set.scalarChannelNames();
+    w.put(std::uint32_t(scalars.size()));
+    for (const std::string& name : scalars) {
+        w.put(name);
+        const auto& data = set.scalarChannel(name);
+        for (Index i : rows) w.put(data[i]);
+    }
+    const std::vector<std::string> vectors = set.vectorChannelNames();
+    w.put(std::uint32_t(vectors.size()));
+    for (const std::string& name : vectors) {
+        w.put(name);
+        const auto& data = set.vectorChannel(name);
+        for (Index i : rows) w.put(data[i]);
+    }
+}
+
+/// The rows of one message as a particle set (ids as sent).
+ParticleSet unpackRows(const std::vector<char>& in)
+{
+    ParticleSet out;
+    if (in.empty()) return out;
+    Reader r(in);
+    const std::size_t n = std::size_t(r.get<std::uint64_t>());
+    std::vector<Vec3> x(n), v(n);
+    std::vector<Real> m(n), rho(n), p(n);
+    std::vector<ParticleKind> kind(n);
+    std::vector<ParticleId> id(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        x[k] = r.get<Vec3>();
+        v[k] = r.get<Vec3>();
+        m[k] = r.get<Real>();
+        rho[k] = r.get<Real>();
+        p[k] = r.get<Real>();
+        kind[k] = ParticleKind(r.get<std::uint8_t>());
+        id[k] = r.get<ParticleId>();
+    }
+    out.addBatch(x, Real(0), ParticleKind::Liquid);
+    out.velocities() = v;
+    out.masses() = m;
+    out.densities() = rho;
+    out.pressures() = p;
+    out.kinds() = kind;
+    out.ids() = id;
+    const std::uint32_t scalars = r.get<std::uint32_t>();
+    for (std::uint32_t c = 0; c < scalars; ++c) {
+        auto& data = out.addScalarChannel(r.getString());
+        for (std::size_t k = 0; k < n; ++k) data[k] = r.get<Real>();
+    }
+    const std::uint32_t vectors = r.get<std::uint32_t>();
+    for (std::uint32_t c = 0; c < vectors; ++c) {
+        auto& data = out.addVectorChannel(r.getString());
+        for (std::size_t k = 0; k < n; ++k) data[k] = r.get<Vec3>();
+    }
+    if (!r.done()) throw Error("MPI exchange: message longer than its particles");
+    return out;
+}
+
+/// A channel's values as Reals: 1 per particle (scalars) or 3 (vectors).
+struct ChannelView
+{
+    Real* scalar = nullptr;
+    Vec3* vector = nullptr;
+};
+
+ChannelView view(ParticleSet& set, const std::string& name)
+{
+    if (name == "velocity") return {nullptr, set.velocities().data()};
+    if (name == "density") return {set.densities().data(), nullptr};
+    if (name == "pressure") return {set.pressures().data(), nullptr};
+    if (name == "mass") return {set.masses().data(), nullptr};
+    if (set.hasScalarChannel(name)) return {set.scalarChannel(name).data(), nullptr};
+    if (set.hasVectorChannel(name)) return {nullptr, set.vectorChannel(name).data()};
+    throw ValueError(msg("MPI exchange: refresh of '", name, "': no such channel"));
+}
+
+} // namespace
+
+// Session --------------------------------------------------------------------------------------
+
+MpiSession::MpiSession(int* argc, char*** argv)
+{
+    int ready = 0;
+    MPI_Initialized(&ready);
+    if (!ready) {
+        check(MPI_Init(argc, argv), "MPI_Init");
+        mOwner = true;
+    }
+    // Errors come back as codes (thrown as ghostfx errors), not as aborts.
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+}
+
+MpiSession::~MpiSession()
+{
+    if (mOwner) MPI_Finalize();
+}
+
+int MpiSession::rank() const
+{
+    int r = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &r);
+    return r;
+}
+
+int MpiSession::ranks() const
+{
+    int n = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &n);
+    return n;
+}
+
+int launcherRankCount()
+{
+    // Open MPI's mpirun, then the PMI launchers (MPICH's mpiexec, srun --mpi=pmi2).
+    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
+        if (const char* value = std::getenv(name)) {
+            const int n = std::atoi(value);
+            if (n > 0) return n;
+        }
+    }
+    return 1;
+}
+
+// Exchange -------------------------------------------------------------------------------------
+
+MpiExchange::MpiExchange(MPI_Comm comm, const std::vector<Vec3>& points, DecompositionScheme scheme)
+    : mComm(comm)
+    , mScheme(scheme)
+{
+    check(MPI_Comm_rank(comm, &mRank), "MPI_Comm_rank");
+    check(MPI_Comm_size(comm, &mRanks), "MPI_Comm_size");
+    mParts = DomainDecomposition::balanced(points, mRanks, scheme);
+    mSent.resize(static_cast<std::size_t>(mRanks));
+    mReceived.resize(static_cast<std::size_t>(mRanks));
+}
+
+std::vector<std::vector<char>> MpiExchange::allToAll(
+    const std::vector<std::vector<char>>& bytes) const
+{
+    const std::size_t n = std::size_t(mRanks);
+    std::vector<long long> sendCounts(n), receiveCounts(n);
+    for (std::size_t q = 0; q < n; ++q) sendCounts[q] = (long long)bytes[q].size();
+    check(MPI_Alltoall(sendCounts.data(), 1, MPI_LONG_LONG, receiveCounts.data(), 1, MPI_LONG_LONG,
+                       mComm),
+          "MPI_Alltoall (counts)");
+    std::vector<int> sc(n), sd(n), rc(n), rd(n);
+    std::vector<char> send, receive;
+    long long sendTotal = 0, receiveTotal = 0;
+    for (std::size_t q = 0; q < n; ++q) {
+        sd[q] = int(sendTotal);
+        rd[q] = int(receiveTotal);
+        sc[q] = int(sendCounts[q]);
+        rc[q] = int(receiveCounts[q]);
+        sendTotal += sendCounts[q];
+        receiveTotal += receiveCounts[q];
+    }
+    if (sendTotal > std::numeric_limits<int>::max()
+        || receiveTotal > std::numeric_limits<int>::max())
+        throw Error("MPI exchange: more than 2 GB in one exchange (use more ranks)");
+    send.reserve(std::size_t(sendTotal));
+    for (const auto& b : bytes) send.insert(send.end(), b.begin(), b.end());
+    receive.resize(std::size_t(receiveTotal));
+    check(MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_BYTE, receive.data(), rc.data(),
+                        rd.data(), MPI_BYTE, mComm),
+          "MPI_Alltoallv");
+    std::vector<std::vector<char>> out(n);
+    for (std::size_t q = 0; q < n; ++q)
+        out[q].assign(receive.begin() + rd[q], receive.begin() + rd[q] + rc[q]);
+    return out;
+}
+
+void MpiExchange::dropHalo(ParticleSet& set)
+{
+    if (!set.hasScalarChannel(HALO_CHANNEL)) return;
+    const auto& halo = set.scalarChannel(HALO_CHANNEL);
+    std::vector<std::uint8_t> remove(set.size(), 0);
+    bool any = false;
+    for (std::size_t i = 0; i < remove.size(); ++i) any |= (remove[i] = halo[i] != Real(0)) != 0;
+    if (any) set.removeIf(remove);
+}
+
+void MpiExchange::migrate(ParticleSet& set)
+{
+    std::vector<std::vector<Index>> rows(static_cast<std::size_t>(mRanks));
+    std::vector<std::uint8_t> leaving(set.size(), 0);
+    for (std::size_t i = 0; i < set.size(); ++i) {
+        const int owner = mParts.owner(set.positions()[i]);
+        if (owner == mRank) continue;
+        rows[std::size_t(owner)].push_back(Index(i));
+        leaving[i] = 1;
+    }
+    std::vector<std::vector<char>> bytes(static_cast<std::size_t>(mRanks));
+    for (int q = 0; q < mRanks; ++q) {
+        if (!rows[std::size_t(q)].empty())
+            packRows(set, rows[std::size_t(q)], bytes[std::size_t(q)]);
+        mMigrated += rows[std::size_t(q)].size();
+    }
+    set.removeIf(leaving);
+    for (const auto& message : allToAll(bytes)) {
+        if (!message.empty()) set.append(unpackRows(message));
+    }
+}
+
+void MpiExchange::rebalanceIfNeeded(ParticleSet& set)
+{
+    const double owned = double(set.size());
+    const double largest = maxOf(owned), total = sumOf(owned);
+    if (!(total > 0) || largest * mRanks / total <= mRebalanceAbove) return;
+    // Every rank's positions to every rank, then the same cuts everywhere.
+    const int n = int(set.size() * 3);
+    std::vector<int> counts(static_cast<std::size_t>(mRanks)), displs(counts.size());
+    check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, mComm), "MPI_Allgather");
+    int sum = 0;
+    for (int q = 0; q < mRanks; ++q) {
+        displs[std::size_t(q)] = sum;
+        sum += counts[std::size_t(q)];
+    }
+    std::vector<Real> mine(static_cast<std::size_t>(n)), all(static_cast<std::size_t>(sum));
+    for (std::size_t i = 0; i < set.size(); ++i)
+        for (int a = 0; a < 3; ++a) mine[3 * i + std::size_t(a)] = set.positions()[i][a];
+    const MPI_Datatype real = sizeof(Real) == sizeof(double) ? MPI_DOUBLE : MPI_FLOAT;
+    check(
+        MPI_Allgatherv(mine.data(), n, real, all.data(), counts.data(), displs.data(), real, mComm),
+        "MPI_Allgatherv");
+    std::vector<Vec3> points(all.size() / 3);
+    for (std::size_t k = 0; k < points.size(); ++k)
+        points[k] = Vec3(all[3 * k], all[3 * k + 1], all[3 * k + 2]);
+    mParts = DomainDecomposition::balanced(points, mRanks, mScheme);
+    ++mRebalances;
+}
+
+void MpiExchange::exchange(ParticleSet& set, Real width)
+{
+    dropHalo(set);
+    if (!set.hasScalarChannel(HALO_CHANNEL)) set.addScalarChannel(HALO_CHANNEL, Real(0));
+    rebalanceIfNeeded(set);
+    migrate(set);
+
+    // Halo copies: this rank's particles within `width` of another rank's region.
+    std::vector<std::vector<Index>> rows(static_cast<std::size_t>(mRanks));
+    for (auto& ids : mSent) ids.clear();
+    for (std::size_t i = 0; i < set.size(); ++i) {
+        mParts.forEachHaloPart(set.positions()[i], width, [&](int q) {
+            rows[std::size_t(q)].push_back(Index(i));
+            mSent[std::size_t(q)].push_back(set.ids()[i]);
+        });
+    }
+    std::vector<std::vector<char>> bytes(static_cast<std::size_t>(mRanks));
+    for (int q = 0; q < mRanks; ++q) {
+        if (!rows[std::size_t(q)].empty())
+            packRows(set, rows[std::size_t(q)], bytes[std::size_t(q)]);
+    }
+    const std::vector<std::vector<char>> received = allToAll(bytes);
+    for (int q = 0; q < mRanks; ++q) {
+        auto& ids = mReceived[std::size_t(q)];
+        ids.clear();
+        if (received[std::size_t(q)].empty()) continue;
+        ParticleSet copies = unpackRows(received[std::size_t(q)]);
+        auto& flag = copies.addScalarChannel(HALO_CHANNEL);
+        std::fill(flag.begin(), flag.end(), Real(1));
+        ids = copies.ids();
+        mHaloReceived += copies.size();
+        set.append(copies);
+    }
+}
+
+void MpiExchange::refresh(ParticleSet& set, const std::vector<std::string>& channels)
+{
+    const auto& halo = set.scalarChannel(HALO_CHANNEL);
+    std::unordered_map<ParticleId, Index> own, copy;
+    for (std::size_t i = 0; i < set.size(); ++i)
+        (halo[i] != Real(0) ? copy : own)[set.ids()[i]] = Index(i);
+    std::vector<ChannelView> views;
+    for (const std::string& name : channels) views.push_back(view(set, name));
+
+    std::vector<std::vector<char>> bytes(static_cast<std::size_t>(mRanks));
+    for (int q = 0; q < mRanks; ++q) {
+        Writer w(bytes[std::size_t(q)]);
+        for (ParticleId id : mSent[std::size_t(q)]) {
+            const auto it = own.find(id);
+            if (it == own.end())
+                throw Error(msg("MPI exchange: particle id ", id, " sent to rank ", q,
+                                " is gone from rank ", mRank, " before its refresh"));
+            for (const ChannelView& c : views) {
+                if (c.scalar) w.put(c.scalar[it->second]);
+                else w.put(c.vector[it->second]);
+            }
+        }
+    }
+    const std::vector<std::vector<char>> received = allToAll(bytes);
+    for (int q = 0; q < mRanks; ++q) {
+        if (mReceived[std::size_t(q)].empty()) continue;
+        Reader r(received[std::size_t(q)]);
+        for (ParticleId id : mReceived[std::size_t(q)]) {
+            const auto it = copy.find(id);
+            // A copy this rank removed since (the kill box) still has its values in the message.
+            for (const ChannelView& c : views) {
+                if (c.scalar) {
+                    const Real value = r.get<Real>();
+                    if (it != copy.end()) c.scalar[it->second] = value;
+                } else {
+                    const Vec3 value = r.get<Vec3>();
+                    if (it != copy.end()) c.vector[it->second] = value;
+                }
+            }
+        }
+        if (!r.done()) throw Error("MPI exchange: refresh message longer than its copies");
+    }
+}
+
+double MpiExchange::maxOf(double value)
+{
+    double out = value;
+    check(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MAX, mComm), "MPI_Allreduce (max)");
+    return out;
+}
+
+double MpiExchange::minOf(double value)
+{
+    double out = value;
+    check(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MIN, mComm), "MPI_Allreduce (min)");
+    return out;
+}
+
+double MpiExchange::sumOf(double value)
+{
+    double out = value;
+    check(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_SUM, mComm), "MPI_Allreduce (sum)");
+    return out;
+}
+
+} // namespace dist
+} // namespace ghostfx
