@@ -145,11 +145,13 @@ public:
 
     std::string counts() const override
     {
-        return msg(mSolver->count(ParticleKind::Liquid), " liquid, ",
-                   mSolver->count(ParticleKind::GhostAir), " air, ",
-                   mSolver->count(ParticleKind::GhostSolid)
-                       + mSolver->count(ParticleKind::Boundary),
-                   " solid ghosts");
+        const sph::ParticleExchange* shared = mSolver->exchange();
+        return msg(
+            mSolver->count(ParticleKind::Liquid), " liquid, ",
+            mSolver->count(ParticleKind::GhostAir), " air, ",
+            mSolver->count(ParticleKind::GhostSolid) + mSolver->count(ParticleKind::Boundary),
+            " solid ghosts",
+            shared ? msg(" on process ", shared->rank(), " of ", shared->ranks()) : std::string());
     }
     std::size_t particleCount() const override { return liquidParticleCount(*mSolver); }
     std::size_t memoryBytes() const override { return mSolver->memoryBytes(); }
@@ -157,6 +159,24 @@ public:
     std::vector<OutputMedium> media() const override { return {liquidMedium(*mSolver)}; }
 
     std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
+
+    std::vector<Vec3> prepareToShare() override
+    {
+        if (!mSolver->prepare()) {
+            throw SceneError(msg("scene '", mScene.file,
+                                 "': no liquid at the start (an emitter starting later): not "
+                                 "supported on several processes yet"));
+        }
+        return mSolver->particles().positions();
+    }
+    void share(sph::ParticleExchange& exchange) override
+    {
+        try {
+            mSolver->setExchange(&exchange);
+        } catch (const ValueError& e) {
+            throw SceneError(msg("scene '", mScene.file, "': ", e.what()));
+        }
+    }
 
 private:
     const vdbio::Scene& mScene;

@@ -2,6 +2,7 @@
 /// @brief  `ghostfx run`: scene -> solver -> frames, checkpoints, statistics and previews.
 #include "RunCommand.h"
 
+#include "DistributedRun.h"
 #include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "Simulation.h"
@@ -360,10 +361,12 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
     vdbio::renderScenePreview(layers, pv, framed, inFolder(out.previewFile), previewCache);
 }
 
-int runScene(const RunOptions& o)
+/// The run; `distributed` is null for a single process (else rank 0 writes, DistributedRun.h).
+int runSceneWith(const RunOptions& o, DistributedRun* distributed)
 {
     const auto runStart = Clock::now();
     parallel::ThreadLimit threadLimit(o.threads);
+    const bool writes = !distributed || distributed->root();
 
     // Scene, settings and outputs: every input error is found before any simulation.
     vdbio::Scene scene = vdbio::readScene(o.scene, o.defines);
@@ -386,7 +389,16 @@ int runScene(const RunOptions& o)
         sim = makeSimulation(scene);
     }
     checkSolidSequences(scene, sim->frame() + 1, last);
-    vdbio::ensureWritableDirectory(folder);
+    if (distributed) {
+        if (!o.resume.empty()) {
+            throw SceneError(msg("scene '", scene.file,
+                                 "': --resume on several processes is not supported yet (the "
+                                 "checkpoint holds one process's particles): resume as one "
+                                 "process"));
+        }
+        distributed->share(*sim);
+    }
+    if (writes) vdbio::ensureWritableDirectory(folder);
     auto inFolder = [&](const std::string& pattern, int frame) {
         return pattern.empty()
                    ? std::string()
@@ -395,7 +407,7 @@ int runScene(const RunOptions& o)
     const int startFrame = sim->frame();
 
     Progress::Mode mode = Progress::Mode::Log;
-    if (o.quiet || o.progress == "none") mode = Progress::Mode::None;
+    if (o.quiet || o.progress == "none" || !writes) mode = Progress::Mode::None;
     else if (o.progress == "bar" || (o.progress == "auto" && ::isatty(STDERR_FILENO)))
         mode = Progress::Mode::Bar;
     Progress progress(mode, std::max(first, startFrame + 1), last);
@@ -412,12 +424,14 @@ int runScene(const RunOptions& o)
                   scene.forceFields.size() == 1 ? " attractor" : " attractors"),
         ", spacing ", scene.spacing, " m, frames ", std::max(first, startFrame + 1), "-", last,
         (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"), ", ",
-        parallel::maxThreads(), " threads, output in '", folder, "'"));
+        parallel::maxThreads(), " threads",
+        distributed ? msg(" on each of ", distributed->ranks(), " processes") : std::string(),
+        ", output in '", folder, "'"));
     // A fixed step far beyond the stability limit blows up within a few steps, after a frame
     // or more of output: say so before the first step, with both numbers.
     if (const double fixed = sim->fixedTimeStep(); fixed > 0) {
         const double limit = sim->stabilityLimit();
-        if (fixed > limit) {
+        if (fixed > limit && writes) {
             const int substeps = int(std::lround(1.0 / (fixed * scene.frameRate)));
             std::fprintf(stderr, "%s\n",
                          msg("ghostfx: warning: scene '", scene.file, "': the fixed step ", fixed,
@@ -435,7 +449,7 @@ int runScene(const RunOptions& o)
     if (const double depth = sim->boundaryLayerDepth(); depth > 0) {
         for (const vdbio::SceneSolid& solid : scene.solids) {
             const double thin = solid.shape.fractionThinnerThan(sph::Real(depth));
-            if (thin < 0.01) continue;
+            if (thin < 0.01 || !writes) continue;
             std::fprintf(stderr, "%s\n",
                          msg("ghostfx: warning: scene '", scene.file, "': solid '", solid.name,
                              "' is thinner than the kernel support ", depth, " m over ",
@@ -446,15 +460,18 @@ int runScene(const RunOptions& o)
                              .c_str());
         }
     }
-    const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0;
+    const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0 && !distributed;
     if (!out.checkpointFile.empty() && !checkpoints) {
-        progress.message("note: boiling scenes write no checkpoints yet (the phase transition's "
-                         "state is not saved)");
+        progress.message(distributed ? "note: no checkpoints on several processes yet"
+                                     : "note: boiling scenes write no checkpoints yet (the "
+                                       "phase transition's state is not saved)");
     }
 
     // Statistics.
     std::unique_ptr<vdbio::StatsWriter> stats;
-    if (!out.statsFile.empty()) {
+    if (!out.statsFile.empty() && distributed) {
+        progress.message("note: no statistics file on several processes yet");
+    } else if (!out.statsFile.empty()) {
         const std::string h5 = inFolder(out.statsFile, 0);
         const std::string csv = (fs::path(h5).replace_extension(".csv")).string();
         stats = std::make_unique<vdbio::StatsWriter>(h5, csv);
@@ -488,9 +505,16 @@ int runScene(const RunOptions& o)
         sim->advanceFrame();
 
         const bool write = frame >= first;
-        if (write) writer.submit(snapshotFrame(out, *sim, frame));
+        if (write && distributed) {
+            FrameSnapshot snapshot = distributed->snapshot(out, *sim, frame);
+            if (writes) writer.submit(std::move(snapshot));
+        } else if (write) {
+            writer.submit(snapshotFrame(out, *sim, frame));
+        }
         if (stats) stats->flush();
-        const bool interrupted = gInterrupted.load();
+        // Every process stops at the same frame, whichever saw the interrupt.
+        const bool interrupted =
+            distributed ? distributed->any(gInterrupted.load()) : gInterrupted.load();
         std::string checkpoint;
         if (interrupted || frame == last
             || (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
@@ -511,6 +535,12 @@ int runScene(const RunOptions& o)
     writer.finish();
     const double total = seconds(runStart, Clock::now());
     const std::uint64_t steps = sim->stepCount() - stepsAtStart;
+    if (distributed) {
+        const std::string counts = distributed->counts(*sim);
+        progress.message(msg("done: ", steps, " steps in ", duration(total), " (",
+                             total > 0 ? double(steps) / total : 0.0, " steps/s), ", counts));
+        return 0;
+    }
     progress.message(
         msg("done: ", steps, " steps in ", duration(total), " (",
             total > 0 ? double(steps) / total : 0.0, " steps/s), ", sim->particleCount(),
@@ -518,6 +548,22 @@ int runScene(const RunOptions& o)
             sim->particleCount() ? double(sim->memoryBytes()) / double(sim->particleCount()) : 0.0,
             " bytes per particle"));
     return 0;
+}
+
+int runScene(const RunOptions& o)
+{
+    // Under mpirun: one simulation over the processes.
+    const std::unique_ptr<DistributedRun> distributed = DistributedRun::startIfLaunched();
+    if (!distributed) return runSceneWith(o, nullptr);
+    try {
+        return runSceneWith(o, distributed.get());
+    } catch (const std::exception& e) {
+        // An error on one process would leave the others waiting for it: say it, stop all.
+        std::fprintf(stderr, "ghostfx: error: process %d of %d: %s\n", distributed->rank(),
+                     distributed->ranks(), e.what());
+        abortDistributedRun(1);
+        throw;
+    }
 }
 
 Command addRunCommand(CLI::App& parent)

@@ -35,6 +35,18 @@ FieldStats fieldStats(const sph::ParticleSet& p, ParticleKind kind, double rho0,
     return s;
 }
 
+std::vector<sph::Vec3> Simulation::prepareToShare()
+{
+    throw SceneError("only liquid scenes (method ghost) run on several processes yet; run this "
+                     "scene as one process");
+}
+
+void Simulation::share(sph::ParticleExchange& /*exchange*/)
+{
+    throw SceneError("only liquid scenes (method ghost) run on several processes yet; run this "
+                     "scene as one process");
+}
+
 void Simulation::setSolidMotion(std::size_t /*index*/, sph::RigidMotion /*motion*/)
 {
     throw ValueError("changing a solid's motion during a run is supported in liquid scenes only");

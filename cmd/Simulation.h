@@ -6,6 +6,7 @@
 ///          Sec. 4 phase transition). Only the solvers a scene needs are created.
 #pragma once
 
+#include <ghostfx/sph/ParticleExchange.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
@@ -79,6 +80,14 @@ public:
     virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity);
     /// Before simulating towards `frame`: per-frame inputs (deforming solid sequences).
     virtual void beforeFrame(int /*frame*/) {}
+
+    /// One simulation over several processes (`mpirun -np N ghostfx run`): every process
+    /// builds the same simulation, then prepareToShare() makes its first state (the same
+    /// everywhere) and returns the positions the domain is cut by; share() keeps this process's
+    /// part and exchanges with the others from then on. Liquid (Ghost SPH) scenes only; the
+    /// others refuse with a SceneError.
+    virtual std::vector<sph::Vec3> prepareToShare();
+    virtual void share(sph::ParticleExchange& exchange);
 };
 
 /// Build the simulation a scene asks for, fresh or continuing from `restored` states (as saved

@@ -401,6 +401,44 @@ void MpiExchange::refresh(ParticleSet& set, const std::vector<std::string>& chan
     }
 }
 
+ParticleSet MpiExchange::gather(const ParticleSet& set, const std::vector<ParticleKind>& kinds,
+                                int root) const
+{
+    const std::vector<Real>* halo =
+        set.hasScalarChannel(HALO_CHANNEL) ? &set.scalarChannel(HALO_CHANNEL) : nullptr;
+    std::vector<Index> rows;
+    for (std::size_t i = 0; i < set.size(); ++i) {
+        if (halo && (*halo)[i] != Real(0)) continue;
+        if (std::find(kinds.begin(), kinds.end(), set.kinds()[i]) != kinds.end())
+            rows.push_back(Index(i));
+    }
+    std::vector<char> bytes;
+    packRows(set, rows, bytes);
+    const int n = int(bytes.size());
+    std::vector<int> counts(static_cast<std::size_t>(mRanks)), displs(counts.size());
+    check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, root, mComm), "MPI_Gather");
+    long long total = 0;
+    for (std::size_t q = 0; q < counts.size(); ++q) {
+        displs[q] = int(total);
+        total += counts[q];
+    }
+    if (total > std::numeric_limits<int>::max())
+        throw Error("MPI gather: more than 2 GB of particles for one rank");
+    std::vector<char> all(mRank == root ? std::size_t(total) : 0);
+    check(MPI_Gatherv(bytes.data(), n, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE,
+                      root, mComm),
+          "MPI_Gatherv");
+    ParticleSet out;
+    if (mRank != root) return out;
+    for (std::size_t q = 0; q < counts.size(); ++q) {
+        const std::vector<char> part(all.begin() + displs[q], all.begin() + displs[q] + counts[q]);
+        ParticleSet rowsOf = unpackRows(part);
+        if (rowsOf.hasScalarChannel(HALO_CHANNEL)) rowsOf.removeChannel(HALO_CHANNEL);
+        out.append(rowsOf);
+    }
+    return out;
+}
+
 double MpiExchange::maxOf(double value)
 {
     double out = value;

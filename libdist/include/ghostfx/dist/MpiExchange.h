@@ -63,6 +63,11 @@ public:
     double minOf(double value) override;
     double sumOf(double value) override;
 
+    /// The particles of `set` whose kind is in `kinds` (halo copies excluded), from every rank,
+    /// on rank `root` (rank order, each rank's in its own order); an empty set elsewhere.
+    sph::ParticleSet gather(const sph::ParticleSet& set,
+                            const std::vector<sph::ParticleKind>& kinds, int root = 0) const;
+
     const sph::DomainDecomposition& decomposition() const { return mParts; }
     /// Rebuild the parts when the owned counts' largest over mean passes this (default
     /// DomainDecomposition::REBALANCE_IMBALANCE; infinity: never).

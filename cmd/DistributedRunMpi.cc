@@ -1,0 +1,91 @@
+/// @file   DistributedRunMpi.cc
+/// @brief  DistributedRun over MPI (built with GHOSTFX_MPI).
+#include "DistributedRun.h"
+
+#include <ghostfx/dist/MpiExchange.h>
+#include <ghostfx/sph/Exceptions.h>
+
+#include <atomic>
+
+namespace ghostfx {
+namespace cmd {
+
+namespace {
+
+std::atomic<bool> gActive{false};
+
+class MpiRun : public DistributedRun
+{
+public:
+    MpiRun() : mSession(nullptr, nullptr) { gActive = true; }
+    ~MpiRun() override { gActive = false; }
+
+    int rank() const override { return mSession.rank(); }
+    int ranks() const override { return mSession.ranks(); }
+
+    void share(Simulation& sim) override
+    {
+        const std::vector<sph::Vec3> points = sim.prepareToShare();
+        mExchange = std::make_unique<dist::MpiExchange>(MPI_COMM_WORLD, points);
+        sim.share(*mExchange);
+    }
+
+    FrameSnapshot snapshot(const vdbio::SceneOutputs& /*outputs*/, const Simulation& sim,
+                           int frame) override
+    {
+        FrameSnapshot s;
+        s.frame = frame;
+        s.time = sim.time();
+        for (OutputMedium m : sim.media()) {
+            auto all = std::make_shared<sph::ParticleSet>(mExchange->gather(*m.particles, m.kinds));
+            if (!root()) continue;
+            s.particles.push_back(all);
+            m.particles = all.get();
+            m.withGhosts = nullptr; // the ghosts stay with their processes
+            s.media.push_back(std::move(m));
+        }
+        return s;
+    }
+
+    std::string counts(const Simulation& sim) override
+    {
+        double liquid = 0, air = 0;
+        for (const OutputMedium& m : sim.media()) {
+            const auto& kinds = m.particles->kinds();
+            const auto* halo = m.particles->hasScalarChannel(sph::HALO_CHANNEL)
+                                   ? &m.particles->scalarChannel(sph::HALO_CHANNEL)
+                                   : nullptr;
+            for (std::size_t i = 0; i < kinds.size(); ++i) {
+                if (halo && (*halo)[i] != sph::Real(0)) continue;
+                liquid += kinds[i] == sph::ParticleKind::Liquid;
+                air += kinds[i] == sph::ParticleKind::GhostAir;
+            }
+        }
+        return msg(std::size_t(mExchange->sumOf(liquid)), " liquid, ",
+                   std::size_t(mExchange->sumOf(air)), " air on ", ranks(), " processes (",
+                   mExchange->migrated(), " particles migrated and ", mExchange->rebalances(),
+                   " rebalances seen by this one)");
+    }
+
+    bool any(bool yes) override { return mExchange->maxOf(yes ? 1.0 : 0.0) > 0; }
+
+private:
+    dist::MpiSession mSession;
+    std::unique_ptr<dist::MpiExchange> mExchange;
+};
+
+} // namespace
+
+std::unique_ptr<DistributedRun> DistributedRun::startIfLaunched()
+{
+    if (dist::launcherRankCount() <= 1) return nullptr;
+    return std::make_unique<MpiRun>();
+}
+
+void abortDistributedRun(int code)
+{
+    if (gActive) MPI_Abort(MPI_COMM_WORLD, code);
+}
+
+} // namespace cmd
+} // namespace ghostfx
