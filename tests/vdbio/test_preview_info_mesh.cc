@@ -324,7 +324,7 @@ Rendered renderAndRead(const openvdb::FloatGrid& grid, const fs::path& file, con
     vdbio::PreviewOptions options;
     options.width = IMAGE_W;
     options.height = IMAGE_H;
-    Rendered r{vdbio::renderPreview(grid, options, file.string()), {}};
+    Rendered r{vdbio::renderPreview(grid, options, file.string()), {}, nullptr, Vec3d(0)};
     r.image = vdbio::readExrImage(file.string());
     EXPECT_EQ(r.image.width, IMAGE_W);
     EXPECT_EQ(r.image.height, IMAGE_H);
