@@ -1,7 +1,7 @@
 # ghostfx: the two commands of the README.
 #   make demo   install missing Debian packages, configure, build, run the default example
 #   make test   install missing Debian packages, configure, build, run the test suite (ctest)
-# Other targets: build, bench, test-double, test-sanitize, format, clean.
+# Other targets: build, bench, test-double, test-sanitize, test-mpi, format, clean.
 #
 # Variables: BUILD_DIR (default build), JOBS (default: number of cores), CMAKE_ARGS (extra -D...).
 
@@ -11,7 +11,7 @@ CMAKE_ARGS ?=
 GENERATOR  := $(shell command -v ninja >/dev/null 2>&1 && echo Ninja || echo "Unix Makefiles")
 CTEST_ARGS ?=
 
-.PHONY: all deps configure build demo test bench test-double test-sanitize format clean
+.PHONY: all deps configure build demo test bench test-double test-sanitize test-mpi format clean
 
 all: build
 
@@ -48,9 +48,20 @@ test-sanitize:
 	@$(MAKE) --no-print-directory test BUILD_DIR=build-asan \
 	    CMAKE_ARGS="-DGHOSTFX_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGHOSTFX_BUILD_BENCH=OFF $(CMAKE_ARGS)"
 
+# One simulation over MPI processes (docs/distributed.md): Open MPI, a build with GHOSTFX_MPI
+# (the program and the MPI tests only), and the MPI tests under mpirun.
+test-mpi:
+	@./scripts/install-deps.sh --mpi
+	@cmake -S . -B build-mpi -G "$(GENERATOR)" -DGHOSTFX_MPI=ON -DGHOSTFX_PYTHON=OFF \
+	    -DGHOSTFX_BUILD_BENCH=OFF -DGHOSTFX_BUILD_EXAMPLES=OFF $(CMAKE_ARGS) \
+	    > build-mpi.configure.log 2>&1 || (cat build-mpi.configure.log; exit 1)
+	@cmake --build build-mpi --parallel $(JOBS) \
+	    --target ghostfx ghostfx_mpi_tests ghostfx_compare_points ghostfx_sph_tests
+	@cd build-mpi && ctest --output-on-failure -R "^mpi\\.|DomainDecomposition|ParticleSet" $(CTEST_ARGS)
+
 # The house style (.clang-format, from STYLE.md) over every tracked C++ file.
 format:
 	@git ls-files '*.h' '*.cc' | xargs clang-format -i
 
 clean:
-	rm -rf build build-double build-asan build*.configure.log
+	rm -rf build build-double build-asan build-mpi build*.configure.log

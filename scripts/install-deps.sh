@@ -14,6 +14,11 @@ packages=(
     python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
 )
 
+# `install-deps.sh --mpi`: also what one simulation over MPI processes needs (-DGHOSTFX_MPI=ON).
+if [ "${1:-}" = "--mpi" ]; then
+    packages+=(libopenmpi-dev openmpi-bin)
+fi
+
 missing=()
 for p in "${packages[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
