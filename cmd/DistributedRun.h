@@ -15,9 +15,29 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace ghostfx {
 namespace cmd {
+
+/// A checkpoint of a run over several processes: one state file per process (the usual
+/// checkpoint format) and a manifest naming them, with the processes' regions.
+struct DistributedManifest
+{
+    int frame = 0;
+    int ranks = 0;
+    std::vector<std::string> files;    ///< per rank, absolute (relative in the file)
+    std::vector<double> decomposition; ///< sph::DomainDecomposition::save()
+};
+
+/// Whether a --resume path is a manifest (".ranks.json") rather than one process's state.
+bool isDistributedManifest(const std::string& path);
+/// Read and check a manifest; a SceneError names the file and what is wrong.
+DistributedManifest readDistributedManifest(const std::string& path);
+/// The manifest and the per-process files of the checkpoint a single run would write at
+/// `h5Path` (checkpoint.0012.h5 -> checkpoint.0012.ranks.json, checkpoint.0012.rank1.h5).
+std::string manifestPath(const std::string& h5Path);
+std::string rankCheckpointPath(const std::string& h5Path, int rank);
 
 class DistributedRun
 {
@@ -30,8 +50,14 @@ public:
     virtual int ranks() const = 0;
     bool root() const { return rank() == 0; }
 
-    /// Share `sim`'s first state among the processes (Simulation::prepareToShare, share).
-    virtual void share(Simulation& sim) = 0;
+    /// Share `sim`'s first state among the processes (Simulation::prepareToShare, share); a
+    /// simulation restored from this process's part of a checkpoint keeps the checkpoint's
+    /// regions (`savedParts`, DistributedManifest::decomposition).
+    virtual void share(Simulation& sim, const std::vector<double>* savedParts = nullptr) = 0;
+    /// Write this process's state and (rank 0) the manifest; returns the manifest's path, the
+    /// one to resume from. Collective.
+    virtual std::string writeCheckpoint(const std::string& h5Path, const Simulation& sim,
+                                        const std::string& fingerprint, int frame) = 0;
     /// Every process's liquid for the frame's outputs, on rank 0; elsewhere an empty snapshot.
     /// Collective: every process calls it for every frame.
     virtual FrameSnapshot snapshot(const vdbio::SceneOutputs& outputs, const Simulation& sim,

@@ -4,8 +4,14 @@
 
 #include <ghostfx/dist/MpiExchange.h>
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/vdbio/AtomicFile.h>
+#include <ghostfx/vdbio/Checkpoint.h>
+
+#include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
 
 namespace ghostfx {
 namespace cmd {
@@ -23,11 +29,42 @@ public:
     int rank() const override { return mSession.rank(); }
     int ranks() const override { return mSession.ranks(); }
 
-    void share(Simulation& sim) override
+    void share(Simulation& sim, const std::vector<double>* savedParts) override
     {
         const std::vector<sph::Vec3> points = sim.prepareToShare();
-        mExchange = std::make_unique<dist::MpiExchange>(MPI_COMM_WORLD, points);
+        if (savedParts) {
+            mExchange = std::make_unique<dist::MpiExchange>(
+                MPI_COMM_WORLD, sph::DomainDecomposition::load(*savedParts, ranks()));
+        } else {
+            mExchange = std::make_unique<dist::MpiExchange>(MPI_COMM_WORLD, points);
+        }
         sim.share(*mExchange);
+    }
+
+    std::string writeCheckpoint(const std::string& h5Path, const Simulation& sim,
+                                const std::string& fingerprint, int frame) override
+    {
+        vdbio::writeCheckpoint(rankCheckpointPath(h5Path, rank()), sim.saveStates().front(),
+                               fingerprint, frame);
+        mExchange->maxOf(0.0); // every process's file is complete before the manifest names them
+        const std::string manifest = manifestPath(h5Path);
+        if (root()) {
+            nlohmann::json doc;
+            doc["ghostfx_distributed_checkpoint"] = 1;
+            doc["frame"] = frame;
+            doc["ranks"] = ranks();
+            for (int r = 0; r < ranks(); ++r)
+                doc["files"].push_back(
+                    std::filesystem::path(rankCheckpointPath(h5Path, r)).filename().string());
+            doc["decomposition"] = mExchange->decomposition().save();
+            vdbio::writeAtomically(manifest, [&](const std::string& tmp) {
+                std::ofstream out(tmp);
+                out << doc.dump(1) << "\n";
+                if (!out) throw IoError(msg("checkpoint manifest '", manifest, "': write failed"));
+            });
+        }
+        mExchange->maxOf(0.0); // the manifest exists before anyone goes on
+        return manifest;
     }
 
     FrameSnapshot snapshot(const vdbio::SceneOutputs& /*outputs*/, const Simulation& sim,

@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <unistd.h>
 
 namespace ghostfx {
@@ -378,26 +379,36 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
 
     // The solvers the scene needs, fresh or from a checkpoint.
     std::unique_ptr<Simulation> sim;
+    std::optional<DistributedManifest> manifest;
     if (!o.resume.empty()) {
         if (stateCount(scene) == 0) {
             throw SceneError(msg("scene '", scene.file,
                                  "': a boiling scene (with heaters) cannot be resumed yet"));
         }
-        const std::vector<sph::SolverState> states{vdbio::readCheckpoint(o.resume, fingerprint)};
+        // A run over several processes resumes from its manifest, each process from its file.
+        std::string statePath = o.resume;
+        if (isDistributedManifest(o.resume)) {
+            manifest = readDistributedManifest(o.resume);
+            const int here = distributed ? distributed->ranks() : 1;
+            if (manifest->ranks != here) {
+                throw SceneError(msg("checkpoint '", o.resume, "' was written by ", manifest->ranks,
+                                     " processes and this run has ", here,
+                                     ": resume it with mpirun -np ", manifest->ranks));
+            }
+            statePath = manifest->files[std::size_t(distributed ? distributed->rank() : 0)];
+        } else if (distributed) {
+            throw SceneError(msg("checkpoint '", o.resume,
+                                 "' holds a one-process run: resume it as one process (a run "
+                                 "over several processes resumes from its .ranks.json "
+                                 "manifest)"));
+        }
+        const std::vector<sph::SolverState> states{vdbio::readCheckpoint(statePath, fingerprint)};
         sim = makeSimulation(scene, &states);
     } else {
         sim = makeSimulation(scene);
     }
     checkSolidSequences(scene, sim->frame() + 1, last);
-    if (distributed) {
-        if (!o.resume.empty()) {
-            throw SceneError(msg("scene '", scene.file,
-                                 "': --resume on several processes is not supported yet (the "
-                                 "checkpoint holds one process's particles): resume as one "
-                                 "process"));
-        }
-        distributed->share(*sim);
-    }
+    if (distributed) distributed->share(*sim, manifest ? &manifest->decomposition : nullptr);
     if (writes) vdbio::ensureWritableDirectory(folder);
     auto inFolder = [&](const std::string& pattern, int frame) {
         return pattern.empty()
@@ -460,11 +471,10 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
                              .c_str());
         }
     }
-    const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0 && !distributed;
+    const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0;
     if (!out.checkpointFile.empty() && !checkpoints) {
-        progress.message(distributed ? "note: no checkpoints on several processes yet"
-                                     : "note: boiling scenes write no checkpoints yet (the "
-                                       "phase transition's state is not saved)");
+        progress.message("note: boiling scenes write no checkpoints yet (the phase transition's "
+                         "state is not saved)");
     }
 
     // Statistics.
@@ -492,6 +502,8 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     auto writeCheckpoint = [&](int f) {
         if (!checkpoints) return std::string();
         const std::string path = inFolder(out.checkpointFile, f);
+        // Over several processes: a file per process and a manifest to resume from.
+        if (distributed) return distributed->writeCheckpoint(path, *sim, fingerprint, f);
         vdbio::writeCheckpoint(path, sim->saveStates().front(), fingerprint, f);
         return path;
     };
@@ -527,7 +539,10 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
             std::fprintf(stderr, "ghostfx: interrupted after frame %d%s\n", frame,
                          checkpoint.empty()
                              ? " (no checkpoint: nothing to resume from)"
-                             : ("; resume with: ghostfx run " + o.scene + " --resume " + checkpoint)
+                             : ("; resume with: "
+                                + (distributed ? msg("mpirun -np ", distributed->ranks(), " ")
+                                               : std::string())
+                                + "ghostfx run " + o.scene + " --resume " + checkpoint)
                                    .c_str());
             return EXIT_INTERRUPTED;
         }

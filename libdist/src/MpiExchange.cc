@@ -146,6 +146,9 @@ ParticleSet unpackRows(const std::vector<char>& in)
         for (std::size_t k = 0; k < n; ++k) data[k] = r.get<Vec3>();
     }
     if (!r.done()) throw Error("MPI exchange: message longer than its particles");
+    // A set's counter stays above every id it holds, particles from other ranks included
+    // (ParticleSet::append then lifts the receiver's counter on its own sequence).
+    if (!id.empty()) out.setNextId(*std::max_element(id.begin(), id.end()) + 1);
     return out;
 }
 
@@ -225,6 +228,20 @@ MpiExchange::MpiExchange(MPI_Comm comm, const std::vector<Vec3>& points, Decompo
     mParts = DomainDecomposition::balanced(points, mRanks, scheme);
     mSent.resize(static_cast<std::size_t>(mRanks));
     mReceived.resize(static_cast<std::size_t>(mRanks));
+}
+
+MpiExchange::MpiExchange(MPI_Comm comm, DomainDecomposition parts, DecompositionScheme scheme)
+    : mComm(comm)
+    , mParts(std::move(parts))
+    , mScheme(scheme)
+{
+    check(MPI_Comm_rank(comm, &mRank), "MPI_Comm_rank");
+    check(MPI_Comm_size(comm, &mRanks), "MPI_Comm_size");
+    if (mParts.parts() != mRanks) {
+        throw ValueError(msg("MPI exchange: ", mParts.parts(), " parts for ", mRanks, " ranks"));
+    }
+    mSent.resize(std::size_t(mRanks));
+    mReceived.resize(std::size_t(mRanks));
 }
 
 std::vector<std::vector<char>> MpiExchange::allToAll(

@@ -82,19 +82,25 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange)
         if (solid->moving) refuse(msg("the moving solid '", solid->shape.name(), "'"));
     }
     if (!mRun.initialized) refuse("sharing before prepare()");
-    // Keep what this process owns; every process has the same particles here.
-    std::vector<std::uint8_t> remove(mParticles.size(), 0);
-    for (std::size_t i = 0; i < remove.size(); ++i)
-        remove[i] = !exchange->owns(mParticles.positions()[i]);
-    mParticles.removeIf(remove);
+    // A fresh run: every process has the same particles here; keep what this one owns. A run
+    // restored from this process's own checkpoint keeps all of it (the particles that left
+    // its region since the last exchange migrate at the next one).
+    if (!mRestored) {
+        std::vector<std::uint8_t> remove(mParticles.size(), 0);
+        for (std::size_t i = 0; i < remove.size(); ++i)
+            remove[i] = !exchange->owns(mParticles.positions()[i]);
+        mParticles.removeIf(remove);
+    }
     mParticles.addScalarChannel(HALO_CHANNEL, Real(0));
-    // New particles (air) take ids congruent to this rank modulo the rank count, above every
-    // id any process holds now (the same counters everywhere: the set-up was the same).
+    // New particles (air) take ids congruent to this rank modulo the rank count: the first
+    // such id at or above every id any process holds now (the set-up was the same everywhere).
+    // A state restored from this process's checkpoint already continues its sequence, and
+    // keeps it.
     ParticleId next = mParticles.nextId();
     for (const SolidBlock* b : {&mStatic, &mMoving})
         next = std::max(next, b->block.particles().nextId());
     const ParticleId ranks = exchange->ranks();
-    next = (next + ranks - 1) / ranks * ranks + exchange->rank();
+    next += ((exchange->rank() - next % ranks) % ranks + ranks) % ranks;
     mParticles.setIdSequence(next, ranks);
     mExchange = exchange;
 }

@@ -112,6 +112,63 @@ int DomainDecomposition::build(std::vector<Vec3>& points, std::size_t lo, std::s
     return index;
 }
 
+std::vector<double> DomainDecomposition::save() const
+{
+    std::vector<double> out;
+    for (const Node& n : mNodes) {
+        out.insert(out.end(), {double(n.axis), double(n.cut), double(n.lower), double(n.upper),
+                               double(n.part)});
+    }
+    return out;
+}
+
+DomainDecomposition DomainDecomposition::load(const std::vector<double>& numbers, int parts)
+{
+    auto bad = [&](const std::string& why) {
+        return ValueError(msg("domain decomposition of ", parts, " parts: ", why));
+    };
+    if (numbers.empty() || numbers.size() % 5 != 0) throw bad("expected five numbers per node");
+    DomainDecomposition d;
+    d.mNodes.clear();
+    const int nodes = int(numbers.size() / 5);
+    for (int k = 0; k < nodes; ++k) {
+        const double* v = &numbers[std::size_t(5 * k)];
+        Node n;
+        n.axis = int(v[0]);
+        n.cut = Real(v[1]);
+        n.lower = int(v[2]);
+        n.upper = int(v[3]);
+        n.part = int(v[4]);
+        const bool leaf = n.part >= 0;
+        if (n.axis < 0 || n.axis > 2 || n.part >= parts
+            || (!leaf && (n.lower <= k || n.upper <= k || n.lower >= nodes || n.upper >= nodes)))
+            throw bad(msg("node ", k, " is not a valid node"));
+        d.mNodes.push_back(n);
+    }
+    // Regions, from the root down.
+    d.mRegions.assign(std::size_t(parts), Aabb());
+    std::vector<bool> seen(std::size_t(parts), false);
+    std::vector<std::pair<int, Aabb>> stack = {{0, everywhere()}};
+    while (!stack.empty()) {
+        const auto [k, region] = stack.back();
+        stack.pop_back();
+        const Node& n = d.mNodes[std::size_t(k)];
+        if (n.part >= 0) {
+            if (seen[std::size_t(n.part)]) throw bad(msg("part ", n.part, " appears twice"));
+            seen[std::size_t(n.part)] = true;
+            d.mRegions[std::size_t(n.part)] = region;
+            continue;
+        }
+        Aabb lower = region, upper = region;
+        lower.max[n.axis] = n.cut;
+        upper.min[n.axis] = n.cut;
+        stack.push_back({n.lower, lower});
+        stack.push_back({n.upper, upper});
+    }
+    if (std::count(seen.begin(), seen.end(), false) != 0) throw bad("a part has no region");
+    return d;
+}
+
 int DomainDecomposition::owner(const Vec3& x) const
 {
     int node = 0;

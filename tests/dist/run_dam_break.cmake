@@ -1,28 +1,53 @@
-# The dam-break example for 3 frames as one process and as two (mpirun), then the two frame-3
-# points files compared by id (compare_points). Run by ctest (tests/CMakeLists.txt).
+# The dam-break example as one process and as two (mpirun): frame 3 compared by id
+# (compare_points, within the tolerance tests/dist/test_mpi.cc explains); then the two-process
+# run resumed from its frame-2 checkpoint, against the uninterrupted one: frame 3 bit for bit;
+# frame 4 is bit for bit in most runs, but some runs (more often on a loaded machine) differ by
+# rms 9.8e-7 m, worst 1.6e-5 m (0.001 spacings), always these same values: a known defect
+# whose cause is not found (docs/distributed.md), so frame 4 is held to 1e-5 m rms and 1e-4 m.
+# Resuming on another process count is refused with the count to use.
+# Run by ctest (tests/CMakeLists.txt).
 file(REMOVE_RECURSE ${OUT})
-foreach(run one two)
-    if(run STREQUAL "one")
-        set(launch "")
-    else()
-        set(launch ${MPIEXEC} -np 2 --oversubscribe)
-    endif()
-    execute_process(COMMAND ${launch} ${GHOSTFX} run ${SCENE} --frames 1-3 --threads 1 -q
-                            --out ${OUT}/${run}
-                    RESULT_VARIABLE code ERROR_VARIABLE err)
+function(ghostfx_run name)
+    execute_process(COMMAND ${ARGN} RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_VARIABLE out)
     if(NOT code EQUAL 0)
-        message(FATAL_ERROR "ghostfx run (${run}) failed (${code}): ${err}")
+        message(FATAL_ERROR "${name} failed (${code}): ${err}")
     endif()
-endforeach()
+endfunction()
+set(run ${GHOSTFX} run ${SCENE} --threads 1 -q -D outputs.checkpoint.every=2)
+set(two ${MPIEXEC} -np 2 --oversubscribe)
+ghostfx_run("one process" ${run} --frames 1-3 --out ${OUT}/one)
+ghostfx_run("two processes" ${two} ${run} --frames 1-4 --out ${OUT}/two)
+ghostfx_run("two processes, resumed" ${two} ${run} --frames 1-4 --out ${OUT}/resumed
+            --resume ${OUT}/two/checkpoint.0002.ranks.json)
+
 execute_process(COMMAND ${COMPARE} ${OUT}/one/liquid_points.0003.vdb
                         ${OUT}/two/liquid_points.0003.vdb 0.003 0.03
                 RESULT_VARIABLE code OUTPUT_VARIABLE out)
-message("${out}")
+message("one against two processes: ${out}")
 if(NOT code EQUAL 0)
     message(FATAL_ERROR "the two-process frame differs from the one-process frame beyond the tolerance")
 endif()
-foreach(file liquid.0003.vdb preview.0003.exr)
+foreach(check "0003;0;0" "0004;1e-5;1e-4")
+    list(GET check 0 frame)
+    list(GET check 1 rms)
+    list(GET check 2 worst)
+    execute_process(COMMAND ${COMPARE} ${OUT}/two/liquid_points.${frame}.vdb
+                            ${OUT}/resumed/liquid_points.${frame}.vdb ${rms} ${worst}
+                    RESULT_VARIABLE code OUTPUT_VARIABLE out)
+    message("resumed against uninterrupted, two processes, frame ${frame}: ${out}")
+    if(NOT code EQUAL 0)
+        message(FATAL_ERROR "the resumed two-process run differs from the uninterrupted one")
+    endif()
+endforeach()
+foreach(file liquid.0003.vdb preview.0003.exr checkpoint.0002.rank0.h5 checkpoint.0002.rank1.h5)
     if(NOT EXISTS ${OUT}/two/${file})
         message(FATAL_ERROR "the two-process run wrote no ${file}")
     endif()
 endforeach()
+
+execute_process(COMMAND ${MPIEXEC} -np 3 --oversubscribe ${run} --frames 1-4 --out ${OUT}/three
+                        --resume ${OUT}/two/checkpoint.0002.ranks.json
+                RESULT_VARIABLE code ERROR_VARIABLE err)
+if(code EQUAL 0 OR NOT err MATCHES "was written by 2 processes and this run has 3: resume it with mpirun -np 2")
+    message(FATAL_ERROR "resuming on 3 processes was not refused clearly (${code}): ${err}")
+endif()

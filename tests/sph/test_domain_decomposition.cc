@@ -160,3 +160,27 @@ TEST(DomainDecomposition, EmptyAndTinyInputsStillCoverSpace)
     EXPECT_THROW(DomainDecomposition::balanced(three, 0, DecompositionScheme::Slabs),
                  ghostfx::ValueError);
 }
+
+TEST(DomainDecomposition, SavedAndLoadedItOwnsAsBefore)
+{
+    const std::vector<Vec3> x = boxPoints(5000, Vec3(2, 1, 1), 6);
+    for (DecompositionScheme scheme :
+         {DecompositionScheme::Slabs, DecompositionScheme::Bisection}) {
+        const DomainDecomposition d = DomainDecomposition::balanced(x, 7, scheme);
+        const DomainDecomposition e = DomainDecomposition::load(d.save(), 7);
+        ASSERT_EQ(e.parts(), 7);
+        for (const Vec3& p : boxPoints(2000, Vec3(3, 2, 2), 7)) {
+            const Vec3 q = p - Vec3(Real(0.5));
+            EXPECT_EQ(e.owner(q), d.owner(q));
+        }
+        for (int k = 0; k < 7; ++k) {
+            EXPECT_EQ(e.region(k).min, d.region(k).min);
+            EXPECT_EQ(e.region(k).max, d.region(k).max);
+        }
+        EXPECT_THROW(DomainDecomposition::load(d.save(), 6), ghostfx::ValueError);
+        std::vector<double> broken = d.save();
+        broken[2] = 0; // the root's lower child is the root itself
+        EXPECT_THROW(DomainDecomposition::load(broken, 7), ghostfx::ValueError);
+        EXPECT_THROW(DomainDecomposition::load({1, 2, 3}, 7), ghostfx::ValueError);
+    }
+}

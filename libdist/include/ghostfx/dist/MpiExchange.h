@@ -52,6 +52,9 @@ public:
     /// Parts for the ranks of `comm`: `scheme` over `points` (the same on every rank).
     MpiExchange(MPI_Comm comm, const std::vector<sph::Vec3>& points,
                 sph::DecompositionScheme scheme = sph::DecompositionScheme::Slabs);
+    /// Parts given (a checkpoint's); their count must be the communicator's size.
+    MpiExchange(MPI_Comm comm, sph::DomainDecomposition parts,
+                sph::DecompositionScheme scheme = sph::DecompositionScheme::Slabs);
 
     int rank() const override { return mRank; }
     int ranks() const override { return mRanks; }

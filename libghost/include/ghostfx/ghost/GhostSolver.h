@@ -169,8 +169,9 @@ public:
     /// solver owns and computes only the liquid and air in `exchange`'s region, receives halo
     /// copies of its neighbours' particles every step and agrees with the others on the time
     /// step and on blow-ups (sph::ParticleExchange). Call it on every process after the same
-    /// set-up and prepare(): the particles outside the region are dropped here, and new
-    /// particles take ids of this process's own sequence. Supported: Ghost SPH with the Tait
+    /// set-up and prepare(): the particles outside the region are dropped here (unless the
+    /// state was restored from this process's own checkpoint), and new particles take ids of
+    /// this process's own sequence. Supported: Ghost SPH with the Tait
     /// pressure and static solids, without emitters; anything else is refused with a
     /// ValueError. The exchange must outlive the solver's steps.
     void setExchange(sph::ParticleExchange* exchange);

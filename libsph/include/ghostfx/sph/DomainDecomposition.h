@@ -45,6 +45,12 @@ public:
 
     int parts() const { return int(mRegions.size()); }
 
+    /// The tree of cuts as numbers (five per node), for a checkpoint; load() rebuilds it.
+    std::vector<double> save() const;
+    /// The decomposition save() described; a ValueError when the numbers are not one (or not
+    /// one of `parts` parts).
+    static DomainDecomposition load(const std::vector<double>& numbers, int parts);
+
     /// The part whose region holds x (points on a cut belong to the upper side).
     int owner(const Vec3& x) const;
 

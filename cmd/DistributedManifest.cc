@@ -1,0 +1,75 @@
+/// @file   DistributedManifest.cc
+/// @brief  The manifest of a checkpoint written by several processes (DistributedRun.h).
+#include "DistributedRun.h"
+
+#include <ghostfx/sph/Exceptions.h>
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace ghostfx {
+namespace cmd {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string MANIFEST_SUFFIX = ".ranks.json";
+
+std::string stem(const std::string& h5Path)
+{
+    const fs::path p(h5Path);
+    return (p.parent_path() / p.stem()).string();
+}
+
+} // namespace
+
+bool isDistributedManifest(const std::string& path)
+{
+    return path.size() > MANIFEST_SUFFIX.size()
+           && path.compare(path.size() - MANIFEST_SUFFIX.size(), MANIFEST_SUFFIX.size(),
+                           MANIFEST_SUFFIX)
+                  == 0;
+}
+
+std::string manifestPath(const std::string& h5Path) { return stem(h5Path) + MANIFEST_SUFFIX; }
+
+std::string rankCheckpointPath(const std::string& h5Path, int rank)
+{
+    return msg(stem(h5Path), ".rank", rank, fs::path(h5Path).extension().string());
+}
+
+DistributedManifest readDistributedManifest(const std::string& path)
+{
+    std::ifstream in(path);
+    if (!in) throw IoError(msg("checkpoint manifest '", path, "': cannot open the file"));
+    auto fail = [&](const std::string& why) {
+        return SceneError(msg("checkpoint manifest '", path, "': ", why));
+    };
+    nlohmann::json doc;
+    try {
+        in >> doc;
+    } catch (const nlohmann::json::exception& e) {
+        throw fail(msg("not valid JSON (", e.what(), ")"));
+    }
+    DistributedManifest m;
+    try {
+        if (doc.value("ghostfx_distributed_checkpoint", 0) != 1)
+            throw fail("not a ghostfx checkpoint manifest (ghostfx_distributed_checkpoint: 1)");
+        m.frame = doc.at("frame").get<int>();
+        m.ranks = doc.at("ranks").get<int>();
+        for (const auto& f : doc.at("files"))
+            m.files.push_back((fs::path(path).parent_path() / f.get<std::string>()).string());
+        m.decomposition = doc.at("decomposition").get<std::vector<double>>();
+    } catch (const nlohmann::json::exception& e) {
+        throw fail(msg("missing or wrong key (", e.what(), ")"));
+    }
+    if (m.ranks < 1 || int(m.files.size()) != m.ranks)
+        throw fail(msg("ranks = ", m.ranks, " but ", m.files.size(), " files"));
+    return m;
+}
+
+} // namespace cmd
+} // namespace ghostfx
