@@ -52,10 +52,11 @@ void reportRate(benchmark::State& state, std::size_t particles)
         double(particles) * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-void BM_SampleVolume(benchmark::State& state)
+/// The full pipeline (sampleVolume) with `settings`, its rate and the samples' checksum.
+void samplePipeline(benchmark::State& state, const PoissonSettings& settings)
 {
     parallel::ThreadLimit limit(int(state.range(0)));
-    const PoissonDiskSampler sampler(PoissonSettings::forSpacing(SPACING));
+    const PoissonDiskSampler sampler(settings);
     std::size_t n = 0;
     double hash = 0;
     for (auto _ : state) {
@@ -66,6 +67,11 @@ void BM_SampleVolume(benchmark::State& state)
     }
     reportRate(state, n);
     state.counters["checksum"] = hash;
+}
+
+void BM_SampleVolume(benchmark::State& state)
+{
+    samplePipeline(state, PoissonSettings::forSpacing(SPACING));
 }
 
 /// A ghost-solid band: the same sphere sampled one kernel radius (3h) deep, as a solid's
@@ -73,37 +79,18 @@ void BM_SampleVolume(benchmark::State& state)
 /// surface, so level-set lookups and projections weigh more than in the full volume.
 void BM_SampleSolidBand(benchmark::State& state)
 {
-    parallel::ThreadLimit limit(int(state.range(0)));
     PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
     settings.bandDepth = Real(3) * SPACING;
-    const PoissonDiskSampler sampler(settings);
-    std::size_t n = 0;
-    double hash = 0;
-    for (auto _ : state) {
-        const SampleSet s = sampler.sampleVolume(sphere());
-        n = s.size();
-        hash = checksum(s);
-        benchmark::DoNotOptimize(s.positions.data());
-    }
-    reportRate(state, n);
-    state.counters["checksum"] = hash;
+    samplePipeline(state, settings);
 }
 
 /// The same pipeline with the interior deeper than 2r from a relaxed periodic tile
 /// (PoissonSettings::tiledInterior, scene key settings.tiled_sampling).
 void BM_SampleVolumeTiled(benchmark::State& state)
 {
-    parallel::ThreadLimit limit(int(state.range(0)));
     PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
     settings.tiledInterior = true;
-    const PoissonDiskSampler sampler(settings);
-    std::size_t n = 0;
-    for (auto _ : state) {
-        const SampleSet s = sampler.sampleVolume(sphere());
-        n = s.size();
-        benchmark::DoNotOptimize(s.positions.data());
-    }
-    reportRate(state, n);
+    samplePipeline(state, settings);
 }
 
 void BM_SampleWithoutRelaxation(benchmark::State& state)
