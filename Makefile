@@ -1,6 +1,7 @@
 # ghostfx: the two commands of the README.
 #   make demo   install missing Debian packages, configure, build, run the default example
-#   make test   install missing Debian packages, configure, build, run the test suite (ctest)
+#   make test   install missing Debian packages, configure, build, run the test suite (ctest),
+#               then the MPI tests in a GHOSTFX_MPI build (test-mpi; MPI_TESTS=0 skips them)
 # Other targets: build, bench, test-double, test-sanitize, test-mpi, format, clean.
 #
 # Variables: BUILD_DIR (default build), JOBS (default: number of cores), CMAKE_ARGS (extra -D...).
@@ -10,6 +11,7 @@ JOBS       ?= $(shell nproc)
 CMAKE_ARGS ?=
 GENERATOR  := $(shell command -v ninja >/dev/null 2>&1 && echo Ninja || echo "Unix Makefiles")
 CTEST_ARGS ?=
+MPI_TESTS  ?= 1
 
 .PHONY: all deps configure build demo test bench test-double test-sanitize test-mpi format clean
 
@@ -34,18 +36,21 @@ demo: configure
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure --parallel $(JOBS) $(CTEST_ARGS)
+ifneq ($(MPI_TESTS),0)
+	@$(MAKE) --no-print-directory test-mpi
+endif
 
 bench: build
 	@./scripts/run-bench.sh $(BUILD_DIR)
 
 # The double-precision build must pass the same tests (DESIGN.md, "Math").
 test-double:
-	@$(MAKE) --no-print-directory test BUILD_DIR=build-double \
+	@$(MAKE) --no-print-directory test BUILD_DIR=build-double MPI_TESTS=0 \
 	    CMAKE_ARGS="-DGHOSTFX_DOUBLE=ON -DGHOSTFX_BUILD_BENCH=OFF $(CMAKE_ARGS)"
 
 # AddressSanitizer + UndefinedBehaviorSanitizer, debug-ish optimisation.
 test-sanitize:
-	@$(MAKE) --no-print-directory test BUILD_DIR=build-asan \
+	@$(MAKE) --no-print-directory test BUILD_DIR=build-asan MPI_TESTS=0 \
 	    CMAKE_ARGS="-DGHOSTFX_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGHOSTFX_BUILD_BENCH=OFF $(CMAKE_ARGS)"
 
 # One simulation over MPI processes (docs/distributed.md): Open MPI, a build with GHOSTFX_MPI

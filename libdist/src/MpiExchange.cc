@@ -317,24 +317,7 @@ void MpiExchange::rebalanceIfNeeded(ParticleSet& set)
     const double largest = maxOf(owned), total = sumOf(owned);
     if (!(total > 0) || largest * mRanks / total <= mRebalanceAbove) return;
     // Every rank's positions to every rank, then the same cuts everywhere.
-    const int n = int(set.size() * 3);
-    std::vector<int> counts(static_cast<std::size_t>(mRanks)), displs(counts.size());
-    check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, mComm), "MPI_Allgather");
-    int sum = 0;
-    for (int q = 0; q < mRanks; ++q) {
-        displs[std::size_t(q)] = sum;
-        sum += counts[std::size_t(q)];
-    }
-    std::vector<Real> mine(static_cast<std::size_t>(n)), all(static_cast<std::size_t>(sum));
-    for (std::size_t i = 0; i < set.size(); ++i)
-        for (int a = 0; a < 3; ++a) mine[3 * i + std::size_t(a)] = set.positions()[i][a];
-    const MPI_Datatype real = sizeof(Real) == sizeof(double) ? MPI_DOUBLE : MPI_FLOAT;
-    check(
-        MPI_Allgatherv(mine.data(), n, real, all.data(), counts.data(), displs.data(), real, mComm),
-        "MPI_Allgatherv");
-    std::vector<Vec3> points(all.size() / 3);
-    for (std::size_t k = 0; k < points.size(); ++k)
-        points[k] = Vec3(all[3 * k], all[3 * k + 1], all[3 * k + 2]);
+    const std::vector<Vec3> points = allPositions(set.positions());
     mParts = DomainDecomposition::balanced(points, mRanks, mScheme);
     ++mRebalances;
 }
@@ -453,6 +436,31 @@ ParticleSet MpiExchange::gather(const ParticleSet& set, const std::vector<Partic
         if (rowsOf.hasScalarChannel(HALO_CHANNEL)) rowsOf.removeChannel(HALO_CHANNEL);
         out.append(rowsOf);
     }
+    return out;
+}
+
+std::vector<Vec3> MpiExchange::allPositions(const std::vector<Vec3>& mine)
+{
+    const int n = int(mine.size() * 3);
+    std::vector<int> counts(static_cast<std::size_t>(mRanks)), displs(counts.size());
+    check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, mComm), "MPI_Allgather");
+    long long sum = 0;
+    for (int q = 0; q < mRanks; ++q) {
+        displs[std::size_t(q)] = int(sum);
+        sum += counts[std::size_t(q)];
+    }
+    if (sum > std::numeric_limits<int>::max())
+        throw Error("MPI all-gather: more than 2^31 coordinates");
+    std::vector<Real> flat(static_cast<std::size_t>(n)), all(static_cast<std::size_t>(sum));
+    for (std::size_t i = 0; i < mine.size(); ++i)
+        for (int a = 0; a < 3; ++a) flat[3 * i + std::size_t(a)] = mine[i][a];
+    const MPI_Datatype real = sizeof(Real) == sizeof(double) ? MPI_DOUBLE : MPI_FLOAT;
+    check(
+        MPI_Allgatherv(flat.data(), n, real, all.data(), counts.data(), displs.data(), real, mComm),
+        "MPI_Allgatherv");
+    std::vector<Vec3> out(all.size() / 3);
+    for (std::size_t k = 0; k < out.size(); ++k)
+        out[k] = Vec3(all[3 * k], all[3 * k + 1], all[3 * k + 2]);
     return out;
 }
 

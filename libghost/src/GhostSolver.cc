@@ -72,15 +72,10 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange)
     }
     auto refuse = [](const std::string& what) {
         throw ValueError(msg("liquid solver over several processes: ", what,
-                             " is not supported yet (supported: method ghost, pressure tait, "
-                             "static solids, no emitters)"));
+                             " is not supported yet (supported: method ghost, pressure tait)"));
     };
     if (mSettings.method != Method::Ghost) refuse("method basic");
     if (mSettings.pressure != PressureModel::Tait) refuse("pressure dfsph");
-    if (!mEmitters.empty()) refuse("an emitter");
-    for (const auto& solid : mSolids) {
-        if (solid->moving) refuse(msg("the moving solid '", solid->shape.name(), "'"));
-    }
     if (!mRun.initialized) refuse("sharing before prepare()");
     // A fresh run: every process has the same particles here; keep what this one owns. A run
     // restored from this process's own checkpoint keeps all of it (the particles that left
@@ -99,10 +94,20 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange)
     ParticleId next = mParticles.nextId();
     for (const SolidBlock* b : {&mStatic, &mMoving})
         next = std::max(next, b->block.particles().nextId());
-    const ParticleId ranks = exchange->ranks();
-    next += ((exchange->rank() - next % ranks) % ranks + ranks) % ranks;
-    mParticles.setIdSequence(next, ranks);
     mExchange = exchange;
+    continueIdsFrom(next);
+}
+
+void GhostSolver::continueIdsFrom(ParticleId next)
+{
+    if (!mExchange) {
+        mParticles.setNextId(next);
+        return;
+    }
+    // This rank's sequence: the ids congruent to its rank modulo the rank count.
+    const ParticleId ranks = mExchange->ranks();
+    next += ((mExchange->rank() - next % ranks) % ranks + ranks) % ranks;
+    mParticles.setIdSequence(next, ranks);
 }
 
 // Solids ------------------------------------------------------------------------------------------
@@ -223,13 +228,17 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     }
     // Solid particles take their ids from the same counter as the liquid, so ids stay unique
     // across the sets.
-    set.setNextId(std::max(set.nextId(), mParticles.nextId()));
+    // Over several processes every one samples the same solid: its particles take the same
+    // ids everywhere, above every id any process has given.
+    ParticleId firstId = std::max(set.nextId(), mParticles.nextId());
+    if (mExchange) firstId = ParticleId(mExchange->maxOf(double(firstId)));
+    set.setNextId(firstId);
     std::vector<Vec3> positions(samples.positions);
     for (Vec3& x : positions) x = xf.toWorld(x);
     const ParticleKind kind =
         mSettings.method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary;
     const Index first = set.addBatch(positions, mMass, kind);
-    mParticles.setNextId(set.nextId());
+    continueIdsFrom(set.nextId());
     const Real R = mSettings.supportRadius();
     for (std::size_t k = 0; k < samples.size(); ++k) {
         const Index s =
@@ -417,6 +426,12 @@ void GhostSolver::emit()
                 obstacles.push_back(x);
             }
         }
+        // Over several processes, every one sees the emitter's surroundings whole (so all
+        // sample the same new liquid) and keeps the new particles in its own region.
+        if (mExchange) {
+            seeds = mExchange->allPositions(seeds);
+            obstacles = mExchange->allPositions(obstacles);
+        }
         appendSolidPositionsInBox(near, obstacles);
         std::vector<Vec3> fresh;
         if (seeds.empty()) {
@@ -439,6 +454,11 @@ void GhostSolver::emit()
                 return em.shape.phi(x) < Real(0) && !blockedBySolid(x);
             };
             fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
+        }
+        if (mExchange) {
+            fresh.erase(std::remove_if(fresh.begin(), fresh.end(),
+                                       [&](const Vec3& x) { return !mExchange->owns(x); }),
+                        fresh.end());
         }
         if (fresh.empty()) continue;
         const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);

@@ -253,6 +253,7 @@ struct Difference
 {
     std::size_t liquid = 0, matched = 0;
     double rms = 0, worst = 0, com = 0; ///< m
+    Vec3 worstAt{0};                    ///< where the worst one is (the single process's)
 };
 
 Difference compareLiquid(const std::map<ParticleId, Vec3>& shared, const ParticleSet& alone)
@@ -266,7 +267,10 @@ Difference compareLiquid(const std::map<ParticleId, Vec3>& shared, const Particl
         if (it == shared.end()) continue;
         ++d.matched;
         const double e = double((it->second - alone.positions()[i]).length());
-        d.worst = std::max(d.worst, e);
+        if (e > d.worst) {
+            d.worst = e;
+            d.worstAt = alone.positions()[i];
+        }
         sum2 += e * e;
         for (int k = 0; k < 3; ++k) {
             a[k] += double(it->second[k]);
@@ -362,6 +366,87 @@ TEST(DistributedGhost, DamBreakOnSeveralRanksFollowsOneRank)
     // 0.13 / 0.15 h, worst 0.94 / 0.86 h, centre of mass 0.02 / 0.06 h; bounds 0.3 h, 2 h and
     // 0.1 h.
     EXPECT_LT(perturbed.rms, 1e-5);
+    EXPECT_LT(late.rms, 0.3 * h);
+    EXPECT_LT(late.worst, 2 * h);
+    EXPECT_LT(late.com, 0.1 * h);
+}
+
+TEST(DistributedGhost, MovingAndReshapedSolidsOnSeveralRanksFollowOneRank)
+{
+    // A paddle sliding through a water block in a closed tank, on all ranks together and on
+    // each rank alone with the same time steps; half way the paddle changes shape (a solid
+    // sequence's next frame, thicker on its back), which resamples its ghost particles mid-run.
+    // Solids are whole on every rank: the resampled particles must take the same ids
+    // everywhere, above every liquid and air id any rank has given.
+    const Real h = Real(0.01);
+    GhostSettings settings;
+    settings.spacing = h;
+    settings.seed = 9;
+    settings.substeps = 0;
+    const LevelSet tank =
+        makeLevelSet(ghostfx::testing::closedTankGrid(
+                         Vec3(0), Vec3(Real(0.3), Real(0.2), Real(0.1)), 4 * h, h / 2),
+                     "tank");
+    const LevelSet water = makeLevelSet(
+        makeBoxLevelSet(Vec3(0), Vec3(Real(0.2), Real(0.08), Real(0.1)), h / 2), "water");
+    const LevelSet paddle =
+        makeLevelSet(makeBoxLevelSet(Vec3(Real(0.22), Real(0.02), 0),
+                                     Vec3(Real(0.24), Real(0.15), Real(0.1)), h / 2),
+                     "paddle");
+    const LevelSet thicker =
+        makeLevelSet(makeBoxLevelSet(Vec3(Real(0.22), Real(0.02), 0),
+                                     Vec3(Real(0.25), Real(0.15), Real(0.1)), h / 2),
+                     "paddle");
+    auto build = [&]() {
+        auto solver = std::make_unique<GhostSolver>(settings);
+        solver->addSolid(tank);
+        solver->addSolid(paddle, Vec3(Real(-0.2), 0, 0));
+        solver->addLiquid(water);
+        solver->prepare();
+        return solver;
+    };
+    std::unique_ptr<GhostSolver> shared = build(), alone = build();
+    dist::MpiExchange ex(MPI_COMM_WORLD, shared->particles().positions());
+    shared->setExchange(&ex);
+
+    const int steps = 120;
+    ParticleId highestSolid = 0, highestFluid = 0;
+    for (int s = 1; s <= steps; ++s) {
+        const Real dt = shared->stableTimeStep();
+        shared->step(dt);
+        alone->step(dt);
+        if (s == steps / 2) {
+            shared->setSolidShape(1, thicker);
+            alone->setSolidShape(1, thicker);
+            const ParticleSet all = shared->allParticles();
+            for (std::size_t i = 0; i < all.size(); ++i) {
+                const ParticleId id = all.ids()[i];
+                if (all.kinds()[i] == ParticleKind::GhostSolid)
+                    highestSolid = std::max(highestSolid, id);
+                else highestFluid = std::max(highestFluid, id);
+            }
+        }
+    }
+    // The paddle's new particles: the same ids on every rank, above every liquid and air id
+    // of every rank at that moment.
+    const auto agree = [&](ParticleId id) {
+        return ex.maxOf(double(id)) == double(id) && ex.minOf(double(id)) == double(id);
+    };
+    EXPECT_TRUE(agree(highestSolid));
+    EXPECT_GT(double(highestSolid), ex.maxOf(double(highestFluid)));
+    const Difference late = compareLiquid(liquidOf(shared->particles()), alone->particles());
+    if (worldRank() == 0) {
+        std::printf("[measured] %d ranks, %zu liquid, paddle moved %.3f m: after %d steps rms "
+                    "%.2e m (%.3f h), worst %.2e m at (%.3f %.3f %.3f), centre of mass %.2e m; "
+                    "highest paddle id %lld\n",
+                    worldSize(), late.liquid, 0.2 * shared->time(), steps, late.rms, late.rms / h,
+                    late.worst, late.worstAt[0], late.worstAt[1], late.worstAt[2], late.com,
+                    static_cast<long long>(highestSolid));
+    }
+    EXPECT_EQ(late.matched, late.liquid);
+    EXPECT_EQ(liquidOf(shared->particles()).size(), late.liquid);
+    // As the dam break above: each rank's own ghost air, not round-off; the same bounds.
+    // Measured, 2 / 3 ranks: rms 0.10 / 0.11 h, worst 0.65 / 0.55 h, centre of mass 0.01 h.
     EXPECT_LT(late.rms, 0.3 * h);
     EXPECT_LT(late.worst, 2 * h);
     EXPECT_LT(late.com, 0.1 * h);

@@ -62,6 +62,7 @@ public:
     void exchange(sph::ParticleSet& set, sph::Real width) override;
     void refresh(sph::ParticleSet& set, const std::vector<std::string>& channels) override;
     void dropHalo(sph::ParticleSet& set) override;
+    std::vector<sph::Vec3> allPositions(const std::vector<sph::Vec3>& mine) override;
     double maxOf(double value) override;
     double minOf(double value) override;
     double sumOf(double value) override;

@@ -171,9 +171,11 @@ public:
     /// step and on blow-ups (sph::ParticleExchange). Call it on every process after the same
     /// set-up and prepare(): the particles outside the region are dropped here (unless the
     /// state was restored from this process's own checkpoint), and new particles take ids of
-    /// this process's own sequence. Supported: Ghost SPH with the Tait
-    /// pressure and static solids, without emitters; anything else is refused with a
-    /// ValueError. The exchange must outlive the solver's steps.
+    /// this process's own sequence. Emitters sample from their surroundings gathered from
+    /// every process (all sample the same new liquid; each keeps what lies in its region);
+    /// solids, moving or not, are whole on every process. Supported: Ghost SPH with the Tait
+    /// pressure; anything else is refused with a ValueError. The exchange must outlive the
+    /// solver's steps.
     void setExchange(sph::ParticleExchange* exchange);
     sph::ParticleExchange* exchange() const { return mExchange; }
 
@@ -268,6 +270,9 @@ private:
     void sampleSolid(std::size_t solidIndex);
     void claimRestoredSolid(std::size_t solidIndex);
     void emit();
+    /// New liquid and air take ids from `next` on (over several processes: this process's
+    /// sequence, the first of its ids at or above `next`).
+    void continueIdsFrom(sph::ParticleId next);
     void applyKillBox();
     bool blockedBySolid(const Vec3& x) const;
     void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;

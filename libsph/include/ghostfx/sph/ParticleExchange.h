@@ -46,6 +46,10 @@ public:
     /// Remove the halo copies from `set`.
     virtual void dropHalo(ParticleSet& set) = 0;
 
+    /// Every process's `mine`, on every process, in rank order (each process's in its own
+    /// order). For small sets that every process must see whole (an emitter's surroundings).
+    virtual std::vector<Vec3> allPositions(const std::vector<Vec3>& mine) = 0;
+
     virtual double maxOf(double value) = 0;
     virtual double minOf(double value) = 0;
     virtual double sumOf(double value) = 0;
