@@ -71,5 +71,32 @@ DistributedManifest readDistributedManifest(const std::string& path)
     return m;
 }
 
+vdbio::StatsRow DistributedRun::combine(const vdbio::StatsRow& mine)
+{
+    const auto starts = [](const std::string& name, const char* prefix) {
+        return name.rfind(prefix, 0) == 0;
+    };
+    double liquid = 0, weightedError = 0;
+    for (const auto& [name, value] : mine.values) {
+        if (name == "count_liquid") liquid = value;
+    }
+    vdbio::StatsRow all;
+    for (const auto& [name, value] : mine.values) {
+        double v;
+        if (name == "density_error_mean") {
+            weightedError = value * liquid;
+            const double total = sumOf(liquid);
+            v = total > 0 ? sumOf(weightedError) / total : 0.0;
+        } else if (starts(name, "count_") && name != "count_ghost_solid"
+                   && name != "count_boundary") {
+            v = sumOf(value);
+        } else {
+            v = maxOf(value);
+        }
+        all.values.emplace_back(name, v);
+    }
+    return all;
+}
+
 } // namespace cmd
 } // namespace ghostfx

@@ -12,6 +12,7 @@
 #include "Simulation.h"
 
 #include <ghostfx/vdbio/Scene.h>
+#include <ghostfx/vdbio/Stats.h>
 
 #include <memory>
 #include <string>
@@ -67,6 +68,16 @@ public:
     /// Whether any process says yes (an interrupt seen by one stops all at the same frame).
     /// Collective.
     virtual bool any(bool yes) = 0;
+    virtual double sumOf(double value) = 0;
+    virtual double maxOf(double value) = 0;
+
+    /// One statistics row for the whole simulation from every process's own row (same
+    /// columns everywhere). Collective. Counts of liquid and air are summed, counts of solid
+    /// particles taken once (solids are whole on every process), `density_error_mean`
+    /// weighted by the processes' liquid; every other column is the largest over the
+    /// processes: maxima, the slowest process's phase times, the heaviest process's
+    /// `bytes_per_particle` (frame, step, time and dt are the same everywhere).
+    vdbio::StatsRow combine(const vdbio::StatsRow& mine);
 };
 
 /// After an error on this process during a run over several: stop them all (MPI_Abort), so

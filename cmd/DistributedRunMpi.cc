@@ -105,6 +105,8 @@ public:
     }
 
     bool any(bool yes) override { return mExchange->maxOf(yes ? 1.0 : 0.0) > 0; }
+    double sumOf(double value) override { return mExchange->sumOf(value); }
+    double maxOf(double value) override { return mExchange->maxOf(value); }
 
 private:
     dist::MpiSession mSession;

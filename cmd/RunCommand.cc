@@ -478,10 +478,10 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     }
 
     // Statistics.
+    // Over several processes, rank 0 writes the rows combined from every process's.
     std::unique_ptr<vdbio::StatsWriter> stats;
-    if (!out.statsFile.empty() && distributed) {
-        progress.message("note: no statistics file on several processes yet");
-    } else if (!out.statsFile.empty()) {
+    const bool combineStats = !out.statsFile.empty() && distributed;
+    if (!out.statsFile.empty() && writes) {
         const std::string h5 = inFolder(out.statsFile, 0);
         const std::string csv = (fs::path(h5).replace_extension(".csv")).string();
         stats = std::make_unique<vdbio::StatsWriter>(h5, csv);
@@ -493,7 +493,12 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         ++substep;
         progress.countStep();
         progress.step(*sim, frame, substep);
-        if (stats) stats->append(sim->statsRow(frame, dt));
+        if (combineStats) {
+            const vdbio::StatsRow row = distributed->combine(sim->statsRow(frame, dt));
+            if (stats) stats->append(row);
+        } else if (stats) {
+            stats->append(sim->statsRow(frame, dt));
+        }
     });
 
     InterruptGuard interruptGuard;

@@ -136,8 +136,10 @@ void GhostSolver::resampleAir(int phase)
     std::vector<std::uint8_t> body(n, 0);
     // Halo copies (other processes' particles, with no lists of their own): their liquid counts
     // as body, never as a seed; their air is an obstacle whose fate its owner decides.
+    // (Read through `halo`, which is fetched again after new air is added below: adding
+    // particles may move the channel's storage.)
     const Real* halo = haloFlags();
-    auto owned = [halo](std::size_t i) { return !halo || halo[i] == Real(0); };
+    auto owned = [&halo](std::size_t i) { return !halo || halo[i] == Real(0); };
     if (halo) {
         for (std::size_t i = 0; i < n; ++i) body[i] = !owned(i) && kind[i] == ParticleKind::Liquid;
     }
@@ -335,6 +337,7 @@ void GhostSolver::resampleAir(int phase)
     // 5. The new air: faded in from weight 0 (the very first layer is there from the start),
     //    with the velocity of the nearest body particle ([SB12] Sec. 4.3).
     const Index first = mParticles.addBatch(air, mMass, ParticleKind::GhostAir);
+    halo = haloFlags();
     const bool fade = mRun.initialized;
     auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
     auto& v = mParticles.velocities();

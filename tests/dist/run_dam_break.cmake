@@ -1,10 +1,9 @@
 # The dam-break example as one process and as two (mpirun): frame 3 compared by id
 # (compare_points, within the tolerance tests/dist/test_mpi.cc explains); then the two-process
-# run resumed from its frame-2 checkpoint, against the uninterrupted one: frame 3 bit for bit;
-# frame 4 is bit for bit in most runs, but some runs (more often on a loaded machine) differ by
-# rms 9.8e-7 m, worst 1.6e-5 m (0.001 spacings), always these same values: a known defect
-# whose cause is not found (docs/distributed.md), so frame 4 is held to 1e-5 m rms and 1e-4 m.
-# Resuming on another process count is refused with the count to use.
+# run resumed from its frame-2 checkpoint, against the uninterrupted one: frames 3 and 4 bit for
+# bit. (Frame 4 once differed in some runs: the air resampling read the halo flags through a
+# pointer that adding air could leave dangling, so what it read depended on the heap; fixed
+# 2026-11-24.) Resuming on another process count is refused with the count to use.
 # Run by ctest (tests/CMakeLists.txt).
 file(REMOVE_RECURSE ${OUT})
 function(ghostfx_run name)
@@ -27,7 +26,7 @@ message("one against two processes: ${out}")
 if(NOT code EQUAL 0)
     message(FATAL_ERROR "the two-process frame differs from the one-process frame beyond the tolerance")
 endif()
-foreach(check "0003;0;0" "0004;1e-5;1e-4")
+foreach(check "0003;0;0" "0004;0;0")
     list(GET check 0 frame)
     list(GET check 1 rms)
     list(GET check 2 worst)
