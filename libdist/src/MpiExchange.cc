@@ -355,14 +355,29 @@ void MpiExchange::exchange(ParticleSet& set, Real width)
         mHaloReceived += copies.size();
         set.append(copies);
     }
+    // The ids every refresh until the next exchange looks for: sent (owned here) and received
+    // (halo copies here). An owned particle sent to several ranks is one key.
+    mWhere.clear();
+    for (const auto* lists : {&mSent, &mReceived})
+        for (const auto& ids : *lists)
+            for (ParticleId id : ids) mWhere.emplace(id, INVALID_INDEX);
 }
 
 void MpiExchange::refresh(ParticleSet& set, const std::vector<std::string>& channels)
 {
+    // Where the sent and received ids are now (the solver may have reordered the set since
+    // the exchange): one pass over the set, looking up only the ids of the last exchange.
     const auto& halo = set.scalarChannel(HALO_CHANNEL);
-    std::unordered_map<ParticleId, Index> own, copy;
-    for (std::size_t i = 0; i < set.size(); ++i)
-        (halo[i] != Real(0) ? copy : own)[set.ids()[i]] = Index(i);
+    for (auto& entry : mWhere) entry.second = INVALID_INDEX;
+    for (std::size_t i = 0; i < set.size(); ++i) {
+        const auto it = mWhere.find(set.ids()[i]);
+        if (it != mWhere.end()) it->second = Index(i);
+    }
+    const auto find = [&](ParticleId id, bool copy) {
+        const auto it = mWhere.find(id);
+        if (it == mWhere.end() || it->second == INVALID_INDEX) return INVALID_INDEX;
+        return (halo[it->second] != Real(0)) == copy ? it->second : INVALID_INDEX;
+    };
     std::vector<ChannelView> views;
     for (const std::string& name : channels) views.push_back(view(set, name));
 
@@ -370,13 +385,13 @@ void MpiExchange::refresh(ParticleSet& set, const std::vector<std::string>& chan
     for (int q = 0; q < mRanks; ++q) {
         Writer w(bytes[std::size_t(q)]);
         for (ParticleId id : mSent[std::size_t(q)]) {
-            const auto it = own.find(id);
-            if (it == own.end())
+            const Index i = find(id, false);
+            if (i == INVALID_INDEX)
                 throw Error(msg("MPI exchange: particle id ", id, " sent to rank ", q,
                                 " is gone from rank ", mRank, " before its refresh"));
             for (const ChannelView& c : views) {
-                if (c.scalar) w.put(c.scalar[it->second]);
-                else w.put(c.vector[it->second]);
+                if (c.scalar) w.put(c.scalar[i]);
+                else w.put(c.vector[i]);
             }
         }
     }
@@ -385,15 +400,15 @@ void MpiExchange::refresh(ParticleSet& set, const std::vector<std::string>& chan
         if (mReceived[std::size_t(q)].empty()) continue;
         Reader r(received[std::size_t(q)]);
         for (ParticleId id : mReceived[std::size_t(q)]) {
-            const auto it = copy.find(id);
+            const Index i = find(id, true);
             // A copy this rank removed since (the kill box) still has its values in the message.
             for (const ChannelView& c : views) {
                 if (c.scalar) {
                     const Real value = r.get<Real>();
-                    if (it != copy.end()) c.scalar[it->second] = value;
+                    if (i != INVALID_INDEX) c.scalar[i] = value;
                 } else {
                     const Vec3 value = r.get<Vec3>();
-                    if (it != copy.end()) c.vector[it->second] = value;
+                    if (i != INVALID_INDEX) c.vector[i] = value;
                 }
             }
         }

@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace ghostfx {
@@ -94,6 +95,8 @@ private:
     double mRebalanceAbove = sph::DomainDecomposition::REBALANCE_IMBALANCE;
     std::vector<std::vector<sph::ParticleId>> mSent;     ///< ids sent as halo, per rank
     std::vector<std::vector<sph::ParticleId>> mReceived; ///< halo ids received, per rank
+    /// The ids sent or received at the last exchange -> their row in the set (refresh()).
+    std::unordered_map<sph::ParticleId, sph::Index> mWhere;
     std::uint64_t mRebalances = 0, mMigrated = 0, mHaloReceived = 0;
 };
 
