@@ -71,6 +71,29 @@ DistributedManifest readDistributedManifest(const std::string& path)
     return m;
 }
 
+sph::SolverState mergeProcessStates(std::vector<sph::SolverState> states)
+{
+    if (states.empty()) throw ValueError("mergeProcessStates: no state");
+    sph::SolverState whole = std::move(states.front());
+    for (std::size_t r = 1; r < states.size(); ++r) {
+        const sph::SolverState& part = states[r];
+        const auto& kinds = part.particles.kinds();
+        std::vector<std::uint8_t> fluid(kinds.size(), 0);
+        for (std::size_t i = 0; i < kinds.size(); ++i)
+            fluid[i] = kinds[i] == sph::ParticleKind::Liquid
+                       || kinds[i] == sph::ParticleKind::GhostAir;
+        whole.particles.append(part.particles.select(fluid));
+        for (const char* key : {"emitted", "killed"})
+            whole.integers[key] = whole.integer(key) + part.integer(key);
+        whole.reals["max_acceleration"] =
+            std::max(whole.real("max_acceleration"), part.real("max_acceleration"));
+    }
+    // The processes' halo flags (all 0 in a saved state) mean nothing to the merged run.
+    if (whole.particles.hasScalarChannel(sph::HALO_CHANNEL))
+        whole.particles.removeChannel(sph::HALO_CHANNEL);
+    return whole;
+}
+
 vdbio::StatsRow DistributedRun::combine(const vdbio::StatsRow& mine)
 {
     const auto starts = [](const std::string& name, const char* prefix) {

@@ -31,6 +31,13 @@ struct DistributedManifest
     std::vector<double> decomposition; ///< sph::DomainDecomposition::save()
 };
 
+/// One state for the whole simulation from the states its processes saved (a manifest's
+/// files, in rank order): the first process's state with every other process's liquid and air
+/// appended (solids are whole in each, so they are taken once), the emitted and killed counts
+/// summed, the largest acceleration the largest. A one-process run continues from it, and a
+/// run over any number of processes cuts it anew (DistributedRun::share).
+sph::SolverState mergeProcessStates(std::vector<sph::SolverState> states);
+
 /// Whether a --resume path is a manifest (".ranks.json") rather than one process's state.
 bool isDistributedManifest(const std::string& path);
 /// Read and check a manifest; a SceneError names the file and what is wrong.

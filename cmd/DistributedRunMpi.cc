@@ -38,7 +38,7 @@ public:
         } else {
             mExchange = std::make_unique<dist::MpiExchange>(MPI_COMM_WORLD, points);
         }
-        sim.share(*mExchange);
+        sim.share(*mExchange, savedParts != nullptr);
     }
 
     std::string writeCheckpoint(const std::string& h5Path, const Simulation& sim,

@@ -169,10 +169,10 @@ public:
         }
         return mSolver->particles().positions();
     }
-    void share(sph::ParticleExchange& exchange) override
+    void share(sph::ParticleExchange& exchange, bool ownPart) override
     {
         try {
-            mSolver->setExchange(&exchange);
+            mSolver->setExchange(&exchange, ownPart);
         } catch (const ValueError& e) {
             throw SceneError(msg("scene '", mScene.file, "': ", e.what()));
         }

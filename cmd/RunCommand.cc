@@ -379,30 +379,40 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
 
     // The solvers the scene needs, fresh or from a checkpoint.
     std::unique_ptr<Simulation> sim;
-    std::optional<DistributedManifest> manifest;
+    std::optional<DistributedManifest> manifest; // resuming on the count that wrote it
+    std::string resumeNote;
     if (!o.resume.empty()) {
         if (stateCount(scene) == 0) {
             throw SceneError(msg("scene '", scene.file,
                                  "': a boiling scene (with heaters) cannot be resumed yet"));
         }
-        // A run over several processes resumes from its manifest, each process from its file.
-        std::string statePath = o.resume;
+        // A run over several processes resumes from its manifest: on as many processes, each
+        // from its own file, with the saved regions (bit for bit); on another count (one
+        // process included), every process reads every file and the domain is cut anew. A
+        // one-process checkpoint resumed on several processes is cut the same way.
+        std::vector<sph::SolverState> states;
+        const int here = distributed ? distributed->ranks() : 1;
         if (isDistributedManifest(o.resume)) {
             manifest = readDistributedManifest(o.resume);
-            const int here = distributed ? distributed->ranks() : 1;
-            if (manifest->ranks != here) {
-                throw SceneError(msg("checkpoint '", o.resume, "' was written by ", manifest->ranks,
-                                     " processes and this run has ", here,
-                                     ": resume it with mpirun -np ", manifest->ranks));
+            if (manifest->ranks == here) {
+                states.push_back(vdbio::readCheckpoint(
+                    manifest->files[std::size_t(distributed ? distributed->rank() : 0)],
+                    fingerprint));
+            } else {
+                std::vector<sph::SolverState> parts;
+                for (const std::string& file : manifest->files)
+                    parts.push_back(vdbio::readCheckpoint(file, fingerprint));
+                states.push_back(mergeProcessStates(std::move(parts)));
+                resumeNote = msg("note: '", o.resume, "' was written by ", manifest->ranks,
+                                 " processes and this run has ", here, ": its parts are merged",
+                                 here > 1 ? " and the domain cut anew" : "",
+                                 " (the run goes on, but not bit for bit as it would have on ",
+                                 manifest->ranks, ")");
+                manifest.reset();
             }
-            statePath = manifest->files[std::size_t(distributed ? distributed->rank() : 0)];
-        } else if (distributed) {
-            throw SceneError(msg("checkpoint '", o.resume,
-                                 "' holds a one-process run: resume it as one process (a run "
-                                 "over several processes resumes from its .ranks.json "
-                                 "manifest)"));
+        } else {
+            states.push_back(vdbio::readCheckpoint(o.resume, fingerprint));
         }
-        const std::vector<sph::SolverState> states{vdbio::readCheckpoint(statePath, fingerprint)};
         sim = makeSimulation(scene, &states);
     } else {
         sim = makeSimulation(scene);
@@ -422,6 +432,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     else if (o.progress == "bar" || (o.progress == "auto" && ::isatty(STDERR_FILENO)))
         mode = Progress::Mode::Bar;
     Progress progress(mode, std::max(first, startFrame + 1), last);
+    if (!resumeNote.empty()) progress.message(resumeNote);
     if (startFrame >= last) {
         progress.message(msg("nothing to do: the checkpoint is at frame ", startFrame,
                              ", the last frame is ", last));

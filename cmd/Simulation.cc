@@ -41,7 +41,7 @@ std::vector<sph::Vec3> Simulation::prepareToShare()
                      "scene as one process");
 }
 
-void Simulation::share(sph::ParticleExchange& /*exchange*/)
+void Simulation::share(sph::ParticleExchange& /*exchange*/, bool /*ownPart*/)
 {
     throw SceneError("only liquid scenes (method ghost) run on several processes yet; run this "
                      "scene as one process");

@@ -84,10 +84,11 @@ public:
     /// One simulation over several processes (`mpirun -np N ghostfx run`): every process
     /// builds the same simulation, then prepareToShare() makes its first state (the same
     /// everywhere) and returns the positions the domain is cut by; share() keeps this process's
-    /// part and exchanges with the others from then on. Liquid (Ghost SPH) scenes only; the
-    /// others refuse with a SceneError.
+    /// part and exchanges with the others from then on (`ownPart`: the simulation was restored
+    /// from this process's own part of a checkpoint, and keeps all of it). Liquid (Ghost SPH)
+    /// scenes only; the others refuse with a SceneError.
     virtual std::vector<sph::Vec3> prepareToShare();
-    virtual void share(sph::ParticleExchange& exchange);
+    virtual void share(sph::ParticleExchange& exchange, bool ownPart);
 };
 
 /// Build the simulation a scene asks for, fresh or continuing from `restored` states (as saved

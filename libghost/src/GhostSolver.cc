@@ -64,7 +64,7 @@ void GhostSolver::setParticleMass(Real mass)
 
 void GhostSolver::setStepObserver(StepObserver observer) { mObserver = std::move(observer); }
 
-void GhostSolver::setExchange(sph::ParticleExchange* exchange)
+void GhostSolver::setExchange(sph::ParticleExchange* exchange, bool ownPart)
 {
     if (!exchange || exchange->ranks() == 1) {
         mExchange = nullptr;
@@ -77,10 +77,11 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange)
     if (mSettings.method != Method::Ghost) refuse("method basic");
     if (mSettings.pressure != PressureModel::Tait) refuse("pressure dfsph");
     if (!mRun.initialized) refuse("sharing before prepare()");
-    // A fresh run: every process has the same particles here; keep what this one owns. A run
-    // restored from this process's own checkpoint keeps all of it (the particles that left
-    // its region since the last exchange migrate at the next one).
-    if (!mRestored) {
+    // A fresh run (or one restored whole): every process has the same particles here; keep
+    // what this one owns. A run restored from this process's own part of a checkpoint keeps
+    // all of it (the particles that left its region since the last exchange migrate at the
+    // next one).
+    if (!ownPart) {
         std::vector<std::uint8_t> remove(mParticles.size(), 0);
         for (std::size_t i = 0; i < remove.size(); ++i)
             remove[i] = !exchange->owns(mParticles.positions()[i]);

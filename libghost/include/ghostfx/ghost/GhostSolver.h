@@ -169,14 +169,14 @@ public:
     /// solver owns and computes only the liquid and air in `exchange`'s region, receives halo
     /// copies of its neighbours' particles every step and agrees with the others on the time
     /// step and on blow-ups (sph::ParticleExchange). Call it on every process after the same
-    /// set-up and prepare(): the particles outside the region are dropped here (unless the
-    /// state was restored from this process's own checkpoint), and new particles take ids of
-    /// this process's own sequence. Emitters sample from their surroundings gathered from
+    /// set-up and prepare(): the particles outside the region are dropped here (unless
+    /// `ownPart`: the state was restored from this process's own part of a checkpoint), and
+    /// new particles take ids of this process's own sequence. Emitters sample from their surroundings gathered from
     /// every process (all sample the same new liquid; each keeps what lies in its region);
     /// solids, moving or not, are whole on every process. Supported: Ghost SPH with the Tait
     /// pressure; anything else is refused with a ValueError. The exchange must outlive the
     /// solver's steps.
-    void setExchange(sph::ParticleExchange* exchange);
+    void setExchange(sph::ParticleExchange* exchange, bool ownPart = false);
     sph::ParticleExchange* exchange() const { return mExchange; }
 
     /// Everything that decides how the run continues, as a SolverState with solver name
