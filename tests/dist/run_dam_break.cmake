@@ -5,13 +5,7 @@
 # pointer that adding air could leave dangling, so what it read depended on the heap; fixed
 # 2026-11-24.) Resumed on another process count, the run goes on from the merged parts.
 # Run by ctest (tests/CMakeLists.txt).
-file(REMOVE_RECURSE ${OUT})
-function(ghostfx_run name)
-    execute_process(COMMAND ${ARGN} RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_VARIABLE out)
-    if(NOT code EQUAL 0)
-        message(FATAL_ERROR "${name} failed (${code}): ${err}")
-    endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/run_common.cmake)
 set(run ${GHOSTFX} run ${SCENE} --threads 1 -q -D outputs.checkpoint.every=2)
 set(two ${MPIEXEC} -np 2 --oversubscribe)
 ghostfx_run("one process" ${run} --frames 1-3 --out ${OUT}/one)
@@ -19,24 +13,14 @@ ghostfx_run("two processes" ${two} ${run} --frames 1-4 --out ${OUT}/two)
 ghostfx_run("two processes, resumed" ${two} ${run} --frames 1-4 --out ${OUT}/resumed
             --resume ${OUT}/two/checkpoint.0002.ranks.json)
 
-execute_process(COMMAND ${COMPARE} ${OUT}/one/liquid_points.0003.vdb
-                        ${OUT}/two/liquid_points.0003.vdb 0.003 0.03
-                RESULT_VARIABLE code OUTPUT_VARIABLE out)
-message("one against two processes: ${out}")
-if(NOT code EQUAL 0)
-    message(FATAL_ERROR "the two-process frame differs from the one-process frame beyond the tolerance")
-endif()
-foreach(check "0003;0;0" "0004;0;0")
-    list(GET check 0 frame)
-    list(GET check 1 rms)
-    list(GET check 2 worst)
-    execute_process(COMMAND ${COMPARE} ${OUT}/two/liquid_points.${frame}.vdb
-                            ${OUT}/resumed/liquid_points.${frame}.vdb ${rms} ${worst}
-                    RESULT_VARIABLE code OUTPUT_VARIABLE out)
-    message("resumed against uninterrupted, two processes, frame ${frame}: ${out}")
-    if(NOT code EQUAL 0)
-        message(FATAL_ERROR "the resumed two-process run differs from the uninterrupted one")
-    endif()
+ghostfx_compare("one against two processes"
+                "the two-process frame differs from the one-process frame beyond the tolerance"
+                ${OUT}/one/liquid_points.0003.vdb ${OUT}/two/liquid_points.0003.vdb 0.003 0.03)
+foreach(frame 0003 0004)
+    ghostfx_compare("resumed against uninterrupted, two processes, frame ${frame}"
+                    "the resumed two-process run differs from the uninterrupted one"
+                    ${OUT}/two/liquid_points.${frame}.vdb
+                    ${OUT}/resumed/liquid_points.${frame}.vdb 0 0)
 endforeach()
 foreach(file liquid.0003.vdb preview.0003.exr checkpoint.0002.rank0.h5 checkpoint.0002.rank1.h5)
     if(NOT EXISTS ${OUT}/two/${file})
@@ -54,11 +38,8 @@ ghostfx_run("two processes' checkpoint on one" ${run} --frames 1-4 --out ${OUT}/
 ghostfx_run("one process's checkpoint on two" ${two} ${run} --frames 1-4 --out ${OUT}/split
             --resume ${OUT}/one/checkpoint.0002.h5)
 foreach(resumed three merged split)
-    execute_process(COMMAND ${COMPARE} ${OUT}/two/liquid_points.0004.vdb
-                            ${OUT}/${resumed}/liquid_points.0004.vdb 0.003 0.03
-                    RESULT_VARIABLE code OUTPUT_VARIABLE out)
-    message("resumed on another count (${resumed}) against two processes, frame 4: ${out}")
-    if(NOT code EQUAL 0)
-        message(FATAL_ERROR "the run resumed on another process count (${resumed}) is off")
-    endif()
+    ghostfx_compare("resumed on another count (${resumed}) against two processes, frame 4"
+                    "the run resumed on another process count (${resumed}) is off"
+                    ${OUT}/two/liquid_points.0004.vdb
+                    ${OUT}/${resumed}/liquid_points.0004.vdb 0.003 0.03)
 endforeach()

@@ -9,13 +9,7 @@
 # of the particles farther than 2 cm from the seed-1 cloud (measured 2026-11-24); two
 # processes: 0.4 %, 1.3 mm, 2.8 % / 1.2 %. Bounds: 5 %, 5 mm (half a spacing), 6 %.
 # Run by ctest (tests/CMakeLists.txt).
-file(REMOVE_RECURSE ${OUT})
-function(ghostfx_run name)
-    execute_process(COMMAND ${ARGN} RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_VARIABLE out)
-    if(NOT code EQUAL 0)
-        message(FATAL_ERROR "${name} failed (${code}): ${err}")
-    endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/run_common.cmake)
 set(run ${GHOSTFX} run ${SCENE} --threads 1 -q --frames 1-4)
 ghostfx_run("one process" ${run} --out ${OUT}/one)
 ghostfx_run("two processes" ${MPIEXEC} -np 2 --oversubscribe ${run} --out ${OUT}/two)
@@ -23,20 +17,13 @@ ghostfx_run("two processes again" ${MPIEXEC} -np 2 --oversubscribe ${run} --out 
 # Two runs on two processes write the same frame, bit for bit (the same ids too). Before a
 # dangling read of the halo flags in the air resampling was fixed (2026-11-24), runs of this
 # scene parted after 16-45 steps, depending on what the heap held.
-execute_process(COMMAND ${COMPARE} ${OUT}/two/liquid_points.0004.vdb
-                        ${OUT}/again/liquid_points.0004.vdb 0 0
-                RESULT_VARIABLE code OUTPUT_VARIABLE out)
-message("two processes, twice: ${out}")
-if(NOT code EQUAL 0)
-    message(FATAL_ERROR "two runs on two processes differ")
-endif()
-execute_process(COMMAND ${COMPARE} --cloud ${OUT}/one/liquid_points.0004.vdb
-                        ${OUT}/two/liquid_points.0004.vdb 0.05 0.005 0.02 0.06
-                RESULT_VARIABLE code OUTPUT_VARIABLE out)
-message("one against two processes: ${out}")
-if(NOT code EQUAL 0)
-    message(FATAL_ERROR "the two-process tomato differs from the one-process one beyond the tolerance")
-endif()
+ghostfx_compare("two processes, twice"
+                "two runs on two processes differ"
+                ${OUT}/two/liquid_points.0004.vdb ${OUT}/again/liquid_points.0004.vdb 0 0)
+ghostfx_compare("one against two processes"
+                "the two-process tomato differs from the one-process one beyond the tolerance"
+                --cloud ${OUT}/one/liquid_points.0004.vdb ${OUT}/two/liquid_points.0004.vdb
+                0.05 0.005 0.02 0.06)
 foreach(file liquid.0004.vdb preview.0004.exr stats.h5 stats.csv)
     if(NOT EXISTS ${OUT}/two/${file})
         message(FATAL_ERROR "the two-process run wrote no ${file}")
@@ -44,7 +31,7 @@ foreach(file liquid.0004.vdb preview.0004.exr stats.h5 stats.csv)
 endforeach()
 
 # The statistics file combines every process's rows: its last row's count_liquid is the liquid
-# the frame file holds (summed over the processes), and its step is the run's last.
+# the frame file holds (summed over the processes).
 file(STRINGS ${OUT}/two/stats.csv rows)
 list(GET rows 0 header)
 list(GET rows -1 last)
@@ -52,7 +39,7 @@ string(REPLACE "," ";" header "${header}")
 string(REPLACE "," ";" last "${last}")
 list(FIND header count_liquid column)
 list(GET last ${column} statsLiquid)
-string(REGEX MATCH "two/liquid_points.0004.vdb: ([0-9]+) particles" match "${out}")
+string(REGEX MATCH "two/liquid_points.0004.vdb: ([0-9]+) particles" match "${compared}")
 message("stats.csv, last row of frame 4: ${statsLiquid} liquid; frame file: ${CMAKE_MATCH_1}")
 if(NOT match OR NOT statsLiquid EQUAL CMAKE_MATCH_1)
     message(FATAL_ERROR "stats.csv says ${statsLiquid} liquid particles at the end of frame 4, "

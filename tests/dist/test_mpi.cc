@@ -290,6 +290,23 @@ std::map<ParticleId, Vec3> liquidOf(const ParticleSet& p)
     return gatherOwned(p.select(keep));
 }
 
+/// The closed 0.3 x 0.2 x 0.1 m tank of the distributed runs below, and their settings.
+LevelSet smallTank(Real h)
+{
+    return makeLevelSet(ghostfx::testing::closedTankGrid(
+                            Vec3(0), Vec3(Real(0.3), Real(0.2), Real(0.1)), 4 * h, h / 2),
+                        "tank");
+}
+
+GhostSettings smallTankSettings(Real h, std::uint64_t seed)
+{
+    GhostSettings settings;
+    settings.spacing = h;
+    settings.seed = seed;
+    settings.substeps = 0;
+    return settings;
+}
+
 } // namespace
 
 TEST(DistributedGhost, DamBreakOnSeveralRanksFollowsOneRank)
@@ -298,14 +315,8 @@ TEST(DistributedGhost, DamBreakOnSeveralRanksFollowsOneRank)
     // all ranks together, on each rank alone, and alone again with every liquid particle moved
     // by 1e-8 m: with the same time steps (the shared run's, the same on every rank).
     const Real h = Real(0.01);
-    GhostSettings settings;
-    settings.spacing = h;
-    settings.seed = 5;
-    settings.substeps = 0;
-    const LevelSet tank =
-        makeLevelSet(ghostfx::testing::closedTankGrid(
-                         Vec3(0), Vec3(Real(0.3), Real(0.2), Real(0.1)), 4 * h, h / 2),
-                     "tank");
+    const GhostSettings settings = smallTankSettings(h, 5);
+    const LevelSet tank = smallTank(h);
     const LevelSet water = makeLevelSet(
         makeBoxLevelSet(Vec3(0), Vec3(Real(0.1), Real(0.15), Real(0.1)), h / 2), "water");
     auto build = [&]() {
@@ -379,14 +390,8 @@ TEST(DistributedGhost, MovingAndReshapedSolidsOnSeveralRanksFollowOneRank)
     // Solids are whole on every rank: the resampled particles must take the same ids
     // everywhere, above every liquid and air id any rank has given.
     const Real h = Real(0.01);
-    GhostSettings settings;
-    settings.spacing = h;
-    settings.seed = 9;
-    settings.substeps = 0;
-    const LevelSet tank =
-        makeLevelSet(ghostfx::testing::closedTankGrid(
-                         Vec3(0), Vec3(Real(0.3), Real(0.2), Real(0.1)), 4 * h, h / 2),
-                     "tank");
+    const GhostSettings settings = smallTankSettings(h, 9);
+    const LevelSet tank = smallTank(h);
     const LevelSet water = makeLevelSet(
         makeBoxLevelSet(Vec3(0), Vec3(Real(0.2), Real(0.08), Real(0.1)), h / 2), "water");
     const LevelSet paddle =
