@@ -80,8 +80,8 @@ sph::SolverState mergeProcessStates(std::vector<sph::SolverState> states)
         const auto& kinds = part.particles.kinds();
         std::vector<std::uint8_t> fluid(kinds.size(), 0);
         for (std::size_t i = 0; i < kinds.size(); ++i)
-            fluid[i] = kinds[i] == sph::ParticleKind::Liquid
-                       || kinds[i] == sph::ParticleKind::GhostAir;
+            fluid[i] =
+                kinds[i] == sph::ParticleKind::Liquid || kinds[i] == sph::ParticleKind::GhostAir;
         whole.particles.append(part.particles.select(fluid));
         for (const char* key : {"emitted", "killed"})
             whole.integers[key] = whole.integer(key) + part.integer(key);

@@ -9,7 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -98,10 +100,13 @@ public:
                 air += kinds[i] == sph::ParticleKind::GhostAir;
             }
         }
-        return msg(std::size_t(mExchange->sumOf(liquid)), " liquid, ",
-                   std::size_t(mExchange->sumOf(air)), " air on ", ranks(), " processes (",
-                   mExchange->migrated(), " particles migrated and ", mExchange->rebalances(),
-                   " rebalances seen by this one)");
+        const double all = mExchange->sumOf(liquid + air);
+        const double largest = mExchange->maxOf(liquid + air);
+        return msg(
+            std::size_t(mExchange->sumOf(liquid)), " liquid, ", std::size_t(mExchange->sumOf(air)),
+            " air on ", ranks(), " processes (the largest part ",
+            int(std::lround(100 * largest / std::max(1.0, all))), " %; ", mExchange->migrated(),
+            " particles migrated and ", mExchange->rebalances(), " rebalances seen by this one)");
     }
 
     bool any(bool yes) override { return mExchange->maxOf(yes ? 1.0 : 0.0) > 0; }

@@ -144,12 +144,14 @@ public:
 
     void countStep() { ++mSteps; }
 
-    void frame(const Simulation& sim, int frame, int steps, double frameSeconds, bool written)
+    /// `counts`: the particles, as Simulation::counts() (or DistributedRun::counts()) says.
+    void frame(const Simulation& sim, const std::string& counts, int frame, int steps,
+               double frameSeconds, bool written)
     {
         if (mMode == Mode::None) return;
         if (mMode == Mode::Bar) std::fprintf(stderr, "\r\033[K");
         std::fprintf(stderr, "frame %d/%d: t = %.4f s, %d steps, %s, %.2f s%s\n", frame, mLast,
-                     sim.time(), steps, sim.counts().c_str(), frameSeconds,
+                     sim.time(), steps, counts.c_str(), frameSeconds,
                      written ? "" : " (not written: before the first frame)");
         std::fflush(stderr);
     }
@@ -549,8 +551,10 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
             writer.finish(); // the frames on disk reach at least as far as the checkpoint
             checkpoint = writeCheckpoint(frame);
         }
-        progress.frame(*sim, frame, int(sim->stepCount() - stepsBefore),
-                       seconds(frameStart, Clock::now()), write);
+        // Over several processes the counts are every process's, summed (collective).
+        progress.frame(*sim, distributed ? distributed->counts(*sim) : sim->counts(), frame,
+                       int(sim->stepCount() - stepsBefore), seconds(frameStart, Clock::now()),
+                       write);
         if (interrupted) {
             std::fprintf(stderr, "ghostfx: interrupted after frame %d%s\n", frame,
                          checkpoint.empty()
