@@ -6,7 +6,9 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <mutex>
 
 namespace ghostfx {
 namespace cmd {
@@ -112,11 +114,52 @@ sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed)
     };
 }
 
+namespace {
+
+struct ProcessSampleCache
+{
+    std::mutex mutex;
+    bool chosen = false;
+    std::string folder;
+    std::unique_ptr<vdbio::SampleCache> cache;
+};
+
+ProcessSampleCache& processCache()
+{
+    static ProcessSampleCache c;
+    return c;
+}
+
+} // namespace
+
+void setProcessSampleCache(const std::string& folder)
+{
+    ProcessSampleCache& c = processCache();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    c.chosen = true;
+    c.folder = folder;
+    c.cache.reset();
+}
+
+vdbio::SampleCache* processSampleCache()
+{
+    ProcessSampleCache& c = processCache();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    if (!c.chosen) {
+        const char* env = std::getenv("GHOSTFX_SAMPLE_CACHE");
+        c.folder = env ? env : "";
+        c.chosen = true;
+    }
+    if (!c.cache && !c.folder.empty()) c.cache = std::make_unique<vdbio::SampleCache>(c.folder);
+    return c.cache.get();
+}
+
 std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
                                               const GhostSettings& settings,
                                               const sph::SolverState* restored)
 {
     auto solver = std::make_unique<GhostSolver>(settings);
+    solver->setSampleStore(processSampleCache());
     if (restored) solver->restoreState(*restored);
     for (const vdbio::SceneSolid& solid : scene.solids) {
         // A solid without motion keys moves at its constant velocity, or stands still: then its

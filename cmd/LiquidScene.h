@@ -5,6 +5,7 @@
 
 #include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/SolverState.h>
+#include <ghostfx/vdbio/SampleCache.h>
 #include <ghostfx/vdbio/Scene.h>
 
 #include <memory>
@@ -22,6 +23,14 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
 std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
                                                      const ghost::GhostSettings& settings,
                                                      const sph::SolverState* restored = nullptr);
+
+/// This process's sample cache (vdbio::SampleCache): the folder of `--sample-cache`, else of
+/// $GHOSTFX_SAMPLE_CACHE, else none (null). Liquid solvers made by makeLiquidSolver take their
+/// solids' and liquid bodies' samples from it. Made on first use; an IoError names the folder
+/// when it cannot be written.
+vdbio::SampleCache* processSampleCache();
+/// Use `folder` (empty: none, and not the environment's either) from now on.
+void setProcessSampleCache(const std::string& folder);
 
 /// The solver-side motion of keys read from a scene (rotation R = Rz Ry Rx, then translation).
 sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed);

@@ -370,6 +370,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     const auto runStart = Clock::now();
     parallel::ThreadLimit threadLimit(o.threads);
     const bool writes = !distributed || distributed->root();
+    if (!o.sampleCache.empty()) setProcessSampleCache(o.sampleCache);
 
     // Scene, settings and outputs: every input error is found before any simulation.
     vdbio::Scene scene = vdbio::readScene(o.scene, o.defines);
@@ -435,6 +436,10 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         mode = Progress::Mode::Bar;
     Progress progress(mode, std::max(first, startFrame + 1), last);
     if (!resumeNote.empty()) progress.message(resumeNote);
+    if (const vdbio::SampleCache* cache = processSampleCache()) {
+        progress.message(msg("sample cache '", cache->folder(), "': ", cache->hits(),
+                             " shapes loaded, ", cache->stored(), " sampled and kept"));
+    }
     if (startFrame >= last) {
         progress.message(msg("nothing to do: the checkpoint is at frame ", startFrame,
                              ", the last frame is ", last));
@@ -621,6 +626,10 @@ Command addRunCommand(CLI::App& parent)
                 "output particles)");
     c->add_option("--progress", o->progress, "auto, bar, log or none")
         ->check(CLI::IsMember({"auto", "bar", "log", "none"}));
+    c->add_option("--sample-cache", o->sampleCache,
+                  "keep the samples of solids and liquid bodies in this folder and take them "
+                  "from it when the same shape is sampled again (default: "
+                  "$GHOSTFX_SAMPLE_CACHE, or none); results are the same bit for bit");
     return {c, [o] { return runScene(*o); }};
 }
 

@@ -24,6 +24,9 @@ struct RunOptions
     bool serialOutput = false;
     /// Progress display: "auto" (bar on a terminal, log lines otherwise), "bar", "log", "none".
     std::string progress = "auto";
+    /// Folder of sampled shapes kept between runs (LiquidScene.h, processSampleCache); empty:
+    /// $GHOSTFX_SAMPLE_CACHE, or none.
+    std::string sampleCache;
 };
 
 /// Exit code of a run stopped by Ctrl-C after writing its checkpoint (128 + SIGINT).

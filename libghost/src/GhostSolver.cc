@@ -200,7 +200,7 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     ps.tiledInterior = mSettings.tiledSampling;
     ps.bandDepth = mSettings.supportRadius();
     ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step;
-    const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(solid);
+    const SampleSet samples = sph::sampleVolumeStored(ps, solid, mSampleStore);
 
     // Outward normal of each particle from its nearest surface sample: phi is clamped beyond
     // the narrow band, which is often thinner than a kernel radius.
@@ -346,7 +346,7 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.tiledInterior = mSettings.tiledSampling;
     ps.seed = mSettings.seed + 7919ULL * (mParticles.count(ParticleKind::Liquid) + 1);
-    SampleSet samples = PoissonDiskSampler(ps).sampleVolume(shape);
+    const SampleSet samples = sph::sampleVolumeStored(ps, shape, mSampleStore);
     // Liquid inside a solid is not liquid, and liquid samples on a surface shared with a solid
     // would sit on top of the solid's own surface samples: keep half a spacing of clearance.
     std::vector<Vec3> kept;

@@ -93,6 +93,44 @@ Real LevelSet::voxelSize() const { return mImpl->voxelSize; }
 Real LevelSet::bandWidth() const { return mImpl->bandWidth; }
 Aabb LevelSet::bounds() const { return mImpl->bounds; }
 
+std::uint64_t LevelSet::contentHash() const
+{
+    std::uint64_t h = 0xcbf29ce484222325ULL; // FNV-1a, 64 bits
+    auto add = [&h](const void* data, std::size_t n) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < n; ++i) {
+            h ^= p[i];
+            h *= 0x100000001b3ULL;
+        }
+    };
+    const openvdb::FloatGrid& grid = *mImpl->grid;
+    const float background = grid.background();
+    add(&background, sizeof background);
+    const openvdb::Mat4d xform = grid.transform().baseMap()->getAffineMap()->getMat4();
+    add(xform.asPointer(), 16 * sizeof(double));
+    // Leaves whole (their inactive voxels are interpolated too), then the tiles.
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+        const openvdb::Coord origin = leaf->origin();
+        add(origin.data(), 3 * sizeof(openvdb::Int32));
+        add(leaf->buffer().data(), leaf->SIZE * sizeof(float));
+        for (openvdb::Index w = 0; w < leaf->getValueMask().WORD_COUNT; ++w) {
+            const auto word = leaf->getValueMask().getWord<openvdb::Index64>(w);
+            add(&word, sizeof word);
+        }
+    }
+    for (auto tile = grid.tree().cbeginValueAll(); tile; ++tile) {
+        if (tile.isVoxelValue()) continue;
+        const openvdb::Coord c = tile.getCoord();
+        const float v = *tile;
+        const std::uint8_t on = tile.isValueOn(), depth = std::uint8_t(tile.getDepth());
+        add(c.data(), 3 * sizeof(openvdb::Int32));
+        add(&v, sizeof v);
+        add(&on, 1);
+        add(&depth, 1);
+    }
+    return h;
+}
+
 Real LevelSet::phi(const Vec3& x) const { return mImpl->sample(x); }
 
 Vec3 LevelSet::gradient(const Vec3& x) const

@@ -720,3 +720,33 @@ TEST_F(Cli, AnimatedSolidsFollowKeysAndFileSequences)
     EXPECT_CONTAINS(line, "solids[1].sequence: file '" + (mDir / "ball.0003.vdb").string()
                               + "' does not exist");
 }
+
+TEST_F(Cli, SampleCacheGivesTheSameRunWithoutSamplingAgain)
+{
+    // `--sample-cache DIR` (or $GHOSTFX_SAMPLE_CACHE): the first run samples the tank and the
+    // water and keeps them, the second loads both; the frame files are the same grid for grid.
+    const std::string path = write(smallScene());
+    const fs::path cache = mDir / "cache", a = mDir / "a", b = mDir / "b";
+    const Result first = run("run " + path + " --frames 1-2 --progress log --out " + a.string()
+                             + " --sample-cache " + cache.string());
+    ASSERT_EQ(first.code, 0) << first.err;
+    EXPECT_CONTAINS(first.err, "0 shapes loaded, 2 sampled and kept");
+    const Result second = run("run " + path + " --frames 1-2 --progress log --out " + b.string()
+                              + " --sample-cache " + cache.string());
+    ASSERT_EQ(second.code, 0) << second.err;
+    EXPECT_CONTAINS(second.err, "2 shapes loaded, 0 sampled and kept");
+    EXPECT_EQ(gridBytes(a / "liquid_points.0002.vdb"), gridBytes(b / "liquid_points.0002.vdb"));
+    // The environment variable does the same.
+    ::setenv("GHOSTFX_SAMPLE_CACHE", cache.string().c_str(), 1);
+    const Result third =
+        run("run " + path + " --frames 1-1 --progress log --out " + (mDir / "c").string());
+    ::unsetenv("GHOSTFX_SAMPLE_CACHE");
+    EXPECT_EQ(third.code, 0) << third.err;
+    EXPECT_CONTAINS(third.err, "2 shapes loaded, 0 sampled and kept");
+
+    // A cache folder that cannot be made: one clear line naming it.
+    std::ofstream(mDir / "file") << "not a folder";
+    const std::string line =
+        errorLine("run " + path + " --sample-cache " + (mDir / "file" / "cache").string());
+    EXPECT_CONTAINS(line, "sample cache folder '" + (mDir / "file" / "cache").string() + "'");
+}

@@ -44,6 +44,7 @@
 #include <ghostfx/sph/ParticleExchange.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/sph/RigidMotion.h>
+#include <ghostfx/sph/SampleStore.h>
 #include <ghostfx/sph/SolverState.h>
 
 #include <openvdb/math/Mat3.h>
@@ -178,6 +179,11 @@ public:
     /// solver's steps.
     void setExchange(sph::ParticleExchange* exchange, bool ownPart = false);
     sph::ParticleExchange* exchange() const { return mExchange; }
+
+    /// Take the samples of solids and liquid bodies from `store` when it holds them, and keep
+    /// new ones there (sph::SampleStore: the same samples, bit for bit, without sampling
+    /// again). Call before adding solids and liquid; the store must outlive them. Null: none.
+    void setSampleStore(sph::SampleStore* store) { mSampleStore = store; }
 
     /// Everything that decides how the run continues, as a SolverState with solver name
     /// methodName(method): all particles and channels, and
@@ -314,6 +320,7 @@ private:
         return mExchange ? mParticles.scalarChannel(sph::HALO_CHANNEL).data() : nullptr;
     }
 
+    sph::SampleStore* mSampleStore = nullptr;
     GhostSettings mSettings;
     sph::CubicSplineKernel mKernel;
     ParticleSet mParticles;         ///< liquid and ghost air

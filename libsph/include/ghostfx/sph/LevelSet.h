@@ -54,6 +54,9 @@ public:
     Real bandWidth() const;
     /// World-space box enclosing every active voxel (m).
     Aabb bounds() const;
+    /// A 64-bit hash of everything phi() reads: every voxel and tile value with its active
+    /// state and place, the background and the transform (SampleStore keys).
+    std::uint64_t contentHash() const;
 
     /// Signed distance (m), negative inside. Trilinear; clamped to +/- bandWidth() beyond the band.
     Real phi(const Vec3& x) const;

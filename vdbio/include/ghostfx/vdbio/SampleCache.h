@@ -1,0 +1,43 @@
+/// @file   SampleCache.h
+/// @brief  A folder of sampled shapes (sph::SampleStore on disk), for `ghostfx run
+///         --sample-cache DIR` and $GHOSTFX_SAMPLE_CACHE.
+/// @details One file per key, `<16 hex digits>.gfxsamples`: an 8-byte magic "GFXSMP01", the
+///          size of Real (4 or 8), the key, the sample count, then the positions (3 Reals each)
+///          and the surface flags (one byte each), little-endian as written. A file that does
+///          not match (another precision, a short or damaged file) is not used and is written
+///          again. Files are written atomically, so runs sharing a folder (a study's cases on
+///          a farm) never read half a file; the folder can be deleted at any time.
+#pragma once
+
+#include <ghostfx/sph/SampleStore.h>
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+namespace ghostfx {
+namespace vdbio {
+
+class SampleCache : public sph::SampleStore
+{
+public:
+    /// Creates `folder` if needed; IoError naming it when it cannot be written.
+    explicit SampleCache(std::string folder);
+
+    std::optional<sph::SampleSet> load(std::uint64_t key) override;
+    /// IoError naming the file when it cannot be written.
+    void store(std::uint64_t key, const sph::SampleSet& samples) override;
+
+    const std::string& folder() const { return mFolder; }
+    std::string pathOf(std::uint64_t key) const;
+    /// Shapes loaded, and shapes sampled and stored, so far.
+    std::uint64_t hits() const { return mHits; }
+    std::uint64_t stored() const { return mStored; }
+
+private:
+    std::string mFolder;
+    std::atomic<std::uint64_t> mHits{0}, mStored{0};
+};
+
+} // namespace vdbio
+} // namespace ghostfx
