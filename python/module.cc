@@ -516,5 +516,24 @@ PYBIND11_MODULE(_ghostfx, m)
         "Poisson-disk samples ([SB12] Sec. 4.5) of the level set `grid` in the .vdb `file` at "
         "particle spacing `spacing` (m): an (N, 3) float64 array");
 
+    m.def(
+        "set_sample_cache",
+        [](const std::string& folder) {
+        cmd::setProcessSampleCache(folder);
+        if (!folder.empty()) cmd::processSampleCache(); // the folder's errors now, not later
+        },
+        py::arg("folder"),
+        "Keep the Poisson-disk samples of solids and liquid bodies in `folder` and take them from "
+        "it when the same shape is sampled again (as `ghostfx run --sample-cache`): the same "
+        "results, bit for bit, without sampling again. \"\" turns it off (also "
+        "$GHOSTFX_SAMPLE_CACHE, read when no folder was set).");
+    m.def(
+        "sample_cache_counts",
+        []() {
+        const vdbio::SampleCache* cache = cmd::processSampleCache();
+        return py::make_tuple(cache ? cache->hits() : 0, cache ? cache->stored() : 0);
+        },
+        "(shapes loaded, shapes sampled and kept) by this process's sample cache so far");
+
     m.attr("__version__") = GHOSTFX_VERSION;
 }

@@ -17,8 +17,10 @@ import tempfile as _tempfile
 
 from ._ghostfx import LevelSet, Scene, Simulation, sample, __version__
 from ._ghostfx import load_scene as _load_scene_file
+from ._ghostfx import sample_cache_counts, set_sample_cache
 
-__all__ = ["LevelSet", "Scene", "Simulation", "load_scene", "sample", "study", "__version__"]
+__all__ = ["LevelSet", "Scene", "Simulation", "load_scene", "sample", "sample_cache_counts",
+           "set_sample_cache", "study", "__version__"]
 
 
 def load_scene(scene, overrides=None, folder=None):

@@ -397,3 +397,23 @@ def test_shipped_plume_fast_and_ambient_rise_alike_with_default_settings():
     # The baseline keeps emitting: its visible gas grows through the run (it stopped at 143
     # particles before its sources filled their free room).
     assert ambient[-1, 0] > 5 * ambient[0, 0]
+
+
+def test_sample_cache_gives_the_same_particles_without_sampling_again(tmp_path):
+    # The same scene set up twice through the cache: the second set-up loads the tank and the
+    # water (2 shapes) and its particles are the first's, bit for bit.
+    ghostfx.set_sample_cache(str(tmp_path / "cache"))
+    try:
+        scene = ghostfx.load_scene(DAM, {"settings.frame_range": [1, 1]})
+        first = ghostfx.Simulation(scene).positions("liquid")
+        loaded_before, kept = ghostfx.sample_cache_counts()
+        assert kept >= 2
+        second = ghostfx.Simulation(scene).positions("liquid")
+        loaded, kept_after = ghostfx.sample_cache_counts()
+        assert loaded - loaded_before == 2 and kept_after == kept
+        assert np.array_equal(first, second)
+    finally:
+        ghostfx.set_sample_cache("")
+    with pytest.raises(OSError, match="sample cache folder"):
+        ghostfx.set_sample_cache("/proc/version/cache")
+    ghostfx.set_sample_cache("")
