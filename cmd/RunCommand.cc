@@ -439,6 +439,13 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     if (const vdbio::SampleCache* cache = processSampleCache()) {
         progress.message(msg("sample cache '", cache->folder(), "': ", cache->hits(),
                              " shapes loaded, ", cache->stored(), " sampled and kept"));
+        if (cache->failures() > 0 && writes) {
+            std::fprintf(stderr,
+                         "ghostfx: warning: sample cache: %llu shapes could not be kept "
+                         "(%s); the run goes on without them\n",
+                         static_cast<unsigned long long>(cache->failures()),
+                         cache->firstFailure().c_str());
+        }
     }
     if (startFrame >= last) {
         progress.message(msg("nothing to do: the checkpoint is at frame ", startFrame,

@@ -78,6 +78,14 @@ TEST(SampleCache, TheSameShapeAndSettingsComeFromTheCacheBitForBit)
     EXPECT_EQ(cache.stored(), 3u);
     EXPECT_TRUE(sameSamples(sampleVolumeStored(settings, ball, &cache), fresh));
     EXPECT_EQ(cache.hits(), 2u);
+
+    // A cache that cannot keep a shape (its folder removed since) costs the time, nothing else.
+    vdbio::SampleCache gone((dir / "gone").string());
+    fs::remove_all(dir / "gone");
+    EXPECT_TRUE(sameSamples(sampleVolumeStored(settings, ball, &gone), fresh));
+    EXPECT_EQ(gone.failures(), 1u);
+    EXPECT_EQ(gone.stored(), 0u);
+    EXPECT_NE(gone.firstFailure().find("gone"), std::string::npos) << gone.firstFailure();
 }
 
 TEST(SampleCache, ALiquidSolverSetUpThroughTheCacheStepsAsOneWithout)

@@ -69,21 +69,34 @@ void SampleCache::store(std::uint64_t key, const sph::SampleSet& samples)
 {
     static_assert(sizeof(sph::Vec3) == 3 * sizeof(sph::Real), "Vec3 is three packed Reals");
     const std::string path = pathOf(key);
-    writeAtomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        const std::uint32_t realSize = sizeof(sph::Real);
-        const std::uint64_t count = samples.size();
-        out.write(MAGIC, 8);
-        out.write(reinterpret_cast<const char*>(&realSize), sizeof realSize);
-        out.write(reinterpret_cast<const char*>(&key), sizeof key);
-        out.write(reinterpret_cast<const char*>(&count), sizeof count);
-        out.write(reinterpret_cast<const char*>(samples.positions.data()),
-                  std::streamsize(count * sizeof(sph::Vec3)));
-        out.write(reinterpret_cast<const char*>(samples.onSurface.data()), std::streamsize(count));
-        out.close();
-        if (!out) throw IoError(msg("sample cache file '", path, "': write failed"));
-    });
+    try {
+        writeAtomically(path, [&](const std::string& tmp) {
+            std::ofstream out(tmp, std::ios::binary);
+            const std::uint32_t realSize = sizeof(sph::Real);
+            const std::uint64_t count = samples.size();
+            out.write(MAGIC, 8);
+            out.write(reinterpret_cast<const char*>(&realSize), sizeof realSize);
+            out.write(reinterpret_cast<const char*>(&key), sizeof key);
+            out.write(reinterpret_cast<const char*>(&count), sizeof count);
+            out.write(reinterpret_cast<const char*>(samples.positions.data()),
+                      std::streamsize(count * sizeof(sph::Vec3)));
+            out.write(reinterpret_cast<const char*>(samples.onSurface.data()),
+                      std::streamsize(count));
+            out.close();
+            if (!out) throw IoError(msg("sample cache file '", path, "': write failed"));
+        });
+    } catch (const Error& e) {
+        std::lock_guard<std::mutex> lock(mMutex);
+        if (mFailures++ == 0) mFirstFailure = e.what();
+        return;
+    }
     ++mStored;
+}
+
+std::string SampleCache::firstFailure() const
+{
+    std::lock_guard<std::mutex> lock(mMutex);
+    return mFirstFailure;
 }
 
 } // namespace vdbio

@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <mutex>
 #include <string>
 
 namespace ghostfx {
@@ -25,7 +26,8 @@ public:
     explicit SampleCache(std::string folder);
 
     std::optional<sph::SampleSet> load(std::uint64_t key) override;
-    /// IoError naming the file when it cannot be written.
+    /// Best effort: a file that cannot be written (a full disk, a folder gone) is counted in
+    /// failures() and the run goes on; the cache only saves time.
     void store(std::uint64_t key, const sph::SampleSet& samples) override;
 
     const std::string& folder() const { return mFolder; }
@@ -33,10 +35,15 @@ public:
     /// Shapes loaded, and shapes sampled and stored, so far.
     std::uint64_t hits() const { return mHits; }
     std::uint64_t stored() const { return mStored; }
+    /// Shapes that could not be kept, and why the first could not.
+    std::uint64_t failures() const { return mFailures; }
+    std::string firstFailure() const;
 
 private:
     std::string mFolder;
-    std::atomic<std::uint64_t> mHits{0}, mStored{0};
+    std::atomic<std::uint64_t> mHits{0}, mStored{0}, mFailures{0};
+    mutable std::mutex mMutex;
+    std::string mFirstFailure;
 };
 
 } // namespace vdbio
