@@ -228,9 +228,8 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
         solidV = &set.addVectorChannel(SOLID_VELOCITY);
     }
     // Solid particles take their ids from the same counter as the liquid, so ids stay unique
-    // across the sets.
-    // Over several processes every one samples the same solid: its particles take the same
-    // ids everywhere, above every id any process has given.
+    // across the sets. Over several processes every one samples the same solid: its particles
+    // take the same ids everywhere, above every id any process has given.
     ParticleId firstId = std::max(set.nextId(), mParticles.nextId());
     if (mExchange) firstId = ParticleId(mExchange->maxOf(double(firstId)));
     set.setNextId(firstId);
