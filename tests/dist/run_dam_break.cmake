@@ -43,3 +43,18 @@ foreach(resumed three merged split)
                     ${OUT}/two/liquid_points.0004.vdb
                     ${OUT}/${resumed}/liquid_points.0004.vdb 0.003 0.03)
 endforeach()
+
+# `ghostfx info` on the manifest: every process's part and the whole simulation's liquid, which
+# is the frame files' (a closed tank: no liquid enters or leaves).
+execute_process(COMMAND ${GHOSTFX} info ${OUT}/two/checkpoint.0002.ranks.json
+                RESULT_VARIABLE code OUTPUT_VARIABLE info ERROR_VARIABLE err)
+message("ghostfx info on the manifest:\n${info}")
+string(REGEX MATCH "whole simulation: [^\n]* ([0-9]+) liquid" whole "${info}")
+set(infoLiquid ${CMAKE_MATCH_1})
+string(REGEX MATCH "liquid_points.0004.vdb: ([0-9]+) particles" frame "${compared}")
+set(frameLiquid ${CMAKE_MATCH_1})
+if(NOT code EQUAL 0 OR NOT info MATCHES "written by 2 processes" OR NOT whole
+   OR NOT infoLiquid EQUAL frameLiquid)
+    message(FATAL_ERROR "ghostfx info on the manifest (${code}; liquid ${infoLiquid} against "
+                        "the frame file's ${frameLiquid}): ${info}${err}")
+endif()
