@@ -417,6 +417,7 @@ struct StudyOptions
     bool collect = false;
     std::string emit;
     bool replot = false;
+    std::string sampleCache; ///< absolute once runStudy has started (LiquidScene.h)
 };
 
 std::string outputFolder(const StudyOptions& o, const StudySpec& spec)
@@ -986,14 +987,16 @@ std::string shellQuoted(const std::string& s)
 
 /// The command a farm runs for case k: absolute paths, since a farm job starts elsewhere.
 std::string caseCommand(const StudySpec& spec, std::size_t k, const std::string& program,
-                        const std::string& folder, const std::string& threads)
+                        const std::string& folder, const std::string& threads,
+                        const std::string& sampleCache)
 {
     // A relative program (an "executables" entry such as build-double/cmd/ghostfx) is taken
     // from where the study was listed; a bare name is left to the farm node's PATH.
     const bool path = program.find('/') != std::string::npos;
     return msg(shellQuoted(path ? fs::absolute(program).lexically_normal().string() : program),
                " study ", shellQuoted(fs::absolute(spec.file).string()), " --case ", k, " --out ",
-               shellQuoted(fs::absolute(folder).string()), " --threads ", threads);
+               shellQuoted(fs::absolute(folder).string()), " --threads ", threads,
+               sampleCache.empty() ? std::string() : " --sample-cache " + shellQuoted(sampleCache));
 }
 
 /// This program's own file (not /proc/self/exe: a farm node runs the command elsewhere).
@@ -1026,10 +1029,10 @@ int listCases(const StudyOptions& o, const StudySpec& spec)
                 spec.cases.size(), collect.c_str());
     for (std::size_t k = 0; k < spec.cases.size(); ++k) {
         const StudyCase& c = spec.cases[k];
-        std::printf(
-            "%zu\t%s\t%s\n", k, c.label.empty() ? "base scene" : c.label.c_str(),
-            caseCommand(spec, k, programFor(spec, c, self), folder, std::to_string(o.threads))
-                .c_str());
+        std::printf("%zu\t%s\t%s\n", k, c.label.empty() ? "base scene" : c.label.c_str(),
+                    caseCommand(spec, k, programFor(spec, c, self), folder,
+                                std::to_string(o.threads), o.sampleCache)
+                        .c_str());
     }
     return 0;
 }
@@ -1070,10 +1073,10 @@ int emitSlurm(const StudyOptions& o, const StudySpec& spec)
              + "}\n"
                "case \"${SLURM_ARRAY_TASK_ID:?run this script with sbatch (an array job)}\" in\n";
     for (std::size_t k = 0; k < spec.cases.size(); ++k) {
-        cases +=
-            msg("  ", k, ") exec ",
-                caseCommand(spec, k, programFor(spec, spec.cases[k], self), folder, "\"$threads\""),
-                " > ", shellQuoted(logPath(folder, k)), " 2>&1 ;;\n");
+        cases += msg("  ", k, ") exec ",
+                     caseCommand(spec, k, programFor(spec, spec.cases[k], self), folder,
+                                 "\"$threads\"", o.sampleCache),
+                     " > ", shellQuoted(logPath(folder, k)), " 2>&1 ;;\n");
     }
     cases += "  *) echo \"no case $SLURM_ARRAY_TASK_ID in this study\" >&2; exit 1 ;;\nesac\n";
     write((fs::path(slurm) / "cases.sbatch").string(), cases);
@@ -1144,8 +1147,16 @@ int collectStudy(const StudyOptions& o, const StudySpec& spec)
     return finishStudy(o, spec, outcomes, folder);
 }
 
-int runStudy(const StudyOptions& o)
+int runStudy(const StudyOptions& options)
 {
+    // One sample cache for every case: this process's, the child processes' (through the
+    // environment) and the farm commands' (--list, --emit), by its absolute path.
+    StudyOptions o = options;
+    if (!o.sampleCache.empty()) {
+        o.sampleCache = fs::absolute(o.sampleCache).lexically_normal().string();
+        setProcessSampleCache(o.sampleCache);
+        ::setenv("GHOSTFX_SAMPLE_CACHE", o.sampleCache.c_str(), 1);
+    }
     const StudySpec spec = readStudy(o.study);
     if (int(o.caseIndex >= 0) + int(o.list) + int(o.collect) + int(!o.emit.empty()) + int(o.replot)
         > 1) {
@@ -1234,6 +1245,10 @@ Command addStudyCommand(CLI::App& parent)
                   "write job scripts for a farm into the output folder: slurm (an sbatch "
                   "--array job, a collect job and submit.sh)")
         ->check(CLI::IsMember({"slurm"}));
+    c->add_option("--sample-cache", o->sampleCache,
+                  "one sample cache folder for every case (ghostfx run --sample-cache): a shape "
+                  "sampled by one case is loaded by the others; also written into the commands "
+                  "of --list and --emit");
     return {c, [o] { return runStudy(*o); }};
 }
 

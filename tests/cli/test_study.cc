@@ -442,3 +442,33 @@ TEST_F(Study, CasesRunAsSeparateJobsInAnyOrderThenCollectGiveTheLocalTable)
         << changed.err;
     EXPECT_NE(changed.err.find("the study changed since the case ran"), std::string::npos);
 }
+
+TEST_F(Study, CasesShareOneSampleCache)
+{
+    // Three stiffnesses of the same drop: the first case samples the drop and keeps it, the
+    // others load it (one file in the cache), and the farm commands carry the folder.
+    Json s = baseStudy();
+    s["sweep"] = Json::parse(R"({ "settings.stiffness": [1000, 2000, 4000] })");
+    const std::string study = writeStudy(s).string();
+    const fs::path cache = mDir / "cache";
+    const Result r =
+        run("study " + study + " --threads 1 --sample-cache " + cache.string() + " -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(cache))
+        files += entry.path().extension() == ".gfxsamples";
+    EXPECT_EQ(files, 1u);
+    const auto rows = readCsv(mDir / "out" / "study.csv");
+    ASSERT_EQ(rows.size(), 3u);
+    for (const auto& row : rows) EXPECT_EQ(row.at("status"), "ok");
+
+    const fs::path listed = mDir / "list.txt";
+    ASSERT_EQ(std::system((std::string(GHOSTFX_EXE) + " study " + study + " --list --sample-cache "
+                           + cache.string() + " > " + listed.string())
+                              .c_str()),
+              0);
+    const std::string list = slurp(listed);
+    EXPECT_NE(list.find("--case 2 "), std::string::npos) << list;
+    EXPECT_NE(list.find("--sample-cache '" + fs::absolute(cache).string() + "'"), std::string::npos)
+        << list;
+}
