@@ -506,6 +506,10 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     // Over several processes, rank 0 writes the rows combined from every process's.
     std::unique_ptr<vdbio::StatsWriter> stats;
     const bool combineStats = !out.statsFile.empty() && distributed;
+    if (distributed && out.pointGhosts && !out.pointsFile.empty()) {
+        progress.message("note: outputs.points.ghosts: over several processes the points files "
+                         "hold the liquid only (the ghosts stay with their processes)");
+    }
     if (!out.statsFile.empty() && writes) {
         const std::string h5 = inFolder(out.statsFile, 0);
         const std::string csv = (fs::path(h5).replace_extension(".csv")).string();
