@@ -3,8 +3,8 @@
 /// @details Every process reads the scene and builds the same simulation and first state; the
 ///          domain is then cut into slabs balanced by particle count (sph::DomainDecomposition),
 ///          each process keeps its slab's particles and exchanges halos with its neighbours
-///          every step (dist::MpiExchange). Rank 0 writes the frames from every rank's liquid,
-///          gathered per frame. Built with GHOSTFX_MPI; a build without it refuses to run as
+///          every step (dist::MpiExchange). Each process builds its region's part of every
+///          frame grid and rank 0 merges and writes them (DistributedFrames.h). Built with GHOSTFX_MPI; a build without it refuses to run as
 ///          more than one process (each would write the same files).
 #pragma once
 
@@ -66,8 +66,8 @@ public:
     /// one to resume from. Collective.
     virtual std::string writeCheckpoint(const std::string& h5Path, const Simulation& sim,
                                         const std::string& fingerprint, int frame) = 0;
-    /// Every process's liquid for the frame's outputs, on rank 0; elsewhere an empty snapshot.
-    /// Collective: every process calls it for every frame.
+    /// The frame's grids built in pieces and merged (DistributedFrames.h), on rank 0 with no
+    /// particles; elsewhere an empty snapshot. Collective: every process calls it every frame.
     virtual FrameSnapshot snapshot(const vdbio::SceneOutputs& outputs, const Simulation& sim,
                                    int frame) = 0;
     /// "N liquid, M air on R processes" summed over the processes. Collective.

@@ -2,6 +2,8 @@
 /// @brief  DistributedRun over MPI (built with GHOSTFX_MPI).
 #include "DistributedRun.h"
 
+#include "DistributedFrames.h"
+
 #include <ghostfx/dist/MpiExchange.h>
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
@@ -69,19 +71,28 @@ public:
         return manifest;
     }
 
-    FrameSnapshot snapshot(const vdbio::SceneOutputs& /*outputs*/, const Simulation& sim,
+    FrameSnapshot snapshot(const vdbio::SceneOutputs& outputs, const Simulation& sim,
                            int frame) override
     {
         FrameSnapshot s;
         s.frame = frame;
         s.time = sim.time();
         for (OutputMedium m : sim.media()) {
-            auto all = std::make_shared<sph::ParticleSet>(mExchange->gather(*m.particles, m.kinds));
+            const bool points = !(m.liquid ? outputs.pointsFile : outputs.gasPointsFile).empty();
+            const bool volumes = !(m.liquid ? outputs.volumeFile : outputs.gasVolumeFile).empty();
+            const vdbio::PointsOptions po = pointsOptions(m, outputs);
+            const vdbio::VolumeOptions vo = volumeOptions(m, outputs);
+            BuiltGrids built =
+                buildFrameGrids(*mExchange, *m.particles, m.kinds, points ? &po : nullptr,
+                                volumes ? &vo : nullptr, &mPieceCounts);
             if (!root()) continue;
-            s.particles.push_back(all);
-            m.particles = all.get();
-            m.withGhosts = nullptr; // the ghosts stay with their processes
+            // The writer reads the grids; the particles stay with their processes.
+            auto none = std::make_shared<const sph::ParticleSet>();
+            s.particles.push_back(none);
+            m.particles = none.get();
+            m.withGhosts = nullptr;
             s.media.push_back(std::move(m));
+            s.built.push_back(std::move(built));
         }
         return s;
     }
@@ -106,7 +117,11 @@ public:
             std::size_t(mExchange->sumOf(liquid)), " liquid, ", std::size_t(mExchange->sumOf(air)),
             " air on ", ranks(), " processes (the largest part ",
             int(std::lround(100 * largest / std::max(1.0, all))), " %; ", mExchange->migrated(),
-            " particles migrated and ", mExchange->rebalances(), " rebalances seen by this one)");
+            " particles migrated and ", mExchange->rebalances(), " rebalances seen by this one",
+            mPieceCounts.own ? msg("; the last frame's pieces copied ", mPieceCounts.copies,
+                                   " particles between processes")
+                             : std::string(),
+            ")");
     }
 
     bool any(bool yes) override { return mExchange->maxOf(yes ? 1.0 : 0.0) > 0; }
@@ -116,6 +131,7 @@ public:
 private:
     dist::MpiSession mSession;
     std::unique_ptr<dist::MpiExchange> mExchange;
+    FramePieceCounts mPieceCounts;
 };
 
 } // namespace

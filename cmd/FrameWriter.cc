@@ -1,8 +1,59 @@
 /// @file   FrameWriter.cc
 #include "FrameWriter.h"
 
+#include <ghostfx/sph/Exceptions.h>
+
+#include <algorithm>
+
 namespace ghostfx {
 namespace cmd {
+
+vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out)
+{
+    vdbio::PointsOptions po;
+    po.channels = m.liquid ? out.pointChannels : out.gasPointChannels;
+    po.kinds = m.kinds;
+    if (out.pointGhosts && !m.ghostKinds.empty()) {
+        po.kinds.insert(po.kinds.end(), m.ghostKinds.begin(), m.ghostKinds.end());
+        if (std::find(po.channels.begin(), po.channels.end(), "kind") == po.channels.end()) {
+            po.channels.push_back("kind");
+        }
+    }
+    return po;
+}
+
+vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutputs& out)
+{
+    const std::vector<std::string>& wanted = m.liquid ? out.volumeGrids : out.gasVolumeGrids;
+    auto wants = [&](const char* g) {
+        return std::find(wanted.begin(), wanted.end(), g) != wanted.end();
+    };
+    vdbio::VolumeOptions vo;
+    // The liquid's surface at h / 2 by default; the gathered grids (the gas has no surface) at
+    // h (VolumeOptions::densityVoxelSize says what that keeps).
+    if (m.liquid) {
+        vo.voxelSize = out.voxelSize > 0 ? out.voxelSize : 0.5 * m.spacing;
+        vo.densityVoxelSize = out.densityVoxelSize;
+    } else {
+        vo.voxelSize = vo.densityVoxelSize = out.gasVoxelSize > 0 ? out.gasVoxelSize : m.spacing;
+    }
+    vo.kernelSupport = m.support;
+    vo.restDensity = m.restDensity;
+    vo.particleSpacing = m.spacing;
+    vo.kinds = m.kinds;
+    vo.surface = m.liquid && wants("surface");
+    vo.surfaceMethod = out.surfaceMethod;
+    vo.density = wants("density");
+    vo.velocity = wants("vel");
+    if (wants("temperature")) {
+        if (!m.particles->hasScalarChannel("temperature")) {
+            throw SceneError(msg("outputs: grid 'temperature' asked for, but the ", m.name,
+                                 " particles carry no temperature in this scene"));
+        }
+        vo.scalarChannels.push_back("temperature");
+    }
+    return vo;
+}
 
 FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation& sim, int frame)
 {

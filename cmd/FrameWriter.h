@@ -12,6 +12,7 @@
 
 #include "Simulation.h"
 
+#include <ghostfx/vdbio/FrameFiles.h>
 #include <ghostfx/vdbio/ScenePreview.h>
 
 #include <condition_variable>
@@ -26,14 +27,31 @@
 namespace ghostfx {
 namespace cmd {
 
-/// What one frame's outputs need, owned: the media with copies of their particles.
+/// A medium's points and volume grids built before they reach the writer: a run over several
+/// processes merges them from every process's piece (DistributedRun::snapshot).
+struct BuiltGrids
+{
+    openvdb::GridBase::Ptr points; ///< the "particles" PointDataGrid, or null: none written
+    openvdb::GridPtrVec volumes;   ///< the volume file's grids (the preview draws them)
+};
+
+/// What one frame's outputs need, owned: the media with copies of their particles, or their
+/// grids already built.
 struct FrameSnapshot
 {
     int frame = 0;
     double time = 0; ///< s
     std::vector<OutputMedium> media;
     std::vector<std::shared_ptr<const sph::ParticleSet>> particles; ///< what `media` point to
+    /// Per medium where its grids were built before the snapshot, else empty: the writer
+    /// builds them from the particles.
+    std::vector<BuiltGrids> built;
 };
+
+/// The options a medium's points and volume outputs are built with, from the scene's outputs
+/// (the liquid's surface at h / 2 unless the scene says otherwise, its gathered grids at h).
+vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
+vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
 
 /// Copy what the scene's outputs of `frame` read from `sim` (with the ghosts only where the
 /// points output asks for them).

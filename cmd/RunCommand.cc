@@ -233,58 +233,23 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
 }
 
 /// Write one medium's points and volume files for `frame`; returns its grids (for previews).
+/// `built`: the grids already built (a run over several processes), else built here.
 openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
                                 const std::string& pointsPath, const std::string& volumePath,
-                                const openvdb::MetaMap& fileMeta)
+                                const openvdb::MetaMap& fileMeta, const BuiltGrids* built)
 {
-    const std::vector<std::string>& channels = m.liquid ? out.pointChannels : out.gasPointChannels;
     if (!pointsPath.empty()) {
-        vdbio::PointsOptions po;
-        po.channels = channels;
-        po.kinds = m.kinds;
-        if (out.pointGhosts && !m.ghostKinds.empty()) {
-            po.kinds.insert(po.kinds.end(), m.ghostKinds.begin(), m.ghostKinds.end());
-            if (std::find(po.channels.begin(), po.channels.end(), "kind") == po.channels.end()) {
-                po.channels.push_back("kind");
-            }
-        }
-        if (out.pointGhosts && m.withGhosts) {
-            vdbio::writePointsFile(pointsPath, m.withGhosts(), po, fileMeta);
+        if (built) {
+            vdbio::writePointsGridFile(pointsPath, built->points, fileMeta);
+        } else if (out.pointGhosts && m.withGhosts) {
+            vdbio::writePointsFile(pointsPath, m.withGhosts(), pointsOptions(m, out), fileMeta);
         } else {
-            vdbio::writePointsFile(pointsPath, *m.particles, po, fileMeta);
+            vdbio::writePointsFile(pointsPath, *m.particles, pointsOptions(m, out), fileMeta);
         }
     }
-    openvdb::GridPtrVec grids;
-    if (volumePath.empty()) return grids;
-    const std::vector<std::string>& wanted = m.liquid ? out.volumeGrids : out.gasVolumeGrids;
-    auto wants = [&](const char* g) {
-        return std::find(wanted.begin(), wanted.end(), g) != wanted.end();
-    };
-    vdbio::VolumeOptions vo;
-    // The liquid's surface at h / 2 by default; the gathered grids (the gas has no surface) at
-    // h (VolumeOptions::densityVoxelSize says what that keeps).
-    if (m.liquid) {
-        vo.voxelSize = out.voxelSize > 0 ? out.voxelSize : 0.5 * m.spacing;
-        vo.densityVoxelSize = out.densityVoxelSize;
-    } else {
-        vo.voxelSize = vo.densityVoxelSize = out.gasVoxelSize > 0 ? out.gasVoxelSize : m.spacing;
-    }
-    vo.kernelSupport = m.support;
-    vo.restDensity = m.restDensity;
-    vo.particleSpacing = m.spacing;
-    vo.kinds = m.kinds;
-    vo.surface = m.liquid && wants("surface");
-    vo.surfaceMethod = out.surfaceMethod;
-    vo.density = wants("density");
-    vo.velocity = wants("vel");
-    if (wants("temperature")) {
-        if (!m.particles->hasScalarChannel("temperature")) {
-            throw SceneError(msg("outputs: grid 'temperature' asked for, but the ", m.name,
-                                 " particles carry no temperature in this scene"));
-        }
-        vo.scalarChannels.push_back("temperature");
-    }
-    grids = vdbio::makeVolumeGrids(*m.particles, vo);
+    if (volumePath.empty()) return {};
+    const openvdb::GridPtrVec grids =
+        built ? built->volumes : vdbio::makeVolumeGrids(*m.particles, volumeOptions(m, out));
     vdbio::writeVolumeFile(volumePath, grids, fileMeta);
     return grids;
 }
@@ -312,9 +277,11 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
     bool namedGridFound = false;
     for (const OutputMedium& m : snapshot.media) {
         const bool liquid = m.liquid;
+        const std::size_t index = std::size_t(&m - snapshot.media.data());
         const openvdb::GridPtrVec grids =
             writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile),
-                        inFolder(liquid ? out.volumeFile : out.gasVolumeFile), fileMeta);
+                        inFolder(liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
+                        index < snapshot.built.size() ? &snapshot.built[index] : nullptr);
         if (out.previewFile.empty()) continue;
         // outputs.preview.grid where the medium has it, else the medium's default.
         std::vector<std::string> wanted = liquid ? std::vector<std::string>{"surface", "density"}

@@ -454,6 +454,69 @@ ParticleSet MpiExchange::gather(const ParticleSet& set, const std::vector<Partic
     return out;
 }
 
+ParticleSet MpiExchange::surroundings(const ParticleSet& set,
+                                      const std::vector<ParticleKind>& kinds, Real width,
+                                      std::size_t* own) const
+{
+    const std::vector<Real>* halo =
+        set.hasScalarChannel(HALO_CHANNEL) ? &set.scalarChannel(HALO_CHANNEL) : nullptr;
+    std::vector<Index> mine;
+    std::vector<std::vector<Index>> rows(static_cast<std::size_t>(mRanks));
+    for (std::size_t i = 0; i < set.size(); ++i) {
+        if (halo && (*halo)[i] != Real(0)) continue;
+        if (std::find(kinds.begin(), kinds.end(), set.kinds()[i]) == kinds.end()) continue;
+        mine.push_back(Index(i));
+        // A particle that moved into another region since the last exchange is still this
+        // rank's; forEachHaloPart leaves out the region it lies in, so that one is added here.
+        const int at = mParts.owner(set.positions()[i]);
+        if (at != mRank) rows[std::size_t(at)].push_back(Index(i));
+        mParts.forEachHaloPart(set.positions()[i], width, [&](int q) {
+            if (q != mRank) rows[std::size_t(q)].push_back(Index(i));
+        });
+    }
+    std::vector<std::vector<char>> bytes(static_cast<std::size_t>(mRanks));
+    for (int q = 0; q < mRanks; ++q) {
+        if (!rows[std::size_t(q)].empty())
+            packRows(set, rows[std::size_t(q)], bytes[std::size_t(q)]);
+    }
+    const std::vector<std::vector<char>> received = allToAll(bytes);
+    std::vector<char> ownBytes;
+    packRows(set, mine, ownBytes);
+    ParticleSet out = unpackRows(ownBytes);
+    if (own) *own = out.size();
+    for (const auto& message : received) {
+        if (!message.empty()) out.append(unpackRows(message));
+    }
+    if (out.hasScalarChannel(HALO_CHANNEL)) out.removeChannel(HALO_CHANNEL);
+    return out;
+}
+
+void MpiExchange::collect(const std::string& mine,
+                          const std::function<void(int, const std::string&)>& fn, int root) const
+{
+    constexpr int SIZE_TAG = 7101, BYTES_TAG = 7102;
+    if (mine.size() > std::size_t(std::numeric_limits<int>::max()))
+        throw Error(msg("MPI collect: ", mine.size(), " bytes from one rank (at most 2 GB)"));
+    if (mRank != root) {
+        const long long n = (long long)mine.size();
+        check(MPI_Send(&n, 1, MPI_LONG_LONG, root, SIZE_TAG, mComm), "MPI_Send (size)");
+        check(MPI_Send(mine.data(), int(n), MPI_BYTE, root, BYTES_TAG, mComm), "MPI_Send");
+        return;
+    }
+    fn(mRank, mine);
+    std::string theirs;
+    for (int q = 0; q < mRanks; ++q) {
+        if (q == root) continue;
+        long long n = 0;
+        check(MPI_Recv(&n, 1, MPI_LONG_LONG, q, SIZE_TAG, mComm, MPI_STATUS_IGNORE),
+              "MPI_Recv (size)");
+        theirs.assign(std::size_t(n), '\0');
+        check(MPI_Recv(theirs.data(), int(n), MPI_BYTE, q, BYTES_TAG, mComm, MPI_STATUS_IGNORE),
+              "MPI_Recv");
+        fn(q, theirs);
+    }
+}
+
 std::vector<Vec3> MpiExchange::allPositions(const std::vector<Vec3>& mine)
 {
     const int n = int(mine.size() * 3);

@@ -104,11 +104,20 @@ void PointsOptions::validate() const
     }
 }
 
-void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
-                     const PointsOptions& options, const openvdb::MetaMap& fileMetadata)
+double autoPointsVoxelSize(const std::vector<sph::Vec3>& positions)
+{
+    std::vector<openvdb::Vec3d> x(positions.size());
+    for (std::size_t k = 0; k < x.size(); ++k)
+        x[k] = openvdb::Vec3d(positions[k][0], positions[k][1], positions[k][2]);
+    return double(
+        openvdb::points::computeVoxelSize(openvdb::points::PointAttributeVector<openvdb::Vec3d>(x),
+                                          PointsOptions::AUTO_POINTS_PER_VOXEL));
+}
+
+openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
+                                      const PointsOptions& options, const std::string& where)
 {
     options.validate();
-    detail::checkOutputFolder(path, "points output");
     // Resolve every channel before any work, so a typo costs nothing.
     for (const std::string& name : options.channels) {
         bool builtin = false;
@@ -120,7 +129,7 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
                                            std::end(BUILTIN_CHANNELS));
         for (const std::string& n : particles.scalarChannelNames()) available.push_back(n);
         for (const std::string& n : particles.vectorChannelNames()) available.push_back(n);
-        throw ValueError(msg("points output '", path, "': channel '", name,
+        throw ValueError(msg(where, ": channel '", name,
                              "' not found: available: ", detail::joinNames(available)));
     }
 
@@ -191,8 +200,67 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
     for (sph::ParticleKind k : options.kinds)
         written += (written.empty() ? "" : ",") + std::string(sph::kindName(k));
     grid->insertMeta("kinds_written", openvdb::StringMetadata(written));
+    return grid;
+}
 
+openvdb::GridBase::Ptr mergePointsGrids(const std::vector<openvdb::GridBase::Ptr>& pieces)
+{
+    PointDataGrid::Ptr merged;
+    std::int64_t count = 0;
+    for (const openvdb::GridBase::Ptr& base : pieces) {
+        PointDataGrid::Ptr piece = openvdb::gridPtrCast<PointDataGrid>(base);
+        if (!piece) throw ValueError("points merge: a piece is not a PointDataGrid");
+        if (!merged) {
+            merged = piece;
+        } else if (!(piece->transform() == merged->transform())) {
+            throw ValueError("points merge: the pieces have different voxel sizes");
+        } else {
+            // Move the piece's leaves over: they must not overlap the merged ones.
+            std::vector<openvdb::Coord> origins;
+            for (auto leaf = piece->tree().cbeginLeaf(); leaf; ++leaf)
+                origins.push_back(leaf->origin());
+            for (const openvdb::Coord& origin : origins) {
+                if (merged->tree().probeConstLeaf(origin)) {
+                    throw ValueError(msg("points merge: two pieces hold the leaf at ", origin,
+                                         " (the pieces must own disjoint leaves)"));
+                }
+                auto* leaf = piece->tree().template stealNode<PointDataTree::LeafNodeType>(
+                    origin, openvdb::PointDataIndex32(0), false);
+                merged->tree().addLeaf(leaf);
+            }
+        }
+        if (auto c = piece->getMetadata<openvdb::Int64Metadata>("point_count")) count += c->value();
+    }
+    if (!merged) throw ValueError("points merge: no pieces");
+    // One descriptor for every leaf (each piece made its own, with the same attributes).
+    auto first = merged->tree().beginLeaf();
+    if (first) {
+        const auto descriptor = first->attributeSet().descriptorPtr();
+        for (auto leaf = merged->tree().beginLeaf(); leaf; ++leaf) {
+            if (!(leaf->attributeSet().descriptor() == *descriptor)) {
+                throw ValueError("points merge: the pieces carry different attributes");
+            }
+            leaf->resetDescriptor(descriptor);
+        }
+    }
+    merged->insertMeta("point_count", openvdb::Int64Metadata(count));
+    return merged;
+}
+
+void writePointsGridFile(const std::string& path, const openvdb::GridBase::ConstPtr& grid,
+                         const openvdb::MetaMap& fileMetadata)
+{
+    detail::checkOutputFolder(path, "points output");
     detail::writeVdbFile(path, "points output", openvdb::GridCPtrVec{grid}, fileMetadata);
+}
+
+void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
+                     const PointsOptions& options, const openvdb::MetaMap& fileMetadata)
+{
+    options.validate();
+    detail::checkOutputFolder(path, "points output");
+    writePointsGridFile(path, makePointsGrid(particles, options, msg("points output '", path, "'")),
+                        fileMetadata);
 }
 
 } // namespace vdbio

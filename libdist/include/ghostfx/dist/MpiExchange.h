@@ -20,6 +20,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -72,6 +73,21 @@ public:
     /// on rank `root` (rank order, each rank's in its own order); an empty set elsewhere.
     sph::ParticleSet gather(const sph::ParticleSet& set,
                             const std::vector<sph::ParticleKind>& kinds, int root = 0) const;
+
+    /// This rank's particles of `kinds` (halo copies excluded), then copies of every other
+    /// rank's within `width` of this rank's region, without the halo channel: what a frame's
+    /// piece for this region needs (DistributedFrames). `own` gets the count of the first part.
+    /// Collective.
+    sph::ParticleSet surroundings(const sph::ParticleSet& set,
+                                  const std::vector<sph::ParticleKind>& kinds, sph::Real width,
+                                  std::size_t* own = nullptr) const;
+
+
+    /// Every rank's `mine` handed to fn(rank, bytes) on rank `root`: the root's own first,
+    /// then the others' in rank order, one message in memory at a time; elsewhere fn is not
+    /// called. Collective.
+    void collect(const std::string& mine, const std::function<void(int, const std::string&)>& fn,
+                 int root = 0) const;
 
     const sph::DomainDecomposition& decomposition() const { return mParts; }
     /// Rebuild the parts when the owned counts' largest over mean passes this (default

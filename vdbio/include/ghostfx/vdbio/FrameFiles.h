@@ -79,6 +79,28 @@ void writePointsFile(const std::string& path, const sph::ParticleSet& particles,
                      const PointsOptions& options,
                      const openvdb::MetaMap& fileMetadata = openvdb::MetaMap());
 
+/// The PointDataGrid "particles" that writePointsFile writes (nothing written). `where`
+/// prefixes an unknown-channel error ("points output 'path'").
+/// @throw ValueError for a bad option or an unknown channel.
+openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
+                                      const PointsOptions& options,
+                                      const std::string& where = "points output");
+
+/// The voxel size PointsOptions::voxelSize = 0 picks for these positions (OpenVDB's
+/// points::computeVoxelSize at AUTO_POINTS_PER_VOXEL; 0.1 m for fewer than two).
+double autoPointsVoxelSize(const std::vector<sph::Vec3>& positions);
+
+/// Write a grid made by makePointsGrid or mergePointsGrids to `path` atomically.
+/// @throw IoError if the file cannot be written.
+void writePointsGridFile(const std::string& path, const openvdb::GridBase::ConstPtr& grid,
+                         const openvdb::MetaMap& fileMetadata = openvdb::MetaMap());
+
+/// One PointDataGrid from pieces made by makePointsGrid with the same options and voxel size
+/// whose leaves do not overlap (a run over several processes: each makes the leaves it owns,
+/// DistributedFrames.h). The leaves are moved out of the pieces; "point_count" is the sum.
+/// @throw ValueError for overlapping leaves, different voxel sizes or attributes, or no piece.
+openvdb::GridBase::Ptr mergePointsGrids(const std::vector<openvdb::GridBase::Ptr>& pieces);
+
 // ---------------------------------------------------------------------------------------------
 // Volumes
 // ---------------------------------------------------------------------------------------------
@@ -221,6 +243,31 @@ struct VolumeOptions
 /// @throw ValueError for a bad option or unknown channel.
 openvdb::GridPtrVec makeVolumeGrids(const sph::ParticleSet& particles,
                                     const VolumeOptions& options);
+
+/// The distance (m) from a selected particle beyond which it changes no voxel of the grids
+/// `options` asks for: a grid built from every particle within this reach of a region has the
+/// values of the grid built from all particles at every voxel centre in the region (used to
+/// build a frame in pieces, one per process: keepVoxelsIn, mergeVolumeGrids). A bound, not a
+/// measurement: the surface's union of spheres, its interior clean-up, the re-normalisation
+/// and band growth of each filter pass and offset step (two voxels each, plus one for a
+/// curvature stencil), and the density kernel's support (VolumeFile.cc says each term).
+double volumeReach(const VolumeOptions& options);
+
+/// Keep of each grid only the voxels whose centres lie in `region` (min <= x < max on each
+/// axis, the convention of sph::DomainDecomposition: a point on a cut belongs to the upper
+/// side); the rest is deactivated (leaves wholly outside dropped).
+void keepVoxelsIn(openvdb::GridPtrVec& grids, const sph::Aabb& region);
+
+/// The grids of several pieces cut by keepVoxelsIn from disjoint regions, as one list (the
+/// first piece's names, order, metadata and transforms): every piece's active values copied
+/// into fresh grids; level sets then get their inside and outside signs anew
+/// (tools::signedFloodFill). Grids of a name missing from the first piece are refused.
+/// @throw ValueError for pieces with different grid lists, types or transforms.
+openvdb::GridPtrVec mergeVolumeGrids(std::vector<openvdb::GridPtrVec> pieces);
+
+/// Grids as bytes (an OpenVDB stream) and back, to send them between processes.
+std::string gridsToBytes(const openvdb::GridPtrVec& grids);
+openvdb::GridPtrVec gridsFromBytes(const std::string& bytes);
 
 /// Write `grids` to `path` atomically, with `fileMetadata`. Each grid is stored at full float
 /// precision (saveFloatAsHalf off). Point grids are refused (ValueError): they go to their
