@@ -82,7 +82,6 @@ public:
                                   const std::vector<sph::ParticleKind>& kinds, sph::Real width,
                                   std::size_t* own = nullptr) const;
 
-
     /// Every rank's `mine` handed to fn(rank, bytes) on rank `root`: the root's own first,
     /// then the others' in rank order, one message in memory at a time; elsewhere fn is not
     /// called. Collective.
