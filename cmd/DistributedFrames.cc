@@ -17,29 +17,17 @@ namespace {
 /// Voxels per leaf edge of OpenVDB's standard trees, the points grid's among them.
 constexpr int LEAF_DIM = int(openvdb::FloatTree::LeafNodeType::DIM);
 
-/// A particle lies within this many voxels (per axis 7.5: its voxel is at most 7 past the
-/// leaf's first, plus half a voxel) of the centre of its leaf's first voxel.
-const double LEAF_REACH_VOXELS = 7.5 * std::sqrt(3.0) + 0.5;
-
-/// The rows of `near` whose points-grid leaf (voxel size of `xform`) this process owns.
-sph::ParticleSet ownedLeaves(const sph::ParticleSet& near, const openvdb::math::Transform& xform,
-                             const dist::MpiExchange& exchange)
+/// The process that owns the points-grid leaf (voxel size of `xform`) holding x: the one whose
+/// region holds the centre of the leaf's first voxel.
+int leafOwner(const sph::Vec3& x, const openvdb::math::Transform& xform,
+              const sph::DomainDecomposition& parts)
 {
     const double dx = xform.voxelSize()[0];
-    std::vector<std::uint8_t> other(near.size(), 0);
-    for (std::size_t i = 0; i < near.size(); ++i) {
-        const sph::Vec3& x = near.positions()[i];
-        // As OpenVDB buckets the point (PointsFile.cc passes positions in double).
-        const openvdb::Coord voxel =
-            xform.worldToIndexCellCentered(openvdb::Vec3d(x[0], x[1], x[2]));
-        const openvdb::Coord origin = voxel & ~(LEAF_DIM - 1);
-        const sph::Vec3 first(sph::Real(origin.x() * dx), sph::Real(origin.y() * dx),
-                              sph::Real(origin.z() * dx));
-        other[i] = exchange.decomposition().owner(first) != exchange.rank();
-    }
-    sph::ParticleSet mine = near;
-    mine.removeIf(other);
-    return mine;
+    // As OpenVDB buckets the point (PointsFile.cc passes positions in double).
+    const openvdb::Coord voxel = xform.worldToIndexCellCentered(openvdb::Vec3d(x[0], x[1], x[2]));
+    const openvdb::Coord origin = voxel & ~(LEAF_DIM - 1);
+    return parts.owner(sph::Vec3(sph::Real(origin.x() * dx), sph::Real(origin.y() * dx),
+                                 sph::Real(origin.z() * dx)));
 }
 
 } // namespace
@@ -50,7 +38,6 @@ BuiltGrids buildFrameGrids(dist::MpiExchange& exchange, const sph::ParticleSet& 
                            FramePieceCounts* counts)
 {
     vdbio::PointsOptions po;
-    double width = 0;
     if (points) {
         po = *points;
         // Ghosts stay with their processes: only `kinds` travel.
@@ -76,35 +63,36 @@ BuiltGrids buildFrameGrids(dist::MpiExchange& exchange, const sph::ParticleSet& 
             po.voxelSize = exchange.minOf(local);
             if (!std::isfinite(po.voxelSize)) po.voxelSize = 0.1; // as writePointsFile does
         }
-        width = LEAF_REACH_VOXELS * po.voxelSize;
-    }
-    if (volumes) width = std::max(width, vdbio::volumeReach(*volumes));
-
-    std::size_t own = 0;
-    const sph::ParticleSet near = exchange.surroundings(set, kinds, sph::Real(width), &own);
-    if (counts) {
-        counts->own = std::uint64_t(exchange.sumOf(double(own)));
-        counts->copies = std::uint64_t(exchange.sumOf(double(near.size() - own)));
-        counts->largest = std::uint64_t(exchange.maxOf(double(near.size())));
     }
 
     openvdb::GridPtrVec piece;
+    FramePieceCounts mine;
     if (points) {
+        // Each particle to the process owning its leaf: no leaf is split between pieces.
         const auto xform = openvdb::math::Transform::createLinearTransform(po.voxelSize);
-        const sph::ParticleSet leaves = ownedLeaves(near, *xform, exchange);
-        // Every particle in exactly one piece: a leaf's particles all reach its owner.
-        const double claimed = exchange.sumOf(double(leaves.size()));
-        const double owned = exchange.sumOf(double(own));
-        if (claimed != owned) {
-            throw Error(msg("frame pieces: the points pieces hold ", claimed, " particles, the ",
-                            "processes own ", owned, " (a piece is missing some of its leaves)"));
-        }
+        const sph::DomainDecomposition& parts = exchange.decomposition();
+        std::size_t sent = 0;
+        const sph::ParticleSet leaves = exchange.redistribute(
+            set, po.kinds, [&](const sph::Vec3& x) { return leafOwner(x, *xform, parts); }, &sent);
+        mine.moved = sent;
         piece.push_back(vdbio::makePointsGrid(leaves, po));
     }
     if (volumes) {
+        std::size_t own = 0;
+        const sph::ParticleSet near =
+            exchange.surroundings(set, kinds, sph::Real(vdbio::volumeReach(*volumes)), &own);
+        mine.own = own;
+        mine.copies = near.size() - own;
+        mine.largest = near.size();
         openvdb::GridPtrVec grids = vdbio::makeVolumeGrids(near, *volumes);
         vdbio::keepVoxelsIn(grids, exchange.decomposition().region(exchange.rank()));
         piece.insert(piece.end(), grids.begin(), grids.end());
+    }
+    if (counts) {
+        counts->own = std::uint64_t(exchange.sumOf(double(mine.own)));
+        counts->copies = std::uint64_t(exchange.sumOf(double(mine.copies)));
+        counts->largest = std::uint64_t(exchange.maxOf(double(mine.largest)));
+        counts->moved = std::uint64_t(exchange.sumOf(double(mine.moved)));
     }
 
     std::vector<openvdb::GridBase::Ptr> pointPieces;

@@ -118,9 +118,11 @@ public:
             " air on ", ranks(), " processes (the largest part ",
             int(std::lround(100 * largest / std::max(1.0, all))), " %; ", mExchange->migrated(),
             " particles migrated and ", mExchange->rebalances(), " rebalances seen by this one",
-            mPieceCounts.own ? msg("; the last frame's pieces copied ", mPieceCounts.copies,
-                                   " particles between processes")
-                             : std::string(),
+            mPieceCounts.own + mPieceCounts.moved
+                ? msg("; the last frame's pieces: ", mPieceCounts.copies,
+                      " particles copied for the volumes, the largest piece from ",
+                      mPieceCounts.largest, ", ", mPieceCounts.moved, " moved to their points leaf")
+                : std::string(),
             ")");
     }
 

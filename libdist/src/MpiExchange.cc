@@ -491,6 +491,41 @@ ParticleSet MpiExchange::surroundings(const ParticleSet& set,
     return out;
 }
 
+ParticleSet MpiExchange::redistribute(const ParticleSet& set,
+                                      const std::vector<ParticleKind>& kinds,
+                                      const std::function<int(const Vec3&)>& destination,
+                                      std::size_t* sent) const
+{
+    const std::vector<Real>* halo =
+        set.hasScalarChannel(HALO_CHANNEL) ? &set.scalarChannel(HALO_CHANNEL) : nullptr;
+    std::vector<std::vector<Index>> rows(static_cast<std::size_t>(mRanks));
+    for (std::size_t i = 0; i < set.size(); ++i) {
+        if (halo && (*halo)[i] != Real(0)) continue;
+        if (std::find(kinds.begin(), kinds.end(), set.kinds()[i]) == kinds.end()) continue;
+        const int q = destination(set.positions()[i]);
+        if (q < 0 || q >= mRanks)
+            throw Error(msg("MPI redistribute: destination rank ", q, " of ", mRanks));
+        rows[std::size_t(q)].push_back(Index(i));
+    }
+    std::vector<std::vector<char>> bytes(static_cast<std::size_t>(mRanks));
+    std::size_t away = 0;
+    for (int q = 0; q < mRanks; ++q) {
+        if (q == mRank || rows[std::size_t(q)].empty()) continue;
+        packRows(set, rows[std::size_t(q)], bytes[std::size_t(q)]);
+        away += rows[std::size_t(q)].size();
+    }
+    if (sent) *sent = away;
+    const std::vector<std::vector<char>> received = allToAll(bytes);
+    std::vector<char> ownBytes;
+    packRows(set, rows[std::size_t(mRank)], ownBytes);
+    ParticleSet out = unpackRows(ownBytes);
+    for (const auto& message : received) {
+        if (!message.empty()) out.append(unpackRows(message));
+    }
+    if (out.hasScalarChannel(HALO_CHANNEL)) out.removeChannel(HALO_CHANNEL);
+    return out;
+}
+
 void MpiExchange::collect(const std::string& mine,
                           const std::function<void(int, const std::string&)>& fn, int root) const
 {

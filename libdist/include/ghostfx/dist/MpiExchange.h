@@ -82,6 +82,14 @@ public:
                                   const std::vector<sph::ParticleKind>& kinds, sph::Real width,
                                   std::size_t* own = nullptr) const;
 
+    /// This rank's particles of `kinds` (halo copies excluded) sent each to the rank
+    /// `destination` names for it; returns those that arrive here (this rank's own first),
+    /// without the halo channel. `sent` gets how many this rank sent away. Collective.
+    sph::ParticleSet redistribute(const sph::ParticleSet& set,
+                                  const std::vector<sph::ParticleKind>& kinds,
+                                  const std::function<int(const sph::Vec3&)>& destination,
+                                  std::size_t* sent = nullptr) const;
+
     /// Every rank's `mine` handed to fn(rank, bytes) on rank `root`: the root's own first,
     /// then the others' in rank order, one message in memory at a time; elsewhere fn is not
     /// called. Collective.
