@@ -48,6 +48,13 @@
 ///           - a liquid particle with fewer than MIN_NEIGHBOURS liquid and solid neighbours is
 ///             spray (a thin stream's edge, a drop): too little to push against; it takes no
 ///             part in the solve.
+///
+///          Over several processes (setExchange) each solves for the particles it owns: before
+///          a pass reads its neighbours' values (the search direction, G k, v*), the halo
+///          copies get their owners' (ParticleExchange::refresh), and every sum the iteration
+///          decides on (dot products, the error, the count) is summed over the processes, so
+///          all take the same iterations and stop together. The result equals the one-process
+///          solve up to summation order.
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "GhostInternal.h"
@@ -89,11 +96,13 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
         0, n,
         [&](std::size_t j) { mLiquidMass[j] = kind[j] == ParticleKind::Liquid ? M : Real(0); },
         4096);
+    const Real* halo = haloFlags();
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) continue;
+            // A halo copy is solved by its owner (alpha 0 here: not an unknown of this one).
+            if (kind[i] != ParticleKind::Liquid || (halo && halo[i] != Real(0))) continue;
             const Vec3 xi = x[i];
             Vec3 sum(0), all(0);
             Real squares = 0;
@@ -147,6 +156,22 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // The particles in the solve: liquid that is not spray.
     auto solved = [&](std::size_t i) { return mAlpha[i] > Real(0); };
     const std::vector<Real>& lm = mLiquidMass;
+    // Over several processes: sums over every process, and the owners' values for the halo
+    // copies (a solve's vectors are this process's; DFSPH_SYNC carries them).
+    const Real* halo = haloFlags();
+    auto everywhere = [&](double value) { return mExchange ? mExchange->sumOf(value) : value; };
+    auto fromOwners = [&](std::vector<Real>& values) {
+        if (!mExchange) return;
+        auto& channel = mParticles.scalarChannel(DFSPH_SYNC);
+        std::copy(values.begin(), values.end(), channel.begin());
+        mExchange->refresh(mParticles, {DFSPH_SYNC});
+        for (std::size_t i = 0; i < n; ++i) {
+            if (halo[i] != Real(0)) values[i] = channel[i];
+        }
+    };
+    auto velocitiesFromOwners = [&] {
+        if (mExchange) mExchange->refresh(mParticles, {VSTAR});
+    };
 
     // G k (see the file comment), zero for air and spray.
     std::vector<Vec3> u(n, Vec3(0));
@@ -201,27 +226,31 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
             },
             512);
     };
+    // (Over the solved particles: a halo copy's entries are its owner's, not summed here.)
     auto dot = [&](const std::vector<Real>& a, const std::vector<Real>& b) {
-        return parallel::sum(0, n, [&](std::size_t i) { return double(a[i]) * double(b[i]); });
+        return everywhere(parallel::sum(
+            0, n, [&](std::size_t i) { return solved(i) ? double(a[i]) * double(b[i]) : 0.0; }));
     };
-    const double count = parallel::sum(0, n, [&](std::size_t i) { return solved(i) ? 1.0 : 0.0; });
+    const double count =
+        everywhere(parallel::sum(0, n, [&](std::size_t i) { return solved(i) ? 1.0 : 0.0; }));
     const Real dt2 = dt * dt;
     // Mean |e| / rho0 over the solved particles of residuals r = e / dt^2.
     auto meanError = [&](const std::vector<Real>& r) {
-        const double sum =
-            parallel::sum(0, n, [&](std::size_t i) { return double(std::abs(r[i])); });
+        const double sum = everywhere(parallel::sum(
+            0, n, [&](std::size_t i) { return solved(i) ? double(std::abs(r[i])) : 0.0; }));
         return count > 0 ? sum * double(dt2) / count / double(rho0) : 0.0;
     };
 
     // Warm start: the last step's pressure terms first ([BK15] Sec. 4.3).
     std::vector<Real> k(n, Real(0));
     // (Nothing to apply on the first step, or after a restart from rest.)
-    const bool warm = opt.warmStart && parallel::sum(0, n, [&](std::size_t i) {
+    const bool warm = opt.warmStart && everywhere(parallel::sum(0, n, [&](std::size_t i) {
                                            return solved(i) && total[i] != Real(0) ? 1.0 : 0.0;
-                                       }) > 0;
+                                       })) > 0;
     if (warm) {
         parallel::forEach(
             0, n, [&](std::size_t i) { k[i] = solved(i) ? total[i] : Real(0); }, 4096);
+        fromOwners(k);
         gradient(k);
         parallel::forEach(
             0, n, [&](std::size_t i) { w[i] -= dt * u[i]; }, 4096);
@@ -232,6 +261,7 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
 
     // The error the velocities leave: beta (rho - rho0) + dt D rho / Dt for the density solve,
     // dt D rho / Dt for the divergence solve.
+    velocitiesFromOwners();
     divergence(w, true);
     std::vector<Real> r(n, Real(0)), z(n, Real(0)), p(n, Real(0)), q(n, Real(0));
     std::vector<Vec3> change(n, Vec3(0)); // G k
@@ -257,7 +287,17 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
         double rz = dot(r, z);
         while (iteration < opt.maxIterations) {
             ++iteration;
+            fromOwners(p);
             gradient(p);
+            if (mExchange) {
+                // G p of the halo copies, from their owners.
+                auto& channel = mParticles.vectorChannel(DFSPH_SYNC_VECTOR);
+                std::copy(u.begin(), u.end(), channel.begin());
+                mExchange->refresh(mParticles, {DFSPH_SYNC_VECTOR});
+                for (std::size_t i = 0; i < n; ++i) {
+                    if (halo[i] != Real(0)) u[i] = channel[i];
+                }
+            }
             divergence(u, false);
             parallel::forEach(
                 0, n, [&](std::size_t i) { q[i] = solved(i) ? rate[i] : Real(0); }, 4096);
@@ -314,6 +354,11 @@ void GhostSolver::stepDfsph(Real dt)
 
     t0 = std::chrono::steady_clock::now();
     const std::size_t n = mParticles.size();
+    if (mExchange) {
+        // What the solves hand to the halo copies (removed again at the end of the step).
+        mParticles.addScalarChannel(DFSPH_SYNC, Real(0));
+        mParticles.addVectorChannel(DFSPH_SYNC_VECTOR, Vec3(0));
+    }
     const auto& kind = mParticles.kinds();
     const auto& v = mParticles.velocities();
     auto& w = mParticles.vectorChannel(VSTAR);
@@ -347,6 +392,12 @@ void GhostSolver::stepDfsph(Real dt)
     // determines k only up to the particle-scale patterns that G cannot see, which change no
     // velocity but scatter single particles' k by tens of percent of the hydrostatic pressure
     // (measured: +98 % on a tank's slope at 2 cm, 0.5 % after averaging).
+    if (mExchange) {
+        // The halo copies' v* (XSPH reads it) and pressure terms (the average below).
+        mExchange->refresh(mParticles, {VSTAR, DENSITY_KAPPA, DIVERGENCE_KAPPA});
+        mParticles.removeChannel(DFSPH_SYNC);
+        mParticles.removeChannel(DFSPH_SYNC_VECTOR);
+    }
     const auto& rho = mParticles.densities();
     const auto& x = mParticles.positions();
     const auto& m = mParticles.masses();
@@ -360,6 +411,7 @@ void GhostSolver::stepDfsph(Real dt)
         },
         4096);
     std::vector<Real> accel(n, Real(0));
+    const Real* halo = haloFlags();
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
@@ -376,11 +428,17 @@ void GhostSolver::stepDfsph(Real dt)
                 sum += b.sum(b.f);
             });
             p[i] = (weight > Real(0) ? sum / weight : mScratch[i]) * sqr(rho[i]);
-            accel[i] = (w[i] - start[i]).length() / dt;
+            if (!halo || halo[i] == Real(0)) accel[i] = (w[i] - start[i]).length() / dt;
         }
         },
         512);
     mRun.maxAcceleration = *std::max_element(accel.begin(), accel.end());
+    if (mExchange) {
+        // The largest acceleration bounds everyone's next step; the solids near the cut take
+        // the pressure of a halo copy as their nearest liquid.
+        mRun.maxAcceleration = Real(mExchange->maxOf(double(mRun.maxAcceleration)));
+        mExchange->refresh(mParticles, {"pressure"});
+    }
     for (SolidBlock* b : {&mStatic, &mMoving}) {
         parallel::forEach(
             0, b->touched.size(),

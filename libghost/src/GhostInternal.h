@@ -51,6 +51,9 @@ constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, ma
 constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
 constexpr const char* DENSITY_KAPPA = "dfsph_k"; ///< DFSPH: density solve's p / rho^2 (warm start)
 constexpr const char* DIVERGENCE_KAPPA = "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
+/// DFSPH over several processes: a solve's values handed to the halo copies (refresh)
+constexpr const char* DFSPH_SYNC = "dfsph_sync";
+constexpr const char* DFSPH_SYNC_VECTOR = "dfsph_sync_v"; ///< the same for G k
 
 /// parallel::forRange over particles [0, n): each task gets its own copy of `kernel` and a
 /// PairBatch of its own, and calls body(lo, hi, kernel, batch) on its range.

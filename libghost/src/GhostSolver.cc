@@ -72,10 +72,10 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange, bool ownPart)
     }
     auto refuse = [](const std::string& what) {
         throw ValueError(msg("liquid solver over several processes: ", what,
-                             " is not supported yet (supported: method ghost, pressure tait)"));
+                             " is not supported yet (supported: method ghost, pressure tait or "
+                         "dfsph)"));
     };
     if (mSettings.method != Method::Ghost) refuse("method basic");
-    if (mSettings.pressure != PressureModel::Tait) refuse("pressure dfsph");
     if (!mRun.initialized) refuse("sharing before prepare()");
     // A fresh run (or one restored whole): every process has the same particles here; keep
     // what this one owns. A run restored from this process's own part of a checkpoint keeps

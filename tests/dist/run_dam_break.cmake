@@ -16,6 +16,14 @@ ghostfx_run("two processes, resumed" ${two} ${run} --frames 1-4 --out ${OUT}/res
 ghostfx_compare("one against two processes"
                 "the two-process frame differs from the one-process frame beyond the tolerance"
                 ${OUT}/one/liquid_points.0003.vdb ${OUT}/two/liquid_points.0003.vdb 0.003 0.03)
+# The implicit pressure (settings.pressure dfsph) over two processes, against one.
+set(dfsph ${run} -D settings.pressure=dfsph --frames 1-3)
+ghostfx_run("one process, dfsph" ${dfsph} --out ${OUT}/dfsph_one)
+ghostfx_run("two processes, dfsph" ${two} ${dfsph} --out ${OUT}/dfsph_two)
+ghostfx_compare("one against two processes, dfsph"
+                "the two-process dfsph frame differs from the one-process frame beyond the tolerance"
+                ${OUT}/dfsph_one/liquid_points.0003.vdb ${OUT}/dfsph_two/liquid_points.0003.vdb
+                0.003 0.03)
 # The volumes, built in pieces (one per process) and merged on rank 0: the surface and density
 # grids of the same frame hold as many voxels as the one-process run's within 2 % (the
 # particles themselves differ by the rms above; measured 0.2 %). tests/dist/test_mpi_frames.cc
