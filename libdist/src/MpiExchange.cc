@@ -207,9 +207,19 @@ int MpiSession::ranks() const
 
 int launcherRankCount()
 {
-    // Open MPI's mpirun, then the PMI launchers (MPICH's mpiexec, srun --mpi=pmi2).
+    // Open MPI's mpirun, then the PMI launchers (MPICH's and Intel's mpiexec, srun
+    // --mpi=pmi2), then a task of a Slurm job step (srun --mpi=pmix sets no size of its own;
+    // SLURM_STEP_NUM_TASKS belongs to the step, not to the batch script that sbatch runs, and
+    // SLURM_PROCID only to a task srun started). A wrong guess costs nothing worse than
+    // MPI_Init: a run whose MPI world has one process runs as one.
     for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
         if (const char* value = std::getenv(name)) {
+            const int n = std::atoi(value);
+            if (n > 0) return n;
+        }
+    }
+    if (std::getenv("SLURM_PROCID")) {
+        if (const char* value = std::getenv("SLURM_STEP_NUM_TASKS")) {
             const int n = std::atoi(value);
             if (n > 0) return n;
         }
