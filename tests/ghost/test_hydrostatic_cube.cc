@@ -174,16 +174,12 @@ Shape measureShape(const ParticleSet& p)
 
 } // namespace
 
-// KNOWN OPEN DEFECT, disabled. Before: with the default air handling (kept air thinned at 0.8 r)
-// gyration +10..30 %, 1.3 - 5 m/s by 2 s, the air mass growing +35 % over ten resamplings. Now
-// (kept air thinned at r, density-matched air weights, region-by-region resampling): no blow-up,
-// the air mass grows far slower, gyration +5.8 % and a late 3.7 m/s spike (seed 1); with air
-// resampled every 20 steps +4.1 % and 0.17 m/s. Replace-all (airKeepFraction 10) passes here
-// (-0.4 %, 0.41 m/s) but breaks HydrostaticTank (0.16 m/s residual speed, bound 0.1) and the
-// 300-step HydrostaticCube shell bound: the fresh layer is sparser than the liquid.
-TEST(ZeroGravityCube, DISABLED_DefaultGhostAirKeepsTheCubeTogetherForTwoSeconds)
+namespace {
+
+void expectCubeKeepsTogether(AirWeights weights)
 {
-    GhostSettings settings; // default air handling: the subject of this test
+    GhostSettings settings; // default air handling but the weights: the subject of this test
+    settings.airWeights = weights;
     settings.spacing = ZG_H;
     settings.gravity = Vec3(0);
     settings.seed = 1;
@@ -198,8 +194,9 @@ TEST(ZeroGravityCube, DISABLED_DefaultGhostAirKeepsTheCubeTogetherForTwoSeconds)
             lateSpeed = std::max(lateSpeed, measureShape(solver.particles()).maxSpeed);
     }
     const Shape end = measureShape(solver.particles());
-    std::printf("[measured] zero-g cube, 2 s: gyration %+.2f %%, max speed over 1-2 s %.3f m/s, "
-                "%zu air\n",
+    std::printf("[measured] zero-g cube, 2 s, %s air weights: gyration %+.2f %%, max speed over "
+                "1-2 s %.3f m/s, %zu air\n",
+                weights == AirWeights::Matched ? "matched" : "complete",
                 100.0 * (end.gyration / start.gyration - 1.0), lateSpeed,
                 solver.count(ParticleKind::GhostAir));
 
@@ -209,4 +206,28 @@ TEST(ZeroGravityCube, DISABLED_DefaultGhostAirKeepsTheCubeTogetherForTwoSeconds)
     // +10 % to +30 % and 1.3 - 5 m/s by 2 s, growing. Bounds: gyration 4 %, speed 0.6 m/s.
     EXPECT_NEAR(end.gyration / start.gyration, 1.0, 0.04);
     EXPECT_LT(lateSpeed, 0.6);
+}
+
+} // namespace
+
+// KNOWN OPEN DEFECT, disabled. Before: with the default air handling (kept air thinned at 0.8 r)
+// gyration +10..30 %, 1.3 - 5 m/s by 2 s, the air mass growing +35 % over ten resamplings. Now
+// (kept air thinned at r, density-matched air weights, region-by-region resampling): no blow-up,
+// the air mass grows far slower, gyration +5.8 % and a late 3.7 m/s spike (seed 1); with air
+// resampled every 20 steps +4.1 % and 0.17 m/s. Replace-all (airKeepFraction 10) passes here
+// (-0.4 %, 0.41 m/s) but breaks HydrostaticTank (0.16 m/s residual speed, bound 0.1) and the
+// 300-step HydrostaticCube shell bound: the fresh layer is sparser than the liquid. The
+// weights of settings.air_weights "complete" pass (the next test) but change how an emitter
+// fills its nozzle (Emitter.EmitsCrossSectionTimesSpeedWithoutOverlap +20 % in the double
+// build, bound 15 %), so they are not the default yet.
+TEST(ZeroGravityCube, DISABLED_DefaultGhostAirKeepsTheCubeTogetherForTwoSeconds)
+{
+    expectCubeKeepsTogether(AirWeights::Matched);
+}
+
+// The same with settings.air_weights "complete" (GhostAir.cc): the air weighs what the liquid
+// next to it lacks. Measured -0.39 % and 0.056 m/s (float), +0.97 % and 0.070 m/s (double).
+TEST(ZeroGravityCube, CompletingAirWeightsKeepTheCubeTogetherForTwoSeconds)
+{
+    expectCubeKeepsTogether(AirWeights::Complete);
 }
