@@ -307,6 +307,28 @@ GhostSettings smallTankSettings(Real h, std::uint64_t seed)
     return settings;
 }
 
+/// A water block 0.1 x 0.15 x 0.1 m in the small closed tank, the same on every rank.
+struct DamBreak
+{
+    explicit DamBreak(const GhostSettings& s)
+        : settings(s)
+        , tank(smallTank(s.spacing))
+        , water(makeLevelSet(
+              makeBoxLevelSet(Vec3(0), Vec3(Real(0.1), Real(0.15), Real(0.1)), s.spacing / 2),
+              "water"))
+    {}
+    std::unique_ptr<GhostSolver> build() const
+    {
+        auto solver = std::make_unique<GhostSolver>(settings);
+        solver->addSolid(tank);
+        solver->addLiquid(water);
+        solver->prepare();
+        return solver;
+    }
+    GhostSettings settings;
+    LevelSet tank, water;
+};
+
 } // namespace
 
 TEST(DistributedGhost, DamBreakOnSeveralRanksFollowsOneRank)
@@ -315,18 +337,8 @@ TEST(DistributedGhost, DamBreakOnSeveralRanksFollowsOneRank)
     // all ranks together, on each rank alone, and alone again with every liquid particle moved
     // by 1e-8 m: with the same time steps (the shared run's, the same on every rank).
     const Real h = Real(0.01);
-    const GhostSettings settings = smallTankSettings(h, 5);
-    const LevelSet tank = smallTank(h);
-    const LevelSet water = makeLevelSet(
-        makeBoxLevelSet(Vec3(0), Vec3(Real(0.1), Real(0.15), Real(0.1)), h / 2), "water");
-    auto build = [&]() {
-        auto solver = std::make_unique<GhostSolver>(settings);
-        solver->addSolid(tank);
-        solver->addLiquid(water);
-        solver->prepare();
-        return solver;
-    };
-    std::unique_ptr<GhostSolver> shared = build(), alone = build(), nudged = build();
+    const DamBreak dam(smallTankSettings(h, 5));
+    std::unique_ptr<GhostSolver> shared = dam.build(), alone = dam.build(), nudged = dam.build();
     for (std::size_t i = 0; i < nudged->particles().size(); ++i) {
         if (nudged->particles().kinds()[i] == ParticleKind::Liquid)
             nudged->particles().positions()[i][0] += Real(1e-8) * Real(int(i % 3) - 1);
@@ -389,17 +401,8 @@ TEST(DistributedGhost, DfsphDamBreakOnSeveralRanksFollowsOneRank)
     const Real h = Real(0.01);
     GhostSettings settings = smallTankSettings(h, 5);
     settings.pressure = ghost::PressureModel::Dfsph;
-    const LevelSet tank = smallTank(h);
-    const LevelSet water = makeLevelSet(
-        makeBoxLevelSet(Vec3(0), Vec3(Real(0.1), Real(0.15), Real(0.1)), h / 2), "water");
-    auto build = [&]() {
-        auto solver = std::make_unique<GhostSolver>(settings);
-        solver->addSolid(tank);
-        solver->addLiquid(water);
-        solver->prepare();
-        return solver;
-    };
-    std::unique_ptr<GhostSolver> shared = build(), alone = build();
+    const DamBreak dam(settings);
+    std::unique_ptr<GhostSolver> shared = dam.build(), alone = dam.build();
     dist::MpiExchange ex(MPI_COMM_WORLD, shared->particles().positions());
     shared->setExchange(&ex);
 
