@@ -100,14 +100,12 @@ void densityBatch(const Scene& s, std::vector<Real>& out)
         PairBatch b;
         const CubicSplineKernel kernel = s.kernel;
         for (std::size_t i = lo; i < hi; ++i) {
-            const NeighborLists::List list = s.lists[i];
             Real sum = 0;
-            for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
-                const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
-                for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]];
-                for (int k = 0; k < n; ++k) b.f[k] *= kernel.W(b.r[k]);
+            b.forEachBatch(x[i], x.data(), s.lists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
+                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
                 sum += b.sum(b.f);
-            }
+            });
             out[i] = sum;
         }
         },
@@ -142,15 +140,13 @@ void pressureBatch(const Scene& s, std::vector<Vec3>& out)
         [&](std::size_t lo, std::size_t hi) {
         PairBatch b;
         for (std::size_t i = lo; i < hi; ++i) {
-            const NeighborLists::List list = s.lists[i];
             const Real pi = s.ratio[i];
             Vec3 a(0);
-            for (std::size_t k0 = 0; k0 < list.size(); k0 += PairBatch::SIZE) {
-                const int n = b.load(x[i], x.data(), list.begin() + k0, list.size() - k0);
-                for (int k = 0; k < n; ++k) b.f[k] = m[b.j[k]] * (pi + s.ratio[b.j[k]]);
-                for (int k = 0; k < n; ++k) b.f[k] *= -s.kernel.gradFactor(b.r[k]);
+            b.forEachBatch(x[i], x.data(), s.lists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + s.ratio[b.j[k]]);
+                for (int k = 0; k < b.n; ++k) b.f[k] *= -s.kernel.gradFactor(b.r[k]);
                 a += b.sumScaledOffsets(b.f);
-            }
+            });
             out[i] = a;
         }
         },

@@ -172,13 +172,19 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
         0, chunks,
         [&](std::size_t chunk) {
         Chunk& out = mChunks[chunk];
-        std::size_t used = 0;
+        std::size_t used = 0; // units of the chunk
+        std::size_t start = 0, hits = 0;
+        // The query's indices, written as 32-bit entries from unit `start` on.
+        auto wideAt = [&] { return reinterpret_cast<Index*>(out.units.get() + start); };
         Stencil stencil;
         alignas(16) Real r2[BATCH] = {};
         const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
         for (std::size_t q = chunk * CHUNK; q < qEnd; ++q) {
+            start = (used + 1) & ~std::size_t(1);
+            hits = 0;
             if (empty || (wanted && !wanted[q]) || !isFinite(queries[q])) {
-                mEnd[q] = std::uint32_t(used);
+                used = start;
+                mEnd[q] = {std::uint32_t(used), 0};
                 continue;
             }
             const Vec3& x = queries[q];
@@ -208,12 +214,12 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
             // Reachable cells whose slots follow each other (neighbours along z usually do: z
             // is the lowest Morton bit) are searched as one range.
             auto search = [&](NeighborGrid::SlotRange range) {
-                out.reserve(used + (range.end - range.begin) + 8, used);
-                Index* dst = out.data.get();
+                out.reserve(start + 2 * (hits + (range.end - range.begin) + 8), start + 2 * hits);
+                Index* dst = wideAt();
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
                 if (avx2) {
                     const float q[3] = {qx, qy, qz};
-                    used = searchRangeAvx2(X, Y, Z, range.begin, range.end, q, radius2, dst, used);
+                    hits = searchRangeAvx2(X, Y, Z, range.begin, range.end, q, radius2, dst, hits);
                     return;
                 }
 #endif
@@ -229,7 +235,7 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
                         const Real dx = qx - xs[k], dy = qy - ys[k], dz = qz - zs[k];
                         r2[k] = dx * dx + dy * dy + dz * dz;
                     }
-                    used = appendHits(r2, len, radius2, s0, dst, used);
+                    hits = appendHits(r2, len, radius2, s0, dst, hits);
                 }
             };
             NeighborGrid::SlotRange run;
@@ -245,19 +251,39 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
                 run = range;
             }
             if (!run.empty()) search(run);
-            if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
-                throw ValueError("neighbour lists: more than 2^32 pairs in one chunk");
+            // Slots to particle indices (nothing to do for a grid over a sorted set), then
+            // 16-bit offsets from the smallest index when they all fit.
+            Index* dst = wideAt();
+            if (!targets.identityOrder()) {
+                for (std::size_t k = 0; k < hits; ++k) dst[k] = targets.particleAt(dst[k]);
             }
-            mEnd[q] = std::uint32_t(used);
+            Index lo = WIDE, hi = 0;
+            for (std::size_t k = 0; k < hits; ++k) {
+                lo = std::min(lo, dst[k]);
+                hi = std::max(hi, dst[k]);
+            }
+            Index base = 0;
+            if (hits == 0) {
+                used = start;
+            } else if (hi - lo <= 0xffff) {
+                // In place: offset k goes to unit start + k, which belongs to an entry at or
+                // before k, already read.
+                std::uint16_t* narrow = out.units.get() + start;
+                for (std::size_t k = 0; k < hits; ++k) narrow[k] = std::uint16_t(dst[k] - lo);
+                base = lo;
+                used = start + hits;
+            } else {
+                base = WIDE;
+                used = start + 2 * hits;
+            }
+            if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
+                throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
+            }
+            mEnd[q] = {std::uint32_t(used), base};
         }
         // A chunk that holds far more than it needs gives the room back (its lists shrank,
         // e.g. after a splash settled): capacity is what the process holds.
         if (out.capacity > 2 * used + 4096) out.shrink(used);
-        // Slots to particle indices (nothing to do for a grid over a sorted set).
-        if (!targets.identityOrder()) {
-            Index* dst = out.data.get();
-            for (std::size_t k = 0; k < used; ++k) dst[k] = targets.particleAt(dst[k]);
-        }
         },
         1);
 }
@@ -275,35 +301,41 @@ bool NeighborLists::wideSimd()
 
 void NeighborLists::Chunk::shrink(std::size_t used)
 {
-    const std::size_t fitted = used + used / 8 + 256;
-    std::unique_ptr<Index[]> smaller(new Index[fitted]);
-    std::copy(data.get(), data.get() + used, smaller.get());
-    data = std::move(smaller);
+    const std::size_t fitted = used + used / 8 + 512;
+    std::unique_ptr<std::uint16_t[]> smaller(new std::uint16_t[fitted]);
+    std::copy(units.get(), units.get() + used, smaller.get());
+    units = std::move(smaller);
     capacity = fitted;
 }
 
 void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)
 {
     if (size <= capacity) return;
-    const std::size_t grown = std::max(size, capacity + capacity / 8 + 1024);
-    std::unique_ptr<Index[]> bigger(new Index[grown]);
-    if (used > 0) std::copy(data.get(), data.get() + used, bigger.get());
-    data = std::move(bigger);
+    const std::size_t grown = std::max(size, capacity + capacity / 8 + 2048);
+    std::unique_ptr<std::uint16_t[]> bigger(new std::uint16_t[grown]);
+    if (used > 0) std::copy(units.get(), units.get() + used, bigger.get());
+    units = std::move(bigger);
     capacity = grown;
 }
 
 std::size_t NeighborLists::pairCount() const
 {
     std::size_t total = 0;
-    for (std::size_t q = CHUNK - 1; q < mEnd.size(); q += CHUNK) total += mEnd[q];
-    if (mEnd.size() % CHUNK != 0) total += mEnd.back();
+    for (std::size_t q = 0; q < mEnd.size(); ++q) total += (*this)[q].size();
+    return total;
+}
+
+std::size_t NeighborLists::wideListCount() const
+{
+    std::size_t total = 0;
+    for (const End& e : mEnd) total += e.base == WIDE;
     return total;
 }
 
 std::size_t NeighborLists::memoryBytes() const
 {
-    std::size_t bytes = mEnd.capacity() * sizeof(std::uint32_t);
-    for (const auto& c : mChunks) bytes += c.capacity * sizeof(Index);
+    std::size_t bytes = mEnd.capacity() * sizeof(End);
+    for (const auto& c : mChunks) bytes += c.capacity * sizeof(std::uint16_t);
     return bytes;
 }
 

@@ -17,6 +17,12 @@
 ///          count: list q holds the target indices in a fixed order (cells in stencil order,
 ///          slots ascending). A query is its own neighbour when it is in the target grid.
 ///          The storage keeps its capacity from step to step.
+///
+///          Storage: a list whose indices all lie within 65,536 of its smallest is kept as
+///          16-bit offsets from that smallest index (the usual case for particles sorted by the
+///          grid: neighbours are nearby in the sort order), any other as 32-bit indices. Reading
+///          a short list adds the offset to the base as it loads; bench/RESULTS.md ("Neighbour
+///          lists in 16 bits") has the memory and the cost.
 #pragma once
 
 #include "ghostfx/sph/NeighborGrid.h"
@@ -35,15 +41,92 @@ public:
     /// Queries per chunk (a chunk is filled by one task).
     static constexpr std::size_t CHUNK = 256;
 
-    /// A list: contiguous target indices.
-    struct List
+    /// A list: the neighbours of one query, either 16-bit offsets from a base index or
+    /// 32-bit indices. Read it with forEach, PairBatch::forEachBatch, or begin()/end().
+    class List
     {
-        const Index* first = nullptr;
-        const Index* last = nullptr;
-        const Index* begin() const { return first; }
-        const Index* end() const { return last; }
-        std::size_t size() const { return std::size_t(last - first); }
-        bool empty() const { return first == last; }
+    public:
+        /// A forward iterator over the neighbour indices. Branch-free for both kinds of list:
+        /// it reads 4 bytes at each entry and keeps the low 16 bits (adding the base) or all
+        /// 32 (the storage keeps 2 readable bytes past every list).
+        class Iterator
+        {
+        public:
+            using iterator_category = std::forward_iterator_tag;
+            using value_type = Index;
+            using difference_type = std::ptrdiff_t;
+            using pointer = const Index*;
+            using reference = Index;
+
+            Index operator*() const
+            {
+                std::uint32_t bits;
+                std::memcpy(&bits, mAt, sizeof(bits));
+                return mBase + (bits & mMask);
+            }
+            Iterator& operator++()
+            {
+                mAt += mStride;
+                return *this;
+            }
+            Iterator operator++(int)
+            {
+                Iterator before = *this;
+                ++*this;
+                return before;
+            }
+            bool operator==(const Iterator& o) const { return mAt == o.mAt; }
+            bool operator!=(const Iterator& o) const { return mAt != o.mAt; }
+
+        private:
+            friend class List;
+            const unsigned char* mAt = nullptr;
+            std::size_t mStride = 0;
+            std::uint32_t mMask = 0;
+            Index mBase = 0;
+        };
+
+        Iterator begin() const { return at(0); }
+        Iterator end() const { return at(mSize); }
+        std::size_t size() const { return mSize; }
+        bool empty() const { return mSize == 0; }
+
+        /// 32-bit indices (null for a 16-bit list).
+        const Index* wide() const { return mWide; }
+        /// 16-bit offsets from base() (null for a 32-bit list).
+        const std::uint16_t* narrow() const { return mNarrow; }
+        /// The index that narrow() offsets are added to.
+        Index base() const { return mBase; }
+
+        /// Call fn(j) for each neighbour j in order.
+        template <typename Fn>
+        void forEach(Fn&& fn) const
+        {
+            for (Iterator it = begin(), last = end(); it != last; ++it) fn(*it);
+        }
+
+    private:
+        friend class NeighborLists;
+        Iterator at(std::size_t k) const
+        {
+            Iterator it;
+            if (mWide) {
+                it.mAt = reinterpret_cast<const unsigned char*>(mWide + k);
+                it.mStride = sizeof(Index);
+                it.mMask = ~std::uint32_t(0);
+            } else {
+                it.mAt = reinterpret_cast<const unsigned char*>(mNarrow + k);
+                it.mStride = sizeof(std::uint16_t);
+                it.mMask = 0xffff;
+                it.mBase = mBase;
+            }
+            return it;
+        }
+
+        const std::uint16_t* mNarrow = nullptr;
+        const Index* mWide = nullptr;
+        Index mBase = 0;
+        std::size_t mSize = 0;
     };
 
     /// Build the lists of the particles of `targets` closer than `radius` (m, at most the
@@ -59,9 +142,20 @@ public:
     /// The neighbours of query q.
     List operator[](std::size_t q) const
     {
-        const Index* base = mChunks[q / CHUNK].data.get();
-        const std::uint32_t first = q % CHUNK == 0 ? 0 : mEnd[q - 1];
-        return {base + first, base + mEnd[q]};
+        const std::uint16_t* units = mChunks[q / CHUNK].units.get();
+        // Every list starts at an even unit (4-byte aligned for 32-bit indices).
+        const std::uint32_t from = q % CHUNK == 0 ? 0 : (mEnd[q - 1].end + 1) & ~1u;
+        const End& e = mEnd[q];
+        List list;
+        if (e.base == WIDE) {
+            list.mWide = reinterpret_cast<const Index*>(units + from);
+            list.mSize = (e.end - from) / 2;
+        } else {
+            list.mNarrow = units + from;
+            list.mBase = e.base;
+            list.mSize = e.end - from;
+        }
+        return list;
     }
     /// Use the AVX2 search where the processor has it (default), or always the portable one.
     /// Both give the same lists; this switch lets a test compare them.
@@ -70,22 +164,34 @@ public:
 
     /// Total number of (query, neighbour) pairs.
     std::size_t pairCount() const;
+    /// Number of lists kept as 32-bit indices (the others are 16-bit offsets).
+    std::size_t wideListCount() const;
     /// Bytes held (capacity).
     std::size_t memoryBytes() const;
 
 private:
-    /// A chunk's lists, back to back; grows geometrically and keeps its capacity.
+    /// `End::base` of a list of 32-bit indices.
+    static constexpr Index WIDE = ~Index(0);
+
+    /// A chunk's lists, back to back in 16-bit units; grows by an eighth and keeps its capacity.
     struct Chunk
     {
-        std::unique_ptr<Index[]> data;
-        std::size_t capacity = 0;
-        /// Make room for `size` entries, keeping the first `used`.
+        std::unique_ptr<std::uint16_t[]> units;
+        std::size_t capacity = 0; ///< in units
+        /// Make room for `size` units, keeping the first `used`.
         void reserve(std::size_t size, std::size_t used);
-        /// Give back room beyond `used` entries (and a little slack).
+        /// Give back room beyond `used` units (and a little slack).
         void shrink(std::size_t used);
     };
+    /// Per query: the end of its list within its chunk (units), and the base its 16-bit offsets
+    /// are added to (WIDE: 32-bit indices).
+    struct End
+    {
+        std::uint32_t end;
+        Index base;
+    };
 
-    std::vector<std::uint32_t> mEnd; ///< per query: end of its list within its chunk
+    std::vector<End> mEnd;
     std::vector<Chunk> mChunks;
 };
 

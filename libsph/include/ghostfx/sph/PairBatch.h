@@ -26,9 +26,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <iterator>
+#include <type_traits>
+#include <utility>
 
 namespace ghostfx {
 namespace sph {
+
+/// Whether List may hold 16-bit offsets (NeighborLists::List: narrow(), wide(), base()).
+template <typename List, typename = void>
+struct HasNarrow : std::false_type
+{};
+template <typename List>
+struct HasNarrow<List, std::void_t<decltype(std::declval<const List&>().narrow())>> : std::true_type
+{};
 
 struct PairBatch
 {
@@ -57,14 +69,47 @@ struct PairBatch
         return n;
     }
 
-    /// Call fn(*this) for each batch of the neighbours `list` (any range of Index with begin(),
-    /// size()) of the particle at xi.
+    /// Load up to SIZE neighbours `base + offset[0..count)` of the particle at xi (a 16-bit
+    /// NeighborLists list); returns how many.
+    int load(const Vec3& xi, const Vec3* x, Index base, const std::uint16_t* offset,
+             std::size_t count)
+    {
+        n = int(std::min<std::size_t>(count, SIZE));
+        for (int k = 0; k < n; ++k) {
+            const Index q = base + offset[k];
+            j[k] = q;
+            dx[k] = xi[0] - x[q][0];
+            dy[k] = xi[1] - x[q][1];
+            dz[k] = xi[2] - x[q][2];
+        }
+        for (int k = 0; k < n; ++k) r[k] = std::sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
+        return n;
+    }
+
+    /// Call fn(*this) for each batch of SIZE consecutive neighbours of the particle at xi (the
+    /// last batch may be shorter). `list` is a NeighborLists::List (16-bit offsets or 32-bit
+    /// indices) or a contiguous range of Index (std::data, size()).
     template <typename List, typename Fn>
     void forEachBatch(const Vec3& xi, const Vec3* x, const List& list, Fn&& fn)
     {
         const std::size_t size = list.size();
+        const Index* wide = nullptr;
+        if constexpr (HasNarrow<List>::value) {
+            wide = list.wide();
+            if (!wide) {
+                const std::uint16_t* offset = list.narrow();
+                const Index base = list.base();
+                for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+                    load(xi, x, base, offset + k0, size - k0);
+                    fn(*this);
+                }
+                return;
+            }
+        } else {
+            wide = std::data(list);
+        }
         for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
-            load(xi, x, list.begin() + k0, size - k0);
+            load(xi, x, wide + k0, size - k0);
             fn(*this);
         }
     }
