@@ -41,10 +41,10 @@ inline void forEachListed(const NeighborLists& lists, const std::vector<Vec3>& x
                           Fn&& fn)
 {
     const Vec3 xi = x[i];
-    for (const Index j : lists[i]) {
+    lists[i].forEach([&](Index j) {
         const Vec3 xij = xi - x[j];
         fn(j, xij, xij.length());
-    }
+    });
 }
 
 /// gamma^2 of Eq. 15 as a fraction of the squared pair support ([RYY15]: "gamma^2 << 1"; the

@@ -98,11 +98,16 @@ public:
         /// The index that narrow() offsets are added to.
         Index base() const { return mBase; }
 
-        /// Call fn(j) for each neighbour j in order.
+        /// Call fn(j) for each neighbour j in order (one loop per kind of list: faster than the
+        /// iterator in hot loops).
         template <typename Fn>
         void forEach(Fn&& fn) const
         {
-            for (Iterator it = begin(), last = end(); it != last; ++it) fn(*it);
+            if (mWide) {
+                for (std::size_t k = 0; k < mSize; ++k) fn(mWide[k]);
+            } else {
+                for (std::size_t k = 0; k < mSize; ++k) fn(Index(mBase + mNarrow[k]));
+            }
         }
 
     private:
