@@ -155,6 +155,13 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
                              "grid's cell size ",
                              targets.cellSize(), " m"));
     }
+    mSize = count;
+    if (targets.size() == 0) {
+        // Every list is empty: hold nothing per query (a solid block with no particles).
+        mEnd = std::vector<End>();
+        mChunks = std::vector<Chunk>();
+        return;
+    }
     const std::size_t chunks = (count + CHUNK - 1) / CHUNK;
     mEnd.resize(count);
     if (mChunks.size() < chunks) mChunks.resize(chunks);
@@ -163,7 +170,6 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
     const Real* X = targets.sortedX();
     const Real* Y = targets.sortedY();
     const Real* Z = targets.sortedZ();
-    const bool empty = targets.size() == 0;
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
     const bool avx2 = haveAvx2() && gWideSimd.load();
 #endif
@@ -182,7 +188,7 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
         for (std::size_t q = chunk * CHUNK; q < qEnd; ++q) {
             start = (used + 1) & ~std::size_t(1);
             hits = 0;
-            if (empty || (wanted && !wanted[q]) || !isFinite(queries[q])) {
+            if ((wanted && !wanted[q]) || !isFinite(queries[q])) {
                 used = start;
                 mEnd[q] = {std::uint32_t(used), 0};
                 continue;
@@ -321,7 +327,7 @@ void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)
 std::size_t NeighborLists::pairCount() const
 {
     std::size_t total = 0;
-    for (std::size_t q = 0; q < mEnd.size(); ++q) total += (*this)[q].size();
+    for (std::size_t q = 0; q < mSize; ++q) total += (*this)[q].size();
     return total;
 }
 

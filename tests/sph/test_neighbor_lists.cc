@@ -219,6 +219,26 @@ TEST(NeighborLists, IdenticalForOneThreadAndAllThreads)
     }
 }
 
+TEST(NeighborLists, NoTargetsGiveEmptyListsAndHoldNothingPerQuery)
+{
+    // A solid block without particles: the solver still asks for the lists of every liquid
+    // particle, and they must cost nothing.
+    NeighborGrid grid(Real(0.03));
+    grid.build(std::vector<Vec3>{});
+    const std::vector<Vec3> queries = randomPoints(5000, Real(0.3), 8);
+    NeighborLists lists;
+    lists.build(grid, queries.data(), queries.size(), Real(0.03));
+    ASSERT_EQ(lists.size(), queries.size());
+    for (std::size_t q = 0; q < queries.size(); q += 499) EXPECT_TRUE(lists[q].empty());
+    EXPECT_EQ(lists.pairCount(), 0u);
+    EXPECT_LT(lists.memoryBytes(), 1024u);
+    // And a later build with targets fills them again.
+    NeighborGrid full(Real(0.03));
+    full.build(queries);
+    lists.build(full, queries.data(), queries.size(), Real(0.03));
+    EXPECT_EQ(sorted(lists[7]), bruteForce(queries[7], queries, Real(0.03)));
+}
+
 TEST(NeighborLists, RadiusBeyondTheCellSizeIsRefused)
 {
     NeighborGrid grid(Real(0.1));

@@ -143,10 +143,11 @@ public:
                const std::uint8_t* wanted = nullptr, const Real* queryRadius = nullptr);
 
     /// Number of query points of the last build.
-    std::size_t size() const { return mEnd.size(); }
+    std::size_t size() const { return mSize; }
     /// The neighbours of query q.
     List operator[](std::size_t q) const
     {
+        if (mEnd.empty()) return List(); // no targets: every list is empty
         const std::uint16_t* units = mChunks[q / CHUNK].units.get();
         // Every list starts at an even unit (4-byte aligned for 32-bit indices).
         const std::uint32_t from = q % CHUNK == 0 ? 0 : (mEnd[q - 1].end + 1) & ~1u;
@@ -196,7 +197,8 @@ private:
         Index base;
     };
 
-    std::vector<End> mEnd;
+    std::size_t mSize = 0; ///< queries of the last build
+    std::vector<End> mEnd; ///< empty when the last build had no targets
     std::vector<Chunk> mChunks;
 };
 
