@@ -59,8 +59,8 @@ void GhostSolver::stepBasic(Real dt)
         }
         const Real pi = p[i] / sqr(rho[i]);
         Vec3 a = g;
-        for (Index j : mFluidLists[i]) {
-            if (j == i) continue;
+        mFluidLists[i].forEach([&](Index j) {
+            if (j == i) return;
             const Vec3 xij = x[i] - x[j];
             const Real r = xij.length();
             Real term = pi + p[j] / sqr(rho[j]);
@@ -70,17 +70,17 @@ void GhostSolver::stepBasic(Real dt)
                 term += -nu * vx / (r * r + Real(0.01) * s * s);
             }
             a -= m[j] * term * mKernel.gradW(xij, r);
-        }
+        });
         for (const SolidBlock* b : {&mStatic, &mMoving}) {
             const Vec3* y = b->block.particles().positions().data();
-            for (Index k : b->lists[i]) {
+            b->lists[i].forEach([&](Index k) {
                 const Vec3 xik = x[i] - y[k];
                 const Real r = xik.length();
-                if (!(r < r0) || !(r > Real(0))) continue;
+                if (!(r < r0) || !(r > Real(0))) return;
                 const Real q = r0 / r;
                 const Real q2 = q * q, q4 = q2 * q2;
                 a += (D * (q4 * q4 * q4 - q4) / (r * r)) * xik;
-            }
+            });
         }
         vnew[i] = v[i] + dt * a;
         accel[i] = a.length();
@@ -100,11 +100,11 @@ void GhostSolver::stepBasic(Real dt)
         xnew[i] = x[i];
         if (kind[i] != ParticleKind::Liquid) return;
         Vec3 dv(0);
-        for (Index j : mFluidLists[i]) {
-            if (j == i || kind[j] != ParticleKind::Liquid) continue;
+        mFluidLists[i].forEach([&](Index j) {
+            if (j == i || kind[j] != ParticleKind::Liquid) return;
             const Real r = (x[i] - x[j]).length();
             dv += (Real(2) * m[j] / (rho[i] + rho[j]) * mKernel.W(r)) * (vnew[j] - vnew[i]);
-        }
+        });
         xnew[i] = x[i] + dt * (vnew[i] + eps * dv);
         },
         512);
