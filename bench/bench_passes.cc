@@ -84,7 +84,7 @@ void densityScalar(const Scene& s, std::vector<Real>& out)
         0, COUNT,
         [&](std::size_t i) {
         Real sum = 0;
-        for (Index j : s.lists[i]) sum += m[j] * s.kernel.W((x[i] - x[j]).length());
+        s.lists[i].forEach([&](Index j) { sum += m[j] * s.kernel.W((x[i] - x[j]).length()); });
         out[i] = sum;
         },
         512);
@@ -121,11 +121,11 @@ void pressureScalar(const Scene& s, std::vector<Vec3>& out)
         [&](std::size_t i) {
         Vec3 a(0);
         const Real pi = s.ratio[i];
-        for (Index j : s.lists[i]) {
-            if (j == i) continue;
+        s.lists[i].forEach([&](Index j) {
+            if (j == i) return;
             const Vec3 xij = x[i] - x[j];
             a -= m[j] * (pi + s.ratio[j]) * s.kernel.gradW(xij, xij.length());
-        }
+        });
         out[i] = a;
         },
         512);
