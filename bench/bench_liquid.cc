@@ -63,7 +63,7 @@ struct Options
     double shifting = -1;          ///< >= 0: particle shifting coefficient instead of the default
     double lennardJones = 0;       ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
     int threads = 0;               ///< TBB threads, 0 = all
-    std::string scenes = "all";    ///< dam, sphere or all
+    std::string scenes = "all";    ///< dam, sphere, all or splish_dam
     std::string methods = "both";  ///< ghost, basic or both
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     std::uint64_t seed = 1;
@@ -128,6 +128,40 @@ Scene damBreak(double targetLiquid, double floorFactor)
         Vec3(0),
         Aabb{toVec3(outerLo), toVec3(outerHi)}.padded(Real(2 * h))};
     return s;
+}
+
+/// SPlisHSPlasH's dam break (its `DamBreakModel` scene, as `shared/anchors/splishsplash.md`
+/// scales it to 104k particles): a 1 m cube of liquid 5 cm from the floor and the left wall,
+/// centred between the front and back walls, in a closed box 4 x 3 x 1.5 m (inside). The same
+/// scene as the comparator's, so wall seconds per simulated second compare (its particles are
+/// twice as far apart as those of `damBreak` at the same count, and its steps twice as long).
+Scene splishDamBreak(double targetLiquid)
+{
+    const double h = std::cbrt(SAMPLES_PER_CUBIC_SPACING * 1.0 / targetLiquid);
+    const double wall = 3 * h, voxel = 0.5 * h;
+    const openvdb::Vec3d innerLo(0, 0, 0), innerHi(4, 3, 1.5);
+    const openvdb::Vec3d outerLo = innerLo - openvdb::Vec3d(wall);
+    const openvdb::Vec3d outerHi = innerHi + openvdb::Vec3d(wall);
+    auto boxSdf = [=](const openvdb::Vec3d& x) {
+        return std::max(boxSignedDistance(x, outerLo, outerHi),
+                        -boxSignedDistance(x, innerLo, innerHi));
+    };
+    const Vec3 blockLo(Real(0.05), Real(0.05), Real(0.25));
+    const Vec3 blockHi = blockLo + Vec3(1);
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "SPlisHSPlasH's DamBreakModel: 1 m cube at (0.05, 0.05, 0.25) m in a closed box "
+                  "4 x 3 x 1.5 m (inside), walls %.4f m, h = %.5f m",
+                  wall, h);
+    return Scene{
+        "splish_dam_break",
+        text,
+        Real(h),
+        makeLevelSet(levelSetFromSdf(boxSdf, Aabb{toVec3(outerLo), toVec3(outerHi)}, Real(voxel)),
+                     "box"),
+        makeLevelSet(makeBoxLevelSet(blockLo, blockHi, Real(voxel)), "water"),
+        Vec3(0),
+        Aabb{toVec3(outerLo), toVec3(outerHi)}.padded(Real(2 * h))};
 }
 
 /// Liquid sphere (radius from the target count) 2 h above a solid sphere of radius 0.2 m, its
@@ -489,9 +523,11 @@ int main(int argc, char** argv)
     app.add_option("--threads", opt.threads, "TBB threads (0 = all)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    app.add_option("--scene", opt.scenes, "dam, sphere or all")
+    app.add_option("--scene", opt.scenes,
+                   "dam, sphere, all (dam and sphere) or splish_dam (SPlisHSPlasH's dam-break "
+                   "scene, --liquid particles)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"dam", "sphere", "all"}));
+        ->check(CLI::IsMember({"dam", "sphere", "all", "splish_dam"}));
     app.add_option("--pressure", opt.pressure,
                    "Ghost SPH pressure: tait ([SB12]) or dfsph (implicit, CFL steps on the flow "
                    "speed)")
@@ -521,11 +557,15 @@ int main(int argc, char** argv)
                     opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str() : "1/600 s (fixed)");
 
         std::vector<RunResult> all;
-        if (opt.scenes != "sphere") {
+        if (opt.scenes == "splish_dam") {
+            for (const RunResult& r : runScene(splishDamBreak(opt.damLiquid), opt))
+                all.push_back(r);
+        }
+        if (opt.scenes == "dam" || opt.scenes == "all") {
             for (const RunResult& r : runScene(damBreak(opt.damLiquid, opt.tankFloor), opt))
                 all.push_back(r);
         }
-        if (opt.scenes != "dam") {
+        if (opt.scenes == "sphere" || opt.scenes == "all") {
             const Scene scene = sphereDrop(opt.sphereLiquid, opt.sphereSpacing);
             for (const RunResult& r : runScene(scene, opt)) all.push_back(r);
         }
