@@ -57,16 +57,7 @@ struct PairBatch
     /// Load up to SIZE neighbours `idx[0..count)` of the particle at xi; returns how many.
     int load(const Vec3& xi, const Vec3* x, const Index* idx, std::size_t count)
     {
-        n = int(std::min<std::size_t>(count, SIZE));
-        for (int k = 0; k < n; ++k) {
-            const Index q = idx[k];
-            j[k] = q;
-            dx[k] = xi[0] - x[q][0];
-            dy[k] = xi[1] - x[q][1];
-            dz[k] = xi[2] - x[q][2];
-        }
-        for (int k = 0; k < n; ++k) r[k] = std::sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
-        return n;
+        return loadEach(xi, x, count, [idx](int k) { return idx[k]; });
     }
 
     /// Load up to SIZE neighbours `base + offset[0..count)` of the particle at xi (a 16-bit
@@ -74,16 +65,7 @@ struct PairBatch
     int load(const Vec3& xi, const Vec3* x, Index base, const std::uint16_t* offset,
              std::size_t count)
     {
-        n = int(std::min<std::size_t>(count, SIZE));
-        for (int k = 0; k < n; ++k) {
-            const Index q = base + offset[k];
-            j[k] = q;
-            dx[k] = xi[0] - x[q][0];
-            dy[k] = xi[1] - x[q][1];
-            dz[k] = xi[2] - x[q][2];
-        }
-        for (int k = 0; k < n; ++k) r[k] = std::sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
-        return n;
+        return loadEach(xi, x, count, [base, offset](int k) { return Index(base + offset[k]); });
     }
 
     /// Call fn(*this) for each batch of SIZE consecutive neighbours of the particle at xi (the
@@ -112,6 +94,22 @@ struct PairBatch
             load(xi, x, wide + k0, size - k0);
             fn(*this);
         }
+    }
+
+    /// Load neighbours indexOf(0..min(count, SIZE)) of the particle at xi.
+    template <typename IndexOf>
+    int loadEach(const Vec3& xi, const Vec3* x, std::size_t count, IndexOf indexOf)
+    {
+        n = int(std::min<std::size_t>(count, SIZE));
+        for (int k = 0; k < n; ++k) {
+            const Index q = indexOf(k);
+            j[k] = q;
+            dx[k] = xi[0] - x[q][0];
+            dy[k] = xi[1] - x[q][1];
+            dz[k] = xi[2] - x[q][2];
+        }
+        for (int k = 0; k < n; ++k) r[k] = std::sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
+        return n;
     }
 
     /// sum_k a[k] over the batch, in LANES interleaved partial sums (fixed order).
