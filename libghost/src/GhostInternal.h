@@ -49,8 +49,13 @@ constexpr const char* SOLID_LOCAL_NORMAL =
     "solid_n";                                   ///< moving solid particle: normal, solid frame
 constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, mass = weight m
 constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
+/// Ghost air keeps this many particle spacings from every solid: closer, it is removed at the
+/// next step and not sampled ([SB12] places air outside the solids; a film of air between
+/// liquid and a wall has nowhere to go, GhostAir.cc, fadeAir).
+constexpr Real AIR_WALL_GAP = Real(0.5);
 constexpr const char* DENSITY_KAPPA = "dfsph_k"; ///< DFSPH: density solve's p / rho^2 (warm start)
-constexpr const char* DIVERGENCE_KAPPA = "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
+constexpr const char* DIVERGENCE_KAPPA =
+    "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
 /// DFSPH over several processes: a solve's values handed to the halo copies (refresh)
 constexpr const char* DFSPH_SYNC = "dfsph_sync";
 constexpr const char* DFSPH_SYNC_VECTOR = "dfsph_sync_v"; ///< the same for G k
