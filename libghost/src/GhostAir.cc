@@ -205,8 +205,8 @@ void GhostSolver::resampleAir(int phase)
         return mGrid.nearest(
             q, R, [&](Index j) { return body[j] != 0; }, distance);
     };
-    // Air keeps AIR_WALL_GAP spacings from every solid (see fadeAir): new air is not placed
-    // closer, kept air closer is not kept.
+    // Air stays outside every solid (AIR_WALL_GAP, see fadeAir): new air is not placed inside,
+    // kept air inside is not kept.
     const Real wallGap = AIR_WALL_GAP * mSettings.spacing;
     auto insideSolid = [&](const Vec3& q) {
         for (const auto& solid : mSolids) {
@@ -447,10 +447,9 @@ void GhostSolver::fadeAir()
     const auto& target = mParticles.scalarChannel(AIR_TARGET);
     const Real rate = Real(1) / Real(mSettings.airResampleSteps);
     std::vector<std::uint8_t> remove(mParticles.size(), 0);
-    // Air squeezed against a solid goes at once, not at the next resampling. Liquid landing on
-    // a floor would otherwise press the air layer under it into a film on the wall: the film's
-    // mass stays in the liquid's density sums while the air, which moves with the liquid and
-    // takes no pressure, cannot leave, and the pressure that builds up against it threw
+    // Air pressed into a solid goes at once, not at the next resampling. Air moves with its
+    // nearest liquid and takes no pressure, so liquid landing on a floor presses the air layer
+    // under it into the wall, where its mass stays in the liquid's density sums: that threw
     // particles out at 75-87 m/s in SPlisHSPlasH's dam break with DFSPH (bench/RESULTS.md,
     // "DFSPH on SPlisHSPlasH's own dam break").
     const Real wallGap = AIR_WALL_GAP * mSettings.spacing;
