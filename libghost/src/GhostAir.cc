@@ -205,12 +205,9 @@ void GhostSolver::resampleAir(int phase)
         return mGrid.nearest(
             q, R, [&](Index j) { return body[j] != 0; }, distance);
     };
-    // Air stays outside every solid (AIR_WALL_GAP, see fadeAir): new air is not placed inside,
-    // kept air inside is not kept.
-    const Real wallGap = AIR_WALL_GAP * mSettings.spacing;
     auto insideSolid = [&](const Vec3& q) {
         for (const auto& solid : mSolids) {
-            if (solid->phi(q, time) < wallGap) return true;
+            if (solid->phi(q, time) < Real(0)) return true;
         }
         return false;
     };
@@ -447,30 +444,9 @@ void GhostSolver::fadeAir()
     const auto& target = mParticles.scalarChannel(AIR_TARGET);
     const Real rate = Real(1) / Real(mSettings.airResampleSteps);
     std::vector<std::uint8_t> remove(mParticles.size(), 0);
-    // Air pressed into a solid goes at once, not at the next resampling. Air moves with its
-    // nearest liquid and takes no pressure, so liquid landing on a floor presses the air layer
-    // under it into the wall, where its mass stays in the liquid's density sums: that threw
-    // particles out at 75-87 m/s in SPlisHSPlasH's dam break with DFSPH (bench/RESULTS.md,
-    // "DFSPH on SPlisHSPlasH's own dam break").
-    const Real wallGap = AIR_WALL_GAP * mSettings.spacing;
-    if (!mSolids.empty()) {
-        const auto& x = mParticles.positions();
-        parallel::forEach(
-            0, mParticles.size(),
-            [&](std::size_t i) {
-            if (mParticles.kinds()[i] != ParticleKind::GhostAir) return;
-            for (const auto& solid : mSolids) {
-                if (solid->phi(x[i], mRun.time) < wallGap) {
-                    remove[i] = 1;
-                    return;
-                }
-            }
-            },
-            256);
-    }
-    bool anyRemoved = std::find(remove.begin(), remove.end(), std::uint8_t(1)) != remove.end();
+    bool anyRemoved = false;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        if (mParticles.kinds()[i] != ParticleKind::GhostAir || remove[i]) continue;
+        if (mParticles.kinds()[i] != ParticleKind::GhostAir) continue;
         weight[i] = target[i] > weight[i] ? std::min(target[i], weight[i] + rate)
                                           : std::max(target[i], weight[i] - rate);
         mParticles.masses()[i] = weight[i] * mMass;

@@ -49,15 +49,8 @@ constexpr const char* SOLID_LOCAL_NORMAL =
     "solid_n";                                   ///< moving solid particle: normal, solid frame
 constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, mass = weight m
 constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
-/// Ghost air closer to a solid than this many particle spacings (inside it when 0) is removed
-/// at the start of every step and not sampled ([SB12] places air outside the solids; GhostAir.cc,
-/// fadeAir). 0, not a gap: a gap of 0.5 h also held the landing below, but the hard removal of
-/// air near every wall made the DFSPH dam break on 3 processes drift from one process past its
-/// test's bound (0.355 h against 0.3 h after 60 steps; 0.19 h with 0).
-constexpr Real AIR_WALL_GAP = Real(0);
 constexpr const char* DENSITY_KAPPA = "dfsph_k"; ///< DFSPH: density solve's p / rho^2 (warm start)
-constexpr const char* DIVERGENCE_KAPPA =
-    "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
+constexpr const char* DIVERGENCE_KAPPA = "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
 /// DFSPH over several processes: a solve's values handed to the halo copies (refresh)
 constexpr const char* DFSPH_SYNC = "dfsph_sync";
 constexpr const char* DFSPH_SYNC_VECTOR = "dfsph_sync_v"; ///< the same for G k
