@@ -67,7 +67,8 @@ struct Options
     std::string methods = "both";  ///< ghost, basic or both
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     std::uint64_t seed = 1;
-    bool halo = false; ///< print the halos of domain decompositions of the state
+    bool halo = false;  ///< print the halos of domain decompositions of the state
+    bool trace = false; ///< print one line per measured step (stderr)
 };
 
 double seconds(std::chrono::steady_clock::time_point start)
@@ -219,6 +220,33 @@ struct RunResult
 /// computes); its halo is the liquid and air of other parts within a support radius R of its
 /// region (copies it receives every step); its solid particles are those in or within R of
 /// its region (sampled locally, never exchanged).
+/// One line per step (--trace): what to look at when a run goes wrong at some step.
+void traceStep(const GhostSolver& solver, Real dt, double wall)
+{
+    const ParticleSet& p = solver.particles();
+    const Real rho0 = solver.settings().restDensity;
+    double vmax = 0, rmax = 0;
+    std::size_t fastest = 0, air = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] == ParticleKind::GhostAir) ++air;
+        if (p.kinds()[i] != ParticleKind::Liquid) continue;
+        const double v = double(p.velocities()[i].length());
+        if (v > vmax) vmax = v, fastest = i;
+        rmax = std::max(rmax, double(p.densities()[i] / rho0));
+    }
+    const PressureSolveStats& s = solver.pressureSolveStats();
+    const Vec3 x = p.size() ? p.positions()[fastest] : Vec3(0);
+    std::fprintf(
+        stderr,
+        "trace step %llu t %.5f dt %.3e wall %.3f s | vmax %.3f at (%.3f %.3f %.3f) rho/rho0 "
+        "%.3f | max rho/rho0 %.3f | dfsph %d density (%.2e) %d divergence (%.2e) | "
+        "air %zu\n",
+        (unsigned long long)solver.stepCount(), double(solver.time()), double(dt), wall, vmax,
+        double(x[0]), double(x[1]), double(x[2]),
+        p.size() ? double(p.densities()[fastest] / rho0) : 0.0, rmax, s.lastDensityIterations,
+        s.lastDensityError, s.lastDivergenceIterations, s.lastDivergenceError, air);
+}
+
 void printHalo(const GhostSolver& solver, const std::string& when)
 {
     const ParticleSet& p = solver.particles();
@@ -316,6 +344,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
             times.push_back(t);
             nbrs += solver.meanNeighbors();
             ++out.steps;
+            if (opt.trace) traceStep(solver, dt, t);
         }
         out.ok = true;
     } catch (const NumericalError& e) {
@@ -431,10 +460,12 @@ void printRun(const RunResult& r)
     if (r.pressure == PressureModel::Dfsph) {
         const PressureSolveStats& st = r.solve;
         std::printf("  DFSPH: %.1f density + %.1f divergence iterations per step, last errors "
-                    "%.2e / %.2e, %llu unconverged solves\n",
+                    "%.2e / %.2e, largest of one particle %.2e / %.2e, %llu unconverged "
+                    "solves\n",
                     double(st.densityIterations) / double(st.steps),
                     double(st.divergenceIterations) / double(st.steps), st.lastDensityError,
-                    st.lastDivergenceError, static_cast<unsigned long long>(st.unconverged));
+                    st.lastDivergenceError, st.largestDensityError, st.largestDivergenceError,
+                    static_cast<unsigned long long>(st.unconverged));
     }
 }
 
@@ -537,6 +568,9 @@ int main(int argc, char** argv)
         ->capture_default_str()
         ->check(CLI::IsMember({"ghost", "basic", "both"}));
     app.add_option("--seed", opt.seed, "random seed of all sampling")->capture_default_str();
+    app.add_flag("--trace", opt.trace,
+                 "print a line per measured step to stderr: time, dt, the fastest and densest "
+                 "liquid particle, the pressure solve's iterations, the air count");
     app.add_flag("--halo", opt.halo,
                  "print the halos of slab and bisection decompositions into 2-1024 parts, "
                  "after the first step and at the end (the multi-rank scaling model)");

@@ -88,11 +88,16 @@ struct PressureSolveStats
     std::uint64_t steps = 0;                ///< steps solved
     std::uint64_t densityIterations = 0;    ///< constant-density iterations, all steps
     std::uint64_t divergenceIterations = 0; ///< divergence iterations, all steps
-    std::uint64_t unconverged = 0;          ///< solves that reached DfsphSettings::maxIterations
+    std::uint64_t unconverged = 0;          ///< solves that stopped short of either limit
+                                            ///< (DfsphSettings::maxIterations)
     int lastDensityIterations = 0, lastDivergenceIterations = 0;
     double lastDensityError = 0; ///< mean |rho* / rho0 - 1| the last density solve reached
     double lastDivergenceError =
         0; ///< mean |D rho / Dt| dt / rho0 the last divergence solve reached
+    /// The largest error of one particle a density (divergence) solve left, over the steps:
+    /// a solve stops when its mean error is within the limit and no particle's exceeds ten
+    /// times the limit.
+    double largestDensityError = 0, largestDivergenceError = 0;
 };
 
 class GhostSolver
@@ -307,8 +312,10 @@ private:
     /// density solve (density = true) drives rho + dt D rho / Dt to rho0, the divergence solve
     /// D rho / Dt to 0. `total` is the
     /// per-particle channel of accumulated pressure terms (warm start in, result out).
-    /// Returns the iterations; sets `error` to the mean error reached.
-    int solvePressure(Real dt, bool density, std::vector<Real>& total, double& error);
+    /// Returns the iterations; sets `error` to the mean error reached and `largest` to the
+    /// largest error of one particle it left.
+    int solvePressure(Real dt, bool density, std::vector<Real>& total, double& error,
+                      double& largest);
     void stepBasic(Real dt);
     void moveSolids(double time);
     void projectOutOfSolids(Real dt);

@@ -12,6 +12,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -95,6 +96,31 @@ double sum(std::size_t begin, std::size_t end, Fn&& fn, std::size_t block = 1024
     double total = 0.0;
     for (double s : partial) total += s;
     return total;
+}
+
+/// Largest `fn(i)` (as double) over [begin, end), or `lowest` when the range is empty; a maximum
+/// does not depend on the order, so neither on the thread count.
+template <typename Fn>
+double maximum(std::size_t begin, std::size_t end, Fn&& fn, double lowest = 0.0,
+               std::size_t block = 1024)
+{
+    if (end <= begin) return lowest;
+    if (block == 0) block = 1;
+    const std::size_t nBlocks = (end - begin + block - 1) / block;
+    std::vector<double> partial(nBlocks, lowest);
+    forEach(
+        0, nBlocks,
+        [&](std::size_t b) {
+        const std::size_t lo = begin + b * block;
+        const std::size_t hi = lo + block < end ? lo + block : end;
+        double m = lowest;
+        for (std::size_t i = lo; i < hi; ++i) m = std::max(m, double(fn(i)));
+        partial[b] = m;
+        },
+        1);
+    double result = lowest;
+    for (double m : partial) result = std::max(result, m);
+    return result;
 }
 
 } // namespace parallel
