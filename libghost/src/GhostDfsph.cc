@@ -74,10 +74,6 @@ using namespace detail;
 
 namespace {
 
-/// A solve stops when the mean error is within its limit and no particle's error exceeds this
-/// many times the limit (1 % at the default 0.1 %).
-constexpr double DFSPH_PEAK_FACTOR = 10;
-
 /// Liquid and solid neighbours (self included) below which a liquid particle is spray, about a
 /// fifth of a full neighbourhood at [SB12]'s 3 h support. Measured: with 10 (liquid only) the
 /// tomato's stream blew up at frame 8; with 20 liquid only, the still tank's corner particles
@@ -248,13 +244,13 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // Largest |e| / rho0 of one particle. The mean alone does not see a few particles in a
     // hundred thousand: in SPlisHSPlasH's dam break at 100k, a handful beside the floor were
     // squeezed from 1.3 to 2.7 rho0 over ten steps in which the mean stayed under its limit
-    // and no iteration ran (bench/RESULTS.md, "DFSPH: a peak limit").
+    // and no iteration ran (bench/RESULTS.md, "DFSPH: a peak limit"; DfsphSettings::PEAK_FACTOR).
     auto largestError = [&](const std::vector<Real>& r) {
         const double m = parallel::maximum(
             0, n, [&](std::size_t i) { return solved(i) ? double(std::abs(r[i])) : 0.0; });
         return (mExchange ? mExchange->maxOf(m) : m) * double(dt2) / double(rho0);
     };
-    const double peakLimit = DFSPH_PEAK_FACTOR * limit;
+    const double peakLimit = DfsphSettings::PEAK_FACTOR * limit;
     auto converged = [&](double mean, const std::vector<Real>& r) {
         largest = largestError(r);
         return mean <= limit && largest <= peakLimit;

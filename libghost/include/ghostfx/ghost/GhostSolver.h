@@ -95,8 +95,8 @@ struct PressureSolveStats
     double lastDivergenceError =
         0; ///< mean |D rho / Dt| dt / rho0 the last divergence solve reached
     /// The largest error of one particle a density (divergence) solve left, over the steps:
-    /// a solve stops when its mean error is within the limit and no particle's exceeds ten
-    /// times the limit.
+    /// a solve stops when its mean error is within the limit and no particle's exceeds
+    /// DfsphSettings::PEAK_FACTOR times the limit.
     double largestDensityError = 0, largestDivergenceError = 0;
 };
 
