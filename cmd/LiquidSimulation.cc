@@ -57,13 +57,16 @@ public:
             const ghost::DfsphSettings& d = mSolver->settings().dfsph;
             std::fprintf(stderr,
                          "ghostfx: warning: scene '%s', frame %d: %llu DFSPH solves stopped at "
-                         "dfsph.max_iterations = %d above their error limit (last: density "
-                         "%.2e against %.0e, divergence %.2e against %.0e); raise "
-                         "max_iterations or the limits, or lower cfl / max_dt\n",
+                         "dfsph.max_iterations = %d above their error limit (last: density mean "
+                         "%.2e, largest %.2e, against %.0e and %g x that; divergence %.2e, "
+                         "largest %.2e, against %.0e); raise max_iterations or the limits, or "
+                         "lower cfl / max_dt\n",
                          mScene.file.c_str(), mSolver->frame(),
                          static_cast<unsigned long long>(st.unconverged - unconverged),
-                         d.maxIterations, st.lastDensityError, double(d.densityError),
-                         st.lastDivergenceError, double(d.divergenceError));
+                         d.maxIterations, st.lastDensityError, st.lastLargestDensityError,
+                         double(d.densityError), ghost::DfsphSettings::PEAK_FACTOR,
+                         st.lastDivergenceError, st.lastLargestDivergenceError,
+                         double(d.divergenceError));
         }
     }
     int frame() const override { return mSolver->frame(); }

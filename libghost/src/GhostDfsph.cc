@@ -477,6 +477,8 @@ void GhostSolver::stepDfsph(Real dt)
     mSolveStats.lastDivergenceIterations = divergenceIterations;
     mSolveStats.lastDensityError = densityError;
     mSolveStats.lastDivergenceError = divergenceError;
+    mSolveStats.lastLargestDensityError = densityPeak;
+    mSolveStats.lastLargestDivergenceError = divergencePeak;
     mSolveStats.largestDensityError = std::max(mSolveStats.largestDensityError, densityPeak);
     mSolveStats.largestDivergenceError =
         std::max(mSolveStats.largestDivergenceError, divergencePeak);

@@ -311,6 +311,24 @@ TEST_F(Cli, FixedStepBeyondTheStabilityLimitIsWarnedAboutBeforeTheFirstStep)
     EXPECT_EQ(good.err.find("warning"), std::string::npos) << good.err;
 }
 
+TEST_F(Cli, DfsphSolvesStoppedAtTheIterationCapAreWarnedAbout)
+{
+    // One iteration per solve and a limit of 1e-5 cannot be met while the cube collapses: the
+    // frame's warning names the cap and, per solve, the mean and the largest error of one
+    // particle against the limit and its peak factor.
+    const std::string path = write(smallScene());
+    const Result r =
+        run("run " + path + " --out " + (mDir / "out").string()
+            + " -q --frames 1-1 -D settings.pressure=dfsph -D settings.substeps=0"
+              " -D settings.dfsph.max_iterations=1 -D settings.dfsph.density_error=1e-5"
+              " -D settings.dfsph.divergence_error=1e-5");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_CONTAINS(r.err, "ghostfx: warning: scene '" + path + "', frame 1: ");
+    EXPECT_CONTAINS(r.err, "DFSPH solves stopped at dfsph.max_iterations = 1 above their error "
+                           "limit (last: density mean ");
+    EXPECT_CONTAINS(r.err, "against 1e-05 and 30 x that; divergence ");
+}
+
 TEST_F(Cli, SolidThinnerThanTheKernelSupportIsWarnedAbout)
 {
     // The tank's walls default to one kernel radius (3 h = 0.045 m): no warning (checked by

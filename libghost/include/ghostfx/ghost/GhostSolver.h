@@ -98,6 +98,7 @@ struct PressureSolveStats
     /// a solve stops when its mean error is within the limit and no particle's exceeds
     /// DfsphSettings::PEAK_FACTOR times the limit.
     double largestDensityError = 0, largestDivergenceError = 0;
+    double lastLargestDensityError = 0, lastLargestDivergenceError = 0; ///< the last step's
 };
 
 class GhostSolver
