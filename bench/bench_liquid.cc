@@ -24,6 +24,7 @@
 #include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/DomainDecomposition.h>
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
 
@@ -236,15 +237,33 @@ void traceStep(const GhostSolver& solver, Real dt, double wall)
     }
     const PressureSolveStats& s = solver.pressureSolveStats();
     const Vec3 x = p.size() ? p.positions()[fastest] : Vec3(0);
-    std::fprintf(
-        stderr,
-        "trace step %llu t %.5f dt %.3e wall %.3f s | vmax %.3f at (%.3f %.3f %.3f) rho/rho0 "
-        "%.3f | max rho/rho0 %.3f | dfsph %d density (%.2e) %d divergence (%.2e) | "
-        "air %zu\n",
-        (unsigned long long)solver.stepCount(), double(solver.time()), double(dt), wall, vmax,
-        double(x[0]), double(x[1]), double(x[2]),
-        p.size() ? double(p.densities()[fastest] / rho0) : 0.0, rmax, s.lastDensityIterations,
-        s.lastDensityError, s.lastDivergenceIterations, s.lastDivergenceError, air);
+    // The fastest particle's density by the kind of neighbour (at the positions after the
+    // step, so the parts need not add up to the density the step used).
+    const CubicSplineKernel kernel(solver.settings().supportRadius());
+    double parts[3] = {0, 0, 0}; // liquid, air, solid
+    auto add = [&](const ParticleSet& set) {
+        for (std::size_t j = 0; j < set.size(); ++j) {
+            const Real w = kernel.W((set.positions()[j] - x).length());
+            if (w == Real(0)) continue;
+            const int k = set.kinds()[j] == ParticleKind::Liquid     ? 0
+                          : set.kinds()[j] == ParticleKind::GhostAir ? 1
+                                                                     : 2;
+            parts[k] += double(set.masses()[j] * w / rho0);
+        }
+    };
+    add(p);
+    add(solver.solidParticles());
+    std::fprintf(stderr,
+                 "trace step %llu t %.5f dt %.3e wall %.3f s | vmax %.3f at (%.3f %.3f %.3f) "
+                 "rho/rho0 %.3f (liquid %.3f, air %.3f, solid %.3f) | max rho/rho0 %.3f | dfsph "
+                 "%d density (mean %.2e, largest %.2e) %d divergence (mean %.2e, largest %.2e) "
+                 "| air %zu\n",
+                 (unsigned long long)solver.stepCount(), double(solver.time()), double(dt), wall,
+                 vmax, double(x[0]), double(x[1]), double(x[2]),
+                 p.size() ? double(p.densities()[fastest] / rho0) : 0.0, parts[0], parts[1],
+                 parts[2], rmax, s.lastDensityIterations, s.lastDensityError,
+                 s.lastLargestDensityError, s.lastDivergenceIterations, s.lastDivergenceError,
+                 s.lastLargestDivergenceError, air);
 }
 
 void printHalo(const GhostSolver& solver, const std::string& when)
