@@ -179,14 +179,15 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
         [&](std::size_t chunk) {
         Chunk& out = mChunks[chunk];
         std::size_t used = 0; // units of the chunk
-        std::size_t start = 0, hits = 0;
-        // The query's indices, written as 32-bit entries from unit `start` on.
-        auto wideAt = [&] { return reinterpret_cast<Index*>(out.units.get() + start); };
+        std::size_t hits = 0;
+        // The current query's hits as 32-bit entries; the chunk then gets them in their
+        // final form, so it needs room for the lists only, not for a search's candidates.
+        std::vector<Index> found(1024);
         Stencil stencil;
         alignas(16) Real r2[BATCH] = {};
         const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
         for (std::size_t q = chunk * CHUNK; q < qEnd; ++q) {
-            start = (used + 1) & ~std::size_t(1);
+            const std::size_t start = (used + 1) & ~std::size_t(1);
             hits = 0;
             if ((wanted && !wanted[q]) || !isFinite(queries[q])) {
                 used = start;
@@ -220,8 +221,9 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
             // Reachable cells whose slots follow each other (neighbours along z usually do: z
             // is the lowest Morton bit) are searched as one range.
             auto search = [&](NeighborGrid::SlotRange range) {
-                out.reserve(start + 2 * (hits + (range.end - range.begin) + 8), start + 2 * hits);
-                Index* dst = wideAt();
+                const std::size_t room = hits + (range.end - range.begin) + 8;
+                if (found.size() < room) found.resize(std::max(room, 2 * found.size()));
+                Index* dst = found.data();
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
                 if (avx2) {
                     const float q[3] = {qx, qy, qz};
@@ -259,37 +261,40 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
             if (!run.empty()) search(run);
             // Slots to particle indices (nothing to do for a grid over a sorted set), then
             // 16-bit offsets from the smallest index when they all fit.
-            Index* dst = wideAt();
+            Index* src = found.data();
             if (!targets.identityOrder()) {
-                for (std::size_t k = 0; k < hits; ++k) dst[k] = targets.particleAt(dst[k]);
+                for (std::size_t k = 0; k < hits; ++k) src[k] = targets.particleAt(src[k]);
             }
             Index lo = WIDE, hi = 0;
             for (std::size_t k = 0; k < hits; ++k) {
-                lo = std::min(lo, dst[k]);
-                hi = std::max(hi, dst[k]);
+                lo = std::min(lo, src[k]);
+                hi = std::max(hi, src[k]);
             }
             Index base = 0;
             if (hits == 0) {
                 used = start;
             } else if (hi - lo <= 0xffff) {
-                // In place: offset k goes to unit start + k, which belongs to an entry at or
-                // before k, already read.
-                std::uint16_t* narrow = out.units.get() + start;
-                for (std::size_t k = 0; k < hits; ++k) narrow[k] = std::uint16_t(dst[k] - lo);
-                base = lo;
                 used = start + hits;
+                out.reserve(used + 2, start); // 2 readable units past the list (List::Iterator)
+                std::uint16_t* narrow = out.units.get() + start;
+                for (std::size_t k = 0; k < hits; ++k) narrow[k] = std::uint16_t(src[k] - lo);
+                base = lo;
             } else {
-                base = WIDE;
                 used = start + 2 * hits;
+                out.reserve(used + 2, start);
+                std::copy(src, src + hits, reinterpret_cast<Index*>(out.units.get() + start));
+                base = WIDE;
             }
             if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
                 throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
             }
             mEnd[q] = {std::uint32_t(used), base};
         }
-        // A chunk that holds far more than it needs gives the room back (its lists shrank,
-        // e.g. after a splash settled): capacity is what the process holds.
-        if (out.capacity > 2 * used + 4096) out.shrink(used);
+        // Fit the chunk to its lists (they shrank since an earlier step, or it grew by a
+        // sixteenth while being filled): capacity is what the process holds. Most chunks are
+        // re-allocated in most steps; that costs less than a step's noise (bench/RESULTS.md,
+        // "Memory: lists fitted").
+        if (out.capacity > used + used / 64 + 64) out.shrink(used);
         },
         1);
 }
@@ -307,7 +312,7 @@ bool NeighborLists::wideSimd()
 
 void NeighborLists::Chunk::shrink(std::size_t used)
 {
-    const std::size_t fitted = used + used / 8 + 512;
+    const std::size_t fitted = used + 32;
     std::unique_ptr<std::uint16_t[]> smaller(new std::uint16_t[fitted]);
     std::copy(units.get(), units.get() + used, smaller.get());
     units = std::move(smaller);
@@ -317,7 +322,7 @@ void NeighborLists::Chunk::shrink(std::size_t used)
 void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)
 {
     if (size <= capacity) return;
-    const std::size_t grown = std::max(size, capacity + capacity / 8 + 2048);
+    const std::size_t grown = std::max(size, capacity + capacity / 16 + 256);
     std::unique_ptr<std::uint16_t[]> bigger(new std::uint16_t[grown]);
     if (used > 0) std::copy(units.get(), units.get() + used, bigger.get());
     units = std::move(bigger);

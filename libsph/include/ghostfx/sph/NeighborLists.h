@@ -16,7 +16,11 @@
 ///          second counting pass and no copy, and the result does not depend on the thread
 ///          count: list q holds the target indices in a fixed order (cells in stencil order,
 ///          slots ascending). A query is its own neighbour when it is in the target grid.
-///          The storage keeps its capacity from step to step.
+///          A task gathers each query's hits as 32-bit entries in a buffer of its own and writes
+///          the list in its final form to its chunk, which is fitted to what it holds at the end
+///          of the build (within 1/64 plus 64 units): the lists are memory a step holds for
+///          every particle, so they carry no room for a search's candidates and no growth left
+///          from an earlier, busier step.
 ///
 ///          Storage: a list whose indices all lie within 65,536 of its smallest is kept as
 ///          16-bit offsets from that smallest index (the usual case for particles sorted by the
@@ -179,7 +183,8 @@ private:
     /// `End::base` of a list of 32-bit indices.
     static constexpr Index WIDE = ~Index(0);
 
-    /// A chunk's lists, back to back in 16-bit units; grows by an eighth and keeps its capacity.
+    /// A chunk's lists, back to back in 16-bit units; grows by a sixteenth while it is filled
+    /// and is fitted to its lists at the end of the build.
     struct Chunk
     {
         std::unique_ptr<std::uint16_t[]> units;
