@@ -39,6 +39,7 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
             msg("neighbour grid: ", count, " particles exceed the 32-bit index range"));
     }
     mIdentity = false;
+    mSize = count;
     // Table size: the smallest power of two >= 2 N (at least 64), so buckets average <= 0.5
     // particle-cells and a compact block of cells never wraps onto itself.
     std::size_t tableSize = 64;
@@ -174,14 +175,10 @@ void NeighborGrid::sortParticles(ParticleSet& particles)
 {
     build(particles.positions());
     particles.reorder(mIndex);
-    // The set now is in slot order: particle k sits in slot k.
-    parallel::forEach(
-        0, mIndex.size(),
-        [&](std::size_t k) {
-        mIndex[k] = Index(k);
-        mSlotOf[k] = std::uint32_t(k);
-        },
-        8192);
+    // The set now is in slot order: particle k sits in slot k, and the index arrays would
+    // only say so (8 bytes per particle, given back).
+    std::vector<Index>().swap(mIndex);
+    std::vector<std::uint32_t>().swap(mSlotOf);
     mIdentity = true;
 }
 

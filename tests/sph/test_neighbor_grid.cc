@@ -354,9 +354,21 @@ TEST(NeighborGrid, SortParticlesReordersTheSetConsistently)
         EXPECT_EQ(set.scalarChannel("tag")[k], Real(3 * id + 1));
         EXPECT_EQ(set.velocities()[k], Vec3(Real(id)));
     }
-    // The set is now in grid order: order() is the identity and neighbour indices are indices
-    // into the reordered set.
-    for (std::size_t k = 0; k < grid.order().size(); ++k) ASSERT_EQ(grid.order()[k], Index(k));
+    // The set is now in grid order: slot k holds particle k, the grid keeps no index arrays
+    // for it, and neighbour indices are indices into the reordered set.
+    ASSERT_TRUE(grid.identityOrder());
+    EXPECT_TRUE(grid.order().empty());
+    ASSERT_EQ(grid.size(), xs.size());
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+        ASSERT_EQ(grid.particleAt(std::uint32_t(k)), Index(k));
+        ASSERT_EQ(grid.slotOf(Index(k)), std::uint32_t(k));
+        ASSERT_EQ(grid.sortedPosition(std::uint32_t(k)), set.positions()[k]);
+    }
+    // Without the two index arrays it holds 8 bytes per particle less than a grid built over
+    // the same (now sorted) positions without sorting them.
+    NeighborGrid unsorted(cellSize);
+    unsorted.build(set.positions());
+    EXPECT_LE(grid.memoryBytes() + 8 * xs.size(), unsorted.memoryBytes());
     expectNeighborsMatchBruteForce(grid, set.positions());
     // Particles of one cell are contiguous after the sort (each cell is one run).
     std::map<std::array<int, 3>, int> runs;

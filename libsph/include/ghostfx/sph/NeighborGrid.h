@@ -76,10 +76,12 @@ public:
     /// mapping as the identity, so neighbour indices are indices into the reordered set.
     void sortParticles(ParticleSet& particles);
 
-    /// Sorted slot k holds particle `order()[k]`: pass it to ParticleSet::reorder.
+    /// Sorted slot k holds particle `order()[k]`: pass it to ParticleSet::reorder. Empty after
+    /// sortParticles(), where slot k holds particle k (identityOrder()): the grid then keeps no
+    /// index arrays.
     const std::vector<Index>& order() const { return mIndex; }
 
-    std::size_t size() const { return mIndex.size(); }
+    std::size_t size() const { return mSize; }
     /// Buckets in the hash table (a power of two).
     std::size_t bucketCount() const { return mBucketCell.empty() ? 0 : mBucketCell.size() - 1; }
     /// Occupied cells.
@@ -124,9 +126,9 @@ public:
     /// Position (m) of sorted slot s.
     Vec3 sortedPosition(std::uint32_t s) const { return Vec3(mX[s], mY[s], mZ[s]); }
     /// The particle index held by sorted slot s.
-    Index particleAt(std::uint32_t s) const { return mIndex[s]; }
+    Index particleAt(std::uint32_t s) const { return mIdentity ? Index(s) : mIndex[s]; }
     /// The sorted slot of particle i.
-    std::uint32_t slotOf(Index i) const { return mSlotOf[i]; }
+    std::uint32_t slotOf(Index i) const { return mIdentity ? std::uint32_t(i) : mSlotOf[i]; }
     /// Whether slot s holds particle s for every s (after sortParticles).
     bool identityOrder() const { return mIdentity; }
 
@@ -136,7 +138,7 @@ public:
     template <typename Fn>
     void forEachNeighbor(Index i, Fn&& fn) const
     {
-        forEachInRadius(sortedPosition(mSlotOf[i]), mCellSize, fn);
+        forEachInRadius(sortedPosition(slotOf(i)), mCellSize, fn);
     }
 
     /// Call fn(j, x - x_j, r) for every particle j with |x - x_j| < radius (m).
@@ -208,10 +210,11 @@ private:
     std::vector<std::uint64_t> mCellKey;    ///< packed key of each occupied cell, sorted order
     std::vector<std::uint32_t> mCellStart;  ///< cell k holds slots [start[k], start[k+1])
     std::vector<Real> mX, mY, mZ;           ///< positions in sorted order (m)
-    std::vector<Index> mIndex;              ///< particle index of each sorted slot
-    std::vector<std::uint32_t> mSlotOf;     ///< sorted slot of each particle index
-    bool mIdentity = false;                 ///< mIndex[s] == s for every slot
-    std::size_t mPerCellHint = 1;           ///< see setParticlesPerCellHint
+    std::vector<Index> mIndex;          ///< particle index of each sorted slot (empty if identity)
+    std::vector<std::uint32_t> mSlotOf; ///< sorted slot of each particle index (empty if identity)
+    std::size_t mSize = 0;              ///< particles in the grid
+    bool mIdentity = false;             ///< slot s holds particle s for every slot
+    std::size_t mPerCellHint = 1;       ///< see setParticlesPerCellHint
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -239,7 +242,7 @@ inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, 
         }
         for (std::uint32_t h = 0; h < n; ++h) {
             const std::uint32_t s = hit[h];
-            fn(mIndex[s], x - sortedPosition(s), std::sqrt(hitR2[h]));
+            fn(particleAt(s), x - sortedPosition(s), std::sqrt(hitR2[h]));
         }
         k = stop;
     }
@@ -248,14 +251,14 @@ inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, 
 template <typename Fn>
 inline void NeighborGrid::forEachInRadius(const Vec3& x, Real radius, Fn&& fn) const
 {
-    if (mIndex.empty() || !isFinite(x) || !(radius > Real(0))) return;
+    if (mSize == 0 || !isFinite(x) || !(radius > Real(0))) return;
     const Real radius2 = radius * radius;
     const Real reachCells = std::ceil(radius * mInvCellSize);
     if (sweepIsCheaper(reachCells)) {
-        for (std::uint32_t s = 0; s < mIndex.size(); ++s) {
+        for (std::uint32_t s = 0; s < mSize; ++s) {
             const Vec3 xij = x - sortedPosition(s);
             const Real r2 = xij.lengthSqr();
-            if (r2 < radius2) fn(mIndex[s], xij, std::sqrt(r2));
+            if (r2 < radius2) fn(particleAt(s), xij, std::sqrt(r2));
         }
         return;
     }
@@ -273,14 +276,14 @@ inline void NeighborGrid::forEachInRadius(const Vec3& x, Real radius, Fn&& fn) c
 template <typename Fn>
 inline void NeighborGrid::forEachInBox(const Aabb& box, Fn&& fn) const
 {
-    if (mIndex.empty() || box.empty() || !isFinite(box.min) || !isFinite(box.max)) return;
+    if (mSize == 0 || box.empty() || !isFinite(box.min) || !isFinite(box.max)) return;
     const Cell lo = cellOf(box.min), hi = cellOf(box.max);
     const double cells =
         double(hi.i - lo.i + 1) * double(hi.j - lo.j + 1) * double(hi.k - lo.k + 1);
     if (cells > double(cellCount())) {
-        for (std::uint32_t s = 0; s < mIndex.size(); ++s) {
+        for (std::uint32_t s = 0; s < mSize; ++s) {
             const Vec3 x = sortedPosition(s);
-            if (box.contains(x)) fn(mIndex[s], x);
+            if (box.contains(x)) fn(particleAt(s), x);
         }
         return;
     }
@@ -290,7 +293,7 @@ inline void NeighborGrid::forEachInBox(const Aabb& box, Fn&& fn) const
                 const SlotRange r = cellSlots(Cell{i, j, k});
                 for (std::uint32_t s = r.begin; s < r.end; ++s) {
                     const Vec3 x = sortedPosition(s);
-                    if (box.contains(x)) fn(mIndex[s], x);
+                    if (box.contains(x)) fn(particleAt(s), x);
                 }
             }
         }
@@ -311,12 +314,12 @@ inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, R
             best = j;
         }
     };
-    if (!mIndex.empty() && isFinite(x) && maxRadius > Real(0)) {
+    if (mSize != 0 && isFinite(x) && maxRadius > Real(0)) {
         const Real maxRingCells = std::ceil(maxRadius * mInvCellSize);
         if (sweepIsCheaper(maxRingCells)) {
             // A search this wide would visit more cells than there are particles.
-            for (std::uint32_t s = 0; s < mIndex.size(); ++s) {
-                consider(mIndex[s], x - sortedPosition(s), Real(0));
+            for (std::uint32_t s = 0; s < mSize; ++s) {
+                consider(particleAt(s), x - sortedPosition(s), Real(0));
             }
         } else {
             const Cell c = cellOf(x);
