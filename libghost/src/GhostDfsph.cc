@@ -202,6 +202,8 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // sum_s M (v_i - v_s) . grad W_is = v_i . (the step's solid gradient sum) - the moving
     // block's sum_s M v_s . grad W_is (static solids have v_s = 0).
     const bool movingSolids = !mMoving.block.empty();
+    const Vec3* movingV =
+        movingSolids ? mMoving.block.particles().vectorChannel(SOLID_VELOCITY).data() : nullptr;
     auto divergence = [&](const std::vector<Vec3>& vel, bool solidMoves) {
         forRangeWithBatch(
             n, mKernel,
@@ -219,7 +221,7 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
                     batch.forEachBatch(xi, set.positions().data(), mMoving.lists[i],
                                        [&](PairBatch& b) {
                         for (int c = 0; c < b.n; ++c) b.f[c] = M * kernel.gradFactor(b.r[c]);
-                        sum -= b.sumScaledApproach(b.f, set.velocities().data(), Vec3(0));
+                        sum -= b.sumScaledApproach(b.f, movingV, Vec3(0));
                     });
                 }
                 rate[i] = sum;
@@ -460,12 +462,13 @@ void GhostSolver::stepDfsph(Real dt)
         mExchange->refresh(mParticles, {"pressure"});
     }
     for (SolidBlock* b : {&mStatic, &mMoving}) {
+        Real* pSolid = b->block.particles().pressures().data();
         parallel::forEach(
             0, b->touched.size(),
             [&](std::size_t t) {
             const Index s = b->touched[t];
             const Index j = nearestIndex(b->nearest[s]);
-            b->p[s] = p[j];
+            pSolid[s] = p[j];
             b->pOverRho2[s] = p[j] / sqr(rho[j]);
             },
             1024);

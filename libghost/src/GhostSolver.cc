@@ -73,7 +73,7 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange, bool ownPart)
     auto refuse = [](const std::string& what) {
         throw ValueError(msg("liquid solver over several processes: ", what,
                              " is not supported yet (supported: method ghost, pressure tait or "
-                         "dfsph)"));
+                             "dfsph)"));
     };
     if (mSettings.method != Method::Ghost) refuse("method basic");
     if (!mRun.initialized) refuse("sharing before prepare()");
@@ -142,9 +142,35 @@ GhostSolver::SolidBlock& GhostSolver::blockOf(std::size_t solidIndex)
     return mSolids[solidIndex]->moving ? mMoving : mStatic;
 }
 
+void GhostSolver::restSolidValues(SolidBlock& b) const
+{
+    ParticleSet& set = b.block.particles();
+    const std::vector<Vec3>* solidV =
+        set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
+    for (Index k : b.touched) {
+        set.densities()[k] = mSettings.restDensity;
+        set.pressures()[k] = 0;
+        set.velocities()[k] = solidV ? (*solidV)[k] : Vec3(0);
+    }
+    b.touched.clear();
+}
+
+ParticleSet GhostSolver::restingParticles(const SolidBlock& b) const
+{
+    ParticleSet set = b.block.particles();
+    const std::vector<Vec3>* solidV =
+        set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
+    for (Index k : b.touched) {
+        set.densities()[k] = mSettings.restDensity;
+        set.pressures()[k] = 0;
+        set.velocities()[k] = solidV ? (*solidV)[k] : Vec3(0);
+    }
+    return set;
+}
+
 void GhostSolver::clearSolidScratch(SolidBlock& b)
 {
-    b.touched.clear();
+    restSolidValues(b);
     b.nearest.assign(b.block.size(), NO_LIQUID);
     b.block.touch();
     mProjectAll = true;
@@ -157,6 +183,7 @@ void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
                              mSolids.size(), " solids)"));
     }
     // Drop the old particles of this solid, then sample the new shape.
+    restSolidValues(blockOf(solidIndex)); // its indices are about to change
     ParticleSet& set = blockOf(solidIndex).block.particles();
     const auto& index = set.scalarChannel(SOLID_INDEX);
     std::vector<std::uint8_t> remove(set.size(), 0);
@@ -524,7 +551,7 @@ bool GhostSolver::initialize()
                 probe->mSolids.push_back(std::make_unique<Solid>(*solid));
             for (const SolidBlock* b : {&mStatic, &mMoving}) {
                 SolidBlock& to = b == &mStatic ? probe->mStatic : probe->mMoving;
-                to.block.particles() = b->block.particles();
+                to.block.particles() = restingParticles(*b);
                 auto& kinds = to.block.particles().kinds();
                 std::fill(kinds.begin(), kinds.end(), ParticleKind::GhostSolid);
                 to.block.touch();
@@ -584,14 +611,9 @@ ParticleSet GhostSolver::solidParticles() const
 {
     ParticleSet out;
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
-        ParticleSet set = b->block.particles();
-        // The last step's extrapolation where liquid reached ([SB12] Algorithm 3).
-        for (Index k : b->touched) {
-            set.densities()[k] = b->rho[k];
-            set.pressures()[k] = b->p[k];
-            set.velocities()[k] = b->vstar[k];
-        }
-        out.append(set);
+        // The last step's extrapolation where liquid reached ([SB12] Algorithm 3), rest values
+        // elsewhere: the block keeps both in its channels.
+        out.append(b->block.particles());
     }
     out.append(mPendingSolids);
     return out;
@@ -617,9 +639,7 @@ std::size_t GhostSolver::memoryBytes() const
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
         bytes += b->block.memoryBytes() + b->lists.memoryBytes()
                  + b->nearest.capacity() * sizeof(std::uint64_t)
-                 + b->touched.capacity() * sizeof(Index)
-                 + (b->rho.capacity() + b->p.capacity() + b->pOverRho2.capacity()) * sizeof(Real)
-                 + b->vstar.capacity() * sizeof(Vec3);
+                 + b->touched.capacity() * sizeof(Index) + b->pOverRho2.capacity() * sizeof(Real);
     }
     return bytes;
 }
@@ -632,7 +652,7 @@ SolverState GhostSolver::saveState() const
     state.solver = methodName(mSettings.method);
     // The solid particles as the blocks hold them (the step's extrapolation is scratch).
     state.particles = mParticles;
-    for (const SolidBlock* b : {&mStatic, &mMoving}) state.particles.append(b->block.particles());
+    for (const SolidBlock* b : {&mStatic, &mMoving}) state.particles.append(restingParticles(*b));
     state.particles.append(mPendingSolids);
     mRun.save(state);
     state.reals["particle_mass"] = double(mMass);

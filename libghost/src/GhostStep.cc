@@ -51,16 +51,11 @@ void GhostSolver::prepareSolidBlocks()
     // whose particles changed or moved.
     for (SolidBlock* b : {&mStatic, &mMoving}) {
         for (Index k : b->touched) b->nearest[k] = NO_LIQUID;
-        b->touched.clear();
+        restSolidValues(*b);
         if (b->block.stale()) b->block.rebuild();
         const std::size_t n = b->block.size();
         if (b->nearest.size() != n) b->nearest.assign(n, NO_LIQUID);
-        if (b->rho.size() != n) {
-            b->rho.resize(n);
-            b->p.resize(n);
-            b->pOverRho2.resize(n);
-            b->vstar.resize(n);
-        }
+        if (b->pOverRho2.size() != n) b->pOverRho2.resize(n);
     }
 }
 
@@ -193,13 +188,15 @@ void GhostSolver::computeDensity()
     // Lines 5-7: a ghost solid takes the density (and so the pressure) of its nearest liquid
     // particle. The order of `touched` depends on the threads; nothing below depends on it.
     for (SolidBlock* b : blocks) {
+        Real* rhoSolid = b->block.particles().densities().data();
+        Real* pSolid = b->block.particles().pressures().data();
         parallel::forEach(
             0, b->touched.size(),
             [&](std::size_t t) {
             const Index s = b->touched[t];
             const Index j = nearestIndex(b->nearest[s]);
-            b->rho[s] = rho[j];
-            b->p[s] = p[j];
+            rhoSolid[s] = rho[j];
+            pSolid[s] = p[j];
             b->pOverRho2[s] = p[j] / sqr(rho[j]);
             },
             1024);
@@ -288,9 +285,10 @@ void GhostSolver::extrapolateSolidVelocity()
     const auto& vstar = mParticles.vectorChannel(VSTAR);
     const bool freeSlip = mSettings.solidSlip == SolidSlip::Free;
     for (SolidBlock* b : {&mStatic, &mMoving}) {
-        const ParticleSet& set = b->block.particles();
+        ParticleSet& set = b->block.particles();
         if (b->touched.empty()) continue;
         const auto& normal = set.vectorChannel(SOLID_NORMAL);
+        Vec3* vstarSolid = set.velocities().data();
         const std::vector<Vec3>* solidV =
             set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
         parallel::forEach(
@@ -299,12 +297,12 @@ void GhostSolver::extrapolateSolidVelocity()
             const Index s = b->touched[t];
             const Vec3 vs = solidV ? (*solidV)[s] : Vec3(0);
             if (!freeSlip) {
-                b->vstar[s] = vs;
+                vstarSolid[s] = vs;
                 return;
             }
             const Vec3& nrm = normal[s];
             const Vec3& vl = vstar[nearestIndex(b->nearest[s])];
-            b->vstar[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
+            vstarSolid[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
             },
             1024);
     }
@@ -459,12 +457,13 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
                 dv += b.sumScaledDifferences(b.f, vstar.data(), vi);
             });
             for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                const Real* rhoSolid = block->rho.data();
+                const Real* rhoSolid = block->block.particles().densities().data();
+                const Vec3* vstarSolid = block->block.particles().velocities().data();
                 batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
                                    [&](PairBatch& b) {
                     for (int k = 0; k < b.n; ++k) b.f[k] = epsSolid * M / rhoSolid[b.j[k]];
                     for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                    dv += b.sumScaledDifferences(b.f, block->vstar.data(), vi);
+                    dv += b.sumScaledDifferences(b.f, vstarSolid, vi);
                 });
             }
             v[i] = vi + dv;

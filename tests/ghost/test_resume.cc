@@ -14,8 +14,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -258,4 +260,60 @@ TEST(StepObserver, CalledAfterEveryStepWithItsDt)
     solver.setStepObserver({});
     solver.step(Real(1) / 600);
     EXPECT_EQ(solver.stepCount(), 12u);
+}
+
+TEST(SolidParticles, CarryTheStepWhereLiquidReachesAndRestValuesElsewhere)
+{
+    // A ghost solid takes the density, pressure and Eq. 3 velocity of its nearest liquid
+    // particle ([SB12] Algorithm 3) only while liquid reaches it; the block keeps these in its
+    // own channels, so every other solid particle must show rest values, and a checkpoint
+    // stores rest values everywhere (the extrapolation is the step's scratch).
+    const Scene scene(Method::Ghost, 0);
+    GhostSolver solver(scene.settings);
+    scene.addInputs(solver);
+    solver.addLiquid(scene.liquid);
+    solver.advanceFrame();
+    solver.advanceFrame();
+
+    const Real rho0 = scene.settings.restDensity, R = scene.settings.supportRadius();
+    std::vector<Vec3> liquid;
+    const ParticleSet& fluid = solver.particles();
+    for (std::size_t i = 0; i < fluid.size(); ++i) {
+        if (fluid.kinds()[i] == ParticleKind::Liquid) liquid.push_back(fluid.positions()[i]);
+    }
+    auto atRest = [rho0](const ParticleSet& set, std::size_t i) {
+        const Vec3 vs = set.hasVectorChannel("solid_v") ? set.vectorChannel("solid_v")[i] : Vec3(0);
+        return set.densities()[i] == rho0 && set.pressures()[i] == Real(0)
+               && set.velocities()[i] == vs;
+    };
+    const ParticleSet solids = solver.solidParticles();
+    std::size_t far = 0, farMoved = 0, extrapolated = 0;
+    for (std::size_t i = 0; i < solids.size(); ++i) {
+        Real nearest2 = std::numeric_limits<Real>::max();
+        for (const Vec3& y : liquid)
+            nearest2 = std::min(nearest2, (solids.positions()[i] - y).lengthSqr());
+        const bool rest = atRest(solids, i);
+        extrapolated += !rest;
+        // Liquid moves far less than R in the step since the extrapolation; 2R leaves room.
+        if (nearest2 > sqr(2 * R)) {
+            ++far;
+            farMoved += !rest;
+        }
+    }
+    std::printf("[measured] solid particles %zu: %zu carry the step's values, %zu farther than 2R "
+                "from liquid (%zu of them not at rest)\n",
+                solids.size(), extrapolated, far, farMoved);
+    EXPECT_GT(extrapolated, 0u);
+    EXPECT_GT(far, 0u);
+    EXPECT_EQ(farMoved, 0u);
+
+    const SolverState state = solver.saveState();
+    std::size_t savedSolids = 0, savedMoved = 0;
+    for (std::size_t i = 0; i < state.particles.size(); ++i) {
+        if (state.particles.kinds()[i] != ParticleKind::GhostSolid) continue;
+        ++savedSolids;
+        savedMoved += !atRest(state.particles, i);
+    }
+    EXPECT_EQ(savedSolids, solids.size());
+    EXPECT_EQ(savedMoved, 0u);
 }

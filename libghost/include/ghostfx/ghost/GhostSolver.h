@@ -265,10 +265,11 @@ private:
         sph::NeighborLists lists;           ///< this step: liquid particle -> block particles
         std::vector<std::uint64_t> nearest; ///< per particle: packed (r^2, nearest liquid) or EMPTY
         std::vector<Index> touched;         ///< particles some liquid reached this step
-        /// Per particle, valid where touched: density and pressure ([SB12] Algorithm 3 lines
-        /// 5-10), p / rho^2, and the Eq. 3 velocity.
-        std::vector<Real> rho, p, pOverRho2;
-        std::vector<Vec3> vstar;
+        /// Per particle, valid where touched: p / rho^2. The step's density and pressure
+        /// ([SB12] Algorithm 3 lines 5-10) and Eq. 3 velocity of a touched particle are kept in
+        /// the block set's own density, pressure and velocity channels, which every other
+        /// particle holds at rest values (see restSolidValues).
+        std::vector<Real> pOverRho2;
     };
 
     /// Emit, sample the first air layer and scale the mass, once; false while there is no
@@ -278,6 +279,12 @@ private:
     void addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving);
     SolidBlock& blockOf(std::size_t solidIndex);
     void clearSolidScratch(SolidBlock& block);
+    /// Put the values of a particle that no liquid reaches (rest density, zero pressure, the
+    /// solid's velocity) back into the block set's channels of the particles the last step
+    /// touched, and forget them. Call before the block's particles are removed or reordered.
+    void restSolidValues(SolidBlock& block) const;
+    /// The block's particles with rest values everywhere (what a checkpoint stores).
+    ParticleSet restingParticles(const SolidBlock& block) const;
     void prepareSolidBlocks();
     void sampleSolid(std::size_t solidIndex);
     void claimRestoredSolid(std::size_t solidIndex);
