@@ -210,9 +210,8 @@ struct RunResult
     Vec3 fastest{0};                                ///< where the fastest liquid particle is
     double fastestPhi = 0, fastestDensityRatio = 0; ///< its distance to the solid, rho / rho0
     std::size_t escaped = 0, insideSolid = 0;
-    std::size_t memoryBytes = 0; ///< the solver's memoryBytes() at the end
-    std::size_t listBytes = 0;   ///< of which neighbour lists
-    int steps = 0;               ///< measured steps completed
+    GhostSolver::MemoryUse memory; ///< what the solver holds at the end
+    int steps = 0;                 ///< measured steps completed
 };
 
 /// The halos that a domain decomposition of the solver's present state would exchange, for
@@ -407,8 +406,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
     out.air = solver.count(ParticleKind::GhostAir);
     out.solid =
         solver.count(method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary);
-    out.memoryBytes = solver.memoryBytes();
-    out.listBytes = solver.neighborListBytes();
+    out.memory = solver.memoryUse();
 }
 
 double percent(double part, double whole) { return whole > 0 ? 100 * part / whole : 0; }
@@ -426,10 +424,17 @@ void printRun(const RunResult& r)
                 "mass scaling) %.2f s\n",
                 r.solidSampling, r.liquidSampling, r.firstStep);
     const double all = double(r.liquid + r.air + r.solid);
+    const GhostSolver::MemoryUse& m = r.memory;
+    const double lists = double(m.lists + m.solidLists);
     std::printf("  memory: %.1f MB, %.1f bytes per particle (particles, solid blocks, grids, "
                 "scratch %.1f + the step's neighbour lists %.1f)\n",
-                double(r.memoryBytes) / 1e6, double(r.memoryBytes) / all,
-                double(r.memoryBytes - r.listBytes) / all, double(r.listBytes) / all);
+                double(m.total()) / 1e6, double(m.total()) / all, (double(m.total()) - lists) / all,
+                lists / all);
+    auto mb = [](std::size_t bytes) { return double(bytes) / 1e6; };
+    std::printf("    liquid and air: particles %.1f MB, grid %.1f, lists %.1f; solids: particles "
+                "%.1f, grids %.1f, lists from liquid %.1f; step arrays %.1f\n",
+                mb(m.particles), mb(m.grid), mb(m.lists), mb(m.solidParticles), mb(m.solidGrids),
+                mb(m.solidLists), mb(m.stepArrays));
     std::printf("  state at the end: max liquid speed %.3f m/s, max rho/rho0 %.3f, %zu liquid "
                 "outside the container, %zu inside the solid\n",
                 r.maxSpeed, r.maxDensityRatio, r.escaped, r.insideSolid);

@@ -89,9 +89,9 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
     const auto& m = mParticles.masses();
     const auto& kind = mParticles.kinds();
     const Real M = mMass;
-    mAlpha.assign(n, Real(0));
-    mSolidGradient.assign(n, Vec3(0));
-    mLiquidMass.resize(n);
+    assignStepArray(mAlpha, n, Real(0));
+    assignStepArray(mSolidGradient, n, Vec3(0));
+    resizeStepArray(mLiquidMass, n);
     parallel::forEach(
         0, n,
         [&](std::size_t j) { mLiquidMass[j] = kind[j] == ParticleKind::Liquid ? M : Real(0); },
@@ -424,7 +424,7 @@ void GhostSolver::stepDfsph(Real dt)
     const auto& x = mParticles.positions();
     const auto& m = mParticles.masses();
     auto& p = mParticles.pressures();
-    mScratch.resize(n);
+    resizeStepArray(mScratch, n);
     parallel::forEach(
         0, n,
         [&](std::size_t i) {

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 namespace ghostfx {
 namespace ghost {
@@ -50,10 +51,28 @@ constexpr const char* SOLID_LOCAL_NORMAL =
 constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, mass = weight m
 constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
 constexpr const char* DENSITY_KAPPA = "dfsph_k"; ///< DFSPH: density solve's p / rho^2 (warm start)
-constexpr const char* DIVERGENCE_KAPPA = "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
+constexpr const char* DIVERGENCE_KAPPA =
+    "dfsph_kv"; ///< DFSPH: divergence solve's term (warm start)
 /// DFSPH over several processes: a solve's values handed to the halo copies (refresh)
 constexpr const char* DFSPH_SYNC = "dfsph_sync";
 constexpr const char* DFSPH_SYNC_VECTOR = "dfsph_sync_v"; ///< the same for G k
+
+/// Size a per-particle step array for n particles, growing its capacity by an eighth rather
+/// than doubling it (GhostSolver::memoryUse counts capacity, and the air count changes a little
+/// at every resampling), and fill it with `value`.
+template <typename T>
+void assignStepArray(std::vector<T>& array, std::size_t n, const T& value)
+{
+    if (n > array.capacity()) array.reserve(n + n / 8);
+    array.assign(n, value);
+}
+/// The same without filling: the first min(size, n) entries are kept.
+template <typename T>
+void resizeStepArray(std::vector<T>& array, std::size_t n)
+{
+    if (n > array.capacity()) array.reserve(n + n / 8);
+    array.resize(n);
+}
 
 /// parallel::forRange over particles [0, n): each task gets its own copy of `kernel` and a
 /// PairBatch of its own, and calls body(lo, hi, kernel, batch) on its range.

@@ -631,17 +631,26 @@ ParticleSet GhostSolver::allParticles() const
     return out;
 }
 
-std::size_t GhostSolver::memoryBytes() const
+GhostSolver::MemoryUse GhostSolver::memoryUse() const
 {
-    std::size_t bytes = mParticles.memoryBytes() + mGrid.memoryBytes() + mFluidLists.memoryBytes()
-                        + mPendingSolids.memoryBytes() + mQueryMask.capacity()
-                        + mLiquidMask.capacity() + mScratch.capacity() * sizeof(Real);
+    MemoryUse use;
+    use.particles = mParticles.memoryBytes();
+    use.grid = mGrid.memoryBytes();
+    use.lists = mFluidLists.memoryBytes();
+    use.solidParticles = mPendingSolids.memoryBytes();
+    use.stepArrays =
+        mQueryMask.capacity() + mLiquidMask.capacity()
+        + (mScratch.capacity() + mAlpha.capacity() + mLiquidMass.capacity()) * sizeof(Real)
+        + mSolidGradient.capacity() * sizeof(Vec3);
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
-        bytes += b->block.memoryBytes() + b->lists.memoryBytes()
-                 + b->nearest.capacity() * sizeof(std::uint64_t)
-                 + b->touched.capacity() * sizeof(Index) + b->pOverRho2.capacity() * sizeof(Real);
+        use.solidParticles += b->block.particles().memoryBytes();
+        use.solidGrids += b->block.grid().memoryBytes();
+        use.solidLists += b->lists.memoryBytes();
+        use.stepArrays += b->nearest.capacity() * sizeof(std::uint64_t)
+                          + b->touched.capacity() * sizeof(Index)
+                          + b->pOverRho2.capacity() * sizeof(Real);
     }
-    return bytes;
+    return use;
 }
 
 // Save and restore ----------------------------------------------------------------------------------

@@ -68,8 +68,8 @@ void GhostSolver::searchNeighbors()
     // Air is searched too (liquid and air neighbours only): its nearest liquid particle, whose
     // velocity it takes (lines 22-25), is then the nearest liquid entry of its list.
     const auto& kind = mParticles.kinds();
-    mQueryMask.resize(n);
-    mLiquidMask.resize(n);
+    resizeStepArray(mQueryMask, n);
+    resizeStepArray(mLiquidMask, n);
     // Halo copies (other processes' particles) are neighbours, never queries.
     const Real* halo = haloFlags();
     parallel::forEach(
@@ -350,7 +350,7 @@ void GhostSolver::stepGhost(Real dt)
     // Lines 11-14: liquid acceleration from gravity and Monaghan's symmetric pressure gradient
     // over every neighbour, v* = v + dt a.
     const auto t0 = std::chrono::steady_clock::now();
-    mScratch.resize(n);
+    resizeStepArray(mScratch, n);
     parallel::forEach(
         0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);
     std::vector<Real> accel(n, Real(0));
@@ -420,7 +420,7 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
     const auto& vstar = mParticles.vectorChannel(VSTAR);
     const Real M = mMass;
     const bool shifting = !gradMass.empty();
-    mScratch.resize(n);
+    resizeStepArray(mScratch, n);
     extrapolateSolidVelocity();
 
     // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid

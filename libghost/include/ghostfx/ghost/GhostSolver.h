@@ -225,9 +225,27 @@ public:
     ParticleSet allParticles() const;
     /// Particles of one kind, in every set.
     std::size_t count(ParticleKind kind) const;
-    /// Bytes held by the solver: particles, boundary blocks, neighbour grid and lists, scratch.
-    std::size_t memoryBytes() const;
-    /// Of which the step's neighbour lists (rebuilt every step: about 4.5 bytes per pair).
+    /// Bytes held by the solver, by part: the capacity of every array it keeps from one step
+    /// to the next (what the process holds), not the passes' temporaries.
+    struct MemoryUse
+    {
+        std::size_t particles = 0;      ///< liquid and ghost air, every channel
+        std::size_t grid = 0;           ///< their neighbour grid
+        std::size_t lists = 0;          ///< the step's lists, liquid and air to liquid and air
+        std::size_t solidParticles = 0; ///< ghost solid (or boundary) particles, every channel
+        std::size_t solidGrids = 0;     ///< the solid blocks' grids
+        std::size_t solidLists = 0;     ///< the step's lists, liquid to solid particles
+        std::size_t stepArrays = 0;     ///< per-particle scratch: masks, nearest liquid, DFSPH
+
+        std::size_t total() const
+        {
+            return particles + grid + lists + solidParticles + solidGrids + solidLists + stepArrays;
+        }
+    };
+    MemoryUse memoryUse() const;
+    /// memoryUse().total().
+    std::size_t memoryBytes() const { return memoryUse().total(); }
+    /// Of which the step's neighbour lists (rebuilt every step: about 2 bytes per pair).
     std::size_t neighborListBytes() const;
 
     double time() const { return mRun.time; }
