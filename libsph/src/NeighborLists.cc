@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #if defined(__x86_64__)
@@ -167,6 +168,7 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
     if (mChunks.size() < chunks) mChunks.resize(chunks);
     const Real radiusSquared = radius * radius;
     const Real cellSize = targets.cellSize();
+    const bool twoBases = targets.size() <= std::size_t(SPLIT); // a first base below SPLIT
     const Real* X = targets.sortedX();
     const Real* Y = targets.sortedY();
     const Real* Z = targets.sortedZ();
@@ -280,10 +282,31 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
                 for (std::size_t k = 0; k < hits; ++k) narrow[k] = std::uint16_t(src[k] - lo);
                 base = lo;
             } else {
-                used = start + 2 * hits;
-                out.reserve(used + 2, start);
-                std::copy(src, src + hits, reinterpret_cast<Index*>(out.units.get() + start));
-                base = WIDE;
+                // Two windows of 32,768 indices: one from the smallest index, one from the
+                // smallest index beyond the first.
+                const Index cut = lo + (NeighborLists::List::SPLIT_BIT - 1u);
+                Index lo2 = WIDE;
+                for (std::size_t k = 0; k < hits; ++k) {
+                    if (src[k] > cut) lo2 = std::min(lo2, src[k]);
+                }
+                if (twoBases && hi - lo2 < NeighborLists::List::SPLIT_BIT) {
+                    used = start + 2 + hits;
+                    out.reserve(used + 2, start);
+                    std::memcpy(out.units.get() + start, &lo2, sizeof(Index));
+                    std::uint16_t* narrow = out.units.get() + start + 2;
+                    for (std::size_t k = 0; k < hits; ++k) {
+                        narrow[k] =
+                            src[k] <= cut
+                                ? std::uint16_t(src[k] - lo)
+                                : std::uint16_t(NeighborLists::List::SPLIT_BIT | (src[k] - lo2));
+                    }
+                    base = lo | SPLIT;
+                } else {
+                    used = start + 2 * hits;
+                    out.reserve(used + 2, start);
+                    std::copy(src, src + hits, reinterpret_cast<Index*>(out.units.get() + start));
+                    base = WIDE;
+                }
             }
             if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
                 throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
@@ -340,6 +363,13 @@ std::size_t NeighborLists::wideListCount() const
 {
     std::size_t total = 0;
     for (const End& e : mEnd) total += e.base == WIDE;
+    return total;
+}
+
+std::size_t NeighborLists::splitListCount() const
+{
+    std::size_t total = 0;
+    for (const End& e : mEnd) total += e.base != WIDE && (e.base & SPLIT) != 0;
     return total;
 }
 

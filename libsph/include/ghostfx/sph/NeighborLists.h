@@ -24,15 +24,19 @@
 ///
 ///          Storage: a list whose indices all lie within 65,536 of its smallest is kept as
 ///          16-bit offsets from that smallest index (the usual case for particles sorted by the
-///          grid: neighbours are nearby in the sort order), any other as 32-bit indices. Reading
-///          a short list adds the offset to the base as it loads; bench/RESULTS.md ("Neighbour
-///          lists in 16 bits") has the memory and the cost.
+///          grid: neighbours are nearby in the sort order). A list that straddles a large step of
+///          the sort order (its neighbours in two places of it, 32,768 indices wide each) is
+///          kept as 15-bit offsets from one of two bases, the top bit choosing which; any other
+///          as 32-bit indices. Reading a short list adds the offset to its base as it loads;
+///          bench/RESULTS.md ("Neighbour lists in 16 bits", "two bases") has the memory and the
+///          cost.
 #pragma once
 
 #include "ghostfx/sph/NeighborGrid.h"
 #include "ghostfx/sph/Types.h"
 
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -66,7 +70,7 @@ public:
             {
                 std::uint32_t bits;
                 std::memcpy(&bits, mAt, sizeof(bits));
-                return mBase + (bits & mMask);
+                return ((bits & mSelect) ? mBase2 : mBase) + (bits & mMask);
             }
             Iterator& operator++()
             {
@@ -87,7 +91,8 @@ public:
             const unsigned char* mAt = nullptr;
             std::size_t mStride = 0;
             std::uint32_t mMask = 0;
-            Index mBase = 0;
+            std::uint32_t mSelect = 0; ///< the bit that chooses mBase2 (two-base lists)
+            Index mBase = 0, mBase2 = 0;
         };
 
         Iterator begin() const { return at(0); }
@@ -97,10 +102,16 @@ public:
 
         /// 32-bit indices (null for a 16-bit list).
         const Index* wide() const { return mWide; }
-        /// 16-bit offsets from base() (null for a 32-bit list).
+        /// 16-bit offsets from base() (null for a 32-bit list); in a two-base list (split()),
+        /// 15-bit offsets from base(), or from base2() where the top bit is set.
         const std::uint16_t* narrow() const { return mNarrow; }
         /// The index that narrow() offsets are added to.
         Index base() const { return mBase; }
+        /// Whether the list has two bases (SPLIT_BIT of an offset: base2()).
+        bool split() const { return mSplit; }
+        Index base2() const { return mBase2; }
+        /// The offset bit of a two-base list that chooses base2().
+        static constexpr std::uint16_t SPLIT_BIT = 0x8000;
 
         /// Call fn(j) for each neighbour j in order (one loop per kind of list: faster than the
         /// iterator in hot loops).
@@ -109,6 +120,11 @@ public:
         {
             if (mWide) {
                 for (std::size_t k = 0; k < mSize; ++k) fn(mWide[k]);
+            } else if (mSplit) {
+                for (std::size_t k = 0; k < mSize; ++k) {
+                    const std::uint32_t e = mNarrow[k];
+                    fn(Index(((e & SPLIT_BIT) ? mBase2 : mBase) + (e & (SPLIT_BIT - 1u))));
+                }
             } else {
                 for (std::size_t k = 0; k < mSize; ++k) fn(Index(mBase + mNarrow[k]));
             }
@@ -126,15 +142,18 @@ public:
             } else {
                 it.mAt = reinterpret_cast<const unsigned char*>(mNarrow + k);
                 it.mStride = sizeof(std::uint16_t);
-                it.mMask = 0xffff;
+                it.mMask = mSplit ? SPLIT_BIT - 1u : 0xffffu;
+                it.mSelect = mSplit ? SPLIT_BIT : 0u;
                 it.mBase = mBase;
+                it.mBase2 = mBase2;
             }
             return it;
         }
 
         const std::uint16_t* mNarrow = nullptr;
         const Index* mWide = nullptr;
-        Index mBase = 0;
+        Index mBase = 0, mBase2 = 0;
+        bool mSplit = false;
         std::size_t mSize = 0;
     };
 
@@ -160,6 +179,13 @@ public:
         if (e.base == WIDE) {
             list.mWide = reinterpret_cast<const Index*>(units + from);
             list.mSize = (e.end - from) / 2;
+        } else if (e.base & SPLIT) {
+            // The second base (two units), then the offsets.
+            std::memcpy(&list.mBase2, units + from, sizeof(Index));
+            list.mNarrow = units + from + 2;
+            list.mBase = e.base & ~SPLIT;
+            list.mSplit = true;
+            list.mSize = e.end - from - 2;
         } else {
             list.mNarrow = units + from;
             list.mBase = e.base;
@@ -176,12 +202,17 @@ public:
     std::size_t pairCount() const;
     /// Number of lists kept as 32-bit indices (the others are 16-bit offsets).
     std::size_t wideListCount() const;
+    /// Number of lists kept as 15-bit offsets from two bases.
+    std::size_t splitListCount() const;
     /// Bytes held (capacity).
     std::size_t memoryBytes() const;
 
 private:
     /// `End::base` of a list of 32-bit indices.
     static constexpr Index WIDE = ~Index(0);
+    /// Set in `End::base` (with its first base below) for a two-base list. Lists into more
+    /// than 2^31 targets never have two bases.
+    static constexpr Index SPLIT = Index(1) << 31;
 
     /// A chunk's lists, back to back in 16-bit units; grows by a sixteenth while it is filled
     /// and is fitted to its lists at the end of the build.

@@ -81,6 +81,10 @@ struct PairBatch
             if (!wide) {
                 const std::uint16_t* offset = list.narrow();
                 const Index base = list.base();
+                if (list.split()) {
+                    forEachTwoBaseBatch(xi, x, list, fn); // rare: out of the hot loop
+                    return;
+                }
                 for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
                     load(xi, x, base, offset + k0, size - k0);
                     fn(*this);
@@ -92,6 +96,26 @@ struct PairBatch
         }
         for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
             load(xi, x, wide + k0, size - k0);
+            fn(*this);
+        }
+    }
+
+    /// forEachBatch over a two-base list (List::split()): kept apart and not inlined, so the
+    /// common 16-bit path stays as tight as it was.
+    template <typename List, typename Fn>
+    __attribute__((noinline)) void forEachTwoBaseBatch(const Vec3& xi, const Vec3* x,
+                                                       const List& list, Fn& fn)
+    {
+        const std::size_t size = list.size();
+        const std::uint16_t* offset = list.narrow();
+        const Index base = list.base(), base2 = list.base2();
+        constexpr std::uint32_t select = List::SPLIT_BIT, mask = List::SPLIT_BIT - 1u;
+        for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+            const std::uint16_t* at = offset + k0;
+            loadEach(xi, x, size - k0, [base, base2, at](int k) {
+                const std::uint32_t e = at[k];
+                return Index(((e & select) ? base2 : base) + (e & mask));
+            });
             fn(*this);
         }
     }
