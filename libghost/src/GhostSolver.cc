@@ -146,29 +146,33 @@ GhostSolver::SolidBlock& GhostSolver::blockOf(std::size_t solidIndex)
     return mSolids[solidIndex]->moving ? mMoving : mStatic;
 }
 
-void GhostSolver::restSolidValues(SolidBlock& b) const
+namespace {
+
+/// Rest values (rest density, zero pressure, the solid's own velocity) in the particles
+/// `touched` of a solid block's set.
+void putRestValues(ParticleSet& set, const std::vector<Index>& touched, Real restDensity)
 {
-    ParticleSet& set = b.block.particles();
     const std::vector<Vec3>* solidV =
         set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
-    for (Index k : b.touched) {
-        set.densities()[k] = mSettings.restDensity;
+    for (Index k : touched) {
+        set.densities()[k] = restDensity;
         set.pressures()[k] = 0;
         set.velocities()[k] = solidV ? (*solidV)[k] : Vec3(0);
     }
+}
+
+} // namespace
+
+void GhostSolver::restSolidValues(SolidBlock& b) const
+{
+    putRestValues(b.block.particles(), b.touched, mSettings.restDensity);
     b.touched.clear();
 }
 
 ParticleSet GhostSolver::restingParticles(const SolidBlock& b) const
 {
     ParticleSet set = b.block.particles();
-    const std::vector<Vec3>* solidV =
-        set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
-    for (Index k : b.touched) {
-        set.densities()[k] = mSettings.restDensity;
-        set.pressures()[k] = 0;
-        set.velocities()[k] = solidV ? (*solidV)[k] : Vec3(0);
-    }
+    putRestValues(set, b.touched, mSettings.restDensity);
     return set;
 }
 
