@@ -32,10 +32,6 @@ GhostSolver::GhostSolver(const GhostSettings& settings)
     // channels only by Ghost SPH (Basic SPH has no air). Solid channels live on the solid
     // particles only, in their blocks.
     mParticles.addVectorChannel(VSTAR);
-    // A cell one support radius wide holds about 20 particles inside the liquid and fewer at
-    // its surface: a table of two buckets per 4 particles still leaves most buckets empty, at
-    // a quarter of the memory of two per particle.
-    mGrid.setParticlesPerCellHint(4);
     if (mSettings.method == Method::Ghost) {
         mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
