@@ -186,14 +186,22 @@ bool LevelSet::inBand(const Vec3& x) const
 
 SurfaceProjection LevelSet::projectToSurface(const Vec3& x, Real tolerance, int maxIterations) const
 {
+    Vec3 g;
+    const Real p = phiAndGradient(x, g);
+    return projectToSurface(x, p, g, tolerance, maxIterations);
+}
+
+SurfaceProjection LevelSet::projectToSurface(const Vec3& x, Real phiX, const Vec3& gradX,
+                                             Real tolerance, int maxIterations) const
+{
     const Real tol = tolerance > Real(0) ? tolerance : Real(1e-3) * mImpl->voxelSize;
     // phi within this much of the background value is treated as clamped (beyond the band).
     const Real clampLimit = mImpl->bandWidth * Real(0.999);
     SurfaceProjection result;
     result.point = x;
     for (int it = 0; it <= maxIterations; ++it) {
-        Vec3 g;
-        const Real p = phiAndGradient(result.point, g);
+        Vec3 g = gradX;
+        const Real p = it == 0 ? phiX : phiAndGradient(result.point, g);
         result.residual = std::abs(p);
         result.iterations = it;
         if (result.residual <= tol) {

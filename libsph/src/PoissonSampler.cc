@@ -115,6 +115,22 @@ public:
         return found;
     }
 
+    /// Whether any entry lies closer than `radius` (<= 2 cellSize) to x; if so, its position
+    /// is stored in `found`.
+    bool findWithin(const Vec3& x, Real radius, Vec3& found) const
+    {
+        const Real r2 = radius * radius;
+        bool hit = false;
+        visit(x, radius, [&](int id) {
+            if ((mPos[id] - x).lengthSqr() < r2) {
+                found = mPos[id];
+                hit = true;
+            }
+            return !hit;
+        });
+        return hit;
+    }
+
     /// Call fn(position) for the entries other than `ignore` closer than `radius` (<= 2
     /// cellSize) to x.
     template <typename Fn>
@@ -327,13 +343,27 @@ public:
     /// Whether x (with level-set value phi) is within the band.
     bool accepts(const Vec3& x, Real phi) const
     {
+        Vec3 hint(std::numeric_limits<Real>::max());
+        return accepts(
+            x, [phi] { return phi; }, hint);
+    }
+
+    /// Whether x is within the band; `phiOf()` gives phi(x) and is called only when the band
+    /// is set by phi. `hint` is a surface sample found within reach by an earlier call (or far
+    /// away): the surface samples never move, so when x is within reach of it the answer is
+    /// known without a search, and a search that finds one stores it there. The answer is
+    /// the same with any hint.
+    template <typename PhiOf>
+    bool accepts(const Vec3& x, PhiOf&& phiOf, Vec3& hint) const
+    {
         switch (mMode) {
         case Mode::None:
             return true;
         case Mode::Phi:
-            return phi >= -mDepth;
+            return phiOf() >= -mDepth;
         case Mode::SurfaceSamples:
-            return mSurface->anyWithin(x, mReach);
+            if ((hint - x).lengthSqr() < mReach * mReach) return true;
+            return mSurface->findWithin(x, mReach, hint);
         }
         return true;
     }
@@ -708,7 +738,7 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
     // sqrt(3) times the distance moved; 2 leaves room for grids that are only nearly
     // distances. It only decides which candidates can skip a phi lookup, never a result.
     const Real lipschitz = Real(2);
-    auto relaxOne = [&](std::size_t i, int sweep, Ball& ball) {
+    auto relaxOne = [&](std::size_t i, int sweep, Ball& ball, std::vector<Vec3>& directions) {
         const Vec3 p = samples.positions[i];
         const bool surface = samples.onSurface[i] != 0;
         ball.gather(grid, p, Real(2) * r, entry[i]);
@@ -723,15 +753,19 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
         // Band-limited and deeper than the bound: no candidate is outside the shape, so none
         // is projected, and only a candidate that beats the best so far needs the band test.
         const bool inside = !surface && band.limited() && phiP < -lipschitz * r;
+        // A surface sample within the band's reach of the last candidate tested against it.
+        Vec3 hint(std::numeric_limits<Real>::max());
+        auto phiOf = [&shape](const Vec3& x) { return [&shape, x] { return shape.phi(x); }; };
         // One random stream per (pass, sweep, sample).
         Rng rng(mSettings.seed,
                 RELAX + (std::uint64_t(pass) << 40) + (std::uint64_t(sweep) << 32) + i);
+        rng.unitVectors(directions.data(), t);
         for (int a = 0; a < t; ++a) {
             const Real tau = Real(t - a) / Real(t);
-            Vec3 cand = p + rng.unitVector() * (r * tau);
+            Vec3 cand = p + directions[a] * (r * tau);
             if (inside) {
                 const Real c2 = ball.minDistance2(cand);
-                if (!(c2 > d2) || !band.accepts(cand, shape.phi(cand)) || !grid.contains(cand))
+                if (!(c2 > d2) || !band.accepts(cand, phiOf(cand), hint) || !grid.contains(cand))
                     continue;
                 d2 = c2;
                 best = cand;
@@ -745,32 +779,39 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
                     // general path, the cheap one first.
                     const Real c2 = ball.minDistance2(cand);
                     if (!(c2 > d2)) continue;
-                    if (band.limited() && !band.accepts(cand, shape.phi(cand))) continue;
+                    if (band.limited() && !band.accepts(cand, phiOf(cand), hint)) continue;
                     if (!grid.contains(cand)) continue;
                     d2 = c2;
                     best = cand;
                     continue;
                 }
-                // The projection moves cand by about |phi| <= L r tau: skip it without looking
-                // phi up when even that much could not beat the best distance so far (then the
-                // test below on the actual phi would skip it too).
-                if (surface) {
-                    const Real bound = std::sqrt(ball.minDistance2(cand)) + Real(1.05) * reachOut;
-                    if (bound * bound <= d2) continue;
-                }
-                const Real phi = shape.phi(cand);
+                // A projection moves cand by about |phi|, and cand is projected when it is a
+                // surface sample's (|phi| <= L r tau) or outside (0 < phi <= phi(p) + L r tau).
+                // Skip it without looking phi up when even the largest such move could not
+                // beat the best distance so far: then the tests below, on the actual phi, would
+                // skip it too (if it is not projected, it is no farther from B(p) than the
+                // best). Most candidates of samples just inside the surface end here.
+                const Real c2 = ball.minDistance2(cand);
+                const Real largestMove = surface ? reachOut : phiP + reachOut;
+                const Real bound = std::sqrt(c2) + Real(1.05) * largestMove;
+                if (bound * bound <= d2) continue;
+                // A surface sample's candidate is always projected: one stencil gives phi
+                // and the projection's first step.
+                Vec3 grad(0);
+                const Real phi = surface ? shape.phiAndGradient(cand, grad) : shape.phi(cand);
                 if (surface || phi > Real(0)) {
                     // The projection moves cand by about |phi|: skip it when even that
                     // much could not beat the best distance so far.
-                    const Real reach =
-                        std::sqrt(ball.minDistance2(cand)) + Real(1.05) * std::abs(phi);
+                    const Real reach = std::sqrt(c2) + Real(1.05) * std::abs(phi);
                     if (reach * reach <= d2) continue;
-                    const SurfaceProjection proj = shape.projectToSurface(cand);
+                    const SurfaceProjection proj = surface ? shape.projectToSurface(cand, phi, grad)
+                                                           : shape.projectToSurface(cand);
                     // A projection that lands more than 2r away left the neighbourhood this
                     // step may touch (see the colouring below): reject it.
                     if (!proj.converged || (proj.point - p).lengthSqr() > Real(4) * r * r) continue;
                     cand = proj.point;
-                } else if (!band.accepts(cand, phi)) {
+                } else if (!band.accepts(
+                               cand, [phi] { return phi; }, hint)) {
                     continue;
                 }
                 if (!grid.contains(cand)) continue;
@@ -818,8 +859,9 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
                 first, last,
                 [&](std::size_t block) {
                 Ball ball; // B(p): the samples within 2r of p
+                std::vector<Vec3> directions(std::size_t(t), Vec3(0)); // the candidates' directions
                 for (std::size_t k = blockStart[block]; k < blockStart[block + 1]; ++k) {
-                    relaxOne(order[k].index, sweep, ball);
+                    relaxOne(order[k].index, sweep, ball, directions);
                 }
                 },
                 1);

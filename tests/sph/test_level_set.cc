@@ -271,6 +271,17 @@ TEST(LevelSet, ProjectToSurfaceConvergesOntoTheAnalyticClosestPoint)
     EXPECT_LT(worst, bound) << "worst " << worst / h << " voxel, bound " << bound / h;
     EXPECT_LE(maxIterations, 20);
 
+    // Given phiAndGradient at the start, the projection takes the same steps.
+    for (const Vec3& x : pointsNearSphere(s, h, 1.0, 200, 26)) {
+        Vec3 g;
+        const Real phi = ls.phiAndGradient(x, g);
+        const SurfaceProjection a = ls.projectToSurface(x), b = ls.projectToSurface(x, phi, g);
+        EXPECT_EQ(a.point, b.point);
+        EXPECT_EQ(a.iterations, b.iterations);
+        EXPECT_EQ(a.converged, b.converged);
+        EXPECT_EQ(a.residual, b.residual);
+    }
+
     // A looser tolerance stops earlier, and a point already on the surface takes no step.
     const Vec3 onSurface = toVec3(s.center + Vec3d(s.radius, 0, 0));
     const SurfaceProjection p0 = ls.projectToSurface(onSurface, Real(0.05 * h));

@@ -352,6 +352,25 @@ TEST(Sampler, DeterministicForASeed)
     EXPECT_FALSE(a.size() == c.size() && a.positions == c.positions);
 }
 
+TEST(Sampler, BatchedDirectionsAreTheOneAtATimeDraws)
+{
+    // Rng::unitVectors draws from four interleaved copies of the sequence; the relaxation's
+    // samples (and every test calibrated on them) rely on it giving exactly unitVector()'s
+    // directions and leaving the generator where count calls of unitVector() leave it.
+    for (const int count : {1, 2, 7, 16, 17, 50, 131}) {
+        for (std::uint64_t stream = 0; stream < 40; ++stream) {
+            Rng one(9, stream), batch(9, stream);
+            std::vector<Vec3> expected(std::size_t(count), Vec3(0)),
+                got(std::size_t(count), Vec3(0));
+            for (Vec3& v : expected) v = one.unitVector();
+            batch.unitVectors(got.data(), count);
+            ASSERT_TRUE(expected == got) << "count " << count << ", stream " << stream;
+            ASSERT_EQ(one.state(), batch.state()) << "count " << count << ", stream " << stream;
+            ASSERT_EQ(one.next(), batch.next());
+        }
+    }
+}
+
 TEST(Sampler, ShapeSmallerThanRadiusEndsQuickly)
 {
     // A sphere of radius 0.3 r resolved by a fine grid: the sampler may return a sample or two

@@ -84,6 +84,10 @@ public:
     /// false) when x or an iterate is beyond the band, where no direction to the surface is known.
     SurfaceProjection projectToSurface(const Vec3& x, Real tolerance = Real(-1),
                                        int maxIterations = 20) const;
+    /// The same projection for a caller that has phiAndGradient(x) already (`phiX`, `gradX`):
+    /// the same iterates, one stencil lookup fewer.
+    SurfaceProjection projectToSurface(const Vec3& x, Real phiX, const Vec3& gradX,
+                                       Real tolerance = Real(-1), int maxIterations = 20) const;
     /// Move a point inside (phi < 0) to just outside the surface: Newton steps along the
     /// smooth (central-difference) gradient until phi >= 0. Where projectToSurface() oscillates
     /// (at edges and corners the trilinear gradient jumps between cells) this still ends

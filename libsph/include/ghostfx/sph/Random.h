@@ -10,6 +10,7 @@
 #include "ghostfx/sph/Types.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace ghostfx {
@@ -33,7 +34,7 @@ public:
     std::uint32_t next()
     {
         const std::uint64_t old = mState;
-        mState = old * 6364136223846793005ULL + mInc;
+        mState = old * MULTIPLIER + mInc;
         const std::uint32_t xorShifted = std::uint32_t(((old >> 18u) ^ old) >> 27u);
         const std::uint32_t rot = std::uint32_t(old >> 59u);
         return (xorShifted >> rot) | (xorShifted << ((32u - rot) & 31u));
@@ -66,6 +67,35 @@ public:
         }
     }
 
+    /// `count` directions, the same as `count` calls of unitVector() (and the generator left
+    /// in the same state), but drawn several at a time: the 32-bit draws come from four
+    /// interleaved copies of the sequence, each jumping four steps ahead, so the multiplies
+    /// overlap instead of waiting on each other.
+    void unitVectors(Vec3* out, int count)
+    {
+        constexpr int CHUNK = 48; // a multiple of 3 (draws per try) and of 4 (copies)
+        std::uint32_t draws[CHUNK];
+        std::uint64_t states[CHUNK];
+        int made = 0;
+        while (made < count) {
+            fill(draws, states, CHUNK);
+            int k = 0;
+            for (; k < CHUNK && made < count; k += 3) {
+                const double x = 2.0 * toUnit(draws[k]) - 1.0, y = 2.0 * toUnit(draws[k + 1]) - 1.0,
+                             z = 2.0 * toUnit(draws[k + 2]) - 1.0;
+                const double len2 = x * x + y * y + z * z;
+                // Without a branch: half the tries are rejected, at random, so a branch here
+                // is mispredicted about every other try. A rejected try is written to the next
+                // free slot (made < count) and overwritten by the next accepted one.
+                const bool accept = (len2 <= 1.0) & (len2 > 1e-6);
+                const double inv = 1.0 / std::sqrt(accept ? len2 : 1.0);
+                out[made] = Vec3(Real(x * inv), Real(y * inv), Real(z * inv));
+                made += int(accept);
+            }
+            if (k < CHUNK) mState = states[k]; // the state before the first unused draw
+        }
+    }
+
     /// Uniform point in the unit ball.
     Vec3 inUnitBall() { return unitVector() * Real(std::cbrt(uniform01())); }
 
@@ -79,6 +109,36 @@ public:
     }
 
 private:
+    static constexpr std::uint64_t MULTIPLIER = 6364136223846793005ULL;
+
+    static std::uint32_t output(std::uint64_t old)
+    {
+        const std::uint32_t xorShifted = std::uint32_t(((old >> 18u) ^ old) >> 27u);
+        const std::uint32_t rot = std::uint32_t(old >> 59u);
+        return (xorShifted >> rot) | (xorShifted << ((32u - rot) & 31u));
+    }
+
+    static double toUnit(std::uint32_t draw) { return double(draw) * (1.0 / 4294967296.0); }
+
+    /// The next n draws (n a multiple of 4) and the state before each; advances the state by n.
+    void fill(std::uint32_t* draws, std::uint64_t* states, int n)
+    {
+        // Four steps of s -> M s + inc are s -> M^4 s + inc (M^3 + M^2 + M + 1), mod 2^64.
+        const std::uint64_t m2 = MULTIPLIER * MULTIPLIER, m4 = m2 * m2;
+        const std::uint64_t c4 = mInc * ((MULTIPLIER + 1) * (m2 + 1));
+        std::uint64_t s[4];
+        s[0] = mState;
+        for (int j = 1; j < 4; ++j) s[j] = s[j - 1] * MULTIPLIER + mInc;
+        for (int k = 0; k < n; k += 4) {
+            for (int j = 0; j < 4; ++j) {
+                states[k + j] = s[j];
+                draws[k + j] = output(s[j]);
+                s[j] = s[j] * m4 + c4;
+            }
+        }
+        mState = s[0];
+    }
+
     std::uint64_t mState = 0;
     std::uint64_t mInc = 1;
 };
