@@ -73,26 +73,32 @@ public:
     /// overlap instead of waiting on each other.
     void unitVectors(Vec3* out, int count)
     {
-        constexpr int CHUNK = 48; // a multiple of 3 (draws per try) and of 4 (copies)
+        constexpr int TRIES = 16, CHUNK = 3 * TRIES; // a multiple of 4 (copies)
         std::uint32_t draws[CHUNK];
         std::uint64_t states[CHUNK];
+        double x[TRIES], y[TRIES], z[TRIES], inv[TRIES];
+        bool accept[TRIES];
         int made = 0;
         while (made < count) {
             fill(draws, states, CHUNK);
-            int k = 0;
-            for (; k < CHUNK && made < count; k += 3) {
-                const double x = 2.0 * toUnit(draws[k]) - 1.0, y = 2.0 * toUnit(draws[k + 1]) - 1.0,
-                             z = 2.0 * toUnit(draws[k + 2]) - 1.0;
-                const double len2 = x * x + y * y + z * z;
-                // Without a branch: half the tries are rejected, at random, so a branch here
-                // is mispredicted about every other try. A rejected try is written to the next
-                // free slot (made < count) and overwritten by the next accepted one.
-                const bool accept = (len2 <= 1.0) & (len2 > 1e-6);
-                const double inv = 1.0 / std::sqrt(accept ? len2 : 1.0);
-                out[made] = Vec3(Real(x * inv), Real(y * inv), Real(z * inv));
-                made += int(accept);
+            // Every try of the chunk at once, without a branch (half the tries are rejected,
+            // at random, so a branch is mispredicted about every other try).
+            for (int j = 0; j < TRIES; ++j) {
+                x[j] = 2.0 * toUnit(draws[3 * j]) - 1.0;
+                y[j] = 2.0 * toUnit(draws[3 * j + 1]) - 1.0;
+                z[j] = 2.0 * toUnit(draws[3 * j + 2]) - 1.0;
+                const double len2 = x[j] * x[j] + y[j] * y[j] + z[j] * z[j];
+                accept[j] = (len2 <= 1.0) & (len2 > 1e-6);
+                inv[j] = 1.0 / std::sqrt(std::max(len2, 1e-6)); // exact where accepted
             }
-            if (k < CHUNK) mState = states[k]; // the state before the first unused draw
+            // Kept tries in order; a rejected one is written to the next free slot (made <
+            // count) and overwritten by the next kept one.
+            int j = 0;
+            for (; j < TRIES && made < count; ++j) {
+                out[made] = Vec3(Real(x[j] * inv[j]), Real(y[j] * inv[j]), Real(z[j] * inv[j]));
+                made += int(accept[j]);
+            }
+            if (j < TRIES) mState = states[3 * j]; // the state before the first unused draw
         }
     }
 
