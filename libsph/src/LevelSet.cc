@@ -35,29 +35,101 @@ struct LevelSet::Impl
                                         (c & 4) ? box.max().z() + 0.5 : box.min().z() - 0.5);
             bounds.expand(toVec3(grid->transform().indexToWorld(corner)));
         }
+        buildLeafTable();
     }
 
     Accessor& accessor() const { return accessors.local(); }
 
-    /// The values at the eight voxels c + {0,1}^3, as BoxSampler::getValues reads them. When
-    /// all eight lie in one leaf node (7 times in 8 per axis) they are read straight from its
-    /// buffer: the accessor's own per-voxel path checks its caches eight times and costs as
-    /// much as the rest of a lookup.
-    static void corners(Accessor& acc, const openvdb::Coord& c, float (&f)[2][2][2])
+    using Leaf = openvdb::FloatTree::LeafNodeType;
+
+    /// Most leaf slots the direct table below may hold (8 bytes each).
+    static constexpr std::size_t MAX_LEAF_SLOTS = std::size_t(1) << 21;
+
+    /// A dense table of the leaves' value buffers over the leaves' bounding box, one slot per
+    /// leaf-sized block (null where the tree has a tile or nothing): corners() finds a leaf by
+    /// index arithmetic instead of the accessor's cache checks and tree walk. Left empty when
+    /// the box would need more than MAX_LEAF_SLOTS slots; then the accessor serves alone.
+    void buildLeafTable()
     {
-        using Leaf = openvdb::FloatTree::LeafNodeType;
+        openvdb::CoordBBox box;
+        for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) box.expand(leaf->origin());
+        if (box.empty()) return;
+        std::size_t slots = 1;
+        for (int a = 0; a < 3; ++a) {
+            tableMin[a] = box.min()[a] >> Leaf::LOG2DIM;
+            tableDims[a] = (box.max()[a] >> Leaf::LOG2DIM) - tableMin[a] + 1;
+            slots *= std::size_t(tableDims[a]);
+            if (slots > MAX_LEAF_SLOTS) return;
+        }
+        leafTable.assign(slots, nullptr);
+        for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+            const openvdb::Coord o = leaf->origin();
+            leafTable[slotOf(o.x() >> Leaf::LOG2DIM, o.y() >> Leaf::LOG2DIM,
+                             o.z() >> Leaf::LOG2DIM)] = leaf->buffer().data();
+        }
+    }
+
+    std::size_t slotOf(int i, int j, int k) const
+    {
+        return (std::size_t(k - tableMin[2]) * std::size_t(tableDims[1])
+                + std::size_t(j - tableMin[1]))
+                   * std::size_t(tableDims[0])
+               + std::size_t(i - tableMin[0]);
+    }
+
+    /// The value buffer of the leaf holding voxel c, or null (a tile, or outside the table).
+    const float* leafValues(const openvdb::Coord& c) const
+    {
+        const int i = c.x() >> Leaf::LOG2DIM, j = c.y() >> Leaf::LOG2DIM,
+                  k = c.z() >> Leaf::LOG2DIM;
+        if (unsigned(i - tableMin[0]) >= unsigned(tableDims[0])
+            || unsigned(j - tableMin[1]) >= unsigned(tableDims[1])
+            || unsigned(k - tableMin[2]) >= unsigned(tableDims[2]))
+            return nullptr;
+        return leafTable[slotOf(i, j, k)];
+    }
+
+    /// The values at the eight voxels c + {0,1}^3, as BoxSampler::getValues reads them, read
+    /// straight from the leaves' buffers where the leaf table has them (all eight in one leaf
+    /// 7 times in 8 per axis). The accessor's own per-voxel path checks its caches eight times
+    /// and costs as much as the rest of a lookup; it serves tiles and grids without a table.
+    void corners(const openvdb::Coord& c, float (&f)[2][2][2]) const
+    {
         constexpr int LAST = int(Leaf::DIM) - 1;
-        if ((c.x() & LAST) != LAST && (c.y() & LAST) != LAST && (c.z() & LAST) != LAST) {
-            if (const Leaf* leaf = acc.probeConstLeaf(c)) {
+        constexpr int X = 1 << (2 * Leaf::LOG2DIM), Y = 1 << Leaf::LOG2DIM;
+        const bool oneLeaf =
+            (c.x() & LAST) != LAST && (c.y() & LAST) != LAST && (c.z() & LAST) != LAST;
+        if (!leafTable.empty()) {
+            if (oneLeaf) {
+                if (const float* v = leafValues(c)) {
+                    v += Leaf::coordToOffset(c);
+                    for (int a = 0; a < 2; ++a)
+                        for (int b = 0; b < 2; ++b)
+                            for (int d = 0; d < 2; ++d) f[a][b][d] = v[a * X + b * Y + d];
+                    return;
+                }
+            } else {
+                bool all = true;
+                for (int a = 0; a < 2 && all; ++a)
+                    for (int b = 0; b < 2 && all; ++b)
+                        for (int d = 0; d < 2 && all; ++d) {
+                            const openvdb::Coord q = c.offsetBy(a, b, d);
+                            const float* v = leafValues(q);
+                            if (v) f[a][b][d] = v[Leaf::coordToOffset(q)];
+                            all = v != nullptr;
+                        }
+                if (all) return;
+            }
+        } else if (oneLeaf) {
+            if (const Leaf* leaf = accessor().probeConstLeaf(c)) {
                 const float* v = leaf->buffer().data() + Leaf::coordToOffset(c);
-                constexpr int X = 1 << (2 * Leaf::LOG2DIM), Y = 1 << Leaf::LOG2DIM;
                 for (int a = 0; a < 2; ++a)
                     for (int b = 0; b < 2; ++b)
                         for (int d = 0; d < 2; ++d) f[a][b][d] = v[a * X + b * Y + d];
                 return;
             }
         }
-        openvdb::tools::BoxSampler::getValues(f, acc, c);
+        openvdb::tools::BoxSampler::getValues(f, accessor(), c);
     }
 
     /// BoxSampler::sample (the same interpolation, so the same value), with corners() above.
@@ -66,7 +138,7 @@ struct LevelSet::Impl
         const openvdb::Vec3d ijk = map->applyInverseMap(openvdb::Vec3d(x[0], x[1], x[2]));
         const openvdb::Vec3i i = openvdb::tools::local_util::floorVec3(ijk);
         float f[2][2][2];
-        corners(accessor(), openvdb::Coord(i), f);
+        corners(openvdb::Coord(i), f);
         return Real(openvdb::tools::BoxSampler::trilinearInterpolation(f, ijk - i));
     }
 
@@ -79,6 +151,8 @@ struct LevelSet::Impl
     /// The transform's map, held once: Transform::baseMap() returns a shared pointer by value,
     /// and copying it (two atomic operations) per call cost 6 % of a run in the projection.
     openvdb::math::MapBase::ConstPtr map;
+    std::vector<const float*> leafTable; ///< see buildLeafTable()
+    int tableMin[3] = {0, 0, 0}, tableDims[3] = {0, 0, 0};
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -152,7 +226,7 @@ Real LevelSet::phiAndGradient(const Vec3& x, Vec3& grad) const
     const openvdb::Coord c = openvdb::Coord::floor(ijk);
     const double u = ijk.x() - c.x(), v = ijk.y() - c.y(), w = ijk.z() - c.z();
     float values[2][2][2];
-    Impl::corners(mImpl->accessor(), c, values);
+    mImpl->corners(c, values);
     double f[2][2][2];
     for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b)

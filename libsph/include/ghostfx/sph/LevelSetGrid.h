@@ -19,7 +19,8 @@ namespace sph {
 /// with one line naming the grid, the problem and what was expected.
 void validateLevelSetGrid(const openvdb::FloatGrid& grid, const std::string& name);
 
-/// Validate `grid` and wrap it for queries. The grid is shared, not copied.
+/// Validate `grid` and wrap it for queries. The grid is shared, not copied, and must not change
+/// while the LevelSet lives (queries read its leaf buffers directly).
 /// @param name  used in error messages (defaults to the grid's own name)
 LevelSet makeLevelSet(openvdb::FloatGrid::ConstPtr grid, const std::string& name = "");
 
