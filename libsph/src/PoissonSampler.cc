@@ -206,19 +206,23 @@ class Ball
 public:
     void gather(const PointGrid& grid, const Vec3& p, Real radius, int ignore)
     {
-        mX.clear();
-        mY.clear();
-        mZ.clear();
+        // Written through an index into arrays kept large enough: the three push_backs per
+        // member cost a fifth of the gather.
+        std::size_t n = 0;
         grid.forEachWithin(p, radius, ignore, [&](const Vec3& q) {
-            mX.push_back(q[0]);
-            mY.push_back(q[1]);
-            mZ.push_back(q[2]);
+            if (n + 4 > mX.size()) grow(n);
+            mX[n] = q[0];
+            mY[n] = q[1];
+            mZ[n] = q[2];
+            ++n;
         });
-        mCount = mX.size();
-        while (mX.size() % 4 != 0) {
-            mX.push_back(FAR);
-            mY.push_back(FAR);
-            mZ.push_back(FAR);
+        mCount = n;
+        if (n + 4 > mX.size()) grow(n);
+        mPadded = (n + 3) / 4 * 4;
+        for (; n < mPadded; ++n) {
+            mX[n] = FAR;
+            mY[n] = FAR;
+            mZ[n] = FAR;
         }
     }
 
@@ -227,7 +231,7 @@ public:
     /// min over the ball of |x - q|^2.
     Real minDistance2(const Vec3& x) const
     {
-        const std::size_t n = mX.size();
+        const std::size_t n = mPadded;
 #if defined(__SSE2__) && !defined(GHOSTFX_DOUBLE)
         const __m128 cx = _mm_set1_ps(x[0]), cy = _mm_set1_ps(x[1]), cz = _mm_set1_ps(x[2]);
         __m128 best = _mm_set1_ps(std::numeric_limits<float>::max());
@@ -256,8 +260,17 @@ private:
     /// Padding coordinate: far enough that its distance never wins, small enough that its
     /// square stays finite in float.
     static constexpr Real FAR = Real(1e18);
-    std::vector<Real> mX, mY, mZ;
-    std::size_t mCount = 0;
+
+    void grow(std::size_t used)
+    {
+        const std::size_t size = std::max<std::size_t>(64, 2 * (used + 4));
+        mX.resize(size);
+        mY.resize(size);
+        mZ.resize(size);
+    }
+
+    std::vector<Real> mX, mY, mZ; ///< members in [0, mCount), then padding to mPadded
+    std::size_t mCount = 0, mPadded = 0;
 };
 
 /// Random unit vector perpendicular to the unit normal n.
