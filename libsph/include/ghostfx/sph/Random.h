@@ -35,9 +35,7 @@ public:
     {
         const std::uint64_t old = mState;
         mState = old * MULTIPLIER + mInc;
-        const std::uint32_t xorShifted = std::uint32_t(((old >> 18u) ^ old) >> 27u);
-        const std::uint32_t rot = std::uint32_t(old >> 59u);
-        return (xorShifted >> rot) | (xorShifted << ((32u - rot) & 31u));
+        return output(old);
     }
 
     /// Uniform integer in [0, n), n > 0 (Lemire's multiply-shift; bias below 2^-32 n).
@@ -117,6 +115,7 @@ public:
 private:
     static constexpr std::uint64_t MULTIPLIER = 6364136223846793005ULL;
 
+    /// XSH-RR: the 32-bit output of the state before a step.
     static std::uint32_t output(std::uint64_t old)
     {
         const std::uint32_t xorShifted = std::uint32_t(((old >> 18u) ^ old) >> 27u);
