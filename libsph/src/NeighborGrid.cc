@@ -128,20 +128,20 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         4096);
 
     // 6. Cell table: buckets to cells (exclusive scan), cells to slots and keys.
-    mBucketCell.resize(tableSize + 1);
+    std::vector<std::uint32_t> bucketFirstCell(tableSize + 1);
     std::uint32_t cellCount = 0;
     for (std::size_t b = 0; b < tableSize; ++b) {
-        mBucketCell[b] = cellCount;
+        bucketFirstCell[b] = cellCount;
         cellCount += bucketCells[b];
     }
-    mBucketCell[tableSize] = cellCount;
+    bucketFirstCell[tableSize] = cellCount;
     mCellKey.resize(cellCount);
     mCellStart.resize(std::size_t(cellCount) + 1);
     mCellStart[cellCount] = std::uint32_t(count);
     parallel::forEach(
         0, tableSize,
         [&](std::size_t b) {
-        std::uint32_t cell = mBucketCell[b];
+        std::uint32_t cell = bucketFirstCell[b];
         for (std::uint32_t s = bucketStart[b], hi = bucketStart[b + 1]; s < hi; ++s) {
             const std::uint64_t k = key[mIndex[s]];
             if (s == bucketStart[b] || k != key[mIndex[s - 1]]) {
@@ -153,7 +153,20 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         },
         4096);
 
-    // 7. Gather coordinates in sorted order; inverse map for forEachNeighbor(i). The coordinate
+    // 7. Lookup table: cells sit in bucket order, so 2^shift consecutive buckets hold one run
+    //    of cells. Merge as many as keep two lookup buckets per occupied cell: a liquid with
+    //    about 20 particles per cell keeps an eighth of the table the sort used.
+    mLookupShift = 0;
+    while (mLookupShift < MAX_LOOKUP_SHIFT
+           && (tableSize >> (mLookupShift + 1)) >= 2 * std::size_t(cellCount)) {
+        ++mLookupShift;
+    }
+    const std::size_t lookupSize = tableSize >> mLookupShift;
+    mBucketCell.resize(lookupSize + 1);
+    for (std::size_t b = 0; b <= lookupSize; ++b)
+        mBucketCell[b] = bucketFirstCell[b << mLookupShift];
+
+    // 8. Gather coordinates in sorted order; inverse map for forEachNeighbor(i). The coordinate
     //    arrays carry PADDING more entries, so vectorised distance loops may read past a range.
     mX.assign(count + PADDING, Real(0));
     mY.assign(count + PADDING, Real(0));

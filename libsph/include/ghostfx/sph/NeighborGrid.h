@@ -82,8 +82,10 @@ public:
     const std::vector<Index>& order() const { return mIndex; }
 
     std::size_t size() const { return mSize; }
-    /// Buckets in the hash table (a power of two).
-    std::size_t bucketCount() const { return mBucketCell.empty() ? 0 : mBucketCell.size() - 1; }
+    /// Buckets in the hash table that sets the sort order (a power of two).
+    std::size_t bucketCount() const { return std::size_t(mTableMask) + 1; }
+    /// Buckets in the cell-lookup table (a power of two, bucketCount() / 8 to bucketCount()).
+    std::size_t lookupBucketCount() const { return bucketCount() >> mLookupShift; }
     /// Occupied cells.
     std::size_t cellCount() const { return mCellKey.size(); }
     /// Bytes held by the grid's arrays.
@@ -104,7 +106,7 @@ public:
     /// The sorted slots of cell c (empty if no particle lies in it).
     SlotRange cellSlots(const Cell& c) const
     {
-        const std::uint32_t b = bucketOf(c);
+        const std::uint32_t b = bucketOf(c) >> mLookupShift;
         const std::uint64_t key = packKey(c);
         for (std::uint32_t k = mBucketCell[b], end = mBucketCell[b + 1]; k < end; ++k) {
             if (mCellKey[k] == key) return {mCellStart[k], mCellStart[k + 1]};
@@ -205,8 +207,14 @@ private:
     void visitCell(const Cell& c, const Vec3& x, Real radius2, Fn& fn) const;
 
     Real mCellSize, mInvCellSize;
-    std::uint64_t mTableMask = 0;
-    std::vector<std::uint32_t> mBucketCell; ///< bucket b holds cells [cell[b], cell[b+1])
+    /// Buckets of the sort table (minus one). Sorted order is by bucket, then key.
+    std::uint64_t mTableMask = 63;
+    /// The lookup table merges 2^shift consecutive sort buckets (at most a 2 x 2 x 2 block of
+    /// cells, whose keys share a cache line), so a set with many particles per cell keeps a
+    /// small table without changing its sort order.
+    static constexpr unsigned MAX_LOOKUP_SHIFT = 3;
+    unsigned mLookupShift = 0;
+    std::vector<std::uint32_t> mBucketCell; ///< lookup bucket b holds cells [cell[b], cell[b+1])
     std::vector<std::uint64_t> mCellKey;    ///< packed key of each occupied cell, sorted order
     std::vector<std::uint32_t> mCellStart;  ///< cell k holds slots [start[k], start[k+1])
     std::vector<Real> mX, mY, mZ;           ///< positions in sorted order (m)
