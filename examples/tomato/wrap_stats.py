@@ -6,7 +6,7 @@ Usage (repository root, Debian's python3 with python3-openvdb and python3-numpy)
 
 For each run folder it reads liquid.NNNN.vdb (grid 'surface'), and for every voxel centre in a
 shell R < r < R + 1.5 h around the sphere (the tomato: centre (0, 0.35, 0), R = 0.06 m,
-h = 0.01 m) it records whether it is inside the liquid (phi < 0). It prints, averaged over the
+h = 0.01 m, or TOMATO_H) it records whether it is inside the liquid (phi < 0). It prints, averaged over the
 frames, the fraction of the shell covered by liquid in 30-degree latitude bands measured from the
 top of the sphere (0-30 = the cap under the tap, 150-180 = the underside), and the share of the
 liquid volume below the sphere (y < cy - R) that lies within the sphere's shadow (x^2 + z^2 < R^2):
@@ -19,7 +19,7 @@ import pyopenvdb as vdb
 
 CENTER = np.array([0.0, 0.35, 0.0])
 R = float(os.environ.get("TOMATO_R", "0.06"))   # sphere radius (m); TOMATO_R for variants
-H = 0.01
+H = float(os.environ.get("TOMATO_H", "0.01"))   # spacing h (m) that sets the shell; TOMATO_H for the paper size
 BANDS = [(0, 30), (30, 60), (60, 90), (90, 120), (120, 150), (150, 180)]
 
 
