@@ -322,6 +322,59 @@ TEST(Dfsph, ErrorLimitsAndTimeStepCapsAtTheirExtremesStayBounded)
     }
 }
 
+// KNOWN OPEN DEFECT, disabled. A collapse like the one above at 5 mm spacing and CFL 0.1, a
+// quarter of the default step. Small steps are where the solves' limits (on one step's density
+// change) hold after the warm start alone: the warm start applies the last step's pressure
+// whole, no iteration renews a pressure that no longer fits, and the liquid runs away
+// (bench/RESULTS.md, "What a tap pours"). Measured: 22 m/s and dt at dfsph.min_dt (1e-5 s)
+// within 0.06 s (30 s of test). Taking the warm start as the solve's first search direction
+// (its line-searched share in [0, 1]) passes here (1.44 m/s, dt >= 1.8e-4 s) but moves the
+// still tank's interior speed from 0.17 to 0.24 m/s against that test's 0.25 bound, so it is
+// not in yet. Workaround: dfsph.warm_start false (stable here and in the column tank).
+// Asserted as for the extremes above: speed below 3 x the column's free-fall speed, no liquid
+// in the walls, and the steps those of CFL 0.1 at about that speed (dt above a tenth of
+// 0.1 h / 1.7 m/s).
+TEST(Dfsph, DISABLED_SmallCflStepsStayBounded)
+{
+    const Real h = H / 2;
+    const LevelSet tank =
+        makeLevelSet(ghostfx::testing::closedTankGrid(
+                         Vec3(0), Vec3(Real(0.3), Real(0.2), Real(0.1)), 3 * double(h), h / 2),
+                     "tank");
+    const LevelSet water = makeLevelSet(
+        makeBoxLevelSet(Vec3(0), Vec3(Real(0.1), Real(0.15), Real(0.1)), h / 2), "water");
+    GhostSettings s = dfsphSettings();
+    s.spacing = h;
+    s.cflNumber = Real(0.1);
+    GhostSolver solver(s);
+    solver.addSolid(tank);
+    solver.addLiquid(water);
+    double maxSpeed = 0, minDt = 1;
+    int steps = 0;
+    while (solver.time() < 0.06) {
+        const Real dt = solver.stableTimeStep();
+        minDt = std::min(minDt, double(dt));
+        solver.step(dt);
+        ++steps;
+        for (const Vec3& v : solver.particles().velocities())
+            maxSpeed = std::max(maxSpeed, double(v.length()));
+    }
+    double outside = 0;
+    for (std::size_t i = 0; i < solver.particles().size(); ++i) {
+        if (solver.particles().kinds()[i] != ParticleKind::Liquid) continue;
+        outside = std::min(outside, double(tank.phi(solver.particles().positions()[i])));
+    }
+    const PressureSolveStats& st = solver.pressureSolveStats();
+    std::printf("[measured] dfsph CFL 0.1: %d steps to 0.06 s, smallest dt %.2e s, %.1f + %.1f "
+                "iterations per step, max speed %.2f m/s, deepest in wall %.1e m\n",
+                steps, minDt, double(st.densityIterations) / st.steps,
+                double(st.divergenceIterations) / st.steps, maxSpeed, outside);
+    const double freeFall = std::sqrt(2 * 9.81 * 0.15);
+    EXPECT_LT(maxSpeed, 3 * freeFall);
+    EXPECT_GE(outside, -0.01 * double(H));
+    EXPECT_GT(minDt, 0.1 * 0.1 * double(h) / freeFall);
+}
+
 // One particle of a still lattice block (zero gravity, 4,096 particles) starts 0.4 h from the
 // particle below it and moving into it at 5 m/s. Its error is several percent, yet the mean over
 // the block stays within the 0.1 % limit: a solve that stops on the mean alone lets it go
