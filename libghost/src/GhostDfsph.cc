@@ -159,12 +159,23 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     const Real M = mMass, rho0 = mSettings.restDensity;
     const DfsphSettings& opt = mSettings.dfsph;
     const double limit = double(density ? opt.densityError : opt.divergenceError);
-    // The relaxation is a share per step at CFL 0.4; smaller CFL steps take a share in
-    // proportion (DfsphSettings::densityRelaxation).
-    const bool cflSteps = mSettings.substeps == 0;
-    const Real scale = cflSteps && mSettings.cflNumber < DfsphSettings::RELAXATION_CFL
-                           ? mSettings.cflNumber / DfsphSettings::RELAXATION_CFL
-                           : Real(1);
+    // The relaxation is a share per step of the length CFL 0.4 would take; a shorter step takes
+    // a share in proportion (DfsphSettings::densityRelaxation).
+    Real scale = 1;
+    if (density) {
+        const auto& v = mParticles.velocities();
+        const auto& kinds = mParticles.kinds();
+        const Real* copies = haloFlags();
+        double fastest = parallel::maximum(0, n, [&](std::size_t i) {
+            return kinds[i] == ParticleKind::Liquid && (!copies || copies[i] == Real(0))
+                       ? double(v[i].length())
+                       : 0.0;
+        });
+        if (mExchange) fastest = mExchange->maxOf(fastest);
+        const Real reference = dfsphTimeStep(mSettings, Real(fastest), mRun.maxAcceleration,
+                                             DfsphSettings::RELAXATION_CFL);
+        scale = std::min(Real(1), dt / reference);
+    }
     const Real beta = density ? opt.densityRelaxation * scale : Real(0);
     // The particles in the solve: liquid that is not spray.
     auto solved = [&](std::size_t i) { return mAlpha[i] > Real(0); };

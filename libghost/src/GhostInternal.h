@@ -12,7 +12,9 @@
 #include <ghostfx/sph/Timing.h>
 #include <ghostfx/sph/Types.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -113,6 +115,17 @@ inline std::uint64_t nearestKey(Real r, Index liquid)
 inline Index nearestIndex(std::uint64_t key) { return Index(key & 0xffffffffu); }
 
 using sph::secondsSince;
+
+/// DFSPH's CFL step at number `cfl`: dt <= cfl h / |v|max ([BK15] Sec. 4.4) and the force
+/// limit cfl sqrt(h / |a|max), within [minTimeStep, maxTimeStep] (GhostSolver::stableTimeStep).
+inline Real dfsphTimeStep(const GhostSettings& s, Real fastest, Real acceleration, Real cfl)
+{
+    const DfsphSettings& d = s.dfsph;
+    Real dt = fastest > Real(0) ? cfl * s.spacing / fastest : d.maxTimeStep;
+    const Real a = std::max(acceleration, s.gravity.length());
+    if (a > Real(0)) dt = std::min(dt, cfl * std::sqrt(s.spacing / a));
+    return std::clamp(dt, d.minTimeStep, d.maxTimeStep);
+}
 
 } // namespace detail
 } // namespace ghost

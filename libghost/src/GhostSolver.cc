@@ -795,11 +795,7 @@ Real GhostSolver::stableTimeStep() const
     if (mSettings.pressure == PressureModel::Dfsph) {
         // The implicit pressure has no sound speed to resolve: dt <= cfl h / |v|max
         // ([BK15] Sec. 4.4), the force limit, and [minTimeStep, maxTimeStep].
-        const DfsphSettings& d = mSettings.dfsph;
-        Real dt = vmax > Real(0) ? mSettings.cflNumber * h / vmax : d.maxTimeStep;
-        const Real a = std::max(mRun.maxAcceleration, mSettings.gravity.length());
-        if (a > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / a));
-        return std::clamp(dt, d.minTimeStep, d.maxTimeStep);
+        return detail::dfsphTimeStep(mSettings, vmax, mRun.maxAcceleration, mSettings.cflNumber);
     }
     Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
     // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration

@@ -52,11 +52,12 @@ struct DfsphSettings
     /// (Asai et al. 2012's relaxed density invariance; the velocity divergence is removed in
     /// full). 1 is [BK15]'s solve; above about 0.05 the few-percent errors of sampled and
     /// emitted particles become velocity kicks that grow (bench/RESULTS.md, "DFSPH").
-    /// This share is per step at CFL number RELAXATION_CFL (the default, 0.4); CFL steps with
-    /// a smaller number take a share in proportion (0.0125 at CFL 0.1), so that the velocity
-    /// its correction asks for, about beta (rho - rho0) h / (rho0 dt), does not grow as the
-    /// steps shrink: at CFL 0.1 the whole share ran away (bench/RESULTS.md, "DFSPH at small
-    /// steps"). Fixed steps (substeps > 0) take it as set.
+    /// This share is per step of the length that CFL number RELAXATION_CFL (the default, 0.4)
+    /// gives; a shorter step (a smaller CFL number, a frame's last step) takes a share in
+    /// proportion, dt / that step (0.0125 at CFL 0.1), so that the velocity its correction asks
+    /// for, about beta (rho - rho0) h / (rho0 dt), does not grow as the steps shrink: at CFL
+    /// 0.1 the whole share ran away (bench/RESULTS.md, "DFSPH at small steps"). Steps held at
+    /// dfsph.max_dt by a calm scene keep the whole share at any CFL number.
     Real densityRelaxation = Real(0.05);
     static constexpr Real RELAXATION_CFL = Real(0.4);
     /// Besides its mean error, a solve must bring every particle's error within this many times
