@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
+#include <mutex>
 
 #if defined(__SSE2__)
 #include <xmmintrin.h>
@@ -35,50 +37,93 @@ enum Stream : std::uint64_t {
 /// radius.
 constexpr Real TILE_RADII = Real(12);
 
+/// The cells of side `cellSize` over a box, numbered along x, then y, then z: the index
+/// arithmetic that the sampler's search grids share.
+struct CellLattice
+{
+    /// Largest number of cells a grid may allocate.
+    static constexpr std::size_t MAX_CELLS = std::size_t(1) << 28;
+
+    CellLattice(const Aabb& bounds, Real cellSize)
+        : origin(bounds.min)
+        , invCellSize(Real(1) / cellSize)
+    {
+        const Vec3 extent = bounds.extent();
+        for (int a = 0; a < 3; ++a) {
+            dims[a] =
+                std::max<std::int64_t>(1, std::int64_t(std::ceil(extent[a] * invCellSize)) + 1);
+            count *= std::size_t(dims[a]);
+            if (count > MAX_CELLS) {
+                throw SamplingError(msg("sampling region of ", extent[0], " x ", extent[1], " x ",
+                                        extent[2], " m needs more than ", MAX_CELLS,
+                                        " search cells of side ", cellSize,
+                                        " m: use a larger spacing or a smaller region"));
+            }
+        }
+    }
+
+    bool contains(const Vec3& x) const
+    {
+        for (int a = 0; a < 3; ++a) {
+            const Real c = (x[a] - origin[a]) * invCellSize;
+            if (!(c >= Real(0) && c < Real(dims[a]))) return false;
+        }
+        return true;
+    }
+
+    /// The cell that holds x (clamped to the lattice), by coordinates and by index.
+    std::int64_t cellOf(const Vec3& x, std::int64_t c[3]) const
+    {
+        for (int a = 0; a < 3; ++a) {
+            c[a] = std::clamp<std::int64_t>(std::int64_t((x[a] - origin[a]) * invCellSize), 0,
+                                            dims[a] - 1);
+        }
+        return (c[2] * dims[1] + c[1]) * dims[0] + c[0];
+    }
+    std::int64_t cellOf(const Vec3& x) const
+    {
+        std::int64_t c[3];
+        return cellOf(x, c);
+    }
+
+    /// The cells [lo, hi] (per axis) that a ball of `radius` about x touches.
+    void range(const Vec3& x, Real radius, std::int64_t lo[3], std::int64_t hi[3]) const
+    {
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::max<std::int64_t>(
+                0, std::int64_t(std::floor((x[a] - radius - origin[a]) * invCellSize)));
+            hi[a] = std::min<std::int64_t>(
+                dims[a] - 1, std::int64_t(std::floor((x[a] + radius - origin[a]) * invCellSize)));
+        }
+    }
+
+    /// Index of the first cell of the x-row (j, k).
+    std::int64_t row(std::int64_t j, std::int64_t k) const { return (k * dims[1] + j) * dims[0]; }
+
+    Vec3 origin;
+    Real invCellSize;
+    std::int64_t dims[3] = {1, 1, 1};
+    std::size_t count = 1; ///< number of cells
+};
+
 /// Dense grid of cells of side `cellSize` over a box, each cell the head of a linked list of
 /// point entries. Lists stay short (a cell of side r holds at most a few Poisson samples), so
 /// queries cost 27 (radius <= cellSize) or 125 (radius <= 2 cellSize) list heads.
 class PointGrid
 {
 public:
-    /// Largest number of cells the grid may allocate (4 bytes each).
-    static constexpr std::size_t MAX_CELLS = std::size_t(1) << 28;
-
-    PointGrid(const Aabb& bounds, Real cellSize)
-        : mOrigin(bounds.min)
-        , mCellSize(cellSize)
-        , mInvCellSize(Real(1) / cellSize)
+    PointGrid(const Aabb& bounds, Real cellSize) : mCells(bounds, cellSize)
     {
-        const Vec3 extent = bounds.extent();
-        std::size_t total = 1;
-        for (int a = 0; a < 3; ++a) {
-            mDims[a] =
-                std::max<std::int64_t>(1, std::int64_t(std::ceil(extent[a] * mInvCellSize)) + 1);
-            total *= std::size_t(mDims[a]);
-            if (total > MAX_CELLS) {
-                throw SamplingError(msg("sampling region of ", extent[0], " x ", extent[1], " x ",
-                                        extent[2], " m needs more than ", MAX_CELLS,
-                                        " search cells at Poisson radius ", cellSize,
-                                        " m: use a larger spacing or a smaller region"));
-            }
-        }
-        mHead.assign(total, -1);
+        mHead.assign(mCells.count, -1);
     }
 
-    bool contains(const Vec3& x) const
-    {
-        for (int a = 0; a < 3; ++a) {
-            const Real c = (x[a] - mOrigin[a]) * mInvCellSize;
-            if (!(c >= Real(0) && c < Real(mDims[a]))) return false;
-        }
-        return true;
-    }
+    bool contains(const Vec3& x) const { return mCells.contains(x); }
 
     /// Add a point (which must be inside); returns its entry id, ids count up from 0.
     int add(const Vec3& x)
     {
         const int id = int(mPos.size());
-        const std::int64_t c = cellIndex(x);
+        const std::int64_t c = mCells.cellOf(x);
         mPos.push_back(x);
         mNext.push_back(mHead[c]);
         mCell.push_back(c);
@@ -89,7 +134,7 @@ public:
     /// Move entry `id` to x (inside).
     void move(int id, const Vec3& x)
     {
-        const std::int64_t c = cellIndex(x);
+        const std::int64_t c = mCells.cellOf(x);
         if (c != mCell[id]) {
             int* link = &mHead[mCell[id]];
             while (*link != id) link = &mNext[*link];
@@ -131,18 +176,6 @@ public:
         return hit;
     }
 
-    /// Call fn(position) for the entries other than `ignore` closer than `radius` (<= 2
-    /// cellSize) to x.
-    template <typename Fn>
-    void forEachWithin(const Vec3& x, Real radius, int ignore, Fn&& fn) const
-    {
-        const Real r2 = radius * radius;
-        visit(x, radius, [&](int id) {
-            if (id != ignore && (mPos[id] - x).lengthSqr() < r2) fn(mPos[id]);
-            return true;
-        });
-    }
-
     /// Append the entries other than `ignore` closer than `radius` (<= 2 cellSize) to x.
     void gather(const Vec3& x, Real radius, int ignore, std::vector<Vec3>& out) const
     {
@@ -154,32 +187,16 @@ public:
     }
 
 private:
-    std::int64_t cellIndex(const Vec3& x) const
-    {
-        std::int64_t c[3];
-        for (int a = 0; a < 3; ++a) {
-            c[a] = std::clamp<std::int64_t>(std::int64_t((x[a] - mOrigin[a]) * mInvCellSize), 0,
-                                            mDims[a] - 1);
-        }
-        return (c[2] * mDims[1] + c[1]) * mDims[0] + c[0];
-    }
-
     /// Call fn(id) for entries in the cells a ball of `radius` about x touches, until fn
     /// returns false.
     template <typename Fn>
     void visit(const Vec3& x, Real radius, Fn&& fn) const
     {
         std::int64_t lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = std::max<std::int64_t>(
-                0, std::int64_t(std::floor((x[a] - radius - mOrigin[a]) * mInvCellSize)));
-            hi[a] = std::min<std::int64_t>(
-                mDims[a] - 1,
-                std::int64_t(std::floor((x[a] + radius - mOrigin[a]) * mInvCellSize)));
-        }
+        mCells.range(x, radius, lo, hi);
         for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
             for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
-                const std::int64_t row = (k * mDims[1] + j) * mDims[0];
+                const std::int64_t row = mCells.row(j, k);
                 for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
                     for (int id = mHead[row + i]; id >= 0; id = mNext[id]) {
                         if (!fn(id)) return;
@@ -189,13 +206,256 @@ private:
         }
     }
 
-    Vec3 mOrigin;
-    Real mCellSize, mInvCellSize;
-    std::int64_t mDims[3] = {1, 1, 1};
+    CellLattice mCells;
     std::vector<int> mHead;
     std::vector<int> mNext;
     std::vector<std::int64_t> mCell;
     std::vector<Vec3> mPos;
+};
+
+/// The relaxation's search grid: cells of side `cellSize` stored one after another along x,
+/// each with slots for the samples it holds plus `SLACK` more (cells next to a sample only;
+/// far regions of the box cost a start index and a count), free slots holding a far-away
+/// point. The cells a ball touches are then at most 9 runs of contiguous slots, read without
+/// following links (a linked list per cell made every read wait for the one before). A cell
+/// whose slots are full takes further samples in a spill list of its own.
+///
+/// Threads may move samples at once as long as no two touch the same cells, which the
+/// relaxation's colouring ensures; the spill lists' table is shared, so it is locked.
+class SlotGrid
+{
+public:
+    static constexpr std::uint32_t SLACK = 4;
+
+    /// A grid over `bounds` holding the points inside it; `entry[i]` becomes the entry id of
+    /// point i (its index) or -1 when it lies outside.
+    SlotGrid(const Aabb& bounds, Real cellSize, const std::vector<Vec3>& points,
+             std::vector<int>& entry)
+        : mCells(bounds, cellSize)
+    {
+        const std::size_t total = mCells.count;
+        // Count the points per cell; cells next to a point get slack (a move stays within
+        // one cell of where it starts).
+        mCount.assign(total, 0);
+        std::vector<std::uint8_t> active(total, 0);
+        entry.assign(points.size(), -1);
+        mCellOf.assign(points.size(), 0);
+        mSlotOf.assign(points.size(), SPILLED);
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            if (!contains(points[i])) continue;
+            entry[i] = int(i);
+            std::int64_t c[3];
+            const std::int64_t cell = mCells.cellOf(points[i], c);
+            mCellOf[i] = cell;
+            ++mCount[cell];
+            const std::int64_t* dims = mCells.dims;
+            for (std::int64_t k = std::max<std::int64_t>(0, c[2] - 1);
+                 k <= std::min(dims[2] - 1, c[2] + 1); ++k) {
+                for (std::int64_t j = std::max<std::int64_t>(0, c[1] - 1);
+                     j <= std::min(dims[1] - 1, c[1] + 1); ++j) {
+                    const std::int64_t row = mCells.row(j, k);
+                    for (std::int64_t x = std::max<std::int64_t>(0, c[0] - 1);
+                         x <= std::min(dims[0] - 1, c[0] + 1); ++x) {
+                        active[std::size_t(row + x)] = 1;
+                    }
+                }
+            }
+        }
+        mStart.resize(total + 1);
+        std::size_t slots = 0;
+        for (std::size_t c = 0; c < total; ++c) {
+            mStart[c] = slots;
+            slots += mCount[c] + (active[c] ? SLACK : 0);
+        }
+        mStart[total] = slots;
+        // Four free slots after the last, for reads four at a time.
+        mX.assign(slots + 4, FAR);
+        mY.assign(slots + 4, FAR);
+        mZ.assign(slots + 4, FAR);
+        mId.assign(slots + 4, -1);
+        std::fill(mCount.begin(), mCount.end(), 0);
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            if (entry[i] >= 0) put(int(i), mCellOf[i], points[i]);
+        }
+        mSpilled.assign(total, 0);
+    }
+
+    bool contains(const Vec3& x) const { return mCells.contains(x); }
+
+    /// Move entry `id` to x (inside the grid).
+    void move(int id, const Vec3& x)
+    {
+        const std::int64_t cell = mCells.cellOf(x);
+        if (cell == mCellOf[id] && mSlotOf[id] != SPILLED) {
+            const std::size_t s = mSlotOf[id];
+            mX[s] = x[0];
+            mY[s] = x[1];
+            mZ[s] = x[2];
+            return;
+        }
+        take(id);
+        put(id, cell, x);
+    }
+
+    /// Write the entries other than `ignore` closer than `radius` (<= the cell size) to p
+    /// into x, y, z (grown as needed; room for 4 more is left after them); returns how many.
+    std::size_t collect(const Vec3& p, Real radius, int ignore, std::vector<Real>& x,
+                        std::vector<Real>& y, std::vector<Real>& z) const
+    {
+        const Real r2 = radius * radius;
+        std::int64_t lo[3], hi[3];
+        mCells.range(p, radius, lo, hi);
+        // Room for every slot read (each could be a member) and the padding after them.
+        std::size_t room = 4;
+        for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
+            for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
+                const std::int64_t row = mCells.row(j, k);
+                room += mStart[std::size_t(row + hi[0] + 1)] - mStart[std::size_t(row + lo[0])];
+                for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
+                    if (mSpilled[std::size_t(row + i)]) room += spill(row + i).size();
+                }
+            }
+        }
+        if (x.size() < room) {
+            x.resize(2 * room);
+            y.resize(2 * room);
+            z.resize(2 * room);
+        }
+        std::size_t n = 0;
+        for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
+            for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
+                const std::int64_t row = mCells.row(j, k);
+                const std::size_t end = mStart[std::size_t(row + hi[0] + 1)];
+                std::size_t s = mStart[std::size_t(row + lo[0])];
+#if defined(__SSE2__) && !defined(GHOSTFX_DOUBLE)
+                // Four slots at a time; the slot arrays end with four free slots, and lanes
+                // past the run are masked off.
+                const __m128 px = _mm_set1_ps(p[0]), py = _mm_set1_ps(p[1]), pz = _mm_set1_ps(p[2]),
+                             limit = _mm_set1_ps(r2);
+                const __m128i self = _mm_set1_epi32(ignore);
+                for (; s < end; s += 4) {
+                    const __m128 qx = _mm_loadu_ps(mX.data() + s);
+                    const __m128 qy = _mm_loadu_ps(mY.data() + s);
+                    const __m128 qz = _mm_loadu_ps(mZ.data() + s);
+                    const __m128 dx = _mm_sub_ps(qx, px), dy = _mm_sub_ps(qy, py),
+                                 dz = _mm_sub_ps(qz, pz);
+                    const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)),
+                                                 _mm_mul_ps(dz, dz));
+                    const __m128i ids =
+                        _mm_loadu_si128(reinterpret_cast<const __m128i*>(mId.data() + s));
+                    const __m128 notSelf = _mm_castsi128_ps(_mm_cmpeq_epi32(ids, self));
+                    int mask = _mm_movemask_ps(_mm_andnot_ps(notSelf, _mm_cmplt_ps(d2, limit)));
+                    if (end - s < 4) mask &= (1 << (end - s)) - 1;
+                    while (mask != 0) {
+                        const int lane = __builtin_ctz(unsigned(mask));
+                        x[n] = mX[s + std::size_t(lane)];
+                        y[n] = mY[s + std::size_t(lane)];
+                        z[n] = mZ[s + std::size_t(lane)];
+                        ++n;
+                        mask &= mask - 1;
+                    }
+                }
+#else
+                for (; s < end; ++s) {
+                    const Real dx = mX[s] - p[0], dy = mY[s] - p[1], dz = mZ[s] - p[2];
+                    x[n] = mX[s];
+                    y[n] = mY[s];
+                    z[n] = mZ[s];
+                    n += std::size_t((dx * dx + dy * dy + dz * dz < r2) & (mId[s] != ignore));
+                }
+#endif
+                for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
+                    if (!mSpilled[std::size_t(row + i)]) continue;
+                    for (const Slot& q : spill(row + i)) {
+                        const Real dx = q.x - p[0], dy = q.y - p[1], dz = q.z - p[2];
+                        if (dx * dx + dy * dy + dz * dz < r2 && q.id != ignore) {
+                            x[n] = q.x;
+                            y[n] = q.y;
+                            z[n] = q.z;
+                            ++n;
+                        }
+                    }
+                }
+            }
+        }
+        return n;
+    }
+
+private:
+    static constexpr std::uint32_t SPILLED = std::numeric_limits<std::uint32_t>::max();
+    /// Coordinate of a free slot: far enough that it is never within reach, small enough
+    /// that its square stays finite in float.
+    static constexpr Real FAR = Real(1e18);
+
+    struct Slot
+    {
+        Real x, y, z;
+        int id;
+    };
+
+    /// The spill list of `cell` (which has one).
+    std::vector<Slot>& spill(std::int64_t cell) const
+    {
+        std::lock_guard<std::mutex> lock(mSpillMutex);
+        return mSpill[cell];
+    }
+
+    void put(int id, std::int64_t cell, const Vec3& x)
+    {
+        mCellOf[std::size_t(id)] = cell;
+        const std::size_t c = std::size_t(cell);
+        if (mStart[c] + mCount[c] < mStart[c + 1]) {
+            const std::size_t s = mStart[c] + mCount[c]++;
+            mX[s] = x[0];
+            mY[s] = x[1];
+            mZ[s] = x[2];
+            mId[s] = id;
+            mSlotOf[std::size_t(id)] = std::uint32_t(s);
+            return;
+        }
+        mSlotOf[std::size_t(id)] = SPILLED;
+        spill(cell).push_back({x[0], x[1], x[2], id});
+        mSpilled[c] = 1;
+    }
+
+    /// Remove entry `id` from its cell, keeping the cell's slots packed.
+    void take(int id)
+    {
+        const std::size_t c = std::size_t(mCellOf[std::size_t(id)]);
+        if (mSlotOf[std::size_t(id)] == SPILLED) {
+            std::vector<Slot>& list = spill(std::int64_t(c));
+            auto it =
+                std::find_if(list.begin(), list.end(), [id](const Slot& q) { return q.id == id; });
+            *it = list.back();
+            list.pop_back();
+            if (list.empty()) mSpilled[c] = 0;
+            return;
+        }
+        const std::size_t s = mSlotOf[std::size_t(id)];
+        const std::size_t last = mStart[c] + --mCount[c];
+        if (s != last) {
+            mX[s] = mX[last];
+            mY[s] = mY[last];
+            mZ[s] = mZ[last];
+            mId[s] = mId[last];
+            mSlotOf[std::size_t(mId[s])] = std::uint32_t(s);
+        }
+        mX[last] = FAR;
+        mY[last] = FAR;
+        mZ[last] = FAR;
+        mId[last] = -1;
+    }
+
+    CellLattice mCells;
+    std::vector<std::size_t> mStart;    ///< first slot of each cell; mStart[cells] = slot count
+    std::vector<std::uint32_t> mCount;  ///< entries in each cell's slots
+    std::vector<Real> mX, mY, mZ;       ///< slots' coordinates
+    std::vector<int> mId;               ///< slots' entries, -1 when free
+    std::vector<std::int64_t> mCellOf;  ///< per entry: its cell
+    std::vector<std::uint32_t> mSlotOf; ///< per entry: its slot, or SPILLED
+    std::vector<std::uint8_t> mSpilled; ///< per cell: whether its spill list is in use
+    mutable std::map<std::int64_t, std::vector<Slot>> mSpill;
+    mutable std::mutex mSpillMutex;
 };
 
 /// B(p) of Algorithm 2, the samples within 2r of p, as coordinate arrays padded to a multiple
@@ -204,20 +464,10 @@ private:
 class Ball
 {
 public:
-    void gather(const PointGrid& grid, const Vec3& p, Real radius, int ignore)
+    void gather(const SlotGrid& grid, const Vec3& p, Real radius, int ignore)
     {
-        // Written through an index into arrays kept large enough: the three push_backs per
-        // member cost a fifth of the gather.
-        std::size_t n = 0;
-        grid.forEachWithin(p, radius, ignore, [&](const Vec3& q) {
-            if (n + 4 > mX.size()) grow(n);
-            mX[n] = q[0];
-            mY[n] = q[1];
-            mZ[n] = q[2];
-            ++n;
-        });
+        std::size_t n = grid.collect(p, radius, ignore, mX, mY, mZ);
         mCount = n;
-        if (n + 4 > mX.size()) grow(n);
         mPadded = (n + 3) / 4 * 4;
         for (; n < mPadded; ++n) {
             mX[n] = FAR;
@@ -231,6 +481,15 @@ public:
     /// min over the ball of |x - q|^2.
     Real minDistance2(const Vec3& x) const
     {
+        Real best = std::numeric_limits<Real>::max();
+        beats(x, Real(-1), best);
+        return best;
+    }
+
+    /// Whether every member is farther than sqrt(d2) from x; if so, `c2` is the exact
+    /// min over the ball of |x - q|^2 (otherwise it is set to d2).
+    bool beats(const Vec3& x, Real d2, Real& c2) const
+    {
         const std::size_t n = mPadded;
 #if defined(__SSE2__) && !defined(GHOSTFX_DOUBLE)
         const __m128 cx = _mm_set1_ps(x[0]), cy = _mm_set1_ps(x[1]), cz = _mm_set1_ps(x[2]);
@@ -239,35 +498,30 @@ public:
             const __m128 dx = _mm_sub_ps(cx, _mm_loadu_ps(mX.data() + k));
             const __m128 dy = _mm_sub_ps(cy, _mm_loadu_ps(mY.data() + k));
             const __m128 dz = _mm_sub_ps(cz, _mm_loadu_ps(mZ.data() + k));
-            const __m128 d2 =
+            const __m128 q2 =
                 _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-            best = _mm_min_ps(best, d2);
+            best = _mm_min_ps(best, q2);
         }
         alignas(16) float lanes[4];
         _mm_store_ps(lanes, best);
-        return std::min(std::min(lanes[0], lanes[1]), std::min(lanes[2], lanes[3]));
+        c2 = std::min(std::min(lanes[0], lanes[1]), std::min(lanes[2], lanes[3]));
 #else
         Real best = std::numeric_limits<Real>::max();
         for (std::size_t k = 0; k < n; ++k) {
             const Real dx = x[0] - mX[k], dy = x[1] - mY[k], dz = x[2] - mZ[k];
             best = std::min(best, dx * dx + dy * dy + dz * dz);
         }
-        return best;
+        c2 = best;
 #endif
+        if (c2 > d2) return true;
+        c2 = d2;
+        return false;
     }
 
 private:
     /// Padding coordinate: far enough that its distance never wins, small enough that its
     /// square stays finite in float.
     static constexpr Real FAR = Real(1e18);
-
-    void grow(std::size_t used)
-    {
-        const std::size_t size = std::max<std::size_t>(64, 2 * (used + 4));
-        mX.resize(size);
-        mY.resize(size);
-        mZ.resize(size);
-    }
 
     std::vector<Real> mX, mY, mZ; ///< members in [0, mCount), then padding to mPadded
     std::size_t mCount = 0, mPadded = 0;
@@ -724,11 +978,8 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
     const DepthLimit band(samples, shape, mSettings.bandDepth, r);
 
     // Cells of side 2r: B(p) (radius 2r) lies in the 27 cells around p, not in 125 of side r.
-    PointGrid grid(samplingBounds(shape, r), Real(2) * r);
-    std::vector<int> entry(samples.size(), -1);
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-        if (grid.contains(samples.positions[i])) entry[i] = grid.add(samples.positions[i]);
-    }
+    std::vector<int> entry;
+    SlotGrid grid(samplingBounds(shape, r), Real(2) * r, samples.positions, entry);
 
     // Gauss-Seidel sweeps, run in parallel by colouring: samples are grouped into blocks of
     // side 8r and the blocks into 8 colours by the parity of their coordinates. A sample reads
@@ -777,8 +1028,9 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
             const Real tau = Real(t - a) / Real(t);
             Vec3 cand = p + directions[a] * (r * tau);
             if (inside) {
-                const Real c2 = ball.minDistance2(cand);
-                if (!(c2 > d2) || !band.accepts(cand, phiOf(cand), hint) || !grid.contains(cand))
+                Real c2;
+                if (!ball.beats(cand, d2, c2) || !band.accepts(cand, phiOf(cand), hint)
+                    || !grid.contains(cand))
                     continue;
                 d2 = c2;
                 best = cand;
@@ -790,8 +1042,8 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
                 if (!surface && phiP + reachOut < Real(0)) {
                     // Certainly inside, so never projected: the checks below are those of the
                     // general path, the cheap one first.
-                    const Real c2 = ball.minDistance2(cand);
-                    if (!(c2 > d2)) continue;
+                    Real c2;
+                    if (!ball.beats(cand, d2, c2)) continue;
                     if (band.limited() && !band.accepts(cand, phiOf(cand), hint)) continue;
                     if (!grid.contains(cand)) continue;
                     d2 = c2;
@@ -829,8 +1081,8 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
                 }
                 if (!grid.contains(cand)) continue;
             }
-            const Real c2 = ball.minDistance2(cand);
-            if (c2 > d2) {
+            Real c2;
+            if (ball.beats(cand, d2, c2)) {
                 d2 = c2;
                 best = cand;
             }
