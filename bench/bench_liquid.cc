@@ -62,6 +62,7 @@ struct Options
     double cfl = 0;                ///< > 0: CFL-limited dt with this number instead of PAPER_DT
     double stiffness = 0;          ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
     double shifting = -1;          ///< >= 0: particle shifting coefficient instead of the default
+    std::string airWeights;        ///< "matched" or "complete" instead of the default
     double lennardJones = 0;       ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
     int threads = 0;               ///< TBB threads, 0 = all
     std::string scenes = "all";    ///< dam, sphere, all or splish_dam
@@ -503,6 +504,10 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     if (opt.cfl > 0) settings.cflNumber = Real(opt.cfl);
     if (opt.stiffness > 0) settings.stiffness = Real(opt.stiffness);
     if (opt.shifting >= 0) settings.shiftingCoefficient = Real(opt.shifting);
+    if (!opt.airWeights.empty()) {
+        settings.airWeights =
+            opt.airWeights == "matched" ? AirWeights::Matched : AirWeights::Complete;
+    }
     if (opt.lennardJones > 0) settings.lennardJonesStrength = Real(opt.lennardJones);
     const PressureModel pressure = pressureFromName(opt.pressure);
 
@@ -569,6 +574,9 @@ int main(int argc, char** argv)
         ->check(CLI::Range(1e-6, 2.0));
     app.add_option("--shifting", opt.shifting,
                    "particle shifting coefficient A (default 2; 0 = off)");
+    app.add_option("--air-weights", opt.airWeights,
+                   "ghost air weights: matched or complete (default: GhostSettings' default)")
+        ->check(CLI::IsMember({"matched", "complete"}));
     app.add_option("--stiffness", opt.stiffness, "Tait stiffness k (Pa; default: [SB12] 2000)")
         ->check(CLI::PositiveNumber);
     app.add_option("--lj", opt.lennardJones,

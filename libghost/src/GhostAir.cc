@@ -396,11 +396,25 @@ void GhostSolver::resampleAir(int phase)
         freshGrid.build(air);
         std::vector<Real> wanted(n, Real(-1)); // f_i, or -1: not asked
         std::vector<Real> airOf(n, Real(0));   // sum_air W_ia at weight 1
+        // Only liquid with air within R asks (the rest would find A_i = 0): marked from the
+        // air's side, which is a tenth of the liquid or less, so the liquid interior costs
+        // nothing. Serial: many air particles mark the same liquid particle.
+        std::vector<std::uint8_t> besideAir(n, 0);
+        auto markLiquidNear = [&](const Vec3& x) {
+            mGrid.forEachInRadius(x, R, [&](Index j, const Vec3&, Real) {
+                if (kind[j] == ParticleKind::Liquid) besideAir[j] = 1;
+            });
+        };
+        for (std::size_t a = 0; a < n; ++a) {
+            if (kind[a] == ParticleKind::GhostAir && target[a] != Real(0)) markLiquidNear(xs[a]);
+        }
+        for (const Vec3& x : air) markLiquidNear(x);
         parallel::forEach(
             0, n,
             [&](std::size_t i) {
             // A halo copy's own neighbourhood reaches past this process's copies: not asked.
-            if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY) || !body[i] || !owned(i))
+            if (!besideAir[i] || kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)
+                || !body[i] || !owned(i))
                 return;
             Real dense = 0, airUnit = 0;
             mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
