@@ -67,9 +67,12 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
                       : ghost::SolidSlip::NoSlip;
     g.airResampleSteps = int(s.inRange("air_resample_steps", g.airResampleSteps, 1, 1000));
     g.airKeepFraction = Real(s.inRange("air_keep_fraction", g.airKeepFraction, 0, 10));
-    g.airWeights = s.choice("air_weights", "matched", {"matched", "complete"}) == "matched"
-                       ? ghost::AirWeights::Matched
-                       : ghost::AirWeights::Complete;
+    g.airWeights =
+        s.choice("air_weights", g.airWeights == ghost::AirWeights::Matched ? "matched" : "complete",
+                 {"matched", "complete"})
+                == "matched"
+            ? ghost::AirWeights::Matched
+            : ghost::AirWeights::Complete;
     g.basicXsphEpsilon = Real(s.inRange("basic_xsph_epsilon", g.basicXsphEpsilon, 0, 1));
     g.basicViscosityAlpha = Real(s.nonNegative("basic_viscosity_alpha", g.basicViscosityAlpha));
     g.lennardJonesStrength = Real(s.nonNegative("lennard_jones_strength", g.lennardJonesStrength));

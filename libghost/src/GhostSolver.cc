@@ -679,6 +679,7 @@ SolverState GhostSolver::saveState() const
     state.integers["solids"] = std::int64_t(mSolids.size());
     state.integers["emitters"] = std::int64_t(mEmitters.size());
     state.integers["pressure_dfsph"] = mSettings.pressure == PressureModel::Dfsph;
+    state.integers["air_weights_complete"] = mSettings.airWeights == AirWeights::Complete;
     return state;
 }
 
@@ -706,6 +707,16 @@ void GhostSolver::restoreState(const SolverState& state)
                              pressureName(saved), "', this run has '",
                              pressureName(mSettings.pressure),
                              "'; resume with the pressure model the run started with"));
+    }
+    // States from before the air_weights setting, and from before "complete" became the
+    // default (2026-11-25), say nothing: they were saved with matched weights.
+    const auto complete = state.integers.find("air_weights_complete");
+    const bool savedComplete = complete != state.integers.end() && complete->second != 0;
+    if (savedComplete != (mSettings.airWeights == AirWeights::Complete)) {
+        const char* saved = savedComplete ? "complete" : "matched";
+        throw ValueError(msg("restoreState: the state was saved with settings.air_weights = '",
+                             saved, "', this run has '", savedComplete ? "matched" : "complete",
+                             "'; resume with -D settings.air_weights=", saved));
     }
     // Read every key first, so a state missing one leaves the solver untouched.
     const sph::RunCounters run = sph::RunCounters::load(state);

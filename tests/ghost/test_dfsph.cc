@@ -262,6 +262,22 @@ TEST(Dfsph, ResumeIsBitIdenticalAndATaitStateIsRefused)
         EXPECT_THAT(e.what(), ::testing::HasSubstr("settings.pressure = 'dfsph'"));
         EXPECT_THAT(e.what(), ::testing::HasSubstr("'tait'"));
     }
+    // So is one saved with the other air weights (the default changed on 2026-11-25; states
+    // from before say nothing and were saved with matched weights).
+    GhostSettings matched = scene.settings;
+    matched.airWeights = AirWeights::Matched;
+    GhostSolver otherAir(matched);
+    try {
+        otherAir.restoreState(saved);
+        ADD_FAILURE() << "a state with complete air weights restored into a matched solver";
+    } catch (const ValueError& e) {
+        EXPECT_THAT(e.what(), ::testing::HasSubstr("settings.air_weights = 'complete'"));
+        EXPECT_THAT(e.what(), ::testing::HasSubstr("'matched'"));
+    }
+    SolverState old = saved;
+    old.integers.erase("air_weights_complete");
+    GhostSolver fromOld(scene.settings);
+    EXPECT_THROW(fromOld.restoreState(old), ValueError);
 }
 
 TEST(Dfsph, ErrorLimitsAndTimeStepCapsAtTheirExtremesStayBounded)

@@ -86,13 +86,13 @@ enum class SolidSlip {
 /// (GhostAir.cc, step 6). Chosen by name in scenes (settings.air_weights).
 enum class AirWeights {
     /// min(1, n0 / sigma_a): an air particle weighs less where the air around it is packed
-    /// closer than the liquid ([SB12]'s weight 1 elsewhere). The default.
+    /// closer than the liquid ([SB12]'s weight 1 elsewhere). The default until 2026-11-25:
+    /// the kept air's mass grows at every resampling and a zero-gravity cube spreads by 4-6 %
+    /// in 2 s (bench/RESULTS.md, "Air that completes the liquid's density").
     Matched,
     /// What the liquid next to the air lacks: the weight that brings the neighbouring liquid
     /// particles' density sums to rest density (least squares over them, within [0, 1]).
-    /// Keeps a zero-gravity cube together for 2 s where Matched lets it spread by 4-6 %; not
-    /// the default because an emitter's stream then fills its nozzle differently (+20 % volume
-    /// in the double build: bench/RESULTS.md, "Air that completes the liquid's density").
+    /// Keeps a zero-gravity cube together for 2 s and holds a still tank. The default.
     Complete
 };
 
@@ -136,7 +136,7 @@ struct GhostSettings
     /// liquid are replaced; the others stay (temporal coherence). 0 keeps all in the layer;
     /// a value above the largest liquid-air distance replaces all, as in [SB12].
     Real airKeepFraction = Real(0.8);
-    AirWeights airWeights = AirWeights::Matched; ///< how the air's weights are set
+    AirWeights airWeights = AirWeights::Complete; ///< how the air's weights are set
 
     // Basic SPH ([SB12] Sec. 3) -------------------------------------------------------------------
     Real basicXsphEpsilon = Real(0.5);       ///< XSPH on positions [Monaghan 1989]
