@@ -7,6 +7,8 @@
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/PoissonSampler.h>
 
+#include "common/Tap.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -103,15 +105,8 @@ TEST(Emitter, TapUnderGravityPoursItsRateAtAnyStep)
         s.cflNumber = cfl;
         s.seed = 1;
         GhostSolver solver(s);
-        const Real a = Real(0.04);
-        solver.addEmitter(
-            makeLevelSet(makeBoxLevelSet(Vec3(-a, Real(0.47), -a), Vec3(a, Real(0.5), a), h / 2),
-                         "tap"),
-            Vec3(0, -1, 0));
-        while (solver.time() < duration) {
-            solver.step(
-                std::min(solver.stableTimeStep(), Real(duration - solver.time()) + Real(1e-7)));
-        }
+        ghostfx::testing::addTap(solver, h);
+        ghostfx::testing::runFor(solver, duration, [] {});
         const double poured =
             double(solver.count(ParticleKind::Liquid)) * double(solver.particleMass());
         const double nominal = 1000 * (0.08 * 0.08 * 0.03 + 0.08 * 0.08 * 1.0 * solver.time());
