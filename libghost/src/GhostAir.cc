@@ -396,40 +396,56 @@ void GhostSolver::resampleAir(int phase)
         freshGrid.build(air);
         std::vector<Real> wanted(n, Real(-1)); // f_i, or -1: not asked
         std::vector<Real> airOf(n, Real(0));   // sum_air W_ia at weight 1
-        // Only liquid with air within R asks (the rest would find A_i = 0): marked from the
-        // air's side, which is a tenth of the liquid or less, so the liquid interior costs
-        // nothing. Serial: many air particles mark the same liquid particle.
-        std::vector<std::uint8_t> besideAir(n, 0);
-        auto markLiquidNear = [&](const Vec3& x) {
-            mGrid.forEachInRadius(x, R, [&](Index j, const Vec3&, Real) {
-                if (kind[j] == ParticleKind::Liquid) besideAir[j] = 1;
-            });
-        };
-        for (std::size_t a = 0; a < n; ++a) {
-            if (kind[a] == ParticleKind::GhostAir && target[a] != Real(0)) markLiquidNear(xs[a]);
-        }
-        for (const Vec3& x : air) markLiquidNear(x);
-        parallel::forEach(
-            0, n,
-            [&](std::size_t i) {
-            // A halo copy's own neighbourhood reaches past this process's copies: not asked.
-            if (!besideAir[i] || kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY)
-                || !body[i] || !owned(i))
-                return;
-            Real dense = 0, airUnit = 0;
-            mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
-                if (kind[j] == ParticleKind::Liquid) dense += mKernel.W(rij);
-                else if (target[j] != Real(0)) airUnit += mKernel.W(rij);
-            });
-            freshGrid.forEachInRadius(
-                xs[i], R, [&](Index, const Vec3&, Real rij) { airUnit += mKernel.W(rij); });
-            for (const SolidBlock* b : {&mStatic, &mMoving}) {
-                b->block.grid().forEachInRadius(
-                    xs[i], R, [&](Index, const Vec3&, Real rij) { dense += mKernel.W(rij); });
-            }
-            if (airUnit > Real(0)) {
-                wanted[i] = std::clamp((n0 - dense) / airUnit, Real(0), Real(1));
-                airOf[i] = airUnit;
+        // From the step's lists (this resampling runs on the positions they were built for):
+        // the living air and the liquid within R of a liquid particle are in its fluid list,
+        // the solids in its block lists; only the air added above needs a search. Liquid with
+        // no air within R finds A_i = 0 and asks for nothing.
+        forRangeWithBatch(
+            n, mKernel,
+            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+            for (std::size_t i = lo; i < hi; ++i) {
+                // A halo copy's own neighbourhood reaches past this process's copies: not
+                // asked.
+                if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY) || !body[i]
+                    || !owned(i))
+                    continue;
+                Real airUnit = 0;
+                freshGrid.forEachInRadius(
+                    xs[i], R, [&](Index, const Vec3&, Real rij) { airUnit += kernel.W(rij); });
+                bool anyAir = airUnit > Real(0);
+                for (Index j : mFluidLists[i]) {
+                    if (kind[j] == ParticleKind::GhostAir && target[j] != Real(0)) {
+                        anyAir = true;
+                        break;
+                    }
+                }
+                if (!anyAir) continue;
+                Real dense = 0;
+                batch.forEachBatch(xs[i], xs.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) {
+                        const Index j = b.j[k];
+                        b.f[k] = Real(kind[j] == ParticleKind::Liquid);
+                        b.g[k] = Real(kind[j] == ParticleKind::GhostAir && target[j] != Real(0));
+                    }
+                    for (int k = 0; k < b.n; ++k) {
+                        const Real w = kernel.W(b.r[k]);
+                        b.f[k] *= w;
+                        b.g[k] *= w;
+                    }
+                    dense += b.sum(b.f);
+                    airUnit += b.sum(b.g);
+                });
+                for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                    batch.forEachBatch(xs[i], block->block.particles().positions().data(),
+                                       block->lists[i], [&](PairBatch& b) {
+                                           for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
+                                           dense += b.sum(b.f);
+                                       });
+                }
+                if (airUnit > Real(0)) {
+                    wanted[i] = std::clamp((n0 - dense) / airUnit, Real(0), Real(1));
+                    airOf[i] = airUnit;
+                }
             }
             },
             64);
