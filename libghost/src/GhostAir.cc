@@ -24,7 +24,9 @@
 #include <ghostfx/sph/PoissonSampler.h>
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
+#include <memory>
 
 namespace ghostfx {
 namespace ghost {
@@ -396,30 +398,41 @@ void GhostSolver::resampleAir(int phase)
         freshGrid.build(air);
         std::vector<Real> wanted(n, Real(-1)); // f_i, or -1: not asked
         std::vector<Real> airOf(n, Real(0));   // sum_air W_ia at weight 1
-        // From the step's lists (this resampling runs on the positions they were built for):
-        // the living air and the liquid within R of a liquid particle are in its fluid list,
-        // the solids in its block lists; only the air added above needs a search. Liquid with
-        // no air within R finds A_i = 0 and asks for nothing.
+        // Only the liquid within R of this region's air is read below, so only it asks: marked
+        // from the air's side (the region's air is a small share of the particles near it),
+        // from the step's lists for the kept air and by a search for the air added above.
+        // Many air particles mark the same liquid particle: the flags are atomic (relaxed, as
+        // only the value 1 is written and the pass below starts after this one has joined).
+        std::unique_ptr<std::atomic<std::uint8_t>[]> asked(new std::atomic<std::uint8_t>[n]());
+        auto ask = [&](Index j) {
+            if (kind[j] == ParticleKind::Liquid) asked[j].store(1, std::memory_order_relaxed);
+        };
+        parallel::forEach(
+            0, xs.size(),
+            [&](std::size_t a) {
+            if (kind[a] != ParticleKind::GhostAir || target[a] == Real(0)) return;
+            if (a >= n) {
+                mGrid.forEachInRadius(xs[a], R, [&](Index j, const Vec3&, Real) { ask(j); });
+            } else if ((zone[a] & IN_REGION) && owned(a)) {
+                for (Index j : mFluidLists[a]) ask(j);
+            }
+            },
+            64);
+        // The asking liquid's sums come from the step's lists (this resampling runs on the
+        // positions they were built for): the living air and the liquid within R are in its
+        // fluid list, the solids in its block lists; only the new air needs a search.
         forRangeWithBatch(
             n, mKernel,
             [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
             for (std::size_t i = lo; i < hi; ++i) {
                 // A halo copy's own neighbourhood reaches past this process's copies: not
                 // asked.
-                if (kind[i] != ParticleKind::Liquid || !(zone[i] & NEAR_BODY) || !body[i]
+                if (!asked[i].load(std::memory_order_relaxed) || !(zone[i] & NEAR_BODY) || !body[i]
                     || !owned(i))
                     continue;
                 Real airUnit = 0;
                 freshGrid.forEachInRadius(
                     xs[i], R, [&](Index, const Vec3&, Real rij) { airUnit += kernel.W(rij); });
-                bool anyAir = airUnit > Real(0);
-                for (Index j : mFluidLists[i]) {
-                    if (kind[j] == ParticleKind::GhostAir && target[j] != Real(0)) {
-                        anyAir = true;
-                        break;
-                    }
-                }
-                if (!anyAir) continue;
                 Real dense = 0;
                 batch.forEachBatch(xs[i], xs.data(), mFluidLists[i], [&](PairBatch& b) {
                     for (int k = 0; k < b.n; ++k) {
