@@ -259,8 +259,13 @@ void GhostSolver::resampleAir(int phase)
         if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0) || !(zone[i] & IN_REGION)
             || !owned(i))
             return;
-        Real d = -1;
-        keep[i] = nearBody(x[i], &d) != INVALID_INDEX && d >= keepDistance && !insideSolid(x[i])
+        // The nearest body particle within R, from the step's list (the liquid within R).
+        Real nearest2 = std::numeric_limits<Real>::max();
+        for (Index j : mFluidLists[i]) {
+            if (body[j]) nearest2 = std::min(nearest2, (x[i] - x[j]).lengthSqr());
+        }
+        keep[i] = nearest2 != std::numeric_limits<Real>::max()
+                  && std::sqrt(nearest2) >= keepDistance && !insideSolid(x[i])
                   && !insideLiquid(x[i]);
     });
     //    The thinning distance is r, the distance new air keeps from everything: thinning at
@@ -327,14 +332,15 @@ void GhostSolver::resampleAir(int phase)
     }
 
     auto accept = [&](const Vec3& q) {
-        return inPhase(q) && (!mExchange || mExchange->owns(q)) && nearBody(q) != INVALID_INDEX
-               && !insideSolid(q) && !insideLiquid(q);
+        return inPhase(q) && (!mExchange || mExchange->owns(q))
+               && mGrid.anyInRadius(q, R, [&](Index j) { return body[j] != 0; }) && !insideSolid(q)
+               && !insideLiquid(q);
     };
     PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
     ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
     ps.seed = mSettings.seed ^ (0x9e3779b97f4a7c15ULL * (mRun.step + 1));
     const std::vector<Vec3> air =
-        PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, bounds.padded(R));
+        PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, bounds.padded(R), inPhase);
 
     // 5. The new air: faded in from weight 0 (the very first layer is there from the start),
     //    with the velocity of the nearest body particle ([SB12] Sec. 4.3).
@@ -462,19 +468,40 @@ void GhostSolver::resampleAir(int phase)
             }
             },
             64);
-        parallel::forEach(
-            0, xs.size(),
-            [&](std::size_t i) {
-            if (mParticles.kinds()[i] != ParticleKind::GhostAir || target[i] == Real(0)) return;
-            if (i < n && (!(zone[i] & IN_REGION) || !owned(i))) return;
-            Real weight = 0, sum = 0;
-            mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
-                if (wanted[j] < Real(0)) return;
-                const Real w = mKernel.W(rij) * sqr(airOf[j]);
-                weight += w;
-                sum += w * wanted[j];
-            });
-            target[i] = weight > Real(0) ? sum / weight : Real(1);
+        // Each air particle of the region: the kept air reads its list (the liquid within R),
+        // the new air searches.
+        forRangeWithBatch(
+            xs.size(), mKernel,
+            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (kind[i] != ParticleKind::GhostAir || target[i] == Real(0)) continue;
+                Real weight = 0, sum = 0;
+                if (i < n) {
+                    if (!(zone[i] & IN_REGION) || !owned(i)) continue;
+                    batch.forEachBatch(xs[i], xs.data(), mFluidLists[i], [&](PairBatch& b) {
+                        for (int k = 0; k < b.n; ++k) {
+                            const Index j = b.j[k];
+                            const bool asks = wanted[j] >= Real(0);
+                            b.f[k] = asks ? sqr(airOf[j]) : Real(0);
+                            b.g[k] = asks ? wanted[j] : Real(0);
+                        }
+                        for (int k = 0; k < b.n; ++k) {
+                            b.f[k] *= kernel.W(b.r[k]);
+                            b.g[k] *= b.f[k];
+                        }
+                        weight += b.sum(b.f);
+                        sum += b.sum(b.g);
+                    });
+                } else {
+                    mGrid.forEachInRadius(xs[i], R, [&](Index j, const Vec3&, Real rij) {
+                        if (wanted[j] < Real(0)) return;
+                        const Real w = kernel.W(rij) * sqr(airOf[j]);
+                        weight += w;
+                        sum += w * wanted[j];
+                    });
+                }
+                target[i] = weight > Real(0) ? sum / weight : Real(1);
+            }
             },
             64);
     }

@@ -1179,7 +1179,8 @@ void PoissonDiskSampler::relaxSome(SampleSet& samples, const LevelSet& shape, in
 
 std::vector<Vec3> PoissonDiskSampler::sampleFromSeeds(
     const std::vector<Vec3>& seeds, const std::vector<Vec3>& obstacles,
-    const std::function<bool(const Vec3&)>& accept, const Aabb& bounds) const
+    const std::function<bool(const Vec3&)>& accept, const Aabb& bounds,
+    const std::function<bool(const Vec3&)>& where) const
 {
     std::vector<Vec3> added;
     if (seeds.empty() || bounds.empty()) return added;
@@ -1198,7 +1199,8 @@ std::vector<Vec3> PoissonDiskSampler::sampleFromSeeds(
     }
     Rng rng(mSettings.seed, SEEDED);
     growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
-        if (!bounds.contains(q) || grid.anyWithin(q, r) || !accept(q)) return false;
+        if (!bounds.contains(q) || (where && !where(q)) || grid.anyWithin(q, r) || !accept(q))
+            return false;
         grid.add(q);
         added.push_back(q);
         checkCount(added.size(), mSettings, "seeded sampling");

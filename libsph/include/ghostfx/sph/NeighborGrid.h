@@ -159,6 +159,12 @@ public:
     template <typename Pred>
     Index nearest(const Vec3& x, Real maxRadius, Pred&& pred, Real* distance = nullptr) const;
 
+    /// Whether some particle j with pred(j) true lies closer than maxRadius (m) to x: the same
+    /// answer as nearest(x, maxRadius, pred) != INVALID_INDEX, without looking further once
+    /// one is found.
+    template <typename Pred>
+    bool anyInRadius(const Vec3& x, Real maxRadius, Pred&& pred) const;
+
     /// Nearest particle of one kind (e.g. the closest liquid particle to a ghost, [SB12] Sec. 4).
     template <typename KindT>
     Index nearestOfKind(const Vec3& x, const std::vector<KindT>& kinds, KindT kind, Real maxRadius,
@@ -352,6 +358,43 @@ inline Index NeighborGrid::nearest(const Vec3& x, Real maxRadius, Pred&& pred, R
     }
     if (distance) *distance = best == INVALID_INDEX ? Real(-1) : std::sqrt(best2);
     return best;
+}
+
+template <typename Pred>
+inline bool NeighborGrid::anyInRadius(const Vec3& x, Real maxRadius, Pred&& pred) const
+{
+    if (mSize == 0 || !isFinite(x) || !(maxRadius > Real(0))) return false;
+    const Real radius2 = maxRadius * maxRadius;
+    // The distance as nearest() computes it, so both agree on particles at the limit.
+    auto hit = [&](std::uint32_t s) {
+        return (x - sortedPosition(s)).lengthSqr() < radius2 && pred(particleAt(s));
+    };
+    const Real maxRingCells = std::ceil(maxRadius * mInvCellSize);
+    if (sweepIsCheaper(maxRingCells)) {
+        for (std::uint32_t s = 0; s < mSize; ++s) {
+            if (hit(s)) return true;
+        }
+        return false;
+    }
+    const Cell c = cellOf(x);
+    const int reach = int(maxRingCells);
+    // The own cell first (the likeliest hit), then the rest of the block.
+    auto inCell = [&](const Cell& cell) {
+        const SlotRange range = cellSlots(cell);
+        for (std::uint32_t s = range.begin; s < range.end; ++s) {
+            if (hit(s)) return true;
+        }
+        return false;
+    };
+    if (inCell(c)) return true;
+    for (int di = -reach; di <= reach; ++di) {
+        for (int dj = -reach; dj <= reach; ++dj) {
+            for (int dk = -reach; dk <= reach; ++dk) {
+                if ((di | dj | dk) != 0 && inCell(Cell{c.i + di, c.j + dj, c.k + dk})) return true;
+            }
+        }
+    }
+    return false;
 }
 
 } // namespace sph

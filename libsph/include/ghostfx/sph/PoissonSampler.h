@@ -110,11 +110,15 @@ public:
     /// obstacle and every other new sample. Attempts per seed: `volumeAttempts` (set it to
     /// SB12_SEEDED_ATTEMPTS = 8 for air and emission, as [SB12] does).
     /// @param bounds  a box that contains every accepted point (m); sizes the search grid
+    /// @param where   optional cheap part of `accept` (a point it rejects, `accept` would
+    ///                reject too), tested before the distance test: the samples are the same,
+    ///                found with fewer searches where many candidates fall outside it
     /// @return the new samples only
     std::vector<Vec3> sampleFromSeeds(const std::vector<Vec3>& seeds,
                                       const std::vector<Vec3>& obstacles,
                                       const std::function<bool(const Vec3&)>& accept,
-                                      const Aabb& bounds) const;
+                                      const Aabb& bounds,
+                                      const std::function<bool(const Vec3&)>& where = {}) const;
 
 private:
     SampleSet sampleVolumeTiled(const LevelSet& shape) const;
