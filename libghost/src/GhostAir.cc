@@ -145,6 +145,17 @@ void GhostSolver::resampleAir(int phase)
     if (halo) {
         for (std::size_t i = 0; i < n; ++i) body[i] = !owned(i) && kind[i] == ParticleKind::Liquid;
     }
+    // Adds sum_j W_ij over the ghost solids in liquid particle i's block lists to `sum`.
+    auto addSolidSum =
+        [&](std::size_t i, const CubicSplineKernel& kernel, PairBatch& batch, Real& sum) {
+        for (const SolidBlock* block : {&mStatic, &mMoving}) {
+            batch.forEachBatch(x[i], block->block.particles().positions().data(), block->lists[i],
+                               [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
+                sum += b.sum(b.f);
+            });
+        }
+    };
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
@@ -181,13 +192,7 @@ void GhostSolver::resampleAir(int phase)
                 for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
                 sum += b.sum(b.f);
             });
-            for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                batch.forEachBatch(x[i], block->block.particles().positions().data(),
-                                   block->lists[i], [&](PairBatch& b) {
-                                       for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
-                                       sum += b.sum(b.f);
-                                   });
-            }
+            addSolidSum(i, kernel, batch, sum);
             indicator[i] = sum;
         }
         },
@@ -454,13 +459,7 @@ void GhostSolver::resampleAir(int phase)
                     dense += b.sum(b.f);
                     airUnit += b.sum(b.g);
                 });
-                for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                    batch.forEachBatch(xs[i], block->block.particles().positions().data(),
-                                       block->lists[i], [&](PairBatch& b) {
-                                           for (int k = 0; k < b.n; ++k) b.f[k] = kernel.W(b.r[k]);
-                                           dense += b.sum(b.f);
-                                       });
-                }
+                addSolidSum(i, kernel, batch, dense);
                 if (airUnit > Real(0)) {
                     wanted[i] = std::clamp((n0 - dense) / airUnit, Real(0), Real(1));
                     airOf[i] = airUnit;
