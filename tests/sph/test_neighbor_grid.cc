@@ -304,6 +304,38 @@ TEST(NeighborGrid, NearestMatchesBruteForce)
     EXPECT_LT(d, Real(0));
 }
 
+TEST(NeighborGrid, AnyInRadiusAnswersAsNearestDoes)
+{
+    // anyInRadius(x, R, pred) must be exactly nearest(x, R, pred) != INVALID_INDEX (the air
+    // resampling swapped one for the other and keeps the same samples), for a predicate that
+    // rejects most particles and at radii below, at and above the cell size.
+    const Real cellSize = Real(0.05);
+    const std::vector<Vec3> xs = clusteredPoints(4, 500, 0.05, 11);
+    NeighborGrid grid(cellSize);
+    grid.build(xs);
+    std::vector<Vec3> queries = uniformPoints(400, Vec3(-1.2f), Vec3(1.2f), 12);
+    std::mt19937 rng(12);
+    std::normal_distribution<double> offset(0.0, 0.05);
+    for (std::size_t q = 0; q < queries.size(); q += 2) {
+        queries[q] =
+            xs[rng() % xs.size()] + Vec3(Real(offset(rng)), Real(offset(rng)), Real(offset(rng)));
+    }
+    const auto some = [](Index j) { return j % 7 == 3; };
+    std::size_t yes = 0, no = 0;
+    for (Real maxRadius : {Real(0.5) * cellSize, cellSize, Real(2.5) * cellSize}) {
+        for (const Vec3& x : queries) {
+            const bool any = grid.anyInRadius(x, maxRadius, some);
+            ASSERT_EQ(any, grid.nearest(x, maxRadius, some) != INVALID_INDEX)
+                << "query " << x << ", maxRadius " << maxRadius;
+            ++(any ? yes : no);
+        }
+    }
+    EXPECT_GT(yes, 100u); // both answers were compared
+    EXPECT_GT(no, 100u);
+    EXPECT_FALSE(grid.anyInRadius(Vec3(5, 5, 5), Real(0.5), some));
+    EXPECT_FALSE(NeighborGrid(cellSize).anyInRadius(Vec3(0), cellSize, some)); // empty grid
+}
+
 TEST(NeighborGrid, NearestOfKindMatchesBruteForce)
 {
     const Real cellSize = Real(0.04);

@@ -477,6 +477,40 @@ TEST(Sampler, SeededSamplingGrowsAnAirLayer)
     EXPECT_LT(perVolume, 1.3);
 }
 
+TEST(Sampler, SeededSamplingGivesTheSameSamplesWithACheapRegionTestFirst)
+{
+    // sampleFromSeeds' `where` is tried before the distance test; where it is part of
+    // `accept`, the samples must be exactly those of `accept` alone (the air resampling passes
+    // its region, a tenth of space, this way), and fewer candidates reach `accept`.
+    const Shape shape = sphereShape(Real(0.05));
+    const LevelSet ls = makeLevelSet(shape.grid, shape.name);
+    PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
+    const SampleSet liquid = PoissonDiskSampler(settings).sampleVolume(ls);
+    settings.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
+    const Real layer = CubicSplineKernel::fromSpacing(SPACING).supportRadius();
+    auto upperHalf = [](const Vec3& x) { return x[1] > Real(0); };
+    std::size_t calls = 0;
+    auto inLayer = [&](const Vec3& x) {
+        ++calls;
+        const double d = shape.sdf(x);
+        return upperHalf(x) && d > 0 && d < layer;
+    };
+    const Aabb bounds = shape.bounds.padded(layer);
+    const PoissonDiskSampler sampler(settings);
+    const std::vector<Vec3> plain = sampler.sampleFromSeeds(liquid.positions, {}, inLayer, bounds);
+    const std::size_t plainCalls = calls;
+    calls = 0;
+    const std::vector<Vec3> first =
+        sampler.sampleFromSeeds(liquid.positions, {}, inLayer, bounds, upperHalf);
+    std::printf("[measured] seeded sampling: %zu samples; accept called %zu times, %zu with the "
+                "region test first\n",
+                plain.size(), plainCalls, calls);
+    ASSERT_GT(plain.size(), 50u);
+    ASSERT_EQ(first.size(), plain.size());
+    for (std::size_t k = 0; k < plain.size(); ++k) ASSERT_EQ(first[k], plain[k]) << "sample " << k;
+    EXPECT_LT(calls, plainCalls);
+}
+
 TEST(Sampler, SettingsAreValidated)
 {
     PoissonSettings s;
