@@ -261,20 +261,31 @@ TEST(NeighborGrid, ForEachInRadiusMatchesBruteForceForSmallAndLargeRadii)
     }
 }
 
+namespace {
+
+/// 400 query points: half near particles of `xs` (5 cm normal offsets), half anywhere in a box
+/// around the clusters.
+std::vector<Vec3> queriesNearAndAround(const std::vector<Vec3>& xs, unsigned seed)
+{
+    std::vector<Vec3> queries = uniformPoints(400, Vec3(-1.2f), Vec3(1.2f), seed);
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> offset(0.0, 0.05);
+    for (std::size_t q = 0; q < queries.size(); q += 2) {
+        queries[q] =
+            xs[rng() % xs.size()] + Vec3(Real(offset(rng)), Real(offset(rng)), Real(offset(rng)));
+    }
+    return queries;
+}
+
+} // namespace
+
 TEST(NeighborGrid, NearestMatchesBruteForce)
 {
     const Real cellSize = Real(0.05);
     const std::vector<Vec3> xs = clusteredPoints(4, 500, 0.05, 9);
     NeighborGrid grid(cellSize);
     grid.build(xs);
-    // Half the queries near particles, half anywhere in a box around the clusters.
-    std::vector<Vec3> queries = uniformPoints(400, Vec3(-1.2f), Vec3(1.2f), 10);
-    std::mt19937 rng(10);
-    std::normal_distribution<double> offset(0.0, 0.05);
-    for (std::size_t q = 0; q < queries.size(); q += 2) {
-        queries[q] =
-            xs[rng() % xs.size()] + Vec3(Real(offset(rng)), Real(offset(rng)), Real(offset(rng)));
-    }
+    const std::vector<Vec3> queries = queriesNearAndAround(xs, 10);
     const auto any = [](Index) { return true; };
     std::size_t foundCount = 0, noneCount = 0;
     for (Real maxRadius :
@@ -313,13 +324,7 @@ TEST(NeighborGrid, AnyInRadiusAnswersAsNearestDoes)
     const std::vector<Vec3> xs = clusteredPoints(4, 500, 0.05, 11);
     NeighborGrid grid(cellSize);
     grid.build(xs);
-    std::vector<Vec3> queries = uniformPoints(400, Vec3(-1.2f), Vec3(1.2f), 12);
-    std::mt19937 rng(12);
-    std::normal_distribution<double> offset(0.0, 0.05);
-    for (std::size_t q = 0; q < queries.size(); q += 2) {
-        queries[q] =
-            xs[rng() % xs.size()] + Vec3(Real(offset(rng)), Real(offset(rng)), Real(offset(rng)));
-    }
+    const std::vector<Vec3> queries = queriesNearAndAround(xs, 12);
     const auto some = [](Index j) { return j % 7 == 3; };
     std::size_t yes = 0, no = 0;
     for (Real maxRadius : {Real(0.5) * cellSize, cellSize, Real(2.5) * cellSize}) {
