@@ -21,8 +21,13 @@
 int main(int argc, char** argv)
 {
     CLI::App app{"ghostfx: Ghost SPH liquids and fast SPH gases on OpenVDB"};
+#if defined(GHOSTFX_AVX2)
+    const char* simd = ", AVX2";
+#else
+    const char* simd = "";
+#endif
     app.set_version_flag("--version", std::string("ghostfx 0.1.0 (OpenVDB ")
-                                          + openvdb::getLibraryAbiVersionString() + ")");
+                                          + openvdb::getLibraryAbiVersionString() + simd + ")");
     app.require_subcommand(1);
 
     using namespace ghostfx::cmd;
