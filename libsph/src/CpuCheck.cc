@@ -4,7 +4,9 @@
 /// @details This file alone is compiled without AVX (libsph/CMakeLists.txt). The check runs when
 ///          libghostfx_sph is loaded: before the library's other static initialisers
 ///          (constructor priority 101) and before every library and program that links it,
-///          the ghostfx command, the Python module and the tests included.
+///          the ghostfx command, the Python module and the tests included. (In a static
+///          libghostfx_sph.a nothing references this object, so a static link would leave it
+///          out; ghostfx builds shared libraries, and Debian's FindOpenVDB insists on them.)
 #if defined(GHOSTFX_AVX2) && defined(__x86_64__)
 #include <cstdio>
 #include <cstdlib>
