@@ -78,6 +78,9 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.lennardJonesStrength = Real(s.nonNegative("lennard_jones_strength", g.lennardJonesStrength));
     readStepSettings(s, g);
     g.tiledSampling = s.get<bool>("tiled_sampling", g.tiledSampling);
+    g.samplingRelaxation = s.choice("sampling_relaxation", "sb12", {"sb12", "packing"}) == "packing"
+                               ? sph::PoissonSettings::Relaxation::Packing
+                               : sph::PoissonSettings::Relaxation::Sb12;
     g.killBox = scene.killBox;
     s.finish();
     g.validate();

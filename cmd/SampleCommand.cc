@@ -47,6 +47,10 @@ Command addSampleCommand(CLI::App& app)
     c->add_option("--rest-density", o.restDensity, "rest density rho0 (kg/m^3)")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
+    c->add_option("--relaxation", o.relaxation,
+                  "volume relaxation: sb12 ([SB12] Algorithm 2) or packing (SPH packing)")
+        ->check(CLI::IsMember({"sb12", "packing"}))
+        ->capture_default_str();
     c->add_option("--seed", o.seed, "random seed")->capture_default_str();
     c->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
     return {c, [options] { return runSample(*options); }};
@@ -84,6 +88,9 @@ int runSample(const SampleOptions& o)
     PoissonSettings settings = PoissonSettings::forSpacing(h);
     settings.seed = o.seed;
     if (o.bandDepth > 0) settings.bandDepth = Real(o.bandDepth);
+    const bool packing = o.relaxation == "packing";
+    settings.volumeRelaxation =
+        packing ? PoissonSettings::Relaxation::Packing : PoissonSettings::Relaxation::Sb12;
     PoissonDiskSampler sampler(settings);
 
     std::printf("ghostfx sample: %s of size %g m, spacing h = %g m, Poisson radius r = %g m, "
@@ -99,7 +106,7 @@ int runSample(const SampleOptions& o)
     const auto t2 = Clock::now();
     sampler.sampleInterior(s, shape);
     const auto t3 = Clock::now();
-    sampler.relax(s, shape, settings.volumeRelaxSweeps, 1);
+    sampler.relaxVolume(s, shape);
     const auto t4 = Clock::now();
 
     std::printf("  surface sampling   %8.3f s  (Algorithm 1, t = %d, e = %g)\n", seconds(t0, t1),
@@ -108,8 +115,13 @@ int runSample(const SampleOptions& o)
                 settings.surfaceRelaxSweeps, settings.relaxAttempts);
     std::printf("  interior sampling  %8.3f s  (Bridson 2007, t = %d)\n", seconds(t2, t3),
                 settings.volumeAttempts);
-    std::printf("  volume relaxation  %8.3f s  (Algorithm 2, k = %d, t = %d)\n", seconds(t3, t4),
-                settings.volumeRelaxSweeps, settings.relaxAttempts);
+    if (packing) {
+        std::printf("  volume relaxation  %8.3f s  (SPH packing, %d steps)\n", seconds(t3, t4),
+                    settings.packingIterations);
+    } else {
+        std::printf("  volume relaxation  %8.3f s  (Algorithm 2, k = %d, t = %d)\n",
+                    seconds(t3, t4), settings.volumeRelaxSweeps, settings.relaxAttempts);
+    }
     std::printf("  particles          %8zu     (%zu on the surface), %.0f particles/s\n", s.size(),
                 s.surfaceCount(), double(s.size()) / seconds(t0, t4));
 

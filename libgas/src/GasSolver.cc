@@ -160,6 +160,7 @@ void GasSolver::sampleSolid(std::size_t solidIndex)
     ps.bandDepth = mSettings.supportRadius();
     ps.surfaceRelaxSweeps = 0;
     ps.volumeRelaxSweeps = 0;
+    ps.packingIterations = 0;
     ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step;
     const SampleSet samples = PoissonDiskSampler(ps).sampleVolume(body.shape);
 

@@ -214,6 +214,15 @@ void GhostSolver::setSolidMotion(std::size_t solidIndex, RigidMotion motion)
     solid.motion = std::move(motion);
 }
 
+PoissonSettings GhostSolver::bodySampling(std::uint64_t seed) const
+{
+    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+    ps.tiledInterior = mSettings.tiledSampling;
+    ps.volumeRelaxation = mSettings.samplingRelaxation;
+    ps.seed = seed;
+    return ps;
+}
+
 void GhostSolver::sampleSolid(std::size_t solidIndex)
 {
     const Solid& body = *mSolids[solidIndex];
@@ -227,10 +236,8 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     // [SB12] Sec. 4.4 / 4.5: ghost solid particles in a band one kernel radius deep, sampled
     // like liquid (surface, relaxation, interior, relaxation). Basic SPH uses the same layer as
     // its boundary particles.
-    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-    ps.tiledInterior = mSettings.tiledSampling;
+    PoissonSettings ps = bodySampling(mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step);
     ps.bandDepth = mSettings.supportRadius();
-    ps.seed = mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step;
     const SampleSet samples = sph::sampleVolumeStored(ps, solid, mSampleStore);
 
     // Outward normal of each particle from its nearest surface sample: phi is clamped beyond
@@ -373,9 +380,8 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
                              "the restored particles already hold the liquid (skip liquid "
                              "bodies when resuming)"));
     }
-    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-    ps.tiledInterior = mSettings.tiledSampling;
-    ps.seed = mSettings.seed + 7919ULL * (mParticles.count(ParticleKind::Liquid) + 1);
+    const PoissonSettings ps =
+        bodySampling(mSettings.seed + 7919ULL * (mParticles.count(ParticleKind::Liquid) + 1));
     const SampleSet samples = sph::sampleVolumeStored(ps, shape, mSampleStore);
     // Liquid inside a solid is not liquid, and liquid samples on a surface shared with a solid
     // would sit on top of the solid's own surface samples: keep half a spacing of clearance.
@@ -473,8 +479,8 @@ void GhostSolver::emit()
         std::vector<Vec3> fresh;
         if (seeds.empty()) {
             // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
-            PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-            ps.seed = mSettings.seed + 31337ULL * (e + 1) + mRun.step;
+            const PoissonSettings ps =
+                bodySampling(mSettings.seed + 31337ULL * (e + 1) + mRun.step);
             for (const Vec3& x : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
                 bool clear = !blockedBySolid(x);
                 for (const Vec3& o : obstacles) {

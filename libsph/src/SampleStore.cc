@@ -48,6 +48,8 @@ std::uint64_t sampleKey(const LevelSet& shape, const PoissonSettings& s)
     h.value(s.relaxAttempts);
     h.value(s.surfaceRelaxSweeps);
     h.value(s.volumeRelaxSweeps);
+    h.value(std::uint8_t(s.volumeRelaxation));
+    h.value(s.packingIterations);
     h.value(s.bandDepth);
     h.value(s.seed);
     h.value(std::uint8_t(s.tiledInterior));

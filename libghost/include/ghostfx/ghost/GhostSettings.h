@@ -4,6 +4,7 @@
 ///          and the bad value (STYLE.md rule 3). The solver copies its settings at construction.
 #pragma once
 
+#include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/Types.h>
 
 #include <cstdint>
@@ -161,6 +162,11 @@ struct GhostSettings
     /// tile (PoissonSettings::tiledInterior): about twice as fast a set-up, with an interior
     /// packing up to about 1 % off the layer near the surface. Off: [SB12]'s pipeline throughout.
     bool tiledSampling = false;
+    /// Volume relaxation of sampled liquid bodies, emitters and solids
+    /// (PoissonSettings::volumeRelaxation): [SB12]'s Algorithm 2 (default), or SPH packing,
+    /// about three times as fast a set-up with half the interior density noise, whose walls
+    /// and free surfaces the physics tests do not yet hold as well (bench/RESULTS.md).
+    sph::PoissonSettings::Relaxation samplingRelaxation = sph::PoissonSettings::Relaxation::Sb12;
 
     /// Kernel support radius (m).
     Real supportRadius() const { return supportFactor * spacing; }

@@ -295,6 +295,9 @@ private:
     bool initialize();
     void checkRestoredInputs() const;
     void addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving);
+    /// Sampler settings for a liquid body, an emitter or a solid's band ([SB12] Sec. 4.5):
+    /// the spacing's Poisson radius, the settings' relaxation and tiling, and `seed`.
+    sph::PoissonSettings bodySampling(std::uint64_t seed) const;
     SolidBlock& blockOf(std::size_t solidIndex);
     void clearSolidScratch(SolidBlock& block);
     /// Put the values of a particle that no liquid reaches (rest density, zero pressure, the

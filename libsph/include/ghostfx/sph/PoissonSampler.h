@@ -11,6 +11,13 @@
 ///   - Relaxation, [SB12] Algorithm 2: each sample in turn tries t candidates at decreasing
 ///     distance r (t - i) / t and moves to the one farthest from its neighbours within 2r;
 ///     surface samples stay on the surface, interior candidates outside are projected back.
+///   - Packing (SamplePacking.cc; the volume relaxation with `volumeRelaxation = Packing`):
+///     [SB12] Algorithm 2's goal, "to reduce noise in the SPH density by optimizing sample
+///     locations", reached by moving every sample at once down the gradient of its SPH number
+///     density, never closer than r to another sample; eight such steps leave about half the
+///     interior density noise of Algorithm 2's 30 sweeps at a fifth of their cost
+///     (bench/RESULTS.md, "Sampler: SPH packing"). Algorithm 2 stays the surface relaxation
+///     and the default volume relaxation.
 ///   - Seeded sampling (air layers, emission, [SB12] Sec. 4.5.2 with t = 8): grow samples from
 ///     existing particles inside a region given by a predicate, keeping r from other particles.
 ///   With r = 0.92 h ([SB12] Sec. 4.6) the SPH density of the result is close to the rest
@@ -45,8 +52,19 @@ struct PoissonSettings
     Real surfaceStep = Real(1.085); ///< e of Algorithm 1: walk step e r
     int volumeAttempts = 30;        ///< Bridson's t; [SB12] uses 8 for air and emission
     int relaxAttempts = 50;         ///< t of Algorithm 2
-    int surfaceRelaxSweeps = 5;     ///< k of Algorithm 2 for the surface
-    int volumeRelaxSweeps = 30;     ///< k of Algorithm 2 for the volume
+    /// How the volume relaxation (after the interior sampling) moves the samples.
+    enum class Relaxation : std::uint8_t {
+        /// SPH packing: `packingIterations` Jacobi steps down the gradient of each sample's
+        /// number density (SamplePacking.cc).
+        Packing,
+        /// [SB12] Algorithm 2: `volumeRelaxSweeps` sweeps of `relaxAttempts` candidates.
+        Sb12
+    };
+
+    int surfaceRelaxSweeps = 5; ///< k of Algorithm 2 for the surface
+    int volumeRelaxSweeps = 30; ///< k of Algorithm 2 for the volume (Relaxation::Sb12)
+    Relaxation volumeRelaxation = Relaxation::Sb12; ///< the volume relaxation's method
+    int packingIterations = 8; ///< steps of the packing (Relaxation::Packing); 0: none
     /// Sample only down to this depth below the surface (m): solids need one kernel radius
     /// ([SB12] Sec. 4.5). Infinity samples the whole interior.
     Real bandDepth = std::numeric_limits<Real>::infinity();
@@ -104,6 +122,11 @@ public:
     /// Algorithm 2 over every sample, `sweeps` times; `pass` decorrelates the random streams
     /// of separate relaxations.
     void relax(SampleSet& samples, const LevelSet& shape, int sweeps, int pass = 0) const;
+    /// The volume relaxation that sampleVolume runs after the interior sampling: packing or
+    /// Algorithm 2, as `volumeRelaxation` says.
+    void relaxVolume(SampleSet& samples, const LevelSet& shape) const;
+    /// SPH packing of every sample, `iterations` times (SamplePacking.cc).
+    void pack(SampleSet& samples, const LevelSet& shape, int iterations) const;
 
     /// Seeded sampling, [SB12] Sec. 4.5.2: new samples grown from `seeds` (existing particles)
     /// in annuli [r, 2r], kept where `accept(x)` is true, at least r from every seed, every
@@ -128,6 +151,12 @@ private:
     /// Algorithm 2 for the samples with movable[i] (all when empty); the rest hold still.
     void relaxSome(SampleSet& samples, const LevelSet& shape, int sweeps, int pass,
                    const std::vector<std::uint8_t>& movable) const;
+    /// The volume relaxation for the samples with movable[i] (all when empty).
+    void relaxVolumeSome(SampleSet& samples, const LevelSet& shape,
+                         const std::vector<std::uint8_t>& movable) const;
+    /// Packing for the samples with movable[i] (all when empty); the rest hold still.
+    void packSome(SampleSet& samples, const LevelSet& shape, int iterations,
+                  const std::vector<std::uint8_t>& movable) const;
     /// A point set in [0, side)^3 with the Poisson radius across its periodic faces, relaxed.
     std::vector<Vec3> periodicTile(Real side) const;
 
