@@ -93,6 +93,23 @@ void BM_SampleVolumeTiled(benchmark::State& state)
     samplePipeline(state, settings);
 }
 
+/// The full pipeline and the solid band with SPH packing as the volume relaxation
+/// (PoissonSettings::Relaxation::Packing, scene key settings.sampling_relaxation).
+void BM_SampleVolumePacking(benchmark::State& state)
+{
+    PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
+    settings.volumeRelaxation = PoissonSettings::Relaxation::Packing;
+    samplePipeline(state, settings);
+}
+
+void BM_SampleSolidBandPacking(benchmark::State& state)
+{
+    PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
+    settings.bandDepth = Real(3) * SPACING;
+    settings.volumeRelaxation = PoissonSettings::Relaxation::Packing;
+    samplePipeline(state, settings);
+}
+
 void BM_SampleWithoutRelaxation(benchmark::State& state)
 {
     parallel::ThreadLimit limit(int(state.range(0)));
@@ -125,6 +142,18 @@ void BM_VolumeRelaxationSweep(benchmark::State& state)
 
 BENCHMARK(BM_SampleVolume)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 BENCHMARK(BM_SampleSolidBand)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+BENCHMARK(BM_SampleVolumePacking)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+BENCHMARK(BM_SampleSolidBandPacking)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kSecond)

@@ -254,6 +254,8 @@ TEST_F(Cli, BadInputGetsOneClearLine)
          "settings.initial_relaxation = 2.5: expected a whole number of passes, 0 to 1000"},
         {" -D settings.pressure=iisph",
          "settings.pressure = \"iisph\": expected one of 'tait', 'dfsph' (did you mean 'dfsph'?)"},
+        {" -D settings.sampling_relaxation=lloyd",
+         "settings.sampling_relaxation = \"lloyd\": expected one of 'sb12', 'packing'"},
         {" -D settings.dfsph.density_eror=0.01",
          "settings.dfsph.density_eror: unknown key (did you mean 'density_error'?)"},
         {" -D settings.dfsph.density_relaxation=0", "settings.dfsph.density_relaxation = 0: "
