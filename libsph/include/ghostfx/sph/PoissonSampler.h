@@ -15,9 +15,10 @@
 ///     [SB12] Algorithm 2's goal, "to reduce noise in the SPH density by optimizing sample
 ///     locations", reached by moving every sample at once down the gradient of its SPH number
 ///     density, never closer than r to another sample; eight such steps leave about half the
-///     interior density noise of Algorithm 2's 30 sweeps at a fifth of their cost
-///     (bench/RESULTS.md, "Sampler: SPH packing"). Algorithm 2 stays the surface relaxation
-///     and the default volume relaxation.
+///     interior density noise of Algorithm 2's 30 sweeps in about an eighth of their time
+///     (the 107k bench sphere's whole pipeline: 4.9 s -> 1.6 s on 2 threads; bench/RESULTS.md,
+///     "Sampler: SPH packing as the volume relaxation"). Algorithm 2 stays the surface
+///     relaxation and the default volume relaxation.
 ///   - Seeded sampling (air layers, emission, [SB12] Sec. 4.5.2 with t = 8): grow samples from
 ///     existing particles inside a region given by a predicate, keeping r from other particles.
 ///   With r = 0.92 h ([SB12] Sec. 4.6) the SPH density of the result is close to the rest
