@@ -98,6 +98,31 @@ std::vector<Real> nearestNeighbourDistances(const std::vector<Vec3>& x, Real sea
     return d;
 }
 
+/// 300 interior samples thrown into a cube of side r centred on the origin (every pair far
+/// closer than the Poisson radius r).
+SampleSet crowdedCluster(Real r)
+{
+    Rng rng(5, 0);
+    SampleSet s;
+    for (int i = 0; i < 300; ++i) {
+        s.positions.push_back(Vec3(rng.uniform(-r, r), rng.uniform(-r, r), rng.uniform(-r, r))
+                              * Real(0.5));
+        s.onSurface.push_back(0);
+    }
+    return s;
+}
+
+/// The smallest distance between two of the points (m), by brute force.
+Real closestPair(const std::vector<Vec3>& x)
+{
+    Real best = std::numeric_limits<Real>::max();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        for (std::size_t j = i + 1; j < x.size(); ++j)
+            best = std::min(best, (x[i] - x[j]).length());
+    }
+    return best;
+}
+
 double mean(const std::vector<Real>& v)
 {
     return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
@@ -275,21 +300,7 @@ TEST(Sampler, RelaxationOfACrowdedClusterKeepsEveryNeighbourInSight)
     const LevelSet ls = makeLevelSet(shape.grid, shape.name);
     PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
     const Real r = settings.radius;
-    Rng rng(5, 0);
-    SampleSet s;
-    for (int i = 0; i < 300; ++i) {
-        s.positions.push_back(Vec3(rng.uniform(-r, r), rng.uniform(-r, r), rng.uniform(-r, r))
-                              * Real(0.5));
-        s.onSurface.push_back(0);
-    }
-    auto closestPair = [](const std::vector<Vec3>& x) {
-        Real best = std::numeric_limits<Real>::max();
-        for (std::size_t i = 0; i < x.size(); ++i) {
-            for (std::size_t j = i + 1; j < x.size(); ++j)
-                best = std::min(best, (x[i] - x[j]).length());
-        }
-        return best;
-    };
+    SampleSet s = crowdedCluster(r);
     const Real closestBefore = closestPair(s.positions);
     PoissonDiskSampler sampler(settings);
     SampleSet serial = s;
@@ -676,7 +687,7 @@ TEST(Sampler, PackingKeepsThePoissonRadiusAndTheFitAndHalvesTheDensityNoise)
 
 TEST(Sampler, PackingSpreadsACrowdedClusterWithoutBringingAnyPairCloser)
 {
-    // 300 points in a cube of side r/2 (as in the Algorithm 2 cluster test): every pair far
+    // 300 points in a cube of side r (as in the Algorithm 2 cluster test): every pair far
     // closer than r. A packing step is kept only if it leaves the sample at least as far from
     // every other as its nearest was (or r), so the closest pair can only part; the density
     // gradient drives the cluster apart.
@@ -684,21 +695,7 @@ TEST(Sampler, PackingSpreadsACrowdedClusterWithoutBringingAnyPairCloser)
     const LevelSet ls = makeLevelSet(shape.grid, shape.name);
     PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
     const Real r = settings.radius;
-    Rng rng(5, 0);
-    SampleSet s;
-    for (int i = 0; i < 300; ++i) {
-        s.positions.push_back(Vec3(rng.uniform(-r, r), rng.uniform(-r, r), rng.uniform(-r, r))
-                              * Real(0.5));
-        s.onSurface.push_back(0);
-    }
-    auto closestPair = [](const std::vector<Vec3>& x) {
-        Real best = std::numeric_limits<Real>::max();
-        for (std::size_t i = 0; i < x.size(); ++i) {
-            for (std::size_t j = i + 1; j < x.size(); ++j)
-                best = std::min(best, (x[i] - x[j]).length());
-        }
-        return best;
-    };
+    SampleSet s = crowdedCluster(r);
     auto gyration = [](const std::vector<Vec3>& x) {
         double sum = 0;
         for (const Vec3& p : x) sum += double(p.lengthSqr());
