@@ -78,9 +78,12 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.lennardJonesStrength = Real(s.nonNegative("lennard_jones_strength", g.lennardJonesStrength));
     readStepSettings(s, g);
     g.tiledSampling = s.get<bool>("tiled_sampling", g.tiledSampling);
-    g.samplingRelaxation = s.choice("sampling_relaxation", "sb12", {"sb12", "packing"}) == "packing"
-                               ? sph::PoissonSettings::Relaxation::Packing
-                               : sph::PoissonSettings::Relaxation::Sb12;
+    using Relaxation = sph::PoissonSettings::Relaxation;
+    const char* relaxation = g.samplingRelaxation == Relaxation::Packing ? "packing" : "sb12";
+    g.samplingRelaxation =
+        s.choice("sampling_relaxation", relaxation, {"sb12", "packing"}) == "packing"
+            ? Relaxation::Packing
+            : Relaxation::Sb12;
     g.killBox = scene.killBox;
     s.finish();
     g.validate();

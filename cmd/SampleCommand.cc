@@ -47,8 +47,10 @@ Command addSampleCommand(CLI::App& app)
     c->add_option("--rest-density", o.restDensity, "rest density rho0 (kg/m^3)")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
-    c->add_option("--relaxation", o.relaxation,
-                  "volume relaxation: sb12 ([SB12] Algorithm 2) or packing (SPH packing)")
+    c->add_option(
+         "--relaxation", o.relaxation,
+         "volume relaxation: packing (SPH packing, the liquid solver's default) or sb12 ([SB12] "
+         "Algorithm 2)")
         ->check(CLI::IsMember({"sb12", "packing"}))
         ->capture_default_str();
     c->add_option("--seed", o.seed, "random seed")->capture_default_str();

@@ -163,10 +163,11 @@ struct GhostSettings
     /// packing up to about 1 % off the layer near the surface. Off: [SB12]'s pipeline throughout.
     bool tiledSampling = false;
     /// Volume relaxation of sampled liquid bodies, emitters and solids
-    /// (PoissonSettings::volumeRelaxation): [SB12]'s Algorithm 2 (default), or SPH packing,
-    /// about three times as fast a set-up with half the interior density noise, whose walls
-    /// and free surfaces the physics tests do not yet hold as well (bench/RESULTS.md).
-    sph::PoissonSettings::Relaxation samplingRelaxation = sph::PoissonSettings::Relaxation::Sb12;
+    /// (PoissonSettings::volumeRelaxation): SPH packing (default since 2026-11-28), about a
+    /// third of the sampling time of [SB12]'s Algorithm 2 with half its interior density noise,
+    /// or Algorithm 2 itself (Relaxation::Sb12, the paper's pipeline; bench/RESULTS.md,
+    /// "Sampler: SPH packing" and "Tests that hold over sample realisations").
+    sph::PoissonSettings::Relaxation samplingRelaxation = sph::PoissonSettings::Relaxation::Packing;
 
     /// Kernel support radius (m).
     Real supportRadius() const { return supportFactor * spacing; }
