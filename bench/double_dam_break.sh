@@ -5,6 +5,7 @@
 #
 #   bench/double_dam_break.sh [ghostfx] [spacing] [threads] [frames]
 #   defaults:  build/cmd/ghostfx  0.0032  1  1-2
+#   GHOSTFX_BENCH_ARGS: more -D settings, e.g. "-D settings.sampling_relaxation=sb12"
 #
 # h = 3.2 mm gives 750k liquid particles, the paper's count. The step is fixed at 20 substeps per
 # frame as in the paper, with frame_rate 150 so that dt = 1/3000 s (c dt / h = 0.39 at
@@ -25,7 +26,7 @@ echo "h = $h m, walls $wall m, $threads thread(s), frames $frames"
     -D settings.spacing="$h" -D settings.substeps=20 -D settings.frame_rate=150 \
     -D "solids[0].geometry.container.wall=$wall" \
     -D outputs.points=false -D outputs.volume=false -D outputs.preview=false \
-    -D outputs.checkpoint=false -D outputs.stats.file=stats.h5
+    -D outputs.checkpoint=false -D outputs.stats.file=stats.h5 ${GHOSTFX_BENCH_ARGS:-}
 grep -E 'Elapsed|Maximum resident|User time|System time' "$out/time.txt"
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 python3 - "$out/stats.csv" <<'PY'
