@@ -588,9 +588,12 @@ void PoissonDiskSampler::growInterior(SampleSet& samples, const LevelSet& shape,
     }
     Rng rng(mSettings.seed, INTERIOR);
     growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
-        if (!grid.contains(q)) return false;
+        // The distance test first: in a filled region most candidates fail it, and it is
+        // cheaper than a level-set lookup (the tests are pure, so their order does not
+        // change which candidates pass).
+        if (!grid.contains(q) || grid.anyWithin(q, r)) return false;
         const Real phi = shape.phi(q);
-        if (!(phi < Real(0)) || grid.anyWithin(q, r) || !band.accepts(q, phi)) return false;
+        if (!(phi < Real(0)) || !band.accepts(q, phi)) return false;
         grid.add(q);
         samples.positions.push_back(q);
         samples.onSurface.push_back(0);
