@@ -359,7 +359,9 @@ Real GasSolver::referenceMass() const
     // (its particles at least one kernel radius inside): a block at rest then starts at rho0,
     // as the mass scaling of [SB12] Sec. 4.6 does for liquids.
     const Real R = mSettings.supportRadius();
-    const Real half = Real(3) * R; // interior 4 R wide: a few hundred samples at the defaults
+    // Interior 8 R wide, a few thousand samples: the mass then varies by about 1 % with the
+    // seed (a block 4 R wide, a few hundred, varied by about 4 %; bench/RESULTS.md).
+    const Real half = Real(5) * R;
     const LevelSet block =
         makeLevelSet(makeBoxLevelSet(Vec3(-half), Vec3(half), Real(0.5) * mSettings.spacing),
                      "gas reference block");
