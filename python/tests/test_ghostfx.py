@@ -372,12 +372,13 @@ def test_shipped_plume_fast_and_ambient_rise_alike_with_default_settings():
     # the plume's top (95th percentile height of the visible gas) and centroid height, and the
     # visible gas count, compared while both tops are below 90 % of the kill box's height
     # (1.6 m): above it the fast solver's gas leaves the kill box while the baseline's closed
-    # box keeps it. Measured 2026-11-23: top ratio fast / ambient 0.96-1.13, centroid
-    # 0.85-1.11 over 27 frames, count 0.99-1.20 from frame 9 (the fast source's first fill is
-    # a sampled sphere with its surface layer, 187 particles against the 121 air particles
-    # the baseline converts, an offset that the emission then dilutes). Tolerances: top 15 %,
-    # centroid 20 %, count 25 % (from 0.3 s). The default damping C_d = 7 /s is what makes them
-    # agree (C_d = 1 /s: top ratio up to 1.79).
+    # box keeps it. Measured 2026-11-28 over 12 sample realisations (settings.gas.seed 1-6,
+    # the sampler before and after its growth ran in tiles): top ratio fast / ambient
+    # 0.92-1.21, centroid 0.84-1.14 over 27-28 frames, count 0.97-1.23 from frame 9 (the fast
+    # source's first fill is a sampled sphere with its surface layer, 187 particles against the
+    # 121 air particles the baseline converts, an offset that the emission then dilutes).
+    # Tolerances: top 25 %, centroid 20 %, count 25 % (from 0.3 s). The default damping
+    # C_d = 7 /s is what makes them agree (C_d = 1 /s: top ratio up to 1.79).
     fast = _plume_per_frame("gas")
     ambient = _plume_per_frame("gas_ambient")
     below = (fast[:, 2] < 0.9 * 1.6) & (ambient[:, 2] < 0.9 * 1.6)
@@ -391,7 +392,7 @@ def test_shipped_plume_fast_and_ambient_rise_alike_with_default_settings():
           "count %.2f-%.2f (from frame 9)" % (len(frames), top.min(), top.max(),
                                              centroid.min(), centroid.max(), count.min(),
                                              count.max()))
-    assert np.all(np.abs(top - 1) < 0.15), top
+    assert np.all(np.abs(top - 1) < 0.25), top
     assert np.all(np.abs(centroid - 1) < 0.20), centroid
     assert np.all(np.abs(count - 1) < 0.25), count
     # The baseline keeps emitting: its visible gas grows through the run (it stopped at 143
