@@ -437,6 +437,80 @@ void growFromActive(std::vector<Vec3>& active, Rng& rng, Real r, int attempts,
     }
 }
 
+/// Side of the tiles that Bridson's growth runs in, in Poisson radii: large enough that
+/// few samples sit within 2r of a tile's faces (those a neighbour also grows from), small
+/// enough for a few tiles of each colour on a small shape.
+constexpr Real GROWTH_TILE_RADII = Real(16);
+
+/// A random stream of one tile in one phase of a tiled phase `stream`.
+std::uint64_t tileStream(Stream stream, int phase, std::size_t tile)
+{
+    return std::uint64_t(stream) << 56 | std::uint64_t(phase) << 32 | std::uint64_t(tile);
+}
+
+/// Cubic tiles over a box for sampling phases run in parallel: a tile's work writes inside the
+/// tile and reads within one tile of it, so tiles of one colour (the parity of their
+/// coordinates: 8 colours, tiles of one colour at least a tile apart) run at once.
+class TileLattice
+{
+public:
+    static constexpr int COLOURS = 8;
+
+    TileLattice(const Aabb& bounds, Real side) : mCells(bounds, side), mSide(side) {}
+
+    std::size_t count() const { return mCells.count; }
+    /// The tile that holds x (clamped to the lattice).
+    std::size_t tileOf(const Vec3& x) const { return std::size_t(mCells.cellOf(x)); }
+    int colour(std::size_t tile) const
+    {
+        std::int64_t c[3];
+        coords(tile, c);
+        return int((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2);
+    }
+    Aabb box(std::size_t tile) const
+    {
+        std::int64_t c[3];
+        coords(tile, c);
+        Aabb b;
+        for (int a = 0; a < 3; ++a) {
+            b.min[a] = mCells.origin[a] + Real(c[a]) * mSide;
+            b.max[a] = b.min[a] + mSide;
+        }
+        return b;
+    }
+    /// fn(n) for the tile and its up to 26 neighbours, in index order.
+    template <typename Fn>
+    void forNeighbours(std::size_t tile, Fn&& fn) const
+    {
+        std::int64_t c[3];
+        coords(tile, c);
+        const std::int64_t* dims = mCells.dims;
+        for (std::int64_t k = std::max<std::int64_t>(0, c[2] - 1);
+             k <= std::min(dims[2] - 1, c[2] + 1); ++k) {
+            for (std::int64_t j = std::max<std::int64_t>(0, c[1] - 1);
+                 j <= std::min(dims[1] - 1, c[1] + 1); ++j) {
+                const std::int64_t row = mCells.row(j, k);
+                for (std::int64_t i = std::max<std::int64_t>(0, c[0] - 1);
+                     i <= std::min(dims[0] - 1, c[0] + 1); ++i) {
+                    fn(std::size_t(row + i));
+                }
+            }
+        }
+    }
+
+private:
+    void coords(std::size_t tile, std::int64_t c[3]) const
+    {
+        const std::int64_t t = std::int64_t(tile);
+        c[0] = t % mCells.dims[0];
+        c[1] = (t / mCells.dims[0]) % mCells.dims[1];
+        c[2] = t / (mCells.dims[0] * mCells.dims[1]);
+    }
+
+    CellLattice mCells;
+    Real mSide;
+};
+
 void checkCount(std::size_t count, const PoissonSettings& s, const char* phase)
 {
     if (count > s.maxSamples) {
@@ -513,50 +587,91 @@ SampleSet PoissonDiskSampler::sampleSurface(const LevelSet& shape) const
                                 shape.voxelSize(), " m)"));
     }
 
-    SampleSet samples;
-    PointGrid grid(samplingBounds(shape, r), r);
-    Rng rng(mSettings.seed, SURFACE);
+    // Run tile by tile, as the interior growth is (growInterior): a tile's cells place
+    // samples only inside the tile and read only the samples within r of it, so the tiles of
+    // one colour run in parallel and the samples do not depend on the thread count.
+    const Aabb bounds = samplingBounds(shape, r);
+    const CellLattice domain(bounds, r);
+    const TileLattice tiles(bounds, GROWTH_TILE_RADII * r);
+    std::vector<std::vector<std::size_t>> cellsOf(tiles.count());
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+        const Vec3 centre = shape.indexToWorld(
+            Vec3(Real(cells[c][0]) + Real(0.5), Real(cells[c][1]) + Real(0.5),
+                 Real(cells[c][2]) + Real(0.5)));
+        if (domain.contains(centre)) cellsOf[tiles.tileOf(centre)].push_back(c);
+    }
+    std::vector<std::vector<Vec3>> held(tiles.count());
 
-    // Project x to the surface; accept it if it meets the Poisson-disk criterion.
-    auto tryAdd = [&](const Vec3& x, Vec3& accepted) {
-        // Cheap rejection first: projection moves x by about |phi|, so a sample closer than
-        // r - |phi| to x is closer than r to the projected point.
-        const Real p = std::abs(shape.phi(x));
-        if (p < r && grid.anyWithin(x, r - p)) return false;
-        const SurfaceProjection proj = shape.projectToSurface(x);
-        if (!proj.converged || !grid.contains(proj.point)) return false;
-        if (grid.anyWithin(proj.point, r)) return false;
-        grid.add(proj.point);
-        samples.positions.push_back(proj.point);
-        samples.onSurface.push_back(1);
-        accepted = proj.point;
-        return true;
+    auto sampleTile = [&](std::size_t tile, int colour, std::vector<Vec3>& added) {
+        const Aabb near = tiles.box(tile).padded(Real(1.01) * r);
+        PointGrid grid(near, r);
+        tiles.forNeighbours(tile, [&](std::size_t n) {
+            for (const Vec3& x : held[n]) {
+                if (near.contains(x)) grid.add(x);
+            }
+        });
+        Rng rng(mSettings.seed, tileStream(SURFACE, colour, tile));
+
+        // Project x to the surface; accept it if it lands in the tile and meets the
+        // Poisson-disk criterion.
+        auto tryAdd = [&](const Vec3& x, Vec3& accepted) {
+            // Cheap rejection first: projection moves x by about |phi|, so a sample closer
+            // than r - |phi| to x is closer than r to the projected point.
+            const Real p = std::abs(shape.phi(x));
+            if (p < r && grid.anyWithin(x, r - p)) return false;
+            const SurfaceProjection proj = shape.projectToSurface(x);
+            if (!proj.converged || !domain.contains(proj.point)
+                || tiles.tileOf(proj.point) != tile || grid.anyWithin(proj.point, r))
+                return false;
+            grid.add(proj.point);
+            added.push_back(proj.point);
+            accepted = proj.point;
+            return true;
+        };
+
+        for (const std::size_t c : cellsOf[tile]) {
+            const auto& cell = cells[c];
+            // Lines 2-7: up to t random points of the cell projected to the surface.
+            Vec3 p;
+            bool found = false;
+            for (int a = 0; a < t && !found; ++a) {
+                Vec3 ijk;
+                for (int axis = 0; axis < 3; ++axis)
+                    ijk[axis] = Real(cell[axis]) + Real(rng.uniform01());
+                found = tryAdd(shape.indexToWorld(ijk), p);
+            }
+            if (!found) continue;
+            // Lines 10-16: walk along the surface in steps of e r while new samples are
+            // found (each step has t tries at a random tangent direction).
+            for (bool extended = true; extended;) {
+                extended = false;
+                const Vec3 n = shape.normal(p);
+                if (n.lengthSqr() == Real(0)) break;
+                for (int a = 0; a < t && !extended; ++a) {
+                    const Vec3 q = p + randomTangent(rng, n) * (mSettings.surfaceStep * r);
+                    extended = tryAdd(q, p);
+                }
+            }
+            checkCount(added.size(), mSettings, "surface sampling");
+        }
     };
 
-    for (const auto& cell : cells) {
-        // Lines 2-7: up to t random points of the cell projected to the surface.
-        Vec3 p;
-        bool found = false;
-        for (int a = 0; a < t && !found; ++a) {
-            Vec3 ijk;
-            for (int axis = 0; axis < 3; ++axis)
-                ijk[axis] = Real(cell[axis]) + Real(rng.uniform01());
-            found = tryAdd(shape.indexToWorld(ijk), p);
+    SampleSet samples;
+    for (int colour = 0; colour < TileLattice::COLOURS; ++colour) {
+        std::vector<std::size_t> batch;
+        for (std::size_t k = 0; k < tiles.count(); ++k) {
+            if (!cellsOf[k].empty() && tiles.colour(k) == colour) batch.push_back(k);
         }
-        if (!found) continue;
-        // Lines 10-16: walk along the surface in steps of e r while new samples are found
-        // (each step has t tries at a random tangent direction).
-        for (bool extended = true; extended;) {
-            extended = false;
-            const Vec3 n = shape.normal(p);
-            if (n.lengthSqr() == Real(0)) break;
-            for (int a = 0; a < t && !extended; ++a) {
-                const Vec3 q = p + randomTangent(rng, n) * (mSettings.surfaceStep * r);
-                extended = tryAdd(q, p);
-            }
+        std::vector<std::vector<Vec3>> added(batch.size());
+        parallel::forEach(
+            0, batch.size(), [&](std::size_t b) { sampleTile(batch[b], colour, added[b]); }, 1);
+        for (std::size_t b = 0; b < batch.size(); ++b) {
+            held[batch[b]] = added[b];
+            samples.positions.insert(samples.positions.end(), added[b].begin(), added[b].end());
         }
         checkCount(samples.size(), mSettings, "surface sampling");
     }
+    samples.onSurface.assign(samples.size(), 1);
     if (samples.positions.empty()) {
         throw SamplingError(msg("level set '", shape.name(),
                                 "': no surface sample could be "
@@ -575,31 +690,140 @@ void PoissonDiskSampler::sampleInterior(SampleSet& samples, const LevelSet& shap
 void PoissonDiskSampler::growInterior(SampleSet& samples, const LevelSet& shape,
                                       const std::vector<std::uint8_t>& seeds) const
 {
+    // Bridson's growth, run tile by tile: a tile grows from the active samples inside it,
+    // each as Bridson's algorithm does (candidates over its whole [r, 2r) shell until t in a
+    // row fail), so it places samples at most 2r outside the tile and reads the samples at
+    // most 3r outside it. Tiles of one colour, a tile (16r) apart, then grow in parallel;
+    // colours run in order, and a tile grows again when samples were placed in it from a
+    // neighbour, until no tile places any. Only the order in which samples grow differs from
+    // one sequential pass, not how (no seam at tile faces: bench/RESULTS.md), and the
+    // samples depend on the seed and the tiles, never on the thread count.
     const Real r = mSettings.radius;
     const DepthLimit band(samples, shape, mSettings.bandDepth, r);
-    PointGrid grid(samplingBounds(shape, r), r);
-    std::vector<Vec3> active;
-    active.reserve(samples.size());
+    const Aabb bounds = samplingBounds(shape, r);
+    const CellLattice domain(bounds, r); // where samples may lie
+    const TileLattice tiles(bounds, GROWTH_TILE_RADII * r);
+
+    // Every sample by tile, with the phase that placed it: SEED grows in its tile's first
+    // growth, OBSTACLE only keeps others away.
+    struct Held
+    {
+        Vec3 x;
+        int phase;
+    };
+    constexpr int SEED = -1, OBSTACLE = std::numeric_limits<int>::min();
+    std::vector<std::vector<Held>> held(tiles.count());
+    std::vector<std::uint8_t> pending(tiles.count(), 0);
     for (std::size_t i = 0; i < samples.size(); ++i) {
         const Vec3& x = samples.positions[i];
-        if (!grid.contains(x)) continue;
-        grid.add(x);
-        if (seeds.empty() || seeds[i]) active.push_back(x);
+        if (!domain.contains(x)) continue;
+        const bool seed = seeds.empty() || seeds[i];
+        const std::size_t tile = tiles.tileOf(x);
+        held[tile].push_back({x, seed ? SEED : OBSTACLE});
+        if (seed) pending[tile] = 1;
     }
-    Rng rng(mSettings.seed, INTERIOR);
-    growFromActive(active, rng, r, mSettings.volumeAttempts, [&](const Vec3& q) {
-        // The distance test first: in a filled region most candidates fail it, and it is
-        // cheaper than a level-set lookup (the tests are pure, so their order does not
-        // change which candidates pass).
-        if (!grid.contains(q) || grid.anyWithin(q, r)) return false;
-        const Real phi = shape.phi(q);
-        if (!(phi < Real(0)) || !band.accepts(q, phi)) return false;
-        grid.add(q);
-        samples.positions.push_back(q);
-        samples.onSurface.push_back(0);
-        checkCount(samples.size(), mSettings, "interior sampling");
-        return true;
-    });
+    // The phase in which each tile last grew: a sample placed in it later is active.
+    std::vector<int> grown(tiles.count(), SEED - 1);
+
+    // A sample placed by a tile's growth, and whether it is still active (it left the tile's
+    // reach mid-growth: it goes on growing in its own tile).
+    struct Placed
+    {
+        Vec3 x;
+        bool active;
+    };
+    auto growTile = [&](std::size_t tile, int phase, std::vector<Placed>& placed) {
+        const Aabb box = tiles.box(tile);
+        // The tile's reach: the samples in it and the shells [r, 2r) about them. Samples
+        // within r of the reach can reject a candidate (the margin covers round-off in which
+        // tile a point falls).
+        const Aabb reach = box.padded(Real(2.01) * r), near = reach.padded(Real(1.01) * r);
+        PointGrid grid(near, r);
+        tiles.forNeighbours(tile, [&](std::size_t n) {
+            for (const Held& h : held[n]) {
+                if (near.contains(h.x)) grid.add(h.x);
+            }
+        });
+        // Active samples: those in the tile not yet grown from (index -1), then those placed
+        // here (their index in `placed`).
+        struct Active
+        {
+            Vec3 x;
+            std::ptrdiff_t placed;
+        };
+        std::vector<Active> active;
+        for (const Held& h : held[tile]) {
+            if (h.phase > grown[tile]) active.push_back({h.x, -1});
+        }
+        if (active.empty()) return;
+        Rng rng(mSettings.seed, tileStream(INTERIOR, phase, tile));
+        const int t = mSettings.volumeAttempts;
+        // Bridson's loop (growFromActive), up to the reach: a sample placed outside the tile
+        // grows here too until a candidate of it falls beyond the reach; it then stops here,
+        // still active, and its own tile's growth goes on from it. So every sample retires
+        // once, as in one sequential pass.
+        while (!active.empty()) {
+            const std::uint32_t slot = rng.below(std::uint32_t(active.size()));
+            const Active p = active[slot];
+            bool found = false, beyond = false;
+            for (int a = 0; a < t && !found; ++a) {
+                const Vec3 q = p.x + rng.unitVector() * (r * Real(1.0 + rng.uniform01()));
+                if (!domain.contains(q)) continue;
+                if (!reach.contains(q)) {
+                    beyond = true;
+                    break;
+                }
+                // The distance test before the level set: in a filled region most
+                // candidates fail it, and it is the cheaper.
+                if (grid.anyWithin(q, r)) continue;
+                const Real phi = shape.phi(q);
+                if (!(phi < Real(0)) || !band.accepts(q, phi)) continue;
+                grid.add(q);
+                active.push_back({q, std::ptrdiff_t(placed.size())});
+                placed.push_back({q, false});
+                checkCount(samples.size() + placed.size(), mSettings, "interior sampling");
+                found = true;
+            }
+            if (found) continue;
+            if (beyond && p.placed >= 0) placed[std::size_t(p.placed)].active = true;
+            active[slot] = active.back();
+            active.pop_back();
+        }
+    };
+
+    int phase = 0;
+    for (bool grew = true; grew;) {
+        grew = false;
+        for (int colour = 0; colour < TileLattice::COLOURS; ++colour, ++phase) {
+            std::vector<std::size_t> batch;
+            for (std::size_t k = 0; k < tiles.count(); ++k) {
+                if (pending[k] && tiles.colour(k) == colour) batch.push_back(k);
+            }
+            if (batch.empty()) continue;
+            std::vector<std::vector<Placed>> placed(batch.size());
+            parallel::forEach(
+                0, batch.size(), [&](std::size_t b) { growTile(batch[b], phase, placed[b]); },
+                1);
+            for (std::size_t b = 0; b < batch.size(); ++b) {
+                pending[batch[b]] = 0;
+                grown[batch[b]] = phase;
+            }
+            // A sample still active makes its tile grow again.
+            for (std::size_t b = 0; b < batch.size(); ++b) {
+                for (const Placed& x : placed[b]) {
+                    const std::size_t tile = tiles.tileOf(x.x);
+                    held[tile].push_back({x.x, x.active ? phase : OBSTACLE});
+                    if (x.active && tile != batch[b]) {
+                        pending[tile] = 1;
+                        grew = true;
+                    }
+                    samples.positions.push_back(x.x);
+                    samples.onSurface.push_back(0);
+                }
+            }
+            checkCount(samples.size(), mSettings, "interior sampling");
+        }
+    }
 }
 
 // Tiled interior ---------------------------------------------------------------------------------

@@ -24,9 +24,13 @@
 ///   With r = 0.92 h ([SB12] Sec. 4.6) the SPH density of the result is close to the rest
 ///   density; `massForRestDensity` (SphDensity.h) then scales the mass so it averages exactly.
 ///
-///   Every result is a deterministic function of the inputs and the seed. The algorithms are
-///   sequential by nature (each sample depends on all earlier ones); callers sample independent
-///   shapes in parallel.
+///   Every result is a deterministic function of the inputs and the seed, at any thread count.
+///   Algorithm 1 and Bridson's growth are sequential by nature (each sample depends on all
+///   earlier ones), so they run tile by tile: cubes of 16r coloured by the parity of their
+///   coordinates, the tiles of one colour in parallel, the colours in order (Bridson's growth
+///   goes on into a neighbour's tile from samples it placed there, so every sample is grown from
+///   once, as in one pass). The packing and Algorithm 2 run in parallel by coloured blocks too;
+///   seeded sampling stays sequential (air layers and emission are thin).
 #pragma once
 
 #include "ghostfx/sph/LevelSet.h"
@@ -73,7 +77,7 @@ struct PoissonSettings
     /// sampleVolume fills the interior deeper than 2r with copies of a periodic tile that was
     /// relaxed once ([SB12] Algorithms 1 and 2 run only between the surface and that depth):
     /// about twice as fast for large bodies, but the whole interior inherits the one tile's
-    /// packing density, which differs from the layer near the surface by up to about 1 %
+    /// packing density, which differs from the layer near the surface by up to about 2 %
     /// (bench/RESULTS.md); off by default. See sampleVolume.
     bool tiledInterior = false;
     /// Refuse (SamplingError) to create more samples than this: a guard against a spacing far
