@@ -20,7 +20,7 @@ namespace sph {
 
 /// Raise when a change to PoissonDiskSampler changes what sampleVolume() returns for the same
 /// inputs: stored samples of another version are then never used.
-constexpr std::uint32_t SAMPLER_VERSION = 2;
+constexpr std::uint32_t SAMPLER_VERSION = 3;
 
 class SampleStore
 {
