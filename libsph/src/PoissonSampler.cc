@@ -83,18 +83,7 @@ public:
             const std::int64_t cell = mCells.cellOf(points[i], c);
             mCellOf[i] = cell;
             ++mCount[cell];
-            const std::int64_t* dims = mCells.dims;
-            for (std::int64_t k = std::max<std::int64_t>(0, c[2] - 1);
-                 k <= std::min(dims[2] - 1, c[2] + 1); ++k) {
-                for (std::int64_t j = std::max<std::int64_t>(0, c[1] - 1);
-                     j <= std::min(dims[1] - 1, c[1] + 1); ++j) {
-                    const std::int64_t row = mCells.row(j, k);
-                    for (std::int64_t x = std::max<std::int64_t>(0, c[0] - 1);
-                         x <= std::min(dims[0] - 1, c[0] + 1); ++x) {
-                        active[std::size_t(row + x)] = 1;
-                    }
-                }
-            }
+            mCells.forNeighbourhood(c, [&active](std::size_t n) { active[n] = 1; });
         }
         mStart.resize(total + 1);
         std::size_t slots = 0;
@@ -484,18 +473,7 @@ public:
     {
         std::int64_t c[3];
         coords(tile, c);
-        const std::int64_t* dims = mCells.dims;
-        for (std::int64_t k = std::max<std::int64_t>(0, c[2] - 1);
-             k <= std::min(dims[2] - 1, c[2] + 1); ++k) {
-            for (std::int64_t j = std::max<std::int64_t>(0, c[1] - 1);
-                 j <= std::min(dims[1] - 1, c[1] + 1); ++j) {
-                const std::int64_t row = mCells.row(j, k);
-                for (std::int64_t i = std::max<std::int64_t>(0, c[0] - 1);
-                     i <= std::min(dims[0] - 1, c[0] + 1); ++i) {
-                    fn(std::size_t(row + i));
-                }
-            }
-        }
+        mCells.forNeighbourhood(c, fn);
     }
 
 private:

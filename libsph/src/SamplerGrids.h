@@ -83,6 +83,23 @@ struct CellLattice
     /// Index of the first cell of the x-row (j, k).
     std::int64_t row(std::int64_t j, std::int64_t k) const { return (k * dims[1] + j) * dims[0]; }
 
+    /// fn(index) for the cell at coordinates c and its up to 26 neighbours, in index order.
+    template <typename Fn>
+    void forNeighbourhood(const std::int64_t c[3], Fn&& fn) const
+    {
+        for (std::int64_t k = std::max<std::int64_t>(0, c[2] - 1);
+             k <= std::min(dims[2] - 1, c[2] + 1); ++k) {
+            for (std::int64_t j = std::max<std::int64_t>(0, c[1] - 1);
+                 j <= std::min(dims[1] - 1, c[1] + 1); ++j) {
+                const std::int64_t first = row(j, k);
+                for (std::int64_t i = std::max<std::int64_t>(0, c[0] - 1);
+                     i <= std::min(dims[0] - 1, c[0] + 1); ++i) {
+                    fn(std::size_t(first + i));
+                }
+            }
+        }
+    }
+
     Vec3 origin;
     Real invCellSize;
     std::int64_t dims[3] = {1, 1, 1};
