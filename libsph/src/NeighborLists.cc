@@ -159,13 +159,11 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
     mSize = count;
     if (targets.size() == 0) {
         // Every list is empty: hold nothing per query (a solid block with no particles).
-        mEnd = std::vector<End>();
         mChunks = std::vector<Chunk>();
         return;
     }
     const std::size_t chunks = (count + CHUNK - 1) / CHUNK;
-    mEnd.resize(count);
-    if (mChunks.size() < chunks) mChunks.resize(chunks);
+    mChunks.resize(chunks); // chunks beyond this build's queries give their memory back
     const Real radiusSquared = radius * radius;
     const Real cellSize = targets.cellSize();
     const bool twoBases = targets.size() <= std::size_t(SPLIT); // a first base below SPLIT
@@ -181,6 +179,8 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
         [&](std::size_t chunk) {
         Chunk& out = mChunks[chunk];
         std::size_t used = 0; // units of the chunk
+        End ends[CHUNK];
+        const std::size_t qFirst = chunk * CHUNK;
         std::size_t hits = 0;
         // The current query's hits as 32-bit entries; the chunk then gets them in their
         // final form, so it needs room for the lists only, not for a search's candidates.
@@ -188,12 +188,12 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
         Stencil stencil;
         alignas(16) Real r2[BATCH] = {};
         const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
-        for (std::size_t q = chunk * CHUNK; q < qEnd; ++q) {
+        for (std::size_t q = qFirst; q < qEnd; ++q) {
             const std::size_t start = (used + 1) & ~std::size_t(1);
             hits = 0;
             if ((wanted && !wanted[q]) || !isFinite(queries[q])) {
                 used = start;
-                mEnd[q] = {std::uint32_t(used), 0};
+                ends[q - qFirst] = {std::uint32_t(used), 0};
                 continue;
             }
             const Vec3& x = queries[q];
@@ -311,7 +311,15 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
             if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
                 throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
             }
-            mEnd[q] = {std::uint32_t(used), base};
+            ends[q - qFirst] = {std::uint32_t(used), base};
+        }
+        if (used == 0) {
+            out.ends.reset();
+            out.units.reset();
+            out.capacity = 0;
+        } else {
+            if (!out.ends) out.ends.reset(new End[CHUNK]);
+            std::copy(ends, ends + (qEnd - qFirst), out.ends.get());
         }
         // Fit the chunk to its lists (they shrank since an earlier step, or it grew by a
         // sixteenth while being filled): capacity is what the process holds. Most chunks are
@@ -362,21 +370,27 @@ std::size_t NeighborLists::pairCount() const
 std::size_t NeighborLists::wideListCount() const
 {
     std::size_t total = 0;
-    for (const End& e : mEnd) total += e.base == WIDE;
+    for (std::size_t q = 0; q < mSize; ++q) {
+        const List list = (*this)[q];
+        total += !list.empty() && list.wide() != nullptr;
+    }
     return total;
 }
 
 std::size_t NeighborLists::splitListCount() const
 {
     std::size_t total = 0;
-    for (const End& e : mEnd) total += e.base != WIDE && (e.base & SPLIT) != 0;
+    for (std::size_t q = 0; q < mSize; ++q) total += (*this)[q].split();
     return total;
 }
 
 std::size_t NeighborLists::memoryBytes() const
 {
-    std::size_t bytes = mEnd.capacity() * sizeof(End);
-    for (const auto& c : mChunks) bytes += c.capacity * sizeof(std::uint16_t);
+    std::size_t bytes = 0;
+    for (const auto& c : mChunks) {
+        bytes += c.capacity * sizeof(std::uint16_t);
+        if (c.ends) bytes += CHUNK * sizeof(End);
+    }
     return bytes;
 }
 

@@ -252,6 +252,41 @@ TEST(NeighborLists, NoTargetsGiveEmptyListsAndHoldNothingPerQuery)
     EXPECT_EQ(sorted(lists[7]), bruteForce(queries[7], queries, Real(0.03)));
 }
 
+TEST(NeighborLists, ChunksWhoseListsAreAllEmptyHoldNothing)
+{
+    // Lists from liquid into a solid: most liquid particles are far from it. A chunk of queries
+    // without a single neighbour holds neither entries nor ends, so lists with ten such chunks
+    // before one chunk of near queries take exactly the memory of that chunk alone.
+    const Real cell = Real(0.04);
+    const std::vector<Vec3> targets = randomPoints(3000, Real(0.3), 11);
+    NeighborGrid grid(cell);
+    grid.build(targets);
+    const std::vector<Vec3> near = randomPoints(NeighborLists::CHUNK, Real(0.3), 12);
+    std::vector<Vec3> farThenNear(10 * NeighborLists::CHUNK, Vec3(Real(5), Real(5), Real(5)));
+    for (std::size_t q = 0; q < farThenNear.size(); ++q) farThenNear[q][0] += Real(q) * cell;
+    const std::vector<Vec3> far = farThenNear;
+    farThenNear.insert(farThenNear.end(), near.begin(), near.end());
+
+    NeighborLists alone, after;
+    alone.build(grid, near.data(), near.size(), cell);
+    after.build(grid, farThenNear.data(), farThenNear.size(), cell);
+    ASSERT_GT(alone.pairCount(), 0u);
+    EXPECT_EQ(after.memoryBytes(), alone.memoryBytes());
+    for (std::size_t q = 0; q < farThenNear.size(); ++q) {
+        ASSERT_EQ(sorted(after[q]), bruteForce(farThenNear[q], targets, cell)) << "query " << q;
+    }
+    // Rebuilt with the far queries only, every chunk gives its memory back; rebuilt with
+    // fewer queries than before, the lists are those of the new queries.
+    after.build(grid, far.data(), far.size(), cell);
+    EXPECT_EQ(after.memoryBytes(), 0u);
+    EXPECT_EQ(after.pairCount(), 0u);
+    after.build(grid, near.data(), 100, cell);
+    ASSERT_EQ(after.size(), 100u);
+    for (std::size_t q = 0; q < 100; ++q) {
+        ASSERT_EQ(sorted(after[q]), bruteForce(near[q], targets, cell)) << "query " << q;
+    }
+}
+
 TEST(NeighborLists, RadiusBeyondTheCellSizeIsRefused)
 {
     NeighborGrid grid(Real(0.1));

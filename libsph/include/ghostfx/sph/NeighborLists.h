@@ -170,11 +170,14 @@ public:
     /// The neighbours of query q.
     List operator[](std::size_t q) const
     {
-        if (mEnd.empty()) return List(); // no targets: every list is empty
-        const std::uint16_t* units = mChunks[q / CHUNK].units.get();
+        if (mChunks.empty()) return List(); // no targets: every list is empty
+        const Chunk& chunk = mChunks[q / CHUNK];
+        if (!chunk.ends) return List(); // every list of the chunk is empty
+        const std::uint16_t* units = chunk.units.get();
+        const std::size_t k = q % CHUNK;
         // Every list starts at an even unit (4-byte aligned for 32-bit indices).
-        const std::uint32_t from = q % CHUNK == 0 ? 0 : (mEnd[q - 1].end + 1) & ~1u;
-        const End& e = mEnd[q];
+        const std::uint32_t from = k == 0 ? 0 : (chunk.ends[k - 1].end + 1) & ~1u;
+        const End& e = chunk.ends[k];
         List list;
         if (e.base == WIDE) {
             list.mWide = reinterpret_cast<const Index*>(units + from);
@@ -214,17 +217,6 @@ private:
     /// than 2^31 targets never have two bases.
     static constexpr Index SPLIT = Index(1) << 31;
 
-    /// A chunk's lists, back to back in 16-bit units; grows by a sixteenth while it is filled
-    /// and is fitted to its lists at the end of the build.
-    struct Chunk
-    {
-        std::unique_ptr<std::uint16_t[]> units;
-        std::size_t capacity = 0; ///< in units
-        /// Make room for `size` units, keeping the first `used`.
-        void reserve(std::size_t size, std::size_t used);
-        /// Give back room beyond `used` units (and a little slack).
-        void shrink(std::size_t used);
-    };
     /// Per query: the end of its list within its chunk (units), and the base its 16-bit offsets
     /// are added to (WIDE: 32-bit indices).
     struct End
@@ -232,10 +224,24 @@ private:
         std::uint32_t end;
         Index base;
     };
+    /// A chunk's lists, back to back in 16-bit units (grown by a sixteenth while it is filled
+    /// and fitted to its lists at the end of the build), and the ends of its queries' lists.
+    /// A chunk whose lists are all empty holds no ends: lists into a solid are empty for most
+    /// liquid particles, and 8 bytes for each of those was a twentieth of a large run's memory
+    /// (bench/RESULTS.md, "Memory: the lists' ends").
+    struct Chunk
+    {
+        std::unique_ptr<std::uint16_t[]> units;
+        std::size_t capacity = 0;   ///< in units
+        std::unique_ptr<End[]> ends; ///< CHUNK entries, or null: every list is empty
+        /// Make room for `size` units, keeping the first `used`.
+        void reserve(std::size_t size, std::size_t used);
+        /// Give back room beyond `used` units (and a little slack).
+        void shrink(std::size_t used);
+    };
 
-    std::size_t mSize = 0; ///< queries of the last build
-    std::vector<End> mEnd; ///< empty when the last build had no targets
-    std::vector<Chunk> mChunks;
+    std::size_t mSize = 0;      ///< queries of the last build
+    std::vector<Chunk> mChunks; ///< empty when the last build had no targets
 };
 
 } // namespace sph
