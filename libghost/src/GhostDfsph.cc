@@ -549,7 +549,6 @@ void GhostSolver::stepDfsph(Real dt)
             const Index s = b->touched[t];
             const Index j = nearestIndex(b->nearest[s]);
             pSolid[s] = p[j];
-            b->pOverRho2[s] = p[j] / sqr(rho[j]);
             },
             1024);
     }

@@ -59,20 +59,20 @@ constexpr const char* DIVERGENCE_KAPPA =
 constexpr const char* DFSPH_SYNC = "dfsph_sync";
 constexpr const char* DFSPH_SYNC_VECTOR = "dfsph_sync_v"; ///< the same for G k
 
-/// Size a per-particle step array for n particles, growing its capacity by an eighth rather
-/// than doubling it (GhostSolver::memoryUse counts capacity, and the air count changes a little
-/// at every resampling), and fill it with `value`.
+/// Size a per-particle step array for n particles, growing its capacity by a thirty-second
+/// (as ParticleSet grows) rather than doubling it (GhostSolver::memoryUse counts capacity, and
+/// the air count changes a little at every resampling), and fill it with `value`.
 template <typename T>
 void assignStepArray(std::vector<T>& array, std::size_t n, const T& value)
 {
-    if (n > array.capacity()) array.reserve(n + n / 8);
+    if (n > array.capacity()) array.reserve(n + n / 32);
     array.assign(n, value);
 }
 /// The same without filling: the first min(size, n) entries are kept.
 template <typename T>
 void resizeStepArray(std::vector<T>& array, std::size_t n)
 {
-    if (n > array.capacity()) array.reserve(n + n / 8);
+    if (n > array.capacity()) array.reserve(n + n / 32);
     array.resize(n);
 }
 

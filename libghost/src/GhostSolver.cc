@@ -663,8 +663,7 @@ GhostSolver::MemoryUse GhostSolver::memoryUse() const
         use.solidGrids += b->block.grid().memoryBytes();
         use.solidLists += b->lists.memoryBytes();
         use.stepArrays += b->nearest.capacity() * sizeof(std::uint64_t)
-                          + b->touched.capacity() * sizeof(Index)
-                          + b->pOverRho2.capacity() * sizeof(Real);
+                          + b->touched.capacity() * sizeof(Index);
     }
     return use;
 }

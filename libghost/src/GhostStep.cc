@@ -55,7 +55,6 @@ void GhostSolver::prepareSolidBlocks()
         if (b->block.stale()) b->block.rebuild();
         const std::size_t n = b->block.size();
         if (b->nearest.size() != n) b->nearest.assign(n, NO_LIQUID);
-        if (b->pOverRho2.size() != n) b->pOverRho2.resize(n);
     }
 }
 
@@ -197,7 +196,6 @@ void GhostSolver::computeDensity()
             const Index j = nearestIndex(b->nearest[s]);
             rhoSolid[s] = rho[j];
             pSolid[s] = p[j];
-            b->pOverRho2[s] = p[j] / sqr(rho[j]);
             },
             1024);
     }
@@ -380,10 +378,17 @@ void GhostSolver::stepGhost(Real dt)
                 }
             });
             for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                const Real* ratio = block->pOverRho2.data();
-                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
+                // p / rho^2 of a ghost solid from its nearest liquid particle's values (lines
+                // 5-7), computed here: solid pairs are a few percent of all, and an array of
+                // it for every solid particle cost 4 bytes each (bench/RESULTS.md, "Memory:
+                // the lists' ends").
+                const ParticleSet& solids = block->block.particles();
+                const Real* pS = solids.pressures().data();
+                const Real* rhoS = solids.densities().data();
+                batch.forEachBatch(xi, solids.positions().data(), block->lists[i],
                                    [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = M * (pi + ratio[b.j[k]]);
+                    for (int k = 0; k < b.n; ++k)
+                        b.f[k] = M * (pi + pS[b.j[k]] / sqr(rhoS[b.j[k]]));
                     for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
                     a += b.sumScaledOffsets(b.f);
                     if (shifting) {

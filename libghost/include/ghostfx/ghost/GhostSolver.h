@@ -282,12 +282,11 @@ private:
         sph::BoundaryBlock block;
         sph::NeighborLists lists;           ///< this step: liquid particle -> block particles
         std::vector<std::uint64_t> nearest; ///< per particle: packed (r^2, nearest liquid) or EMPTY
-        std::vector<Index> touched;         ///< particles some liquid reached this step
-        /// Per particle, valid where touched: p / rho^2. The step's density and pressure
-        /// ([SB12] Algorithm 3 lines 5-10) and Eq. 3 velocity of a touched particle are kept in
-        /// the block set's own density, pressure and velocity channels, which every other
-        /// particle holds at rest values (see restSolidValues).
-        std::vector<Real> pOverRho2;
+        /// Particles some liquid reached this step. The step's density and pressure ([SB12]
+        /// Algorithm 3 lines 5-10) and Eq. 3 velocity of a touched particle are kept in the
+        /// block set's own density, pressure and velocity channels, which every other particle
+        /// holds at rest values (see restSolidValues).
+        std::vector<Index> touched;
     };
 
     /// Emit, sample the first air layer and scale the mass, once; false while there is no
