@@ -6,6 +6,7 @@
 #   bench/double_dam_break.sh [ghostfx] [spacing] [threads] [frames]
 #   defaults:  build/cmd/ghostfx  0.0032  1  1-2
 #   GHOSTFX_BENCH_ARGS: more -D settings, e.g. "-D settings.sampling_relaxation=sb12"
+#   GHOSTFX_BENCH_OUT: the output directory (default out/double_dam_break_bench)
 #
 # h = 3.2 mm gives 750k liquid particles, the paper's count. The step is fixed at 20 substeps per
 # frame as in the paper, with frame_rate 150 so that dt = 1/3000 s (c dt / h = 0.39 at
@@ -16,7 +17,7 @@ ghostfx=${1:-build/cmd/ghostfx}
 h=${2:-0.0032}
 threads=${3:-1}
 frames=${4:-1-2}
-out=out/double_dam_break_bench
+out=${GHOSTFX_BENCH_OUT:-out/double_dam_break_bench}
 wall=$(python3 -c "print(round(3 * $h, 6))")
 mkdir -p "$out"
 echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; load: $(cut -d' ' -f1-3 /proc/loadavg)"
