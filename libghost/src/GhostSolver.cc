@@ -175,7 +175,7 @@ ParticleSet GhostSolver::restingParticles(const SolidBlock& b) const
 void GhostSolver::clearSolidScratch(SolidBlock& b)
 {
     restSolidValues(b);
-    b.nearest.assign(b.block.size(), NO_LIQUID);
+    b.nearest.clear();
     b.block.touch();
     mProjectAll = true;
 }
@@ -655,15 +655,13 @@ GhostSolver::MemoryUse GhostSolver::memoryUse() const
     use.lists = mFluidLists.memoryBytes();
     use.solidParticles = mPendingSolids.memoryBytes();
     use.stepArrays =
-        mQueryMask.capacity() + mLiquidMask.capacity()
-        + (mScratch.capacity() + mAlpha.capacity() + mLiquidMass.capacity()) * sizeof(Real)
+        mQueryMask.capacity() + (mScratch.capacity() + mAlpha.capacity() + mLiquidMass.capacity()) * sizeof(Real)
         + mSolidGradient.capacity() * sizeof(Vec3);
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
         use.solidParticles += b->block.particles().memoryBytes();
         use.solidGrids += b->block.grid().memoryBytes();
         use.solidLists += b->lists.memoryBytes();
-        use.stepArrays += b->nearest.capacity() * sizeof(std::uint64_t)
-                          + b->touched.capacity() * sizeof(Index);
+        use.stepArrays += b->nearest.memoryBytes() + b->touched.capacity() * sizeof(Index);
     }
     return use;
 }

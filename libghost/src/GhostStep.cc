@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
@@ -50,11 +51,8 @@ void GhostSolver::prepareSolidBlocks()
     // Forget the last step's extrapolation (only where it was made), then re-sort the blocks
     // whose particles changed or moved.
     for (SolidBlock* b : {&mStatic, &mMoving}) {
-        for (Index k : b->touched) b->nearest[k] = NO_LIQUID;
         restSolidValues(*b);
         if (b->block.stale()) b->block.rebuild();
-        const std::size_t n = b->block.size();
-        if (b->nearest.size() != n) b->nearest.assign(n, NO_LIQUID);
     }
 }
 
@@ -67,26 +65,80 @@ void GhostSolver::searchNeighbors()
     // Air is searched too (liquid and air neighbours only): its nearest liquid particle, whose
     // velocity it takes (lines 22-25), is then the nearest liquid entry of its list.
     const auto& kind = mParticles.kinds();
-    resizeStepArray(mQueryMask, n);
-    resizeStepArray(mLiquidMask, n);
-    // Halo copies (other processes' particles) are neighbours, never queries.
-    const Real* halo = haloFlags();
-    parallel::forEach(
-        0, n,
-        [&](std::size_t i) {
-        const bool own = !halo || halo[i] == Real(0);
-        // Halo liquid searches the solid blocks too: a ghost solid's nearest liquid particle
-        // (lines 5-7) may be across the cut.
-        mLiquidMask[i] = kind[i] == ParticleKind::Liquid;
-        mQueryMask[i] =
-            own && (kind[i] == ParticleKind::Liquid || kind[i] == ParticleKind::GhostAir);
-        },
-        4096);
     const Real R = mSettings.supportRadius();
     const Vec3* x = mParticles.positions().data();
-    mFluidLists.build(mGrid, x, n, R, mQueryMask.data());
-    for (SolidBlock* b : {&mStatic, &mMoving})
-        b->lists.build(b->block.grid(), x, n, R, mLiquidMask.data());
+    // Halo copies (other processes' particles) are neighbours, never queries: over several
+    // processes a mask picks the queries. On one, every particle of the set is liquid or air
+    // and each is a query, with no mask (1 byte per particle saved).
+    const Real* halo = haloFlags();
+    auto query = [&](std::size_t i) {
+        return (!halo || halo[i] == Real(0))
+               && (kind[i] == ParticleKind::Liquid || kind[i] == ParticleKind::GhostAir);
+    };
+    const bool everyOne =
+        !halo && parallel::sum(0, n, [&](std::size_t i) { return query(i) ? 0.0 : 1.0; }) == 0;
+    if (everyOne) {
+        mQueryMask = std::vector<std::uint8_t>();
+        mFluidLists.build(mGrid, x, n, R);
+    } else {
+        resizeStepArray(mQueryMask, n);
+        parallel::forEach(0, n, [&](std::size_t i) { mQueryMask[i] = query(i); }, 4096);
+        mFluidLists.build(mGrid, x, n, R, mQueryMask.data());
+    }
+    // Liquid, halo copies included, searches the solid blocks (chosen by the kind channel): a
+    // ghost solid's nearest liquid particle (lines 5-7) may be across the cut. Then the
+    // nearest-liquid keys get a page wherever those lists reach.
+    static_assert(sizeof(ParticleKind) == 1, "the kind channel is a byte per particle");
+    const auto* kindBytes = reinterpret_cast<const std::uint8_t*>(kind.data());
+    for (SolidBlock* b : {&mStatic, &mMoving}) {
+        b->lists.buildFor(b->block.grid(), x, n, R, kindBytes,
+                          std::uint8_t(ParticleKind::Liquid));
+        if (mSettings.method == Method::Ghost) b->nearest.prepare(b->lists, b->block.size());
+        else b->nearest.clear(); // Basic SPH's boundary particles take no liquid values
+    }
+}
+
+void GhostSolver::NearestKeys::prepare(const NeighborLists& lists, std::size_t particles)
+{
+    const std::size_t pages = (particles + PAGE_MASK) >> PAGE_BITS;
+    std::vector<std::uint8_t> reached(pages, 0);
+    parallel::forEach(
+        0, lists.size(),
+        [&](std::size_t q) {
+        lists[q].forEach([&](Index s) {
+            __atomic_store_n(&reached[s >> PAGE_BITS], std::uint8_t(1), __ATOMIC_RELAXED);
+        });
+        },
+        1024);
+    mPage.assign(pages, 0);
+    std::size_t used = 0;
+    for (std::size_t page = 0; page < pages; ++page) {
+        mPage[page] = std::uint32_t(used);
+        if (reached[page]) used += std::size_t(1) << PAGE_BITS;
+    }
+    if (used > std::size_t(std::numeric_limits<std::uint32_t>::max())) {
+        throw ValueError(msg("nearest-liquid table: ", used, " keys exceed 2^32"));
+    }
+    // Pages not reached share offsets with their successor: never read (no list names them).
+    // Capacity grows by a thirty-second and is given back when more than a sixteenth is idle.
+    if (used > mKeys.capacity() || mKeys.capacity() > used + used / 16 + 4096) {
+        std::vector<std::uint64_t> fitted;
+        fitted.reserve(used + used / 32);
+        mKeys.swap(fitted);
+    }
+    mKeys.resize(used);
+    parallel::forEach(0, used, [&](std::size_t k) { mKeys[k] = NO_LIQUID; }, 1 << 14);
+}
+
+void GhostSolver::NearestKeys::clear()
+{
+    mPage = std::vector<std::uint32_t>();
+    mKeys = std::vector<std::uint64_t>();
+}
+
+std::size_t GhostSolver::NearestKeys::memoryBytes() const
+{
+    return mPage.capacity() * sizeof(std::uint32_t) + mKeys.capacity() * sizeof(std::uint64_t);
 }
 
 void GhostSolver::computeDensity()

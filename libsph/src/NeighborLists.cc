@@ -150,6 +150,19 @@ struct Stencil
 void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
                           Real radius, const std::uint8_t* wanted, const Real* queryRadius)
 {
+    buildSelected(targets, queries, count, radius, wanted, -1, queryRadius);
+}
+
+void NeighborLists::buildFor(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
+                             Real radius, const std::uint8_t* tags, std::uint8_t tag)
+{
+    buildSelected(targets, queries, count, radius, tags, int(tag), nullptr);
+}
+
+void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queries,
+                                  std::size_t count, Real radius, const std::uint8_t* select,
+                                  int match, const Real* queryRadius)
+{
     if (!(radius > Real(0)) || radius > targets.cellSize()) {
         throw ValueError(msg("neighbour lists: radius ", radius,
                              " m: expected > 0 and at most the "
@@ -191,7 +204,9 @@ void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std:
         for (std::size_t q = qFirst; q < qEnd; ++q) {
             const std::size_t start = (used + 1) & ~std::size_t(1);
             hits = 0;
-            if ((wanted && !wanted[q]) || !isFinite(queries[q])) {
+            const bool wanted =
+                !select || (match < 0 ? select[q] != 0 : int(select[q]) == match);
+            if (!wanted || !isFinite(queries[q])) {
                 used = start;
                 ends[q - qFirst] = {std::uint32_t(used), 0};
                 continue;

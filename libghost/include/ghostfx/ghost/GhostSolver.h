@@ -275,13 +275,42 @@ public:
 private:
     struct Solid;
     struct Emitter;
+    /// The nearest liquid particle of each particle of a solid block that some liquid reaches
+    /// this step, as packed (distance, index) keys (GhostInternal.h, nearestKey) that the
+    /// density pass lowers. Kept in pages of 2^PAGE_BITS particles, allocated only for the
+    /// pages that the step's lists reach: most of a tank's ghosts are out of every liquid
+    /// particle's reach (bench/RESULTS.md, "Memory: the lists' ends").
+    class NearestKeys
+    {
+    public:
+        static constexpr unsigned PAGE_BITS = 8;
+        /// Allocate the pages of a block of `particles` that `lists` (liquid -> block) reach,
+        /// every key NO_LIQUID; the others hold no memory.
+        void prepare(const sph::NeighborLists& lists, std::size_t particles);
+        /// The key of particle s, whose page must be reached by the lists.
+        std::uint64_t& operator[](Index s)
+        {
+            return mKeys[std::size_t(mPage[s >> PAGE_BITS]) + (s & PAGE_MASK)];
+        }
+        std::uint64_t operator[](Index s) const
+        {
+            return mKeys[std::size_t(mPage[s >> PAGE_BITS]) + (s & PAGE_MASK)];
+        }
+        void clear();
+        std::size_t memoryBytes() const;
+
+    private:
+        static constexpr Index PAGE_MASK = (Index(1) << PAGE_BITS) - 1;
+        std::vector<std::uint32_t> mPage; ///< per page: its first key in mKeys
+        std::vector<std::uint64_t> mKeys;
+    };
     /// Solid particles of one kind of solid (static or moving) and the step's scratch.
     struct SolidBlock
     {
         explicit SolidBlock(Real cellSize) : block(cellSize) {}
         sph::BoundaryBlock block;
-        sph::NeighborLists lists;           ///< this step: liquid particle -> block particles
-        std::vector<std::uint64_t> nearest; ///< per particle: packed (r^2, nearest liquid) or EMPTY
+        sph::NeighborLists lists; ///< this step: liquid particle -> block particles
+        NearestKeys nearest;      ///< this step: the nearest liquid of the reached particles
         /// Particles some liquid reached this step. The step's density and pressure ([SB12]
         /// Algorithm 3 lines 5-10) and Eq. 3 velocity of a touched particle are kept in the
         /// block set's own density, pressure and velocity channels, which every other particle
@@ -361,8 +390,9 @@ private:
     ParticleSet mParticles;         ///< liquid and ghost air
     sph::NeighborGrid mGrid;        ///< over mParticles, rebuilt (and mParticles sorted) each step
     sph::NeighborLists mFluidLists; ///< this step: liquid particle -> mParticles
-    std::vector<std::uint8_t> mQueryMask;  ///< this step: 1 for liquid and air (fluid lists)
-    std::vector<std::uint8_t> mLiquidMask; ///< this step: 1 for liquid (solid-block lists)
+    /// This step, over several processes only: 1 for the liquid and air this process owns
+    /// (their lists; on one process every particle of mParticles is one).
+    std::vector<std::uint8_t> mQueryMask;
     std::vector<Real> mScratch;            ///< per particle scratch of a pass
     SolidBlock mStatic, mMoving;           ///< solid particles of static and of moving solids
     ParticleSet mPendingSolids;            ///< restored solid particles until their solid is added

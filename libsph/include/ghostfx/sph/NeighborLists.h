@@ -164,6 +164,10 @@ public:
     /// particles with their own support radius.
     void build(const NeighborGrid& targets, const Vec3* queries, std::size_t count, Real radius,
                const std::uint8_t* wanted = nullptr, const Real* queryRadius = nullptr);
+    /// The same for the queries whose byte `tags[q]` equals `tag`, e.g. the liquid particles of
+    /// a set that holds liquid and air, chosen by its kind channel with no mask of their own.
+    void buildFor(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
+                  Real radius, const std::uint8_t* tags, std::uint8_t tag);
 
     /// Number of query points of the last build.
     std::size_t size() const { return mSize; }
@@ -211,6 +215,11 @@ public:
     std::size_t memoryBytes() const;
 
 private:
+    /// build() and buildFor(): a query is wanted when `select` is null, or when select[q] is
+    /// non-zero (`match` < 0) or equals `match`.
+    void buildSelected(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
+                       Real radius, const std::uint8_t* select, int match,
+                       const Real* queryRadius);
     /// `End::base` of a list of 32-bit indices.
     static constexpr Index WIDE = ~Index(0);
     /// Set in `End::base` (with its first base below) for a two-base list. Lists into more
