@@ -287,6 +287,35 @@ TEST(NeighborLists, ChunksWhoseListsAreAllEmptyHoldNothing)
     }
 }
 
+TEST(NeighborLists, BuildForATagEqualsBuildWithTheMaskOfThatTag)
+{
+    // A solver picks the liquid of a liquid-and-air set by its kind channel: the lists must be
+    // those of a 0/1 mask of the same queries.
+    const Real cell = Real(0.05);
+    const std::vector<Vec3> targets = randomPoints(3000, Real(0.4), 13);
+    const std::vector<Vec3> queries = randomPoints(2000, Real(0.4), 14);
+    std::vector<std::uint8_t> tags(queries.size()), mask(queries.size());
+    for (std::size_t q = 0; q < tags.size(); ++q) {
+        tags[q] = std::uint8_t(q % 3); // kinds 0, 1, 2
+        mask[q] = tags[q] == 1;
+    }
+    NeighborGrid grid(cell);
+    grid.build(targets);
+    NeighborLists byTag, byMask;
+    byTag.buildFor(grid, queries.data(), queries.size(), cell, tags.data(), 1);
+    byMask.build(grid, queries.data(), queries.size(), cell, mask.data());
+    ASSERT_GT(byMask.pairCount(), 0u);
+    EXPECT_EQ(byTag.pairCount(), byMask.pairCount());
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        ASSERT_EQ(std::vector<Index>(byTag[q].begin(), byTag[q].end()),
+                  std::vector<Index>(byMask[q].begin(), byMask[q].end()))
+            << "query " << q;
+        if (tags[q] != 1) {
+            ASSERT_TRUE(byTag[q].empty()) << "query " << q;
+        }
+    }
+}
+
 TEST(NeighborLists, RadiusBeyondTheCellSizeIsRefused)
 {
     NeighborGrid grid(Real(0.1));

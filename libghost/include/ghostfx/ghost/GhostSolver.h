@@ -279,7 +279,8 @@ private:
     /// this step, as packed (distance, index) keys (GhostInternal.h, nearestKey) that the
     /// density pass lowers. Kept in pages of 2^PAGE_BITS particles, allocated only for the
     /// pages that the step's lists reach: most of a tank's ghosts are out of every liquid
-    /// particle's reach (bench/RESULTS.md, "Memory: the lists' ends").
+    /// particle's reach (bench/RESULTS.md, "Bytes per particle over the double dam break's
+    /// run").
     class NearestKeys
     {
     public:

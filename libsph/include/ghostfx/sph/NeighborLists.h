@@ -236,8 +236,9 @@ private:
     /// A chunk's lists, back to back in 16-bit units (grown by a sixteenth while it is filled
     /// and fitted to its lists at the end of the build), and the ends of its queries' lists.
     /// A chunk whose lists are all empty holds no ends: lists into a solid are empty for most
-    /// liquid particles, and 8 bytes for each of those was a twentieth of a large run's memory
-    /// (bench/RESULTS.md, "Memory: the lists' ends").
+    /// liquid particles, and one vector of ends for every query (doubled by its growth) held
+    /// 11.6 of the paper-size double dam break's 296 MB (bench/RESULTS.md, "Memory: the lists'
+    /// ends").
     struct Chunk
     {
         std::unique_ptr<std::uint16_t[]> units;
