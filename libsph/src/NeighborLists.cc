@@ -106,6 +106,31 @@ __attribute__((target("avx2"))) std::size_t searchRangeAvx2(const float* X, cons
     return used;
 }
 
+/// Where the runs of a list start (where the window src[k] >> 8 changes), eight entries at a
+/// time: the positions k of the changes are left-packed into runStart through the same table.
+/// Reads up to seven entries past `hits` and writes up to eight past the runs.
+__attribute__((target("avx2"))) std::size_t findRunsAvx2(const Index* src, std::size_t hits,
+                                                         std::uint32_t* runStart)
+{
+    runStart[0] = 0;
+    std::size_t runs = 1;
+    for (std::size_t k = 1; k < hits; k += 8) {
+        const __m256i here =
+            _mm256_srli_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + k)), 8);
+        const __m256i before =
+            _mm256_srli_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + k - 1)), 8);
+        int mask =
+            ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(here, before))) & 0xff;
+        if (hits - k < 8) mask &= (1 << (hits - k)) - 1;
+        const __m256i lanes =
+            _mm256_load_si256(reinterpret_cast<const __m256i*>(PACK8.lanes[mask]));
+        const __m256i at = _mm256_add_epi32(lanes, _mm256_set1_epi32(std::int32_t(k)));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(runStart + runs), at);
+        runs += PACK8.count[mask];
+    }
+    return runs;
+}
+
 bool haveAvx2()
 {
     static const bool yes = __builtin_cpu_supports("avx2");
@@ -179,7 +204,6 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
     mChunks.resize(chunks); // chunks beyond this build's queries give their memory back
     const Real radiusSquared = radius * radius;
     const Real cellSize = targets.cellSize();
-    const bool twoBases = targets.size() <= std::size_t(SPLIT); // a first base below SPLIT
     const Real* X = targets.sortedX();
     const Real* Y = targets.sortedY();
     const Real* Z = targets.sortedZ();
@@ -191,23 +215,22 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
         0, chunks,
         [&](std::size_t chunk) {
         Chunk& out = mChunks[chunk];
-        std::size_t used = 0; // units of the chunk
+        std::size_t used = 0; // bytes of the chunk
         End ends[CHUNK];
         const std::size_t qFirst = chunk * CHUNK;
         std::size_t hits = 0;
         // The current query's hits as 32-bit entries; the chunk then gets them in their
         // final form, so it needs room for the lists only, not for a search's candidates.
         std::vector<Index> found(1024);
+        std::vector<std::uint32_t> runStart(found.size() + 9); // the current list's runs
         Stencil stencil;
         alignas(16) Real r2[BATCH] = {};
         const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
         for (std::size_t q = qFirst; q < qEnd; ++q) {
-            const std::size_t start = (used + 1) & ~std::size_t(1);
             hits = 0;
             const bool wanted =
                 !select || (match < 0 ? select[q] != 0 : int(select[q]) == match);
             if (!wanted || !isFinite(queries[q])) {
-                used = start;
                 ends[q - qFirst] = {std::uint32_t(used), 0};
                 continue;
             }
@@ -239,7 +262,10 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
             // is the lowest Morton bit) are searched as one range.
             auto search = [&](NeighborGrid::SlotRange range) {
                 const std::size_t room = hits + (range.end - range.begin) + 8;
-                if (found.size() < room) found.resize(std::max(room, 2 * found.size()));
+                if (found.size() < room) {
+                    found.resize(std::max(room, 2 * found.size()));
+                    runStart.resize(found.size() + 9);
+                }
                 Index* dst = found.data();
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
                 if (avx2) {
@@ -277,60 +303,73 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
             }
             if (!run.empty()) search(run);
             // Slots to particle indices (nothing to do for a grid over a sorted set), then
-            // 16-bit offsets from the smallest index when they all fit.
+            // runs of consecutive neighbours in one window of 256 indices.
             Index* src = found.data();
             if (!targets.identityOrder()) {
                 for (std::size_t k = 0; k < hits; ++k) src[k] = targets.particleAt(src[k]);
             }
-            Index lo = WIDE, hi = 0;
-            for (std::size_t k = 0; k < hits; ++k) {
-                lo = std::min(lo, src[k]);
-                hi = std::max(hi, src[k]);
-            }
-            Index base = 0;
-            if (hits == 0) {
-                used = start;
-            } else if (hi - lo <= 0xffff) {
-                used = start + hits;
-                out.reserve(used + 2, start); // 2 readable units past the list (List::Iterator)
-                std::uint16_t* narrow = out.units.get() + start;
-                for (std::size_t k = 0; k < hits; ++k) narrow[k] = std::uint16_t(src[k] - lo);
-                base = lo;
-            } else {
-                // Two windows of 32,768 indices: one from the smallest index, one from the
-                // smallest index beyond the first.
-                const Index cut = lo + (NeighborLists::List::SPLIT_BIT - 1u);
-                Index lo2 = WIDE;
+            Index window = 0;
+            if (hits > 0) {
+                Index lo = RAW, hi = 0;
                 for (std::size_t k = 0; k < hits; ++k) {
-                    if (src[k] > cut) lo2 = std::min(lo2, src[k]);
+                    lo = std::min(lo, src[k]);
+                    hi = std::max(hi, src[k]);
                 }
-                if (twoBases && hi - lo2 < NeighborLists::List::SPLIT_BIT) {
-                    used = start + 2 + hits;
-                    out.reserve(used + 2, start);
-                    std::memcpy(out.units.get() + start, &lo2, sizeof(Index));
-                    std::uint16_t* narrow = out.units.get() + start + 2;
+                window = lo >> 8;
+                // Where each run starts: where the window changes (branch-free).
+                std::size_t nRuns = 0;
+#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
+                if (avx2) {
+                    nRuns = findRunsAvx2(src, hits, runStart.data());
+                } else
+#endif
+                {
+                    Index previous = RAW;
                     for (std::size_t k = 0; k < hits; ++k) {
-                        narrow[k] =
-                            src[k] <= cut
-                                ? std::uint16_t(src[k] - lo)
-                                : std::uint16_t(NeighborLists::List::SPLIT_BIT | (src[k] - lo2));
+                        const Index w = src[k] >> 8;
+                        runStart[nRuns] = std::uint32_t(k);
+                        nRuns += std::size_t(w != previous);
+                        previous = w;
                     }
-                    base = lo | SPLIT;
+                }
+                const std::size_t HEADER = List::HEADER, COUNT = List::COUNT;
+                const std::size_t bytes = COUNT + HEADER * nRuns + hits;
+                if ((hi >> 8) - window <= 0xffff && nRuns <= 0xffff
+                    && bytes < sizeof(Index) * hits) {
+                    out.reserve(used + bytes + List::READ_PAST, used);
+                    std::uint8_t* at = out.bytes.get() + used;
+                    const std::uint16_t runs16 = std::uint16_t(nRuns);
+                    std::memcpy(at, &runs16, sizeof(runs16));
+                    std::uint8_t* header = at + COUNT;
+                    runStart[nRuns] = std::uint32_t(hits);
+                    for (std::size_t r = 0; r < nRuns; ++r, header += HEADER) {
+                        const std::uint32_t k = runStart[r];
+                        const std::uint16_t w = std::uint16_t((src[k] >> 8) - window);
+                        std::memcpy(header, &w, sizeof(w));
+                        header[2] =
+                            std::uint8_t(runStart[r + 1] - k - 1); // at most 256 in a window
+                    }
+                    std::uint8_t* __restrict entry = header;
+                    const Index* __restrict from = src;
+                    for (std::size_t k = 0; k < hits; ++k) entry[k] = std::uint8_t(from[k]);
+                    used += bytes;
                 } else {
-                    used = start + 2 * hits;
-                    out.reserve(used + 2, start);
-                    std::copy(src, src + hits, reinterpret_cast<Index*>(out.units.get() + start));
-                    base = WIDE;
+                    // Windows too far apart for 16 bits, or more runs than entries (targets
+                    // not sorted): 32-bit indices.
+                    window = RAW;
+                    out.reserve(used + sizeof(Index) * hits + List::READ_PAST, used);
+                    std::memcpy(out.bytes.get() + used, src, sizeof(Index) * hits);
+                    used += sizeof(Index) * hits;
                 }
             }
             if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
                 throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
             }
-            ends[q - qFirst] = {std::uint32_t(used), base};
+            ends[q - qFirst] = {std::uint32_t(used), window};
         }
         if (used == 0) {
             out.ends.reset();
-            out.units.reset();
+            out.bytes.reset();
             out.capacity = 0;
         } else {
             if (!out.ends) out.ends.reset(new End[CHUNK]);
@@ -340,7 +379,7 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
         // sixteenth while being filled): capacity is what the process holds. Most chunks are
         // re-allocated in most steps; that costs less than a step's noise (bench/RESULTS.md,
         // "Memory: lists fitted").
-        if (out.capacity > used + used / 64 + 64) out.shrink(used);
+        if (out.capacity > used + used / 64 + 64 + List::READ_PAST) out.shrink(used);
         },
         1);
 }
@@ -358,20 +397,20 @@ bool NeighborLists::wideSimd()
 
 void NeighborLists::Chunk::shrink(std::size_t used)
 {
-    const std::size_t fitted = used + 32;
-    std::unique_ptr<std::uint16_t[]> smaller(new std::uint16_t[fitted]);
-    std::copy(units.get(), units.get() + used, smaller.get());
-    units = std::move(smaller);
+    const std::size_t fitted = used + List::READ_PAST + 32;
+    std::unique_ptr<std::uint8_t[]> smaller(new std::uint8_t[fitted]);
+    std::copy(bytes.get(), bytes.get() + used, smaller.get());
+    bytes = std::move(smaller);
     capacity = fitted;
 }
 
 void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)
 {
     if (size <= capacity) return;
-    const std::size_t grown = std::max(size, capacity + capacity / 16 + 256);
-    std::unique_ptr<std::uint16_t[]> bigger(new std::uint16_t[grown]);
-    if (used > 0) std::copy(units.get(), units.get() + used, bigger.get());
-    units = std::move(bigger);
+    const std::size_t grown = std::max(size, capacity + capacity / 16 + 512);
+    std::unique_ptr<std::uint8_t[]> bigger(new std::uint8_t[grown]);
+    if (used > 0) std::copy(bytes.get(), bytes.get() + used, bigger.get());
+    bytes = std::move(bigger);
     capacity = grown;
 }
 
@@ -382,20 +421,20 @@ std::size_t NeighborLists::pairCount() const
     return total;
 }
 
-std::size_t NeighborLists::wideListCount() const
+std::size_t NeighborLists::rawListCount() const
 {
     std::size_t total = 0;
     for (std::size_t q = 0; q < mSize; ++q) {
         const List list = (*this)[q];
-        total += !list.empty() && list.wide() != nullptr;
+        total += list.raw() != nullptr && !list.empty();
     }
     return total;
 }
 
-std::size_t NeighborLists::splitListCount() const
+std::size_t NeighborLists::runCount() const
 {
     std::size_t total = 0;
-    for (std::size_t q = 0; q < mSize; ++q) total += (*this)[q].split();
+    for (std::size_t q = 0; q < mSize; ++q) total += (*this)[q].runs();
     return total;
 }
 
@@ -403,7 +442,7 @@ std::size_t NeighborLists::memoryBytes() const
 {
     std::size_t bytes = 0;
     for (const auto& c : mChunks) {
-        bytes += c.capacity * sizeof(std::uint16_t);
+        bytes += c.capacity;
         if (c.ends) bytes += CHUNK * sizeof(End);
     }
     return bytes;

@@ -73,8 +73,8 @@ void expectListsMatchBruteForce(const std::vector<Vec3>& targets, const std::vec
         pairs += expected.size();
     }
     EXPECT_EQ(lists.pairCount(), pairs);
-    // What the storage must hold at least: 2 bytes per pair of a 16-bit list, 4 of a 32-bit.
-    EXPECT_GE(lists.memoryBytes(), 2 * pairs);
+    // What the storage must hold at least: a byte per pair (4 in a list of 32-bit indices).
+    EXPECT_GE(lists.memoryBytes(), pairs);
 }
 
 } // namespace
@@ -148,7 +148,7 @@ TEST(NeighborLists, SortedSetAgainstItselfHoldsEachParticleAndIsTheSameOnBothSea
     }
 }
 
-TEST(NeighborLists, ListsOfASortedLiquidTakeAboutTwoBytesPerNeighbour)
+TEST(NeighborLists, ListsOfASortedLiquidTakeUnderOneAndAHalfBytesPerNeighbour)
 {
     // A liquid block as the solver sees it: a jittered lattice at spacing h, sorted by a grid
     // of cells 3 h wide, lists of radius 3 h ([SB12]'s support): about 100 neighbours each.
@@ -168,51 +168,59 @@ TEST(NeighborLists, ListsOfASortedLiquidTakeAboutTwoBytesPerNeighbour)
     NeighborLists lists;
     lists.build(grid, set.positions().data(), set.size(), Real(3) * h);
     const double pairs = double(lists.pairCount());
-    const double wide = double(lists.wideListCount()) / double(set.size());
-    const double split = double(lists.splitListCount()) / double(set.size());
+    const double runsPerPair = double(lists.runCount()) / pairs;
     // Held (capacity) against the 4 bytes per neighbour of one 32-bit index each.
     const double bytesPerPair = double(lists.memoryBytes()) / pairs;
-    std::printf("[measured] %.1f neighbours per query, %.1f %% of the lists in 32 bits, %.1f %% "
-                "with two bases, %.2f bytes per neighbour held\n",
-                pairs / double(set.size()), 100.0 * wide, 100.0 * split, bytesPerPair);
-    // 110k particles: the neighbours of a query straddle a large step of the Morton order only
-    // near the planes where a high bit of a cell coordinate flips (13.5 % of the lists span
-    // more than 65,536 indices); nearly all of those lie in two windows of 32,768 (measured:
-    // 1.2 % of the lists left in 32 bits). 2 bytes per neighbour, 4 in those (at most 3 %:
-    // +0.06), 8 bytes per query (0.08 per neighbour), a list's alignment and a two-base list's
-    // second base (at most 3 units: 0.06) and a chunk fitted to its lists (within 1/64 and 64
-    // units per 256 queries: 0.04): 2.25 at most (measured 2.13; 2.33 with one base, 2.57
-    // while chunks kept room for a search's candidates, 4.4 with 32 bits for every neighbour).
+    std::printf("[measured] %.1f neighbours per query in %.2f runs, %.3f bytes per neighbour "
+                "held\n",
+                pairs / double(set.size()), runsPerPair * pairs / double(set.size()), bytesPerPair);
     EXPECT_GT(pairs / double(set.size()), 80.0);
-    EXPECT_LT(wide, 0.03);
-    EXPECT_GT(split, 0.05);
-    EXPECT_LT(bytesPerPair, 2.25);
-    // Every kind of list reads back to the brute-force neighbours, through every reader: every
-    // 101st list, and every 13th of those with 32 bits or two bases.
+    // A query's neighbours lie in the cells of its 3 x 3 x 3 block, each a range of the Morton
+    // order; a window of 256 indices holds about nine cells of 27 particles, so the runs are
+    // far fewer than the cells (measured: 9.0 per list of 100.7, 0.090 per neighbour).
+    EXPECT_LT(runsPerPair, 0.1);
+    EXPECT_EQ(lists.rawListCount(), 0u); // 110k targets: every list's windows within 16 bits
+    // 1 byte per neighbour, 3 per run, 2 per list for its run count and 8 per query for its
+    // end (0.10 per neighbour), a chunk fitted to its lists (within 1/64 and 128 bytes per 256
+    // queries: 0.02): 1 + 3 x 0.1 + 0.1 + 0.02 = 1.42 at most (measured 1.37; 2.13 with 16-bit
+    // offsets from one or two bases, 4.4 with 32-bit indices).
+    EXPECT_LT(bytesPerPair, 1.42);
+    // Every list reads back to the brute-force neighbours, through every reader: every 101st
+    // list, and lists against the same targets unsorted (which are kept as 32-bit indices).
     PairBatch batch;
-    std::size_t checkedWide = 0, checkedSplit = 0;
-    for (std::size_t i = 0; i < set.size(); ++i) {
-        const NeighborLists::List list = lists[i];
-        const bool rare = list.wide() != nullptr || list.split();
-        if (i % 101 != 0 && !(rare && i % 13 == 0)) continue;
-        checkedWide += list.wide() != nullptr;
-        checkedSplit += list.split();
-        const std::vector<Index> expected =
-            bruteForce(set.positions()[i], set.positions(), Real(3) * h);
+    auto check = [&](const NeighborLists::List& list, const std::vector<Vec3>& xt, std::size_t i) {
+        const std::vector<Index> expected = bruteForce(xt[i], xt, Real(3) * h);
         ASSERT_EQ(sorted(list), expected) << "particle " << i;
         std::vector<Index> viaForEach, viaBatches;
         list.forEach([&](Index j) { viaForEach.push_back(j); });
-        batch.forEachBatch(set.positions()[i], set.positions().data(), list, [&](PairBatch& b) {
+        batch.forEachBatch(xt[i], xt.data(), list, [&](PairBatch& b) {
             viaBatches.insert(viaBatches.end(), b.j, b.j + b.n);
+            for (int k = 0; k < b.n; ++k) ASSERT_EQ(b.dx[k], xt[i][0] - xt[b.j[k]][0]);
         });
         ASSERT_EQ(viaForEach, std::vector<Index>(list.begin(), list.end())) << "particle " << i;
         ASSERT_EQ(viaBatches, viaForEach) << "particle " << i;
+        ASSERT_EQ(list.size(), viaForEach.size());
+    };
+    std::size_t checkedLong = 0, checkedRaw = 0;
+    for (std::size_t i = 0; i < set.size(); i += 101) {
+        checkedLong += lists[i].size() > std::size_t(PairBatch::SIZE);
+        check(lists[i], set.positions(), i);
     }
-    std::printf("[measured] lists checked against brute force: %zu in 32 bits, %zu with two "
-                "bases\n",
-                checkedWide, checkedSplit);
-    EXPECT_GT(checkedWide, 0u); // every kind was read
-    EXPECT_GT(checkedSplit, 0u);
+    std::vector<Vec3> shuffled = set.positions();
+    std::shuffle(shuffled.begin(), shuffled.end(), rng);
+    NeighborGrid unsorted(Real(3) * h);
+    unsorted.build(shuffled);
+    NeighborLists rawLists;
+    rawLists.build(unsorted, shuffled.data(), shuffled.size(), Real(3) * h);
+    for (std::size_t i = 0; i < shuffled.size(); i += 1009) {
+        checkedRaw += rawLists[i].raw() != nullptr;
+        check(rawLists[i], shuffled, i);
+    }
+    std::printf("[measured] lists checked against brute force: %zu longer than a batch, %zu of "
+                "32-bit indices\n",
+                checkedLong, checkedRaw);
+    EXPECT_GT(checkedLong, 0u); // every kind was read
+    EXPECT_GT(checkedRaw, 0u);
 }
 
 TEST(NeighborLists, IdenticalForOneThreadAndAllThreads)
@@ -362,6 +370,46 @@ TEST(PairBatch, SumsEqualPlainSumsOverLongLists)
     EXPECT_NEAR(bw, w, 1e-5 * w);
     EXPECT_NEAR((bOffsets - offsets).length(), 0.0, 1e-5 * offsets.length() + 1e-9);
     EXPECT_NEAR((bDifferences - differences).length(), 0.0, 1e-5 * differences.length());
+}
+
+TEST(PairBatch, ListsLongerThanItsBufferGiveTheSameBatches)
+{
+    // A dense sorted block and a radius that reaches about 3,000 neighbours: lists past
+    // PairBatch::CAPACITY are decoded batch by batch, shorter ones at once; both must give the
+    // neighbours of forEach in the same batches of SIZE.
+    std::vector<Vec3> xs;
+    for (int i = 0; i < 24; ++i)
+        for (int j = 0; j < 24; ++j)
+            for (int k = 0; k < 24; ++k) xs.emplace_back(Real(i), Real(j), Real(k));
+    ParticleSet set;
+    set.addBatch(xs, Real(1), ParticleKind::Liquid);
+    NeighborGrid grid(Real(9));
+    grid.sortParticles(set);
+    NeighborLists lists;
+    lists.build(grid, set.positions().data(), set.size(), Real(9));
+    PairBatch batch;
+    std::size_t longLists = 0, shortLists = 0;
+    for (std::size_t i = 0; i < set.size(); i += 37) {
+        const NeighborLists::List list = lists[i];
+        ASSERT_EQ(list.raw(), nullptr);
+        longLists += list.size() > std::size_t(PairBatch::CAPACITY);
+        shortLists += list.size() <= std::size_t(PairBatch::CAPACITY);
+        std::vector<Index> viaForEach, viaBatches;
+        list.forEach([&](Index j) { viaForEach.push_back(j); });
+        std::size_t batches = 0;
+        batch.forEachBatch(set.positions()[i], set.positions().data(), list, [&](PairBatch& b) {
+            ++batches;
+            ASSERT_TRUE(b.n == PairBatch::SIZE || viaBatches.size() + b.n == viaForEach.size());
+            viaBatches.insert(viaBatches.end(), b.j, b.j + b.n);
+            for (int k = 0; k < b.n; ++k) {
+                ASSERT_EQ(b.r[k], (set.positions()[i] - set.positions()[b.j[k]]).length());
+            }
+        });
+        ASSERT_EQ(viaBatches, viaForEach) << "particle " << i;
+        EXPECT_EQ(batches, (viaForEach.size() + PairBatch::SIZE - 1) / PairBatch::SIZE);
+    }
+    EXPECT_GT(longLists, 0u);
+    EXPECT_GT(shortLists, 0u);
 }
 
 TEST(BoundaryBlock, OrderDependsOnIdsAndCellsNotOnInsertionOrder)

@@ -18,18 +18,20 @@
 ///          slots ascending). A query is its own neighbour when it is in the target grid.
 ///          A task gathers each query's hits as 32-bit entries in a buffer of its own and writes
 ///          the list in its final form to its chunk, which is fitted to what it holds at the end
-///          of the build (within 1/64 plus 64 units): the lists are memory a step holds for
+///          of the build (within 1/64 plus 64 bytes): the lists are memory a step holds for
 ///          every particle, so they carry no room for a search's candidates and no growth left
 ///          from an earlier, busier step.
 ///
-///          Storage: a list whose indices all lie within 65,536 of its smallest is kept as
-///          16-bit offsets from that smallest index (the usual case for particles sorted by the
-///          grid: neighbours are nearby in the sort order). A list that straddles a large step of
-///          the sort order (its neighbours in two places of it, 32,768 indices wide each) is
-///          kept as 15-bit offsets from one of two bases, the top bit choosing which; any other
-///          as 32-bit indices. Reading a short list adds the offset to its base as it loads;
-///          bench/RESULTS.md ("Neighbour lists in 16 bits", "two bases") has the memory and the
-///          cost.
+///          Storage: a query's neighbours, in list order, fall into runs that lie in one window
+///          of 256 target indices (the window k holds indices 256 k to 256 k + 255). A list
+///          holds its run count (16 bits), a header per run (the window, 16 bits from the list's
+///          first window, and the run's length less one) and then one byte per neighbour, its
+///          index within its window. For particles sorted by the grid a query's neighbours lie
+///          in a few windows: about 1.3 bytes per neighbour, where 16-bit offsets took 2 and
+///          32-bit indices 4. A list whose windows span more than 65,536, or that runs would
+///          make larger (unsorted targets), is kept as 32-bit indices (raw()). The entries are
+///          written and read by loops the compiler vectorises; bench/RESULTS.md ("Neighbour
+///          lists in windows of 256") has the memory and the cost.
 #pragma once
 
 #include "ghostfx/sph/NeighborGrid.h"
@@ -49,14 +51,16 @@ public:
     /// Queries per chunk (a chunk is filled by one task).
     static constexpr std::size_t CHUNK = 256;
 
-    /// A list: the neighbours of one query, either 16-bit offsets from a base index or
-    /// 32-bit indices. Read it with forEach, PairBatch::forEachBatch, or begin()/end().
+    /// A list: the neighbours of one query. Read it with forEach, PairBatch::forEachBatch, or
+    /// begin()/end(); every reader gives the neighbours in the same order.
     class List
     {
     public:
-        /// A forward iterator over the neighbour indices. Branch-free for both kinds of list:
-        /// it reads 4 bytes at each entry and keeps the low 16 bits (adding the base) or all
-        /// 32 (the storage keeps 2 readable bytes past every list).
+        /// Bytes that may be read past a list's end (NeighborLists keeps them readable), so a
+        /// run's entries can be read in blocks of this many.
+        static constexpr std::size_t READ_PAST = 32;
+
+        /// A forward iterator over the neighbour indices.
         class Iterator
         {
         public:
@@ -66,15 +70,14 @@ public:
             using pointer = const Index*;
             using reference = Index;
 
-            Index operator*() const
-            {
-                std::uint32_t bits;
-                std::memcpy(&bits, mAt, sizeof(bits));
-                return ((bits & mSelect) ? mBase2 : mBase) + (bits & mMask);
-            }
+            Index operator*() const { return mRaw ? load32(mAt) : Index(mStart | *mAt); }
             Iterator& operator++()
             {
-                mAt += mStride;
+                if (mRaw) {
+                    mAt += sizeof(Index);
+                } else if (++mAt != mEnd && --mLeft == 0) {
+                    enterRun();
+                }
                 return *this;
             }
             Iterator operator++(int)
@@ -88,73 +91,115 @@ public:
 
         private:
             friend class List;
-            const unsigned char* mAt = nullptr;
-            std::size_t mStride = 0;
-            std::uint32_t mMask = 0;
-            std::uint32_t mSelect = 0; ///< the bit that chooses mBase2 (two-base lists)
-            Index mBase = 0, mBase2 = 0;
+            void enterRun()
+            {
+                mStart = windowStart(mHeader, mWindow);
+                mLeft = runLength(mHeader);
+                mHeader += HEADER;
+            }
+            const std::uint8_t* mAt = nullptr;     ///< the current entry
+            const std::uint8_t* mEnd = nullptr;    ///< past the last entry
+            const std::uint8_t* mHeader = nullptr; ///< the next run's header
+            Index mWindow = 0, mStart = 0;
+            std::size_t mLeft = 0; ///< entries left in the current run
+            bool mRaw = false;
         };
 
-        Iterator begin() const { return at(0); }
-        Iterator end() const { return at(mSize); }
-        std::size_t size() const { return mSize; }
-        bool empty() const { return mSize == 0; }
+        Iterator begin() const
+        {
+            Iterator it = end();
+            if (mRaw) {
+                it.mAt = mAt;
+            } else if (mAt != mEnd) {
+                it.mHeader = mAt + COUNT;
+                it.mAt = entries();
+                it.enterRun();
+            }
+            return it;
+        }
+        Iterator end() const
+        {
+            Iterator it;
+            it.mAt = it.mEnd = mEnd;
+            it.mWindow = mWindow;
+            it.mRaw = mRaw;
+            return it;
+        }
+        /// Number of neighbours.
+        std::size_t size() const
+        {
+            if (mRaw) return std::size_t(mEnd - mAt) / sizeof(Index);
+            return mAt == mEnd ? 0 : std::size_t(mEnd - entries());
+        }
+        bool empty() const { return mAt == mEnd; }
+        /// The list's 32-bit indices (possibly unaligned: read with memcpy), or null for a
+        /// list kept in runs.
+        const std::uint8_t* raw() const { return mRaw ? mAt : nullptr; }
+        /// Bytes the list takes.
+        std::size_t bytes() const { return std::size_t(mEnd - mAt); }
+        /// Number of runs (0 for a raw list).
+        std::size_t runs() const { return mRaw || mAt == mEnd ? 0 : runCount(); }
 
-        /// 32-bit indices (null for a 16-bit list).
-        const Index* wide() const { return mWide; }
-        /// 16-bit offsets from base() (null for a 32-bit list); in a two-base list (split()),
-        /// 15-bit offsets from base(), or from base2() where the top bit is set.
-        const std::uint16_t* narrow() const { return mNarrow; }
-        /// The index that narrow() offsets are added to.
-        Index base() const { return mBase; }
-        /// Whether the list has two bases (SPLIT_BIT of an offset: base2()).
-        bool split() const { return mSplit; }
-        Index base2() const { return mBase2; }
-        /// The offset bit of a two-base list that chooses base2().
-        static constexpr std::uint16_t SPLIT_BIT = 0x8000;
-
-        /// Call fn(j) for each neighbour j in order (one loop per kind of list: faster than the
-        /// iterator in hot loops).
+        /// Call fn(start, offsets, count) for each run of a list kept in runs, in order: its
+        /// neighbours are start + offsets[k] for k < count (1 to 256); offsets may be read up
+        /// to READ_PAST bytes past count.
+        template <typename Fn>
+        void forEachRun(Fn&& fn) const
+        {
+            if (mAt == mEnd) return;
+            const std::uint8_t* header = mAt + COUNT;
+            const std::uint8_t* entry = entries();
+            for (const std::uint8_t* last = entry; header != last; header += HEADER) {
+                const std::size_t count = runLength(header);
+                fn(windowStart(header, mWindow), entry, count);
+                entry += count;
+            }
+        }
+        /// Call fn(j) for each neighbour j in order.
         template <typename Fn>
         void forEach(Fn&& fn) const
         {
-            if (mWide) {
-                for (std::size_t k = 0; k < mSize; ++k) fn(mWide[k]);
-            } else if (mSplit) {
-                for (std::size_t k = 0; k < mSize; ++k) {
-                    const std::uint32_t e = mNarrow[k];
-                    fn(Index(((e & SPLIT_BIT) ? mBase2 : mBase) + (e & (SPLIT_BIT - 1u))));
-                }
-            } else {
-                for (std::size_t k = 0; k < mSize; ++k) fn(Index(mBase + mNarrow[k]));
+            if (mRaw) {
+                for (const std::uint8_t* at = mAt; at != mEnd; at += sizeof(Index)) fn(load32(at));
+                return;
             }
+            forEachRun([&fn](Index start, const std::uint8_t* offset, std::size_t count) {
+                for (std::size_t k = 0; k < count; ++k) fn(Index(start | offset[k]));
+            });
         }
 
     private:
         friend class NeighborLists;
-        Iterator at(std::size_t k) const
+        static constexpr std::size_t COUNT = 2;  ///< bytes of the run count
+        static constexpr std::size_t HEADER = 3; ///< bytes of a run header
+        static Index load32(const std::uint8_t* at)
         {
-            Iterator it;
-            if (mWide) {
-                it.mAt = reinterpret_cast<const unsigned char*>(mWide + k);
-                it.mStride = sizeof(Index);
-                it.mMask = ~std::uint32_t(0);
-            } else {
-                it.mAt = reinterpret_cast<const unsigned char*>(mNarrow + k);
-                it.mStride = sizeof(std::uint16_t);
-                it.mMask = mSplit ? SPLIT_BIT - 1u : 0xffffu;
-                it.mSelect = mSplit ? SPLIT_BIT : 0u;
-                it.mBase = mBase;
-                it.mBase2 = mBase2;
-            }
-            return it;
+            Index v;
+            std::memcpy(&v, at, sizeof(v));
+            return v;
         }
+        static Index windowStart(const std::uint8_t* header, Index firstWindow)
+        {
+            std::uint16_t w;
+            std::memcpy(&w, header, sizeof(w));
+            return (firstWindow + w) << 8;
+        }
+        static std::size_t runLength(const std::uint8_t* header)
+        {
+            return std::size_t(header[2]) + 1;
+        }
+        std::size_t runCount() const
+        {
+            std::uint16_t n;
+            std::memcpy(&n, mAt, sizeof(n));
+            return n;
+        }
+        const std::uint8_t* entries() const { return mAt + COUNT + HEADER * runCount(); }
 
-        const std::uint16_t* mNarrow = nullptr;
-        const Index* mWide = nullptr;
-        Index mBase = 0, mBase2 = 0;
-        bool mSplit = false;
-        std::size_t mSize = 0;
+        const std::uint8_t* mAt = nullptr;  ///< the list's first byte
+        const std::uint8_t* mEnd = nullptr; ///< past its last
+        Index mWindow = 0;                  ///< the first window (runs)
+        bool mRaw = false;
     };
 
     /// Build the lists of the particles of `targets` closer than `radius` (m, at most the
@@ -177,27 +222,14 @@ public:
         if (mChunks.empty()) return List(); // no targets: every list is empty
         const Chunk& chunk = mChunks[q / CHUNK];
         if (!chunk.ends) return List(); // every list of the chunk is empty
-        const std::uint16_t* units = chunk.units.get();
         const std::size_t k = q % CHUNK;
-        // Every list starts at an even unit (4-byte aligned for 32-bit indices).
-        const std::uint32_t from = k == 0 ? 0 : (chunk.ends[k - 1].end + 1) & ~1u;
+        const std::uint8_t* bytes = chunk.bytes.get();
         const End& e = chunk.ends[k];
         List list;
-        if (e.base == WIDE) {
-            list.mWide = reinterpret_cast<const Index*>(units + from);
-            list.mSize = (e.end - from) / 2;
-        } else if (e.base & SPLIT) {
-            // The second base (two units), then the offsets.
-            std::memcpy(&list.mBase2, units + from, sizeof(Index));
-            list.mNarrow = units + from + 2;
-            list.mBase = e.base & ~SPLIT;
-            list.mSplit = true;
-            list.mSize = e.end - from - 2;
-        } else {
-            list.mNarrow = units + from;
-            list.mBase = e.base;
-            list.mSize = e.end - from;
-        }
+        list.mAt = bytes + (k == 0 ? 0 : chunk.ends[k - 1].end);
+        list.mEnd = bytes + e.end;
+        list.mRaw = e.window == RAW;
+        list.mWindow = list.mRaw ? 0 : e.window;
         return list;
     }
     /// Use the AVX2 search where the processor has it (default), or always the portable one.
@@ -207,10 +239,10 @@ public:
 
     /// Total number of (query, neighbour) pairs.
     std::size_t pairCount() const;
-    /// Number of lists kept as 32-bit indices (the others are 16-bit offsets).
-    std::size_t wideListCount() const;
-    /// Number of lists kept as 15-bit offsets from two bases.
-    std::size_t splitListCount() const;
+    /// Number of lists kept as 32-bit indices (List::raw()).
+    std::size_t rawListCount() const;
+    /// Number of runs (windows) over all lists.
+    std::size_t runCount() const;
     /// Bytes held (capacity).
     std::size_t memoryBytes() const;
 
@@ -220,33 +252,29 @@ private:
     void buildSelected(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
                        Real radius, const std::uint8_t* select, int match,
                        const Real* queryRadius);
-    /// `End::base` of a list of 32-bit indices.
-    static constexpr Index WIDE = ~Index(0);
-    /// Set in `End::base` (with its first base below) for a two-base list. Lists into more
-    /// than 2^31 targets never have two bases.
-    static constexpr Index SPLIT = Index(1) << 31;
+    /// `End::window` of a list kept as 32-bit indices.
+    static constexpr Index RAW = ~Index(0);
 
-    /// Per query: the end of its list within its chunk (units), and the base its 16-bit offsets
-    /// are added to (WIDE: 32-bit indices).
+    /// Per query: the end of its list within its chunk (bytes), and the window its runs'
+    /// windows count from (RAW: 32-bit indices).
     struct End
     {
         std::uint32_t end;
-        Index base;
+        Index window;
     };
-    /// A chunk's lists, back to back in 16-bit units (grown by a sixteenth while it is filled
-    /// and fitted to its lists at the end of the build), and the ends of its queries' lists.
-    /// A chunk whose lists are all empty holds no ends: lists into a solid are empty for most
-    /// liquid particles, and one vector of ends for every query (doubled by its growth) held
-    /// 11.6 of the paper-size double dam break's 296 MB (bench/RESULTS.md, "Memory: the lists'
-    /// ends").
+    /// A chunk's lists, back to back (grown by a sixteenth while it is filled and fitted to
+    /// its lists at the end of the build), and the ends of its queries' lists. A chunk whose
+    /// lists are all empty holds no ends: lists into a solid are empty for most liquid
+    /// particles, and one vector of ends for every query (doubled by its growth) held 11.6 of
+    /// the paper-size double dam break's 296 MB (bench/RESULTS.md, "Memory: the lists' ends").
     struct Chunk
     {
-        std::unique_ptr<std::uint16_t[]> units;
-        std::size_t capacity = 0;   ///< in units
+        std::unique_ptr<std::uint8_t[]> bytes;
+        std::size_t capacity = 0;    ///< in bytes
         std::unique_ptr<End[]> ends; ///< CHUNK entries, or null: every list is empty
-        /// Make room for `size` units, keeping the first `used`.
+        /// Make room for `size` bytes, keeping the first `used`.
         void reserve(std::size_t size, std::size_t used);
-        /// Give back room beyond `used` units (and a little slack).
+        /// Give back room beyond `used` bytes (and a little slack).
         void shrink(std::size_t used);
     };
 

@@ -27,6 +27,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
 #include <iterator>
 #include <type_traits>
 #include <utility>
@@ -34,12 +38,12 @@
 namespace ghostfx {
 namespace sph {
 
-/// Whether List may hold 16-bit offsets (NeighborLists::List: narrow(), wide(), base()).
+/// Whether List is read run by run (NeighborLists::List::forEachRun).
 template <typename List, typename = void>
-struct HasNarrow : std::false_type
+struct HasRuns : std::false_type
 {};
 template <typename List>
-struct HasNarrow<List, std::void_t<decltype(std::declval<const List&>().narrow())>> : std::true_type
+struct HasRuns<List, std::void_t<decltype(std::declval<const List&>().bytes())>> : std::true_type
 {};
 
 struct PairBatch
@@ -47,93 +51,119 @@ struct PairBatch
     static constexpr int SIZE = 64; ///< pairs per batch
     static constexpr int LANES = 8; ///< interleaved partial sums
 
+    /// Run entries decoded at a time (NeighborLists::List::READ_PAST bytes may be read past a
+    /// list).
+    static constexpr int BLOCK = 32;
+    /// Neighbours of a list decoded at once (longer lists are decoded batch by batch).
+    static constexpr int CAPACITY = 1024;
+
     int n = 0;                         ///< pairs in this batch
-    Index j[SIZE];                     ///< neighbour indices
+    const Index* j = nullptr;          ///< neighbour indices of this batch
     Real dx[SIZE], dy[SIZE], dz[SIZE]; ///< x_i - x_j (m)
     Real r[SIZE];                      ///< |x_i - x_j| (m)
     Real f[SIZE];                      ///< scratch for the caller's per-pair factor
     Real g[SIZE];                      ///< second scratch array
+    Index decoded[CAPACITY + BLOCK];   ///< a list's indices, decoded (room for a block past)
 
     /// Load up to SIZE neighbours `idx[0..count)` of the particle at xi; returns how many.
     int load(const Vec3& xi, const Vec3* x, const Index* idx, std::size_t count)
     {
-        return loadEach(xi, x, count, [idx](int k) { return idx[k]; });
-    }
-
-    /// Load up to SIZE neighbours `base + offset[0..count)` of the particle at xi (a 16-bit
-    /// NeighborLists list); returns how many.
-    int load(const Vec3& xi, const Vec3* x, Index base, const std::uint16_t* offset,
-             std::size_t count)
-    {
-        return loadEach(xi, x, count, [base, offset](int k) { return Index(base + offset[k]); });
+        n = int(std::min<std::size_t>(count, SIZE));
+        j = idx;
+        gather(xi, x);
+        return n;
     }
 
     /// Call fn(*this) for each batch of SIZE consecutive neighbours of the particle at xi (the
-    /// last batch may be shorter). `list` is a NeighborLists::List (16-bit offsets or 32-bit
-    /// indices) or a contiguous range of Index (std::data, size()).
+    /// last batch may be shorter). `list` is a NeighborLists::List or a contiguous range of
+    /// Index (std::data, size()).
     template <typename List, typename Fn>
     void forEachBatch(const Vec3& xi, const Vec3* x, const List& list, Fn&& fn)
     {
-        const std::size_t size = list.size();
-        const Index* wide = nullptr;
-        if constexpr (HasNarrow<List>::value) {
-            wide = list.wide();
-            if (!wide) {
-                const std::uint16_t* offset = list.narrow();
-                const Index base = list.base();
-                if (list.split()) {
-                    forEachTwoBaseBatch(xi, x, list, fn); // rare: out of the hot loop
-                    return;
-                }
+        if constexpr (HasRuns<List>::value) {
+            const std::size_t size = list.size();
+            if (const std::uint8_t* raw = list.raw()) {
                 for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
-                    load(xi, x, base, offset + k0, size - k0);
+                    const std::size_t count = std::min<std::size_t>(size - k0, SIZE);
+                    std::memcpy(decoded, raw + k0 * sizeof(Index), count * sizeof(Index));
+                    load(xi, x, decoded, count);
                     fn(*this);
                 }
                 return;
             }
-        } else {
-            wide = std::data(list);
-        }
-        for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
-            load(xi, x, wide + k0, size - k0);
-            fn(*this);
-        }
-    }
-
-    /// forEachBatch over a two-base list (List::split()): kept apart and not inlined, so the
-    /// common 16-bit path stays as tight as it was.
-    template <typename List, typename Fn>
-    __attribute__((noinline)) void forEachTwoBaseBatch(const Vec3& xi, const Vec3* x,
-                                                       const List& list, Fn& fn)
-    {
-        const std::size_t size = list.size();
-        const std::uint16_t* offset = list.narrow();
-        const Index base = list.base(), base2 = list.base2();
-        constexpr std::uint32_t select = List::SPLIT_BIT, mask = List::SPLIT_BIT - 1u;
-        for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
-            const std::uint16_t* at = offset + k0;
-            loadEach(xi, x, size - k0, [base, base2, at](int k) {
-                const std::uint32_t e = at[k];
-                return Index(((e & select) ? base2 : base) + (e & mask));
+            if (size <= std::size_t(CAPACITY)) {
+                // The whole list at once, a block of entries per run (usually one), then the
+                // batches over it. The batches hold SIZE neighbours whatever the runs, so
+                // sums do not depend on how the list is stored.
+                Index* to = decoded;
+                list.forEachRun([&](Index start, const std::uint8_t* offset, std::size_t count) {
+                    for (std::size_t k = 0; k < count; k += BLOCK)
+                        decode(start, offset + k, to + k);
+                    to += count;
+                });
+                for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+                    load(xi, x, decoded + k0, size - k0);
+                    fn(*this);
+                }
+                return;
+            }
+            // A long list: batch by batch.
+            n = 0;
+            j = decoded;
+            list.forEachRun([&](Index start, const std::uint8_t* offset, std::size_t count) {
+                for (;;) {
+                    const int take = int(std::min<std::size_t>(count, std::size_t(SIZE - n)));
+                    for (int k0 = 0; k0 < take; k0 += BLOCK)
+                        decode(start, offset + k0, decoded + n + k0);
+                    n += take;
+                    if (n < SIZE) return;
+                    gather(xi, x);
+                    fn(*this);
+                    n = 0;
+                    count -= std::size_t(take);
+                    if (count == 0) return;
+                    offset += take;
+                }
             });
-            fn(*this);
+            if (n > 0) {
+                gather(xi, x);
+                fn(*this);
+            }
+        } else {
+            const Index* idx = std::data(list);
+            const std::size_t size = std::size(list);
+            for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+                load(xi, x, idx + k0, size - k0);
+                fn(*this);
+            }
         }
     }
 
-    /// Load neighbours indexOf(0..min(count, SIZE)) of the particle at xi.
-    template <typename IndexOf>
-    int loadEach(const Vec3& xi, const Vec3* x, std::size_t count, IndexOf indexOf)
+    /// to[k] = start | offset[k] for k < BLOCK.
+    static void decode(Index start, const std::uint8_t* offset, Index* to)
     {
-        n = int(std::min<std::size_t>(count, SIZE));
+#if defined(__AVX2__)
+        const __m256i s = _mm256_set1_epi32(std::int32_t(start));
+        for (int k = 0; k < BLOCK; k += 8) {
+            const __m128i bytes = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(offset + k));
+            const __m256i wide = _mm256_or_si256(_mm256_cvtepu8_epi32(bytes), s);
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(to + k), wide);
+        }
+#else
+        for (int k = 0; k < BLOCK; ++k) to[k] = start | offset[k];
+#endif
+    }
+
+    /// x_i - x_j and r for the n indices in j[].
+    void gather(const Vec3& xi, const Vec3* x)
+    {
         for (int k = 0; k < n; ++k) {
-            const Index q = indexOf(k);
-            j[k] = q;
+            const Index q = j[k];
             dx[k] = xi[0] - x[q][0];
             dy[k] = xi[1] - x[q][1];
             dz[k] = xi[2] - x[q][2];
         }
         for (int k = 0; k < n; ++k) r[k] = std::sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
-        return n;
     }
 
     /// sum_k a[k] over the batch, in LANES interleaved partial sums (fixed order).
