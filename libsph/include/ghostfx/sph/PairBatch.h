@@ -174,7 +174,9 @@ struct PairBatch
         for (; k + LANES <= n; k += LANES) {
             for (int l = 0; l < LANES; ++l) lane[l] += a[k + l];
         }
-        for (int l = 0; k < n; ++k, ++l) lane[l] += a[k];
+        // Fewer than LANES terms are left; `l < LANES` says so to the compiler, which otherwise
+        // warns that lane[] could be overrun where it cannot bound n.
+        for (int l = 0; l < LANES && k < n; ++k, ++l) lane[l] += a[k];
         Real total = 0;
         for (int l = 0; l < LANES; ++l) total += lane[l];
         return total;
@@ -193,7 +195,7 @@ struct PairBatch
                 lz[l] += a[k + l] * (v[2] - vi[2]);
             }
         }
-        for (int l = 0; k < n; ++k, ++l) {
+        for (int l = 0; l < LANES && k < n; ++k, ++l) {
             const Vec3& v = values[j[k]];
             lx[l] += a[k] * (v[0] - vi[0]);
             ly[l] += a[k] * (v[1] - vi[1]);
@@ -218,7 +220,7 @@ struct PairBatch
                               + (vi[2] - v[2]) * dz[k + l]);
             }
         }
-        for (int l = 0; k < n; ++k, ++l) {
+        for (int l = 0; l < LANES && k < n; ++k, ++l) {
             const Vec3& v = values[j[k]];
             lane[l] +=
                 a[k] * ((vi[0] - v[0]) * dx[k] + (vi[1] - v[1]) * dy[k] + (vi[2] - v[2]) * dz[k]);
@@ -240,7 +242,7 @@ struct PairBatch
                 lz[l] += a[k + l] * dz[k + l];
             }
         }
-        for (int l = 0; k < n; ++k, ++l) {
+        for (int l = 0; l < LANES && k < n; ++k, ++l) {
             lx[l] += a[k] * dx[k];
             ly[l] += a[k] * dy[k];
             lz[l] += a[k] * dz[k];
