@@ -58,7 +58,7 @@ struct PairBatch
     static constexpr int CAPACITY = 1024;
 
     int n = 0;                         ///< pairs in this batch
-    const Index* j = nullptr;          ///< neighbour indices of this batch
+    Index j[SIZE + BLOCK];             ///< neighbour indices (room for a block past SIZE)
     Real dx[SIZE], dy[SIZE], dz[SIZE]; ///< x_i - x_j (m)
     Real r[SIZE];                      ///< |x_i - x_j| (m)
     Real f[SIZE];                      ///< scratch for the caller's per-pair factor
@@ -68,8 +68,12 @@ struct PairBatch
     /// Load up to SIZE neighbours `idx[0..count)` of the particle at xi; returns how many.
     int load(const Vec3& xi, const Vec3* x, const Index* idx, std::size_t count)
     {
+        // Copied, not pointed to: with j an array of its own the compiler sees that the
+        // callers' stores to f[] and g[] never touch it, and vectorises their loops over j[]
+        // (a pointer into a list cost DFSPH's solves 40 %: bench/RESULTS.md, "Neighbour lists
+        // in windows of 256").
         n = int(std::min<std::size_t>(count, SIZE));
-        j = idx;
+        std::copy(idx, idx + n, j);
         gather(xi, x);
         return n;
     }
@@ -82,51 +86,19 @@ struct PairBatch
     {
         if constexpr (HasRuns<List>::value) {
             const std::size_t size = list.size();
-            if (const std::uint8_t* raw = list.raw()) {
-                for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
-                    const std::size_t count = std::min<std::size_t>(size - k0, SIZE);
-                    std::memcpy(decoded, raw + k0 * sizeof(Index), count * sizeof(Index));
-                    load(xi, x, decoded, count);
-                    fn(*this);
-                }
+            if (list.raw() || size > std::size_t(CAPACITY)) {
+                forEachRareBatch(xi, x, list, fn);
                 return;
             }
-            if (size <= std::size_t(CAPACITY)) {
-                // The whole list at once, a block of entries per run (usually one), then the
-                // batches over it. The batches hold SIZE neighbours whatever the runs, so
-                // sums do not depend on how the list is stored.
-                Index* to = decoded;
-                list.forEachRun([&](Index start, const std::uint8_t* offset, std::size_t count) {
-                    for (std::size_t k = 0; k < count; k += BLOCK)
-                        decode(start, offset + k, to + k);
-                    to += count;
-                });
-                for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
-                    load(xi, x, decoded + k0, size - k0);
-                    fn(*this);
-                }
-                return;
-            }
-            // A long list: batch by batch.
-            n = 0;
-            j = decoded;
-            list.forEachRun([&](Index start, const std::uint8_t* offset, std::size_t count) {
-                for (;;) {
-                    const int take = int(std::min<std::size_t>(count, std::size_t(SIZE - n)));
-                    for (int k0 = 0; k0 < take; k0 += BLOCK)
-                        decode(start, offset + k0, decoded + n + k0);
-                    n += take;
-                    if (n < SIZE) return;
-                    gather(xi, x);
-                    fn(*this);
-                    n = 0;
-                    count -= std::size_t(take);
-                    if (count == 0) return;
-                    offset += take;
-                }
-            });
-            if (n > 0) {
-                gather(xi, x);
+            // The whole list at once, then the batches over it. The batches hold SIZE
+            // neighbours whatever the runs, so sums do not depend on how the list is stored.
+            // The rare kinds and the decoding stay out of line: this loop is inlined into
+            // every pass, and a larger one kept the passes' bodies from being inlined into
+            // their tasks (DFSPH's solves lost their vectorised kernel loops and took 50 %
+            // longer).
+            decodeRuns(list);
+            for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+                load(xi, x, decoded + k0, size - k0);
                 fn(*this);
             }
         } else {
@@ -136,6 +108,54 @@ struct PairBatch
                 load(xi, x, idx + k0, size - k0);
                 fn(*this);
             }
+        }
+    }
+
+    /// decoded[0, list.size()) = the neighbours of a list kept in runs (at most CAPACITY).
+    template <typename List>
+    __attribute__((noinline)) void decodeRuns(const List& list)
+    {
+        Index* to = decoded;
+        list.forEachRun([&](Index start, const std::uint8_t* offset, std::size_t count) {
+            for (std::size_t k = 0; k < count; k += BLOCK) decode(start, offset + k, to + k);
+            to += count;
+        });
+    }
+
+    /// forEachBatch over a list of 32-bit indices, or one longer than CAPACITY (decoded batch
+    /// by batch).
+    template <typename List, typename Fn>
+    __attribute__((noinline)) void forEachRareBatch(const Vec3& xi, const Vec3* x, const List& list,
+                                                    Fn& fn)
+    {
+        if (const std::uint8_t* raw = list.raw()) {
+            const std::size_t size = list.size();
+            for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+                n = int(std::min<std::size_t>(size - k0, SIZE));
+                std::memcpy(j, raw + k0 * sizeof(Index), std::size_t(n) * sizeof(Index));
+                gather(xi, x);
+                fn(*this);
+            }
+            return;
+        }
+        n = 0;
+        list.forEachRun([&](Index start, const std::uint8_t* offset, std::size_t count) {
+            for (;;) {
+                const int take = int(std::min<std::size_t>(count, std::size_t(SIZE - n)));
+                for (int k0 = 0; k0 < take; k0 += BLOCK) decode(start, offset + k0, j + n + k0);
+                n += take;
+                if (n < SIZE) return;
+                gather(xi, x);
+                fn(*this);
+                n = 0;
+                count -= std::size_t(take);
+                if (count == 0) return;
+                offset += take;
+            }
+        });
+        if (n > 0) {
+            gather(xi, x);
+            fn(*this);
         }
     }
 
