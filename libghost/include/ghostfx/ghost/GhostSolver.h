@@ -245,7 +245,7 @@ public:
     MemoryUse memoryUse() const;
     /// memoryUse().total().
     std::size_t memoryBytes() const { return memoryUse().total(); }
-    /// Of which the step's neighbour lists (rebuilt every step: about 2 bytes per pair).
+    /// Of which the step's neighbour lists (rebuilt every step: about 1.4 bytes per pair).
     std::size_t neighborListBytes() const;
 
     double time() const { return mRun.time; }
