@@ -18,9 +18,9 @@
 ///          slots ascending). A query is its own neighbour when it is in the target grid.
 ///          A task gathers each query's hits as 32-bit entries in a buffer of its own and writes
 ///          the list in its final form to its chunk, which is fitted to what it holds at the end
-///          of the build (within 1/64 plus 64 bytes): the lists are memory a step holds for
-///          every particle, so they carry no room for a search's candidates and no growth left
-///          from an earlier, busier step.
+///          of the build (within 1/64 plus 96 bytes, 32 of them readable past the last list):
+///          the lists are memory a step holds for every particle, so they carry no room for a
+///          search's candidates and no growth left from an earlier, busier step.
 ///
 ///          Storage: a query's neighbours, in list order, fall into runs that lie in one window
 ///          of 256 target indices (the window k holds indices 256 k to 256 k + 255). A list
