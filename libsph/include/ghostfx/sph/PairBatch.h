@@ -68,10 +68,9 @@ struct PairBatch
     /// Load up to SIZE neighbours `idx[0..count)` of the particle at xi; returns how many.
     int load(const Vec3& xi, const Vec3* x, const Index* idx, std::size_t count)
     {
-        // Copied, not pointed to: with j an array of its own the compiler sees that the
-        // callers' stores to f[] and g[] never touch it, and vectorises their loops over j[]
-        // (a pointer into a list cost DFSPH's solves 40 %: bench/RESULTS.md, "Neighbour lists
-        // in windows of 256").
+        // Copied into the batch's own array (as every caller's loops were written and
+        // measured against), not pointed to: a batch's indices are then known to be apart
+        // from f[] and g[], which the callers write while reading j[].
         n = int(std::min<std::size_t>(count, SIZE));
         std::copy(idx, idx + n, j);
         gather(xi, x);
