@@ -149,391 +149,297 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
         512);
 }
 
-/// One step's two DFSPH solves over the step's lists: their vectors, the passes G and D of the
-/// file comment, the sums over every process and the conjugate gradients.
-///
-/// The warm starts of both solves share two passes ([BK15] Sec. 4.3 warm-starts each solve with
-/// its last pressure): one pass finds G of both last pressures, the next the divergence solve's
-/// error and D G of the density solve's last pressure. The density solve then needs no pass of
-/// its own before its iterations: its error follows from the error the divergence solve left
-/// (tracked by the conjugate gradients), since v* = v + dt g changes D v only through the
-/// solids (every liquid and air velocity gains the same dt g): D v* = D v + dt g . S_i, with S_i
-/// the step's solid gradient sum. Measured: bench/RESULTS.md, "DFSPH: the warm starts' passes
-/// shared".
-class GhostSolver::DfsphSolve
+int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, double& error,
+                               double& largest)
 {
-public:
-    DfsphSolve(GhostSolver& solver, Real dt)
-        : s(solver)
-        , dt(dt)
-        , n(solver.mParticles.size())
-        , x(solver.mParticles.positions())
-        , w(solver.mParticles.vectorChannel(VSTAR))
-        , lm(solver.mLiquidMass)
-        , alpha(solver.mAlpha)
-        , solidGradient(solver.mSolidGradient)
-        , halo(solver.haloFlags())
-        , movingSolids(!solver.mMoving.block.empty())
-        , movingV(movingSolids
-                      ? solver.mMoving.block.particles().vectorChannel(SOLID_VELOCITY).data()
-                      : nullptr)
-        , k(n, Real(0))
-        , r(n, Real(0))
-        , z(n, Real(0))
-        , p(n, Real(0))
-        , q(n, Real(0))
-        , u(n, Vec3(0))
-        , change(n, Vec3(0))
-    {
-        count = everywhere(parallel::sum(0, n, [&](std::size_t i) { return solved(i) ? 1.0 : 0.0; }));
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& rho = mParticles.densities();
+    auto& w = mParticles.vectorChannel(VSTAR);
+    const Real M = mMass, rho0 = mSettings.restDensity;
+    const DfsphSettings& opt = mSettings.dfsph;
+    const double limit = double(density ? opt.densityError : opt.divergenceError);
+    // The relaxation is a share per step of the length CFL 0.4 would take; a shorter step takes
+    // a share in proportion (DfsphSettings::densityRelaxation).
+    Real scale = 1;
+    if (density) {
+        const auto& v = mParticles.velocities();
+        const auto& kinds = mParticles.kinds();
+        const Real* copies = haloFlags();
+        double fastest = parallel::maximum(0, n, [&](std::size_t i) {
+            return kinds[i] == ParticleKind::Liquid && (!copies || copies[i] == Real(0))
+                       ? double(v[i].length())
+                       : 0.0;
+        });
+        if (mExchange) fastest = mExchange->maxOf(fastest);
+        const Real reference = dfsphTimeStep(mSettings, Real(fastest), mRun.maxAcceleration,
+                                             DfsphSettings::RELAXATION_CFL);
+        scale = std::min(Real(1), dt / reference);
     }
-
-    /// Both warm starts' passes. Applies the divergence solve's last terms (whole: see
-    /// iterate()) to v* and leaves its error in r; keeps G and D G of the density solve's last
-    /// terms for continueToDensity(). `divergenceTotal` is scaled as the warm start applied it.
-    void start(std::vector<Real>& divergenceTotal, const std::vector<Real>& densityTotal)
-    {
-        const bool useWarm = s.mSettings.dfsph.warmStart;
-        auto anyTerms = [&](const std::vector<Real>& total) {
-            return useWarm && everywhere(parallel::sum(0, n, [&](std::size_t i) {
-                                  return solved(i) && total[i] != Real(0) ? 1.0 : 0.0;
-                              })) > 0;
-        };
-        // Nothing to apply on the first step, or after a restart from rest.
-        const bool warmDivergence = anyTerms(divergenceTotal);
-        mWarmDensity = anyTerms(densityTotal);
-        if (mWarmDensity) {
-            mDensityTerms.assign(n, Real(0));
-            mDensityChange.assign(n, Vec3(0));
-            mDensityRate.assign(n, Real(0));
-            parallel::forEach(
-                0, n, [&](std::size_t i) { mDensityTerms[i] = solved(i) ? densityTotal[i] : Real(0); },
-                4096);
-            fromOwners(mDensityTerms);
-        }
-        if (warmDivergence) {
-            parallel::forEach(
-                0, n, [&](std::size_t i) { k[i] = solved(i) ? divergenceTotal[i] : Real(0); }, 4096);
-            fromOwners(k);
-        }
-        if (warmDivergence && mWarmDensity) {
-            gradientPass<true>(k, u, &mDensityTerms, &mDensityChange);
-        } else if (warmDivergence) {
-            gradientPass<false>(k, u, nullptr, nullptr);
-        } else if (mWarmDensity) {
-            gradientPass<false>(mDensityTerms, mDensityChange, nullptr, nullptr);
-        }
-        if (mWarmDensity) vectorFromOwners(mDensityChange); // D reads the halo copies' G k
-        if (warmDivergence) {
-            parallel::forEach(
-                0, n, [&](std::size_t i) { w[i] -= dt * u[i]; }, 4096);
-        }
-        parallel::forEach(
-            0, n,
-            [&](std::size_t i) {
-            if (!(solved(i) && useWarm)) divergenceTotal[i] = Real(0);
-            },
-            4096);
-
-        // The divergence solve's error dt D v* / dt^2 (its target is D rho / Dt = 0).
-        velocitiesFromOwners();
-        std::vector<Real> rate(n, Real(0));
-        if (mWarmDensity) divergencePass<true>(w, true, rate, &mDensityChange, &mDensityRate);
-        else divergencePass<false>(w, true, rate, nullptr, nullptr);
-        parallel::forEach(
-            0, n, [&](std::size_t i) { r[i] = solved(i) ? rate[i] / dt : Real(0); }, 4096);
-    }
-
-    /// After the divergence solve and v* += dt g: the density solve's error from the one the
-    /// divergence solve left, and its warm start, the share s in [0, 1] of the last pressure
-    /// that best fits this step (the s minimising the error left in the norm of D G):
-    ///     s = (k . r) / (k . D G k),
-    /// a line search along the last pressure before the conjugate gradients start. The solve's
-    /// limit is on one step's density change, which shrinks with the step while a pressure's
-    /// force does not: applied whole, a last pressure that no longer fits (after an impact) is
-    /// a force that small steps find "converged" and apply again, step after step, with no
-    /// iteration to renew it, until the liquid runs away (CFL 0.1: 22 m/s within 0.06 s in
-    /// Dfsph.SmallCflStepsStayBounded). Returns the share (1 without a warm start).
-    Real continueToDensity(Real beta, const Vec3& g, std::vector<Real>& densityTotal)
-    {
-        const auto& rho = s.mParticles.densities();
-        const Real rho0 = s.mSettings.restDensity;
-        const Real dt2 = dt * dt;
-        parallel::forEach(
-            0, n,
-            [&](std::size_t i) {
-            if (!solved(i)) return;
-            const Real rate = dt * r[i] + dt * g.dot(solidGradient[i]);
-            r[i] = (beta * (rho[i] - rho0) + dt * rate) / dt2;
-            },
-            4096);
-        Real share = 1;
-        if (mWarmDensity) {
-            const double kq = dot(mDensityTerms, mDensityRate);
-            share = kq > 0 ? Real(std::clamp(dot(mDensityTerms, r) / kq, 0.0, 1.0)) : Real(0);
-            parallel::forEach(
-                0, n,
-                [&](std::size_t i) {
-                r[i] -= share * (solved(i) ? mDensityRate[i] : Real(0));
-                w[i] -= dt * share * mDensityChange[i];
-                },
-                4096);
-        }
-        const bool useWarm = s.mSettings.dfsph.warmStart;
-        parallel::forEach(
-            0, n,
-            [&](std::size_t i) {
-            densityTotal[i] = solved(i) && useWarm ? share * densityTotal[i] : Real(0);
-            },
-            4096);
-        return share;
-    }
-
-    bool warmDensity() const { return mWarmDensity; }
-
-    /// Preconditioned conjugate gradients on D G k = r from the error start() or
-    /// continueToDensity() left, at least `least` iterations; adds the terms found to `total`
-    /// and their velocity change to v*. Returns the iterations; sets `error` to the mean error
-    /// reached and `largest` to the largest error of one particle it left.
-    int iterate(bool density, int least, std::vector<Real>& total, double& error, double& largest)
-    {
-        const DfsphSettings& opt = s.mSettings.dfsph;
-        const double limit = double(density ? opt.densityError : opt.divergenceError);
-        const double peakLimit = DfsphSettings::PEAK_FACTOR * limit;
-        auto converged = [&](double mean) {
-            largest = largestError();
-            return mean <= limit && largest <= peakLimit;
-        };
-        error = meanError();
-        std::fill(k.begin(), k.end(), Real(0));
-        std::fill(change.begin(), change.end(), Vec3(0));
-        int iteration = 0;
-        bool done = converged(error) && least == 0;
-        if (!done) {
-            parallel::forEach(
-                0, n,
-                [&](std::size_t i) {
-                z[i] = alpha[i] * r[i];
-                p[i] = z[i];
-                },
-                4096);
-            double rz = dot(r, z);
-            while (iteration < opt.maxIterations) {
-                ++iteration;
-                // u = G p, with the halo copies' from their owners; q = D u (solids still).
-                fromOwners(p);
-                gradientPass<false>(p, u, nullptr, nullptr);
-                vectorFromOwners(u);
-                divergencePass<false>(u, false, q, nullptr, nullptr);
-                const double pq = dot(p, q);
-                if (!(pq > 0)) break; // what is left lies where G has no effect
-                const Real step = Real(rz / pq);
-                // G k accumulates with k (G is linear): no gradient pass after the loop.
-                parallel::forEach(
-                    0, n,
-                    [&](std::size_t i) {
-                    k[i] += step * p[i];
-                    r[i] -= step * q[i];
-                    change[i] += step * u[i];
-                    },
-                    4096);
-                error = meanError();
-                if (!std::isfinite(error)) {
-                    throw NumericalError(msg("liquid solver at frame ", s.mRun.frame, ", step ",
-                                             s.mRun.step, " (t = ", s.mRun.time,
-                                             " s): the DFSPH ", density ? "density" : "divergence",
-                                             " solve gave a non-finite error at iteration ",
-                                             iteration, "; reduce the time step (dfsph.max_dt, cfl)"));
-                }
-                done = converged(error) && iteration >= least;
-                if (done) break;
-                parallel::forEach(
-                    0, n, [&](std::size_t i) { z[i] = alpha[i] * r[i]; }, 4096);
-                const double rzNext = dot(r, z);
-                const Real direction = Real(rzNext / rz);
-                rz = rzNext;
-                parallel::forEach(
-                    0, n, [&](std::size_t i) { p[i] = z[i] + direction * p[i]; }, 4096);
-            }
-            parallel::forEach(
-                0, n,
-                [&](std::size_t i) {
-                w[i] -= dt * change[i];
-                total[i] += k[i];
-                },
-                4096);
-        }
-        if (!done) ++s.mSolveStats.unconverged;
-        return iteration;
-    }
-
-private:
-    /// The particles in the solve: liquid that is not spray (a halo copy has alpha 0).
-    bool solved(std::size_t i) const { return alpha[i] > Real(0); }
-
-    /// A sum over every process.
-    double everywhere(double value) const
-    {
-        return s.mExchange ? s.mExchange->sumOf(value) : value;
-    }
-    /// Over several processes: the owners' values for the halo copies (a solve's vectors are
-    /// this process's; DFSPH_SYNC and DFSPH_SYNC_VECTOR carry them).
-    void fromOwners(std::vector<Real>& values)
-    {
-        if (!s.mExchange) return;
-        auto& channel = s.mParticles.scalarChannel(DFSPH_SYNC);
+    const Real beta = density ? opt.densityRelaxation * scale : Real(0);
+    // The particles in the solve: liquid that is not spray.
+    auto solved = [&](std::size_t i) { return mAlpha[i] > Real(0); };
+    const std::vector<Real>& lm = mLiquidMass;
+    // Over several processes: sums over every process, and the owners' values for the halo
+    // copies (a solve's vectors are this process's; DFSPH_SYNC carries them).
+    const Real* halo = haloFlags();
+    auto everywhere = [&](double value) { return mExchange ? mExchange->sumOf(value) : value; };
+    auto fromOwners = [&](std::vector<Real>& values) {
+        if (!mExchange) return;
+        auto& channel = mParticles.scalarChannel(DFSPH_SYNC);
         std::copy(values.begin(), values.end(), channel.begin());
-        s.mExchange->refresh(s.mParticles, {DFSPH_SYNC});
+        mExchange->refresh(mParticles, {DFSPH_SYNC});
         for (std::size_t i = 0; i < n; ++i) {
             if (halo[i] != Real(0)) values[i] = channel[i];
         }
-    }
-    void vectorFromOwners(std::vector<Vec3>& values)
-    {
-        if (!s.mExchange) return;
-        auto& channel = s.mParticles.vectorChannel(DFSPH_SYNC_VECTOR);
-        std::copy(values.begin(), values.end(), channel.begin());
-        s.mExchange->refresh(s.mParticles, {DFSPH_SYNC_VECTOR});
-        for (std::size_t i = 0; i < n; ++i) {
-            if (halo[i] != Real(0)) values[i] = channel[i];
-        }
-    }
-    void velocitiesFromOwners()
-    {
-        if (s.mExchange) s.mExchange->refresh(s.mParticles, {VSTAR});
-    }
+    };
+    auto velocitiesFromOwners = [&] {
+        if (mExchange) mExchange->refresh(mParticles, {VSTAR});
+    };
 
-    /// (Over the solved particles: a halo copy's entries are its owner's, not summed here.)
-    double dot(const std::vector<Real>& a, const std::vector<Real>& b) const
-    {
-        return everywhere(parallel::sum(
-            0, n, [&](std::size_t i) { return solved(i) ? double(a[i]) * double(b[i]) : 0.0; }));
-    }
-    /// Mean |e| / rho0 over the solved particles of the residuals r = e / dt^2.
-    double meanError() const
-    {
-        const double sum = everywhere(parallel::sum(
-            0, n, [&](std::size_t i) { return solved(i) ? double(std::abs(r[i])) : 0.0; }));
-        return count > 0 ? sum * double(dt) * double(dt) / count /
-                               double(s.mSettings.restDensity)
-                         : 0.0;
-    }
-    /// Largest |e| / rho0 of one particle. The mean alone does not see a few particles in a
-    /// hundred thousand: in SPlisHSPlasH's dam break at 100k, a handful beside the floor were
-    /// squeezed from 1.3 to 2.7 rho0 over ten steps in which the mean stayed under its limit
-    /// and no iteration ran (bench/RESULTS.md, "DFSPH: a peak limit"; DfsphSettings::PEAK_FACTOR).
-    double largestError() const
-    {
-        const double m = parallel::maximum(
-            0, n, [&](std::size_t i) { return solved(i) ? double(std::abs(r[i])) : 0.0; });
-        return (s.mExchange ? s.mExchange->maxOf(m) : m) * double(dt) * double(dt) /
-               double(s.mSettings.restDensity);
-    }
-
-    /// out = G a, and out2 = G a2 in the same pass when TWO (see the file comment): zero for
-    /// air and spray.
-    template <bool TWO>
-    void gradientPass(const std::vector<Real>& a, std::vector<Vec3>& out,
-                      const std::vector<Real>* a2, std::vector<Vec3>* out2)
-    {
+    // G k (see the file comment), zero for air and spray.
+    std::vector<Vec3> u(n, Vec3(0));
+    auto gradient = [&](const std::vector<Real>& k) {
         forRangeWithBatch(
-            n, s.mKernel,
+            n, mKernel,
             [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
             for (std::size_t i = lo; i < hi; ++i) {
                 if (lm[i] == Real(0)) continue;
                 const Vec3 xi = x[i];
-                const Real ai = a[i];
-                Vec3 sum(0), sum2(0);
-                if constexpr (TWO) {
-                    const std::vector<Real>& b2 = *a2;
-                    const Real ai2 = b2[i];
-                    batch.forEachBatch(xi, x.data(), s.mFluidLists[i], [&](PairBatch& b) {
-                        for (int c = 0; c < b.n; ++c) b.g[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
-                        for (int c = 0; c < b.n; ++c) b.f[c] = (ai + a[b.j[c]]) * b.g[c];
-                        sum += b.sumScaledOffsets(b.f);
-                        for (int c = 0; c < b.n; ++c) b.f[c] = (ai2 + b2[b.j[c]]) * b.g[c];
-                        sum2 += b.sumScaledOffsets(b.f);
-                    });
-                    // The solids' part, a_i sum_s M grad W_is, from the step's sum.
-                    (*out2)[i] = sum2 + ai2 * solidGradient[i];
-                } else {
-                    batch.forEachBatch(xi, x.data(), s.mFluidLists[i], [&](PairBatch& b) {
-                        for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * (ai + a[b.j[c]]);
-                        for (int c = 0; c < b.n; ++c) b.f[c] *= kernel.gradFactor(b.r[c]);
-                        sum += b.sumScaledOffsets(b.f);
-                    });
-                }
-                out[i] = sum + ai * solidGradient[i];
+                const Real ki = k[i];
+                Vec3 sum(0);
+                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * (ki + k[b.j[c]]);
+                    for (int c = 0; c < b.n; ++c) b.f[c] *= kernel.gradFactor(b.r[c]);
+                    sum += b.sumScaledOffsets(b.f);
+                });
+                // The solids' part, k_i sum_s M grad W_is, from the step's sum.
+                u[i] = sum + ki * mSolidGradient[i];
             }
             },
             512);
-    }
-
-    /// out = D vel for the solved particles: liquid velocities `vel`, solids at their own
-    /// velocity (`solidMoves`) or still; and out2 = D vel2 with the solids still when TWO.
-    /// sum_s M (v_i - v_s) . grad W_is = v_i . (the step's solid gradient sum) - the moving
-    /// block's sum_s M v_s . grad W_is (static solids have v_s = 0).
-    template <bool TWO>
-    void divergencePass(const std::vector<Vec3>& vel, bool solidMoves, std::vector<Real>& out,
-                        const std::vector<Vec3>* vel2, std::vector<Real>* out2)
-    {
+    };
+    // D v for the solved particles: liquid velocities `vel`, solids at their own velocity
+    // (`solidMoves`) or still.
+    std::vector<Real> rate(n, Real(0));
+    // sum_s M (v_i - v_s) . grad W_is = v_i . (the step's solid gradient sum) - the moving
+    // block's sum_s M v_s . grad W_is (static solids have v_s = 0).
+    const bool movingSolids = !mMoving.block.empty();
+    const Vec3* movingV =
+        movingSolids ? mMoving.block.particles().vectorChannel(SOLID_VELOCITY).data() : nullptr;
+    auto divergence = [&](const std::vector<Vec3>& vel, bool solidMoves) {
         forRangeWithBatch(
-            n, s.mKernel,
+            n, mKernel,
             [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
             for (std::size_t i = lo; i < hi; ++i) {
                 if (!solved(i)) continue;
                 const Vec3 xi = x[i], vi = vel[i];
-                Real sum = vi.dot(solidGradient[i]);
-                if constexpr (TWO) {
-                    const std::vector<Vec3>& u2 = *vel2;
-                    const Vec3 vi2 = u2[i];
-                    Real sum2 = vi2.dot(solidGradient[i]);
-                    batch.forEachBatch(xi, x.data(), s.mFluidLists[i], [&](PairBatch& b) {
-                        for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
-                        sum += b.sumScaledApproach(b.f, vel.data(), vi);
-                        sum2 += b.sumScaledApproach(b.f, u2.data(), vi2);
-                    });
-                    (*out2)[i] = sum2;
-                } else {
-                    batch.forEachBatch(xi, x.data(), s.mFluidLists[i], [&](PairBatch& b) {
-                        for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
-                        sum += b.sumScaledApproach(b.f, vel.data(), vi);
-                    });
-                }
+                Real sum = vi.dot(mSolidGradient[i]);
+                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                    for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
+                    sum += b.sumScaledApproach(b.f, vel.data(), vi);
+                });
                 if (solidMoves && movingSolids) {
-                    const ParticleSet& set = s.mMoving.block.particles();
-                    const Real M = s.mMass;
-                    batch.forEachBatch(xi, set.positions().data(), s.mMoving.lists[i],
+                    const ParticleSet& set = mMoving.block.particles();
+                    batch.forEachBatch(xi, set.positions().data(), mMoving.lists[i],
                                        [&](PairBatch& b) {
                         for (int c = 0; c < b.n; ++c) b.f[c] = M * kernel.gradFactor(b.r[c]);
                         sum -= b.sumScaledApproach(b.f, movingV, Vec3(0));
                     });
                 }
-                out[i] = sum;
+                rate[i] = sum;
             }
             },
             512);
-    }
+    };
+    // (Over the solved particles: a halo copy's entries are its owner's, not summed here.)
+    auto dot = [&](const std::vector<Real>& a, const std::vector<Real>& b) {
+        return everywhere(parallel::sum(
+            0, n, [&](std::size_t i) { return solved(i) ? double(a[i]) * double(b[i]) : 0.0; }));
+    };
+    const double count =
+        everywhere(parallel::sum(0, n, [&](std::size_t i) { return solved(i) ? 1.0 : 0.0; }));
+    const Real dt2 = dt * dt;
+    // Mean |e| / rho0 over the solved particles of residuals r = e / dt^2.
+    auto meanError = [&](const std::vector<Real>& r) {
+        const double sum = everywhere(parallel::sum(
+            0, n, [&](std::size_t i) { return solved(i) ? double(std::abs(r[i])) : 0.0; }));
+        return count > 0 ? sum * double(dt2) / count / double(rho0) : 0.0;
+    };
+    // Largest |e| / rho0 of one particle. The mean alone does not see a few particles in a
+    // hundred thousand: in SPlisHSPlasH's dam break at 100k, a handful beside the floor were
+    // squeezed from 1.3 to 2.7 rho0 over ten steps in which the mean stayed under its limit
+    // and no iteration ran (bench/RESULTS.md, "DFSPH: a peak limit"; DfsphSettings::PEAK_FACTOR).
+    auto largestError = [&](const std::vector<Real>& r) {
+        const double m = parallel::maximum(
+            0, n, [&](std::size_t i) { return solved(i) ? double(std::abs(r[i])) : 0.0; });
+        return (mExchange ? mExchange->maxOf(m) : m) * double(dt2) / double(rho0);
+    };
+    const double peakLimit = DfsphSettings::PEAK_FACTOR * limit;
+    auto converged = [&](double mean, const std::vector<Real>& r) {
+        largest = largestError(r);
+        return mean <= limit && largest <= peakLimit;
+    };
 
-    GhostSolver& s;
-    const Real dt;
-    const std::size_t n;
-    const std::vector<Vec3>& x;
-    std::vector<Vec3>& w; ///< v*
-    const std::vector<Real>& lm;
-    const std::vector<Real>& alpha;
-    const std::vector<Vec3>& solidGradient;
-    const Real* halo;
-    const bool movingSolids;
-    const Vec3* movingV;
-    double count = 0; ///< solved particles over every process
-    std::vector<Real> k, r, z, p, q;
-    std::vector<Vec3> u, change; ///< G p, and G k (the velocity change over dt) of the iteration
-    /// The density solve's warm start: its last terms, their G and D G (solids still).
-    bool mWarmDensity = false;
-    std::vector<Real> mDensityTerms, mDensityRate;
-    std::vector<Vec3> mDensityChange;
-};
+    std::vector<Real> k(n, Real(0)), r(n, Real(0)), z(n, Real(0)), p(n, Real(0)), q(n, Real(0));
+    std::vector<Vec3> change(n, Vec3(0)); // G k
+    // u = G values, with the halo copies' from their owners.
+    auto gradientEverywhere = [&](std::vector<Real>& values) {
+        fromOwners(values);
+        gradient(values);
+        if (!mExchange) return;
+        auto& channel = mParticles.vectorChannel(DFSPH_SYNC_VECTOR);
+        std::copy(u.begin(), u.end(), channel.begin());
+        mExchange->refresh(mParticles, {DFSPH_SYNC_VECTOR});
+        for (std::size_t i = 0; i < n; ++i) {
+            if (halo[i] != Real(0)) u[i] = channel[i];
+        }
+    };
+    // q = D u for the solved particles (solids held still).
+    auto divergenceOfChange = [&] {
+        divergence(u, false);
+        parallel::forEach(
+            0, n, [&](std::size_t i) { q[i] = solved(i) ? rate[i] : Real(0); }, 4096);
+    };
+    // r: the error the velocities w leave, beta (rho - rho0) + dt D rho / Dt for the density
+    // solve, dt D rho / Dt for the divergence solve (over dt^2).
+    auto residual = [&] {
+        velocitiesFromOwners();
+        divergence(w, true);
+        parallel::forEach(
+            0, n,
+            [&](std::size_t i) {
+            if (solved(i)) r[i] = (beta * (rho[i] - rho0) + dt * rate[i]) / dt2;
+            },
+            4096);
+    };
+
+    // Warm start: the last step's pressure terms first ([BK15] Sec. 4.3). Nothing to apply on
+    // the first step, or after a restart from rest.
+    const bool warm = opt.warmStart && everywhere(parallel::sum(0, n, [&](std::size_t i) {
+                                           return solved(i) && total[i] != Real(0) ? 1.0 : 0.0;
+                                       })) > 0;
+    // The density solve applies the share s of the last pressure that best fits this step,
+    // the s in [0, 1] minimising the error left in the norm of D G:
+    //     s = (k . r) / (k . D G k),
+    // a line search along the last pressure before the conjugate gradients start. The solve's
+    // limit is on one step's density change, which shrinks with the step while a pressure's
+    // force does not: applied whole, a last pressure that no longer fits (after an impact) is
+    // a force that small steps find "converged" and apply again, step after step, with no
+    // iteration to renew it, until the liquid runs away (CFL 0.1: 22 m/s within 0.06 s in
+    // Dfsph.SmallCflStepsStayBounded). The divergence solve's last terms are applied whole: a
+    // share fitted to each step's divergence there shook a still tank (interior speed 0.17 ->
+    // 0.35 m/s), and whole they do not run away. Where less than WARM_SHARE_RENEWED of the
+    // last pressure fits, the solve iterates at least once whatever its limit says: the share
+    // alone bounds the run-away but leaves local misfits (a global s is set by the bulk) that
+    // at CFL 0.1 kept the column tank's fastest particles at 2 to 9 m/s against 1.3 to 2.3
+    // with the iteration. Measured: bench/RESULTS.md, "DFSPH at small steps".
+    Real share = 1;
+    bool residualKnown = false;
+    if (warm) {
+        parallel::forEach(
+            0, n, [&](std::size_t i) { k[i] = solved(i) ? total[i] : Real(0); }, 4096);
+        // (The halo copies' G k only where D G k is summed below.)
+        if (density && movingSolids) gradientEverywhere(k);
+        else {
+            fromOwners(k);
+            gradient(k);
+        }
+        if (density && movingSolids) {
+            // D counts the moving solids' velocities: the sums below do not, so r and D G k
+            // are found as they are, with one more pass.
+            residual();
+            divergenceOfChange();
+            const double kq = dot(k, q);
+            share = kq > 0 ? Real(std::clamp(dot(k, r) / kq, 0.0, 1.0)) : Real(0);
+            parallel::forEach(
+                0, n, [&](std::size_t i) { r[i] -= share * q[i]; }, 4096);
+            residualKnown = true;
+        } else if (density) {
+            // With the solids still, k . D u = u . G k over the liquid (D G symmetric, see the
+            // file comment): k . D G k = |G k|^2 and k . r = k . beta (rho - rho0) / dt^2 +
+            // w . G k / dt, so no pass beyond the gradient's.
+            auto owned = [&](std::size_t i) {
+                return lm[i] != Real(0) && (!halo || halo[i] == Real(0));
+            };
+            const double uu = everywhere(parallel::sum(
+                0, n, [&](std::size_t i) { return owned(i) ? double(u[i].lengthSqr()) : 0.0; }));
+            const double kr = everywhere(parallel::sum(0, n, [&](std::size_t i) {
+                double term = owned(i) ? double(w[i].dot(u[i])) / double(dt) : 0.0;
+                if (solved(i)) term += double(k[i]) * double(beta * (rho[i] - rho0)) / double(dt2);
+                return term;
+            }));
+            share = uu > 0 ? Real(std::clamp(kr / uu, 0.0, 1.0)) : Real(0);
+        }
+        parallel::forEach(
+            0, n, [&](std::size_t i) { w[i] -= dt * share * u[i]; }, 4096);
+    }
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) { total[i] = solved(i) && opt.warmStart ? share * total[i] : Real(0); },
+        4096);
+    if (!residualKnown) residual();
+    error = meanError(r);
+
+    // Preconditioned conjugate gradients on D G k = r.
+    std::fill(k.begin(), k.end(), Real(0));
+    int iteration = 0;
+    const int least = warm && share < WARM_SHARE_RENEWED ? 1 : 0;
+    bool done = converged(error, r) && least == 0;
+    if (!done) {
+        parallel::forEach(
+            0, n,
+            [&](std::size_t i) {
+            z[i] = mAlpha[i] * r[i];
+            p[i] = z[i];
+            },
+            4096);
+        double rz = dot(r, z);
+        while (iteration < opt.maxIterations) {
+            ++iteration;
+            gradientEverywhere(p);
+            divergenceOfChange();
+            const double pq = dot(p, q);
+            if (!(pq > 0)) break; // what is left lies where G has no effect
+            const Real step = Real(rz / pq);
+            // G k accumulates with k (G is linear): no gradient pass after the loop.
+            parallel::forEach(
+                0, n,
+                [&](std::size_t i) {
+                k[i] += step * p[i];
+                r[i] -= step * q[i];
+                change[i] += step * u[i];
+                },
+                4096);
+            error = meanError(r);
+            if (!std::isfinite(error)) {
+                throw NumericalError(msg("liquid solver at frame ", mRun.frame, ", step ",
+                                         mRun.step, " (t = ", mRun.time, " s): the DFSPH ",
+                                         density ? "density" : "divergence",
+                                         " solve gave a non-finite error at iteration ", iteration,
+                                         "; reduce the time step (dfsph.max_dt, cfl)"));
+            }
+            done = converged(error, r) && iteration >= least;
+            if (done) break;
+            parallel::forEach(
+                0, n, [&](std::size_t i) { z[i] = mAlpha[i] * r[i]; }, 4096);
+            const double rzNext = dot(r, z);
+            const Real direction = Real(rzNext / rz);
+            rz = rzNext;
+            parallel::forEach(
+                0, n, [&](std::size_t i) { p[i] = z[i] + direction * p[i]; }, 4096);
+        }
+        parallel::forEach(
+            0, n,
+            [&](std::size_t i) {
+            w[i] -= dt * change[i];
+            total[i] += k[i];
+            },
+            4096);
+    }
+    if (!done) ++mSolveStats.unconverged;
+    return iteration;
+}
 
 void GhostSolver::stepDfsph(Real dt)
 {
@@ -557,34 +463,15 @@ void GhostSolver::stepDfsph(Real dt)
     auto& w = mParticles.vectorChannel(VSTAR);
     auto& kappaDensity = mParticles.scalarChannel(DENSITY_KAPPA);
     auto& kappaDivergence = mParticles.scalarChannel(DIVERGENCE_KAPPA);
-    const DfsphSettings& opt = mSettings.dfsph;
 
     // The divergence solve: the velocities the last step left, made divergence-free at the
-    // positions they led to. Its last terms are applied whole: a share fitted to each step's
-    // divergence shook a still tank (interior speed 0.17 -> 0.35 m/s), and whole they do not
-    // run away.
+    // positions they led to.
     parallel::forEach(
         0, n, [&](std::size_t i) { w[i] = v[i]; }, 4096);
-    DfsphSolve solve(*this, dt);
-    solve.start(kappaDivergence, kappaDensity);
     double divergenceError = 0;
     double divergencePeak = 0;
     const int divergenceIterations =
-        solve.iterate(false, 0, kappaDivergence, divergenceError, divergencePeak);
-
-    // The density target is relaxed by beta (file comment), a share per step of the length
-    // CFL 0.4 would take; a shorter step takes a share in proportion
-    // (DfsphSettings::densityRelaxation).
-    const Real* halo = haloFlags();
-    double fastest = parallel::maximum(0, n, [&](std::size_t i) {
-        return kind[i] == ParticleKind::Liquid && (!halo || halo[i] == Real(0))
-                   ? double(v[i].length())
-                   : 0.0;
-    });
-    if (mExchange) fastest = mExchange->maxOf(fastest);
-    const Real reference = dfsphTimeStep(mSettings, Real(fastest), mRun.maxAcceleration,
-                                         DfsphSettings::RELAXATION_CFL);
-    const Real beta = opt.densityRelaxation * std::min(Real(1), dt / reference);
+        solvePressure(dt, false, kappaDivergence, divergenceError, divergencePeak);
 
     // Lines 11-14 with the implicit pressure: v* = v + dt g for liquid and air (air falls with
     // the liquid it surrounds), then the constant-density solve on v*.
@@ -597,17 +484,9 @@ void GhostSolver::stepDfsph(Real dt)
         w[i] += dt * g;
         },
         4096);
-    const Real share = solve.continueToDensity(beta, g, kappaDensity);
-    // Where less than WARM_SHARE_RENEWED of the last pressure fits, the solve iterates at least
-    // once whatever its limit says: the share alone bounds the run-away but leaves local
-    // misfits (a global share is set by the bulk) that at CFL 0.1 kept the column tank's
-    // fastest particles at 2 to 9 m/s against 1.3 to 2.3 with the iteration. Measured:
-    // bench/RESULTS.md, "DFSPH at small steps".
-    const int least = solve.warmDensity() && share < WARM_SHARE_RENEWED ? 1 : 0;
     double densityError = 0;
     double densityPeak = 0;
-    const int densityIterations =
-        solve.iterate(true, least, kappaDensity, densityError, densityPeak);
+    const int densityIterations = solvePressure(dt, true, kappaDensity, densityError, densityPeak);
 
     // The pressure terms of both solves act on the velocities (dt G (k_density +
     // k_divergence) a step). The pressure reported, p = k rho^2, is their Shepard average
@@ -634,6 +513,7 @@ void GhostSolver::stepDfsph(Real dt)
         },
         4096);
     std::vector<Real> accel(n, Real(0));
+    const Real* halo = haloFlags();
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {

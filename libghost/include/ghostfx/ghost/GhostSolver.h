@@ -366,10 +366,14 @@ private:
     /// and solid neighbours, of each liquid particle into mAlpha, and with gradMass the sum
     /// of m_j grad W_ij over every neighbour (particle shifting).
     void computeDfsphFactors(std::vector<Vec3>* gradMass);
-    /// One step's two DFSPH solves on the VSTAR velocities (preconditioned conjugate
-    /// gradients, GhostDfsph.cc): the divergence solve drives D rho / Dt to 0, the density
-    /// solve rho + dt D rho / Dt to rho0.
-    class DfsphSolve;
+    /// One DFSPH solve on the VSTAR velocities (preconditioned conjugate gradients): the
+    /// density solve (density = true) drives rho + dt D rho / Dt to rho0, the divergence solve
+    /// D rho / Dt to 0. `total` is the
+    /// per-particle channel of accumulated pressure terms (warm start in, result out).
+    /// Returns the iterations; sets `error` to the mean error reached and `largest` to the
+    /// largest error of one particle it left.
+    int solvePressure(Real dt, bool density, std::vector<Real>& total, double& error,
+                      double& largest);
     void stepBasic(Real dt);
     void moveSolids(double time);
     void projectOutOfSolids(Real dt);
