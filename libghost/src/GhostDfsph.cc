@@ -441,6 +441,64 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     return iteration;
 }
 
+/// The pressure reported, p = k rho^2 with k = k_density + k_divergence, is their Shepard
+/// average over the liquid and the air (at zero pressure): a pressure solve on SPH gradients
+/// determines k only up to the particle-scale patterns that G cannot see, which change no
+/// velocity but scatter single particles' k by tens of percent of the hydrostatic pressure
+/// (measured: +98 % on a tank's slope at 2 cm, 0.5 % after averaging). Each ghost solid takes
+/// the pressure of its nearest liquid particle, as in the Tait step.
+void GhostSolver::reportDfsphPressure()
+{
+    const std::size_t n = mParticles.size();
+    const auto& kind = mParticles.kinds();
+    const auto& rho = mParticles.densities();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& kappaDensity = mParticles.scalarChannel(DENSITY_KAPPA);
+    const auto& kappaDivergence = mParticles.scalarChannel(DIVERGENCE_KAPPA);
+    auto& p = mParticles.pressures();
+    resizeStepArray(mScratch, n);
+    parallel::forEach(
+        0, n,
+        [&](std::size_t i) {
+        mScratch[i] =
+            kind[i] == ParticleKind::Liquid ? kappaDensity[i] + kappaDivergence[i] : Real(0);
+        },
+        4096);
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) {
+                p[i] = 0;
+                continue;
+            }
+            Real weight = 0, sum = 0;
+            batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int c = 0; c < b.n; ++c) b.f[c] = m[b.j[c]] / rho[b.j[c]] * kernel.W(b.r[c]);
+                weight += b.sum(b.f);
+                for (int c = 0; c < b.n; ++c) b.f[c] *= mScratch[b.j[c]];
+                sum += b.sum(b.f);
+            });
+            p[i] = (weight > Real(0) ? sum / weight : mScratch[i]) * sqr(rho[i]);
+        }
+        },
+        512);
+    // The solids near the cut take the pressure of a halo copy as their nearest liquid.
+    if (mExchange) mExchange->refresh(mParticles, {"pressure"});
+    for (SolidBlock* b : {&mStatic, &mMoving}) {
+        Real* pSolid = b->block.particles().pressures().data();
+        parallel::forEach(
+            0, b->touched.size(),
+            [&](std::size_t t) {
+            const Index s = b->touched[t];
+            const Index j = nearestIndex(b->nearest[s]);
+            pSolid[s] = p[j];
+            },
+            1024);
+    }
+}
+
 void GhostSolver::stepDfsph(Real dt)
 {
     // Line 1 and the density of lines 2-7, as in the Tait step (GhostStep.cc).
@@ -489,69 +547,25 @@ void GhostSolver::stepDfsph(Real dt)
     const int densityIterations = solvePressure(dt, true, kappaDensity, densityError, densityPeak);
 
     // The pressure terms of both solves act on the velocities (dt G (k_density +
-    // k_divergence) a step). The pressure reported, p = k rho^2, is their Shepard average
-    // over the liquid and the air (at zero pressure): a pressure solve on SPH gradients
-    // determines k only up to the particle-scale patterns that G cannot see, which change no
-    // velocity but scatter single particles' k by tens of percent of the hydrostatic pressure
-    // (measured: +98 % on a tank's slope at 2 cm, 0.5 % after averaging).
+    // k_divergence) a step).
+    const Real* halo = haloFlags();
     if (mExchange) {
-        // The halo copies' v* (XSPH reads it) and pressure terms (the average below).
+        // The halo copies' v* (XSPH reads it) and pressure terms (the reported pressure).
         mExchange->refresh(mParticles, {VSTAR, DENSITY_KAPPA, DIVERGENCE_KAPPA});
         mParticles.removeChannel(DFSPH_SYNC);
         mParticles.removeChannel(DFSPH_SYNC_VECTOR);
     }
-    const auto& rho = mParticles.densities();
-    const auto& x = mParticles.positions();
-    const auto& m = mParticles.masses();
-    auto& p = mParticles.pressures();
-    resizeStepArray(mScratch, n);
-    parallel::forEach(
-        0, n,
-        [&](std::size_t i) {
-        mScratch[i] =
-            kind[i] == ParticleKind::Liquid ? kappaDensity[i] + kappaDivergence[i] : Real(0);
-        },
-        4096);
-    std::vector<Real> accel(n, Real(0));
-    const Real* halo = haloFlags();
-    forRangeWithBatch(
-        n, mKernel,
-        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) {
-                p[i] = 0;
-                continue;
-            }
-            Real weight = 0, sum = 0;
-            batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
-                for (int c = 0; c < b.n; ++c) b.f[c] = m[b.j[c]] / rho[b.j[c]] * kernel.W(b.r[c]);
-                weight += b.sum(b.f);
-                for (int c = 0; c < b.n; ++c) b.f[c] *= mScratch[b.j[c]];
-                sum += b.sum(b.f);
-            });
-            p[i] = (weight > Real(0) ? sum / weight : mScratch[i]) * sqr(rho[i]);
-            if (!halo || halo[i] == Real(0)) accel[i] = (w[i] - start[i]).length() / dt;
-        }
-        },
-        512);
-    mRun.maxAcceleration = *std::max_element(accel.begin(), accel.end());
-    if (mExchange) {
-        // The largest acceleration bounds everyone's next step; the solids near the cut take
-        // the pressure of a halo copy as their nearest liquid.
-        mRun.maxAcceleration = Real(mExchange->maxOf(double(mRun.maxAcceleration)));
-        mExchange->refresh(mParticles, {"pressure"});
-    }
-    for (SolidBlock* b : {&mStatic, &mMoving}) {
-        Real* pSolid = b->block.particles().pressures().data();
-        parallel::forEach(
-            0, b->touched.size(),
-            [&](std::size_t t) {
-            const Index s = b->touched[t];
-            const Index j = nearestIndex(b->nearest[s]);
-            pSolid[s] = p[j];
-            },
-            1024);
-    }
+    // The largest acceleration of the pressure and gravity bounds the next step
+    // (dfsphTimeStep).
+    mRun.maxAcceleration = Real(parallel::maximum(0, n, [&](std::size_t i) {
+        return kind[i] == ParticleKind::Liquid && (!halo || halo[i] == Real(0))
+                   ? double((w[i] - start[i]).length() / dt)
+                   : 0.0;
+    }));
+    if (mExchange) mRun.maxAcceleration = Real(mExchange->maxOf(double(mRun.maxAcceleration)));
+    // Only output and checkpoints read the pressure (the solves and forces use k): a frame's
+    // inner steps skip its pass (advanceFrame, mReportPressure).
+    if (mReportPressure) reportDfsphPressure();
     ++mSolveStats.steps;
     mSolveStats.densityIterations += std::uint64_t(densityIterations);
     mSolveStats.divergenceIterations += std::uint64_t(divergenceIterations);

@@ -823,9 +823,16 @@ void GhostSolver::advanceFrame()
 {
     checkRestoredInputs();
     initialize();
+    // A DFSPH step that does not end the frame leaves the pressure channel as it was (only
+    // output reads it). A step ends the frame when less than half a step is left after it.
+    const double frameEnd = double(mRun.frame + 1) / double(mSettings.frameRate);
     sph::advanceRunOneFrame(
         mRun, mSettings.frameRate, mSettings.substeps, [this] { return stableTimeStep(); },
-        [this](Real dt) { step(dt); });
+        [this, frameEnd](Real dt) {
+        mReportPressure = frameEnd - (mRun.time + double(dt)) < 0.5 * double(dt);
+        step(dt);
+        });
+    mReportPressure = true;
 }
 
 } // namespace ghost

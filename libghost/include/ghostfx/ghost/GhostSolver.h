@@ -152,6 +152,8 @@ public:
     void addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity = Vec3(0));
 
     /// Advance one frame: `substeps` fixed steps, or CFL-limited steps up to the frame end.
+    /// With settings.pressure = dfsph the pressure channel is set by the frame's last step
+    /// only (a step observer sees the last frame's pressure before it).
     void advanceFrame();
     /// One step of Algorithm 3 (Ghost) or of Basic SPH, of length dt (s).
     void step(Real dt);
@@ -374,6 +376,9 @@ private:
     /// largest error of one particle it left.
     int solvePressure(Real dt, bool density, std::vector<Real>& total, double& error,
                       double& largest);
+    /// The pressure channel after a DFSPH step: the Shepard average of the solves' terms, for
+    /// the liquid and (nearest liquid) the ghost solids.
+    void reportDfsphPressure();
     void stepBasic(Real dt);
     void moveSolids(double time);
     void projectOutOfSolids(Real dt);
@@ -407,6 +412,10 @@ private:
     sph::RunCounters mRun;   ///< clock and counters (maxAcceleration: of the liquid)
     PhaseTimings mTimings;
     PressureSolveStats mSolveStats;
+    /// DFSPH: whether this step sets the pressure channel. Only output and checkpoints read
+    /// it, so advanceFrame() asks for it on each frame's last step only; a step() called
+    /// directly always reports it.
+    bool mReportPressure = true;
     /// DFSPH: each liquid particle's inverse diagonal (0: spray, not solved), and each
     /// particle's mass if liquid, else 0.
     std::vector<Real> mAlpha, mLiquidMass;
