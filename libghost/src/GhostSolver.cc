@@ -829,10 +829,8 @@ void GhostSolver::advanceFrame()
     sph::advanceRunOneFrame(
         mRun, mSettings.frameRate, mSettings.substeps, [this] { return stableTimeStep(); },
         [this, frameEnd](Real dt) {
-        mReportPressure = frameEnd - (mRun.time + double(dt)) < 0.5 * double(dt);
-        step(dt);
+        step(dt, frameEnd - (mRun.time + double(dt)) < 0.5 * double(dt));
         });
-    mReportPressure = true;
 }
 
 } // namespace ghost

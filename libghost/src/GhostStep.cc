@@ -595,12 +595,13 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
 
 // The step ----------------------------------------------------------------------------------------
 
-void GhostSolver::step(Real dt)
+void GhostSolver::step(Real dt, bool reportPressure)
 {
     if (!(dt > Real(0)) || !std::isfinite(dt)) {
         throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
     }
     checkRestoredInputs();
+    mReportPressure = reportPressure;
     const bool fresh = !mRun.initialized;
     const auto start = std::chrono::steady_clock::now();
     if (!initialize()) {

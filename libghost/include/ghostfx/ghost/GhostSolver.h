@@ -156,7 +156,11 @@ public:
     /// only (a step observer sees the last frame's pressure before it).
     void advanceFrame();
     /// One step of Algorithm 3 (Ghost) or of Basic SPH, of length dt (s).
-    void step(Real dt);
+    void step(Real dt) { step(dt, true); }
+    /// The same; with reportPressure false a DFSPH step leaves the pressure channel as it was
+    /// (only output reads it, and its pass costs about a twentieth of the step): for drivers
+    /// that end frames themselves and report on each frame's last step, as advanceFrame() does.
+    void step(Real dt, bool reportPressure);
     /// The CFL-limited time step for the current state (s).
     Real stableTimeStep() const;
     /// |rho / rho0 - 1| over the liquid when the run started: mean and largest, as sampled
@@ -412,9 +416,7 @@ private:
     sph::RunCounters mRun;   ///< clock and counters (maxAcceleration: of the liquid)
     PhaseTimings mTimings;
     PressureSolveStats mSolveStats;
-    /// DFSPH: whether this step sets the pressure channel. Only output and checkpoints read
-    /// it, so advanceFrame() asks for it on each frame's last step only; a step() called
-    /// directly always reports it.
+    /// DFSPH: whether this step sets the pressure channel (step()'s reportPressure).
     bool mReportPressure = true;
     /// DFSPH: each liquid particle's inverse diagonal (0: spray, not solved), and each
     /// particle's mass if liquid, else 0.
