@@ -824,12 +824,18 @@ void GhostSolver::advanceFrame()
     checkRestoredInputs();
     initialize();
     // A DFSPH step that does not end the frame leaves the pressure channel as it was (only
-    // output reads it). A step ends the frame when less than half a step is left after it.
+    // output reads it). The last step is the last substep, or the one after which stepFrame
+    // finds no time left (step() advances the clock by exactly double(dt)).
     const double frameEnd = double(mRun.frame + 1) / double(mSettings.frameRate);
+    const double tolerance = sph::frameEndTolerance(mSettings.frameRate);
+    int substep = 0;
     sph::advanceRunOneFrame(
         mRun, mSettings.frameRate, mSettings.substeps, [this] { return stableTimeStep(); },
-        [this, frameEnd](Real dt) {
-        step(dt, frameEnd - (mRun.time + double(dt)) < 0.5 * double(dt));
+        [&](Real dt) {
+        const bool last = mSettings.substeps > 0
+                              ? ++substep == mSettings.substeps
+                              : !(frameEnd - (mRun.time + double(dt)) > tolerance);
+        step(dt, last);
         });
 }
 

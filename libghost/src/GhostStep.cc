@@ -226,13 +226,19 @@ void GhostSolver::computeDensity()
     mRun.meanNeighbors = pairs / std::max(1.0, liquidCount);
     mPairCount = std::size_t(pairs);
 
-    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0).
+    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0). The DFSPH
+    // step finds its pressure by its solves (and reports it on a frame's last step only).
+    const bool stateEquation = mSettings.pressure == PressureModel::Tait;
     auto& p = mParticles.pressures();
-    parallel::forEach(
-        0, n, [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, mSettings.stiffness); }, 2048);
+    if (stateEquation) {
+        parallel::forEach(
+            0, n, [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, mSettings.stiffness); },
+            2048);
+    }
     if (mExchange) {
         const auto t = std::chrono::steady_clock::now();
-        mExchange->refresh(mParticles, {"density", "pressure"});
+        if (stateEquation) mExchange->refresh(mParticles, {"density", "pressure"});
+        else mExchange->refresh(mParticles, {"density"});
         mTimings.exchange += secondsSince(t);
     }
 
@@ -247,7 +253,7 @@ void GhostSolver::computeDensity()
             const Index s = b->touched[t];
             const Index j = nearestIndex(b->nearest[s]);
             rhoSolid[s] = rho[j];
-            pSolid[s] = p[j];
+            if (stateEquation) pSolid[s] = p[j];
             },
             1024);
     }

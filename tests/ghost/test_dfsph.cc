@@ -232,6 +232,60 @@ TEST(Dfsph, MassIsConservedAndOneAndTwoThreadsAgreeBitForBit)
     EXPECT_TRUE(one.pressures() == two.pressures());
 }
 
+// A frame's inner steps skip the reported pressure's pass (only output reads it): within a
+// frame the liquid's pressures stay as the last frame left them, the frame's last step sets
+// them, and they are then the ones a driver reporting every step gets, bit for bit, with the
+// same motion.
+TEST(Dfsph, AFrameReportsThePressureOnItsLastStepOnly)
+{
+    const Collapse scene;
+    GhostSettings settings = dfsphSettings();
+    settings.frameRate = 60;
+    GhostSolver framed(settings), stepped(settings);
+    for (GhostSolver* s : {&framed, &stepped}) {
+        s->addSolid(scene.tank);
+        s->addLiquid(scene.water);
+        s->advanceFrame(); // the same first frame: the block starts to collapse
+    }
+    // The liquid's pressures as a sorted list (each step sorts the particles).
+    auto liquidPressures = [](const GhostSolver& s) {
+        std::vector<Real> p;
+        const ParticleSet& set = s.particles();
+        for (std::size_t i = 0; i < set.size(); ++i) {
+            if (set.kinds()[i] == ParticleKind::Liquid) p.push_back(set.pressures()[i]);
+        }
+        std::sort(p.begin(), p.end());
+        return p;
+    };
+    std::vector<Real> steps;
+    std::vector<bool> changed;
+    std::vector<Real> last = liquidPressures(framed);
+    framed.setStepObserver([&](const GhostSolver& s, Real dt) {
+        steps.push_back(dt);
+        std::vector<Real> now = liquidPressures(s);
+        changed.push_back(now != last);
+        last = std::move(now);
+    });
+    framed.advanceFrame();
+    for (Real dt : steps) stepped.step(dt);
+
+    std::printf("[measured] frame of %zu steps: pressure set on steps", steps.size());
+    for (std::size_t k = 0; k < changed.size(); ++k) {
+        if (changed[k]) std::printf(" %zu", k + 1);
+    }
+    std::printf("\n");
+    ASSERT_GE(steps.size(), 3u);
+    EXPECT_EQ(std::count(changed.begin(), changed.end(), true), 1);
+    EXPECT_TRUE(changed.back());
+    const ParticleSet& a = framed.particles();
+    const ParticleSet& b = stepped.particles();
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_TRUE(a.ids() == b.ids());
+    EXPECT_TRUE(a.positions() == b.positions());
+    EXPECT_TRUE(a.velocities() == b.velocities());
+    EXPECT_TRUE(a.pressures() == b.pressures());
+}
+
 TEST(Dfsph, ResumeIsBitIdenticalAndATaitStateIsRefused)
 {
     ghostfx::testing::ResumeScene scene(Method::Ghost, 0, Vec3(Real(0.05), 0, 0), 5);

@@ -9,6 +9,12 @@
 namespace ghostfx {
 namespace sph {
 
+/// Time (s) left before a frame's end below which stepFrame() takes no further step.
+inline double frameEndTolerance(Real frameRate)
+{
+    return 1e-6 / double(frameRate);
+}
+
 /// Advance from `time()` to `frameEnd` (s). With `substeps` > 0: that many steps of
 /// 1 / (frameRate substeps). With 0: steps of `stableStep()`, the last one shortened or
 /// stretched to land on the frame's end. Steps are Real and clocks double, so float rounding
@@ -23,7 +29,7 @@ void stepFrame(double frameEnd, Real frameRate, int substeps, Time&& time, Stabl
         for (int s = 0; s < substeps; ++s) step(dt);
         return;
     }
-    const double tolerance = 1e-6 / double(frameRate);
+    const double tolerance = frameEndTolerance(frameRate);
     while (frameEnd - time() > tolerance) {
         const double remaining = frameEnd - time();
         Real dt = stableStep();
