@@ -10,10 +10,7 @@ namespace ghostfx {
 namespace sph {
 
 /// Time (s) left before a frame's end below which stepFrame() takes no further step.
-inline double frameEndTolerance(Real frameRate)
-{
-    return 1e-6 / double(frameRate);
-}
+inline double frameEndTolerance(Real frameRate) { return 1e-6 / double(frameRate); }
 
 /// Advance from `time()` to `frameEnd` (s). With `substeps` > 0: that many steps of
 /// 1 / (frameRate substeps). With 0: steps of `stableStep()`, the last one shortened or
