@@ -623,9 +623,10 @@ int main(int argc, char** argv)
         for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
         std::printf("command: %s\n", command.c_str());
         std::printf("threads: %d, Real = %s, dt = %s; DFSPH reports the pressure on the steps "
-                    "that end a frame (30 fps), as a run does\n",
+                    "that end a frame (%g fps), as a run does\n",
                     parallel::maxThreads(), sizeof(Real) == 4 ? "float" : "double",
-                    opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str() : "1/600 s (fixed)");
+                    opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str() : "1/600 s (fixed)",
+                    double(GhostSettings().frameRate));
 
         std::vector<RunResult> all;
         if (opt.scenes == "splish_dam") {
