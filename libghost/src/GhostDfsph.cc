@@ -488,14 +488,7 @@ void GhostSolver::reportDfsphPressure()
     if (mExchange) mExchange->refresh(mParticles, {"pressure"});
     for (SolidBlock* b : {&mStatic, &mMoving}) {
         Real* pSolid = b->block.particles().pressures().data();
-        parallel::forEach(
-            0, b->touched.size(),
-            [&](std::size_t t) {
-            const Index s = b->touched[t];
-            const Index j = nearestIndex(b->nearest[s]);
-            pSolid[s] = p[j];
-            },
-            1024);
+        forEachReachedSolid(*b, [&](Index s, Index j) { pSolid[s] = p[j]; });
     }
 }
 

@@ -114,6 +114,21 @@ inline std::uint64_t nearestKey(Real r, Index liquid)
 }
 inline Index nearestIndex(std::uint64_t key) { return Index(key & 0xffffffffu); }
 
+/// fn(s, j) for each particle s of a solid block (GhostSolver::SolidBlock) that some liquid
+/// particle reached this step, with j its nearest liquid particle (Algorithm 3 lines 5-7), in
+/// parallel. The order of `touched` depends on the threads; fn must not.
+template <typename Block, typename Fn>
+void forEachReachedSolid(const Block& block, Fn&& fn)
+{
+    parallel::forEach(
+        0, block.touched.size(),
+        [&](std::size_t t) {
+        const Index s = block.touched[t];
+        fn(s, nearestIndex(block.nearest[s]));
+        },
+        1024);
+}
+
 using sph::secondsSince;
 
 /// DFSPH's CFL step at number `cfl`: dt <= cfl h / |v|max ([BK15] Sec. 4.4) and the force

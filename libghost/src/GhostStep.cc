@@ -243,19 +243,14 @@ void GhostSolver::computeDensity()
     }
 
     // Lines 5-7: a ghost solid takes the density (and so the pressure) of its nearest liquid
-    // particle. The order of `touched` depends on the threads; nothing below depends on it.
+    // particle.
     for (SolidBlock* b : blocks) {
         Real* rhoSolid = b->block.particles().densities().data();
         Real* pSolid = b->block.particles().pressures().data();
-        parallel::forEach(
-            0, b->touched.size(),
-            [&](std::size_t t) {
-            const Index s = b->touched[t];
-            const Index j = nearestIndex(b->nearest[s]);
+        forEachReachedSolid(*b, [&](Index s, Index j) {
             rhoSolid[s] = rho[j];
             if (stateEquation) pSolid[s] = p[j];
-            },
-            1024);
+        });
     }
 }
 
@@ -347,20 +342,16 @@ void GhostSolver::extrapolateSolidVelocity()
         Vec3* vstarSolid = set.velocities().data();
         const std::vector<Vec3>* solidV =
             set.hasVectorChannel(SOLID_VELOCITY) ? &set.vectorChannel(SOLID_VELOCITY) : nullptr;
-        parallel::forEach(
-            0, b->touched.size(),
-            [&](std::size_t t) {
-            const Index s = b->touched[t];
+        forEachReachedSolid(*b, [&](Index s, Index j) {
             const Vec3 vs = solidV ? (*solidV)[s] : Vec3(0);
             if (!freeSlip) {
                 vstarSolid[s] = vs;
                 return;
             }
             const Vec3& nrm = normal[s];
-            const Vec3& vl = vstar[nearestIndex(b->nearest[s])];
+            const Vec3& vl = vstar[j];
             vstarSolid[s] = vs.dot(nrm) * nrm + (vl - vl.dot(nrm) * nrm);
-            },
-            1024);
+        });
     }
 }
 
