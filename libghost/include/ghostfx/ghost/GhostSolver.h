@@ -158,7 +158,7 @@ public:
     /// One step of Algorithm 3 (Ghost) or of Basic SPH, of length dt (s).
     void step(Real dt) { step(dt, true); }
     /// The same; with reportPressure false a DFSPH step leaves the pressure channel as it was
-    /// (only output reads it, and its pass costs about a twentieth of the step): for drivers
+    /// (only output reads it, and its pass costs about 3 % of the step): for drivers
     /// that end frames themselves and report on each frame's last step, as advanceFrame() does.
     void step(Real dt, bool reportPressure);
     /// The CFL-limited time step for the current state (s).
