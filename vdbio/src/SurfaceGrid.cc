@@ -270,10 +270,8 @@ void addSprayDroplets(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& x,
     parallel::forEach(
         0, positions.size(),
         [&](std::size_t k) {
-        int within = 0;
-        neighbours.forEachInRadius(positions[k], sph::Real(isolation),
-                                   [&](sph::Index, const sph::Vec3&, sph::Real) { ++within; });
-        isolated[k] = within <= 1; // itself only
+        isolated[k] = !neighbours.anyInRadius(positions[k], sph::Real(isolation),
+                                              [k](sph::Index j) { return j != k; });
         },
         1024);
     std::vector<sph::Vec3> spray;
