@@ -210,17 +210,24 @@ void rasterizeUnion(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& posi
                 hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
                 if (lo[d] > hi[d]) return; // the sphere's box misses this leaf
             }
+            // Squared offsets per axis, then every row of the sphere's box in the leaf, all
+            // eight lanes: a row or lane outside the sphere holds squared distances of at
+            // least reach2, which the minimum (started at reach2) ignores, and a branch-free
+            // loop beats skipping them (the skip was mispredicted).
+            double da2[LEAF_DIM], db2[LEAF_DIM], dc2[LEAF_DIM];
+            for (int k = 0; k < LEAF_DIM; ++k) {
+                const double da = (origin.x() + k) * dx - xj[0];
+                const double db = (origin.y() + k) * dx - xj[1];
+                const double dc = (origin.z() + k) * dx - xj[2];
+                da2[k] = da * da;
+                db2[k] = db * db;
+                dc2[k] = dc * dc;
+            }
             for (int a = lo[0]; a <= hi[0]; ++a) {
-                const double da = (origin.x() + a) * dx - xj[0];
                 for (int b = lo[1]; b <= hi[1]; ++b) {
-                    const double db = (origin.y() + b) * dx - xj[1];
-                    const double dab2 = da * da + db * db;
-                    if (dab2 >= reach2) continue;
+                    const double dab2 = da2[a] + db2[b];
                     double* row = d2 + ((a << 6) | (b << 3));
-                    for (int c = lo[2]; c <= hi[2]; ++c) {
-                        const double dc = (origin.z() + c) * dx - xj[2];
-                        row[c] = std::min(row[c], dab2 + dc * dc);
-                    }
+                    for (int c = 0; c < LEAF_DIM; ++c) row[c] = std::min(row[c], dab2 + dc2[c]);
                 }
             }
         });
