@@ -54,11 +54,11 @@
 #include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/vdbio/MaskDilation.h>
 
 #include <openvdb/math/Mat3.h>
 #include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/FastSweeping.h>
-#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 
 #include <algorithm>
@@ -471,9 +471,7 @@ openvdb::MaskTree bandMask(const openvdb::FloatTree& phi, float iso, int halfWid
     for (auto& leaf : crossings) {
         if (leaf) band.addLeaf(leaf.release());
     }
-    openvdb::tools::dilateActiveValues(band, halfWidthVoxels + 1,
-                                       openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
+    dilateMaxNorm(band, halfWidthVoxels + 1);
     return band;
 }
 

@@ -52,8 +52,8 @@
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/vdbio/LevelSetFlow.h>
+#include <ghostfx/vdbio/MaskDilation.h>
 
-#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tree/LeafManager.h>
@@ -133,8 +133,6 @@ struct Shell
 Shell surfaceParticles(const std::vector<sph::Vec3>& x, const std::vector<sph::Index>& selection,
                        const openvdb::MaskTree& covered, double dx, double radius, int halfWidth)
 {
-    using openvdb::tools::IGNORE_TILES;
-    using openvdb::tools::NN_FACE_EDGE_VERTEX;
     const double R = radius / dx; // voxels
     const int m = int(std::ceil(R + halfWidth + 0.5));
     const int reach =
@@ -142,11 +140,11 @@ Shell surfaceParticles(const std::vector<sph::Vec3>& x, const std::vector<sph::I
     Shell shell;
     // N: uncovered voxels next to the covered set.
     shell.exteriorReach.topologyUnion(covered);
-    dilateActiveValues(shell.exteriorReach, 1, NN_FACE_EDGE_VERTEX, IGNORE_TILES);
+    dilateMaxNorm(shell.exteriorReach, 1);
     shell.exteriorReach.topologyDifference(covered);
-    dilateActiveValues(shell.exteriorReach, m, NN_FACE_EDGE_VERTEX, IGNORE_TILES);
+    dilateMaxNorm(shell.exteriorReach, m);
     openvdb::MaskTree near(shell.exteriorReach);
-    dilateActiveValues(near, reach - m, NN_FACE_EDGE_VERTEX, IGNORE_TILES);
+    dilateMaxNorm(near, reach - m);
 
     const double invDx = 1.0 / dx;
     std::vector<std::uint8_t> keep(selection.size());
@@ -323,9 +321,7 @@ void trimInterior(openvdb::FloatGrid& grid, int halfWidthVoxels)
             if (values->getValue(it.pos()) < 0.0f) leaf.setValueOff(it.pos());
         }
     });
-    openvdb::tools::dilateActiveValues(exterior, halfWidthVoxels,
-                                       openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
+    dilateMaxNorm(exterior, halfWidthVoxels);
     const float inside = -grid.background();
     openvdb::tree::LeafManager<FloatTree> leaves(grid.tree());
     leaves.foreach ([&exterior, inside](FloatTree::LeafNodeType& leaf, std::size_t) {

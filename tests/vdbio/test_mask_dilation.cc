@@ -1,0 +1,97 @@
+/// @file   test_mask_dilation.cc
+/// @brief  dilateMaxNorm (vdbio/MaskDilation.h) against OpenVDB's own k iterations of
+///         26-neighbour dilation: the same active voxels, for k below, at and above a leaf.
+/// @details The masks: scattered single voxels (every bit position of a word exercised,
+///          leaves apart and adjacent, negative coordinates) and a thick spherical shell like
+///          the surface's band (SurfaceGrid.cc dilates such shells by 1, 3, 5 and 8).
+#include <ghostfx/sph/Random.h>
+#include <ghostfx/vdbio/MaskDilation.h>
+
+#include <openvdb/tools/Morphology.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+using namespace ghostfx;
+
+namespace {
+
+openvdb::MaskTree scatteredVoxels()
+{
+    openvdb::MaskTree mask;
+    sph::Rng rng(2718);
+    for (int n = 0; n < 400; ++n) {
+        const openvdb::Coord c(int(std::floor(rng.uniform(-40.0f, 40.0f))),
+                               int(std::floor(rng.uniform(-40.0f, 40.0f))),
+                               int(std::floor(rng.uniform(-40.0f, 40.0f))));
+        mask.setValueOn(c);
+    }
+    return mask;
+}
+
+openvdb::MaskTree sphericalShell()
+{
+    openvdb::MaskTree mask;
+    openvdb::Coord c;
+    for (c.x() = -30; c.x() <= 30; ++c.x()) {
+        for (c.y() = -30; c.y() <= 30; ++c.y()) {
+            for (c.z() = -30; c.z() <= 30; ++c.z()) {
+                const double r = c.asVec3d().length();
+                if (r > 24.0 && r < 27.0) mask.setValueOn(c);
+            }
+        }
+    }
+    return mask;
+}
+
+/// Active voxels in exactly one of a and b.
+openvdb::Index64 symmetricDifference(const openvdb::MaskTree& a, const openvdb::MaskTree& b)
+{
+    openvdb::MaskTree onlyA(a), onlyB(b);
+    onlyA.topologyDifference(b);
+    onlyB.topologyDifference(a);
+    return onlyA.activeVoxelCount() + onlyB.activeVoxelCount();
+}
+
+void expectSameAsOpenVdb(const openvdb::MaskTree& input, const char* name)
+{
+    for (int k : {1, 2, 3, 5, 7, 8, 9, 13}) {
+        openvdb::MaskTree reference(input), ours(input);
+        openvdb::tools::dilateActiveValues(reference, k, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                           openvdb::tools::IGNORE_TILES);
+        vdbio::dilateMaxNorm(ours, k);
+        const openvdb::Index64 differ = symmetricDifference(reference, ours);
+        std::printf("[measured] %s, k = %d: %llu voxels, %llu differ\n", name, k,
+                    static_cast<unsigned long long>(ours.activeVoxelCount()),
+                    static_cast<unsigned long long>(differ));
+        EXPECT_EQ(ours.activeVoxelCount(), reference.activeVoxelCount()) << name << " k " << k;
+        EXPECT_EQ(differ, 0u) << name << " k " << k;
+    }
+}
+
+} // namespace
+
+TEST(MaskDilation, ScatteredVoxelsGrowAsOpenVdbsIterations)
+{
+    expectSameAsOpenVdb(scatteredVoxels(), "scattered");
+}
+
+TEST(MaskDilation, AShellGrowsAsOpenVdbsIterations)
+{
+    expectSameAsOpenVdb(sphericalShell(), "shell");
+}
+
+TEST(MaskDilation, OneVoxelBecomesACube)
+{
+    openvdb::MaskTree mask;
+    mask.setValueOn(openvdb::Coord(7, 0, -1)); // on leaf faces in x and z
+    vdbio::dilateMaxNorm(mask, 4);
+    EXPECT_EQ(mask.activeVoxelCount(), 9u * 9u * 9u);
+    openvdb::CoordBBox box;
+    ASSERT_TRUE(mask.evalActiveVoxelBoundingBox(box));
+    EXPECT_EQ(box.min(), openvdb::Coord(3, -4, -5));
+    EXPECT_EQ(box.max(), openvdb::Coord(11, 4, 3));
+    EXPECT_THROW(vdbio::dilateMaxNorm(mask, -1), openvdb::ValueError);
+}
