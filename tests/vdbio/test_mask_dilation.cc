@@ -83,6 +83,25 @@ TEST(MaskDilation, AShellGrowsAsOpenVdbsIterations)
     expectSameAsOpenVdb(sphericalShell(), "shell");
 }
 
+TEST(MaskDilation, FaceNeighboursAsOpenVdbsNnFace)
+{
+    for (const openvdb::MaskTree& input : {scatteredVoxels(), sphericalShell()}) {
+        openvdb::MaskTree reference(input), ours(input);
+        openvdb::tools::dilateActiveValues(reference, 1, openvdb::tools::NN_FACE,
+                                           openvdb::tools::IGNORE_TILES);
+        vdbio::dilateFaces(ours);
+        EXPECT_EQ(ours.activeVoxelCount(), reference.activeVoxelCount());
+        EXPECT_EQ(symmetricDifference(reference, ours), 0u);
+    }
+    openvdb::MaskTree one;
+    one.setValueOn(openvdb::Coord(0, 7, 8)); // on leaf faces in y and z
+    vdbio::dilateFaces(one);
+    EXPECT_EQ(one.activeVoxelCount(), 7u);
+    EXPECT_TRUE(one.isValueOn(openvdb::Coord(0, 8, 8)));
+    EXPECT_TRUE(one.isValueOn(openvdb::Coord(0, 7, 7)));
+    EXPECT_FALSE(one.isValueOn(openvdb::Coord(1, 8, 8)));
+}
+
 TEST(MaskDilation, OneVoxelBecomesACube)
 {
     openvdb::MaskTree mask;

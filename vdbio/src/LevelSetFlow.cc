@@ -10,8 +10,8 @@
 ///          double from float differences; LevelSetTracker's Normalizer::eval with
 ///          ISGradientNormSqrd<FIRST_BIAS>, in float), so the results are equal bit for bit.
 #include <ghostfx/vdbio/LevelSetFlow.h>
+#include <ghostfx/vdbio/MaskDilation.h>
 
-#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tree/LeafManager.h>
 
@@ -222,8 +222,11 @@ void NarrowBandFlow::renormalise()
 void NarrowBandFlow::track()
 {
     Tree& tree = mGrid.tree();
-    openvdb::tools::dilateActiveValues(tree, 1, openvdb::tools::NN_FACE,
-                                       openvdb::tools::IGNORE_TILES);
+    // Grow the band by its face neighbours (LevelSetTracker::track's NN_FACE dilation): new
+    // voxels keep their inactive values, and leaves added over a tile take the tile's value.
+    openvdb::MaskTree band(tree, false, openvdb::TopologyCopy());
+    dilateFaces(band);
+    tree.topologyUnion(band);
     renormalise();
     // Voxels that left the band become inactive at +-background, as LevelSetTracker trims.
     const float gamma = mGrid.background();

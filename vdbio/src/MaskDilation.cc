@@ -112,7 +112,53 @@ void dilateAlong(openvdb::MaskTree& tree, int axis, int k)
     openvdb::tools::pruneInactive(tree);
 }
 
+/// One pass adding the face neighbours: the union of dilateX, dilateY and dilateZ by one
+/// voxel, each from the input.
+void dilateFacesOnce(openvdb::MaskTree& tree)
+{
+    const openvdb::MaskTree input(tree);
+    const openvdb::Coord steps[3] = {openvdb::Coord(DIM, 0, 0), openvdb::Coord(0, DIM, 0),
+                                     openvdb::Coord(0, 0, DIM)};
+    {
+        std::vector<openvdb::Coord> origins;
+        origins.reserve(input.leafCount());
+        for (auto it = input.cbeginLeaf(); it; ++it) origins.push_back(it->origin());
+        openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(tree);
+        for (const openvdb::Coord& o : origins) {
+            for (const openvdb::Coord& step : steps) {
+                acc.touchLeaf(o - step);
+                acc.touchLeaf(o + step);
+            }
+        }
+    }
+    openvdb::tree::LeafManager<openvdb::MaskTree> leaves(tree);
+    leaves.foreach ([&](MaskLeaf& leaf, std::size_t) {
+        openvdb::tree::ValueAccessor<const openvdb::MaskTree> acc(input);
+        const openvdb::Coord o = leaf.origin();
+        Word c[DIM], lo[3][DIM], hi[3][DIM];
+        loadWords(acc.probeConstLeaf(o), c);
+        for (int axis = 0; axis < 3; ++axis) {
+            loadWords(acc.probeConstLeaf(o - steps[axis]), lo[axis]);
+            loadWords(acc.probeConstLeaf(o + steps[axis]), hi[axis]);
+        }
+        openvdb::util::NodeMask<3>& out = leaf.getValueMask();
+        for (int n = 0; n < DIM; ++n) {
+            out.getWord<Word>(n) = dilateX(lo[0], c, hi[0], n, 1)
+                                   | dilateY(lo[1][n], c[n], hi[1][n], 1)
+                                   | dilateZ(lo[2][n], c[n], hi[2][n], 1);
+        }
+    });
+    openvdb::tools::pruneInactive(tree);
+}
+
 } // namespace
+
+void dilateFaces(openvdb::MaskTree& mask)
+{
+    if (mask.empty()) return;
+    if (mask.hasActiveTiles()) mask.voxelizeActiveTiles();
+    dilateFacesOnce(mask);
+}
 
 void dilateMaxNorm(openvdb::MaskTree& mask, int k)
 {

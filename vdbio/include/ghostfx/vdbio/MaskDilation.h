@@ -20,5 +20,10 @@ namespace vdbio {
 /// the result does not depend on the thread count.
 void dilateMaxNorm(openvdb::MaskTree& mask, int k);
 
+/// Adds to `mask` the six face neighbours of every active voxel: one iteration of
+/// tools::dilateActiveValues(mask, 1, NN_FACE), the union of one-voxel dilations along x, y
+/// and z of the same input.
+void dilateFaces(openvdb::MaskTree& mask);
+
 } // namespace vdbio
 } // namespace ghostfx
