@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -80,13 +81,26 @@ void gatherPadded(const openvdb::tree::ValueAccessor<const Tree>& acc, const Lea
     }
 }
 
+/// Calls fn(v) for each active voxel v of `leaf`, in order (the mask's words, lowest bit first).
+template <typename Fn>
+inline void forEachActive(const Leaf& leaf, Fn&& fn)
+{
+    const openvdb::util::NodeMask<3>& mask = leaf.getValueMask();
+    for (int n = 0; n < DIM; ++n) {
+        for (std::uint64_t w = mask.getWord<std::uint64_t>(n); w != 0; w &= w - 1) {
+            fn((n << 6) | __builtin_ctzll(w));
+        }
+    }
+}
+
 /// One Jacobi pass: every active voxel v of every leaf gets op(block, padded index of v).
+/// `scratch` holds the new values until every leaf has read its neighbours' old ones.
 template <typename StencilOp>
-void stencilPass(Tree& tree, const StencilOp& op)
+void stencilPass(Tree& tree, const StencilOp& op, std::vector<float>& scratch)
 {
     LeafManager leaves(tree);
     const std::size_t count = leaves.leafCount();
-    std::vector<float> result(count * Leaf::SIZE);
+    if (scratch.size() < count * Leaf::SIZE) scratch.resize(count * Leaf::SIZE);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 4),
                       [&](const tbb::blocked_range<std::size_t>& range) {
         openvdb::tree::ValueAccessor<const Tree> acc(tree);
@@ -94,17 +108,15 @@ void stencilPass(Tree& tree, const StencilOp& op)
         for (std::size_t n = range.begin(); n != range.end(); ++n) {
             const Leaf& leaf = leaves.leaf(n);
             gatherPadded(acc, leaf, block);
-            float* out = &result[n * Leaf::SIZE];
-            std::copy(leaf.buffer().data(), leaf.buffer().data() + Leaf::SIZE, out);
-            for (auto it = leaf.cbeginValueOn(); it; ++it) {
-                const int v = int(it.pos());
-                out[v] = op(block, padded(v >> 6, (v >> 3) & 7, v & 7));
-            }
+            float* out = &scratch[n * Leaf::SIZE];
+            forEachActive(leaf,
+                          [&](int v) { out[v] = op(block, padded(v >> 6, (v >> 3) & 7, v & 7)); });
         }
     });
-    leaves.foreach ([&result](Leaf& leaf, std::size_t n) {
-        const float* in = &result[n * Leaf::SIZE];
-        std::copy(in, in + Leaf::SIZE, leaf.buffer().data());
+    leaves.foreach ([&scratch](Leaf& leaf, std::size_t n) {
+        const float* in = &scratch[n * Leaf::SIZE];
+        float* values = leaf.buffer().data();
+        forEachActive(leaf, [&](int v) { values[v] = in[v]; });
     });
 }
 
@@ -193,7 +205,7 @@ void NarrowBandFlow::meanCurvature()
 {
     const double inv2Dx = float(0.5 / mDx); // OpenVDB's CurvatureStencil rounds 1 / (2 dx)
     const CurvatureStep step{mDx * mDx / 3.0f, float(4.0 * inv2Dx * inv2Dx)};
-    stencilPass(mGrid.tree(), step);
+    stencilPass(mGrid.tree(), step, mScratch);
     track();
 }
 
@@ -216,7 +228,7 @@ void NarrowBandFlow::offset(float distance)
 void NarrowBandFlow::renormalise()
 {
     const RenormaliseStep step{mDx * 0.3f, 1.0f / mDx};
-    for (int n = 0; n < mSweeps; ++n) stencilPass(mGrid.tree(), step);
+    for (int n = 0; n < mSweeps; ++n) stencilPass(mGrid.tree(), step, mScratch);
 }
 
 void NarrowBandFlow::track()

@@ -23,6 +23,8 @@
 
 #include <openvdb/openvdb.h>
 
+#include <vector>
+
 namespace ghostfx {
 namespace vdbio {
 
@@ -48,6 +50,7 @@ private:
     openvdb::FloatGrid& mGrid;
     float mDx;
     int mSweeps;
+    std::vector<float> mScratch; ///< a pass's new values (stencil passes are Jacobi updates)
 };
 
 } // namespace vdbio
