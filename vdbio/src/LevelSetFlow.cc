@@ -94,7 +94,10 @@ inline void forEachActive(const Leaf& leaf, Fn&& fn)
 }
 
 /// One Jacobi pass: every active voxel v of every leaf gets op(block, padded index of v).
-/// `scratch` holds the new values until every leaf has read its neighbours' old ones.
+/// `scratch` holds the new values until every leaf has read its neighbours' old ones. The
+/// ops are branch-free and a row of eight voxels along z is contiguous in the block (and so
+/// are its neighbour rows), so each row with an active voxel is computed whole, eight lanes
+/// at a time; only the active voxels' values are written back.
 template <typename StencilOp>
 void stencilPass(Tree& tree, const StencilOp& op, std::vector<float>& scratch)
 {
@@ -109,8 +112,16 @@ void stencilPass(Tree& tree, const StencilOp& op, std::vector<float>& scratch)
             const Leaf& leaf = leaves.leaf(n);
             gatherPadded(acc, leaf, block);
             float* out = &scratch[n * Leaf::SIZE];
-            forEachActive(leaf,
-                          [&](int v) { out[v] = op(block, padded(v >> 6, (v >> 3) & 7, v & 7)); });
+            const openvdb::util::NodeMask<3>& mask = leaf.getValueMask();
+            for (int x = 0; x < DIM; ++x) {
+                const std::uint64_t word = mask.getWord<std::uint64_t>(x);
+                for (int y = 0; y < DIM; ++y) {
+                    if (((word >> (8 * y)) & 0xFFu) == 0) continue; // no active voxel
+                    const int base = padded(x, y, 0);
+                    float* row = out + (x << 6) + (y << 3);
+                    for (int z = 0; z < DIM; ++z) row[z] = op(block, base + z);
+                }
+            }
         }
     });
     leaves.foreach ([&scratch](Leaf& leaf, std::size_t n) {
@@ -133,7 +144,6 @@ struct CurvatureStep
         const float zm = p[i - 1], zp = p[i + 1];
         const double Dx = 0.5 * (xp - xm), Dy = 0.5 * (yp - ym), Dz = 0.5 * (zp - zm);
         const double Dx2 = Dx * Dx, Dy2 = Dy * Dy, Dz2 = Dz * Dz, normGrad2 = Dx2 + Dy2 + Dz2;
-        if (normGrad2 <= openvdb::math::Tolerance<double>::value()) return v0 + dt * 0.0f;
         const double Dxx = xp - 2 * v0 + xm, Dyy = yp - 2 * v0 + ym, Dzz = zp - 2 * v0 + zm;
         const double Dxy =
             0.25 * (p[i + SX + SY] - p[i + SX - SY] + p[i - SX - SY] - p[i - SX + SY]);
@@ -142,7 +152,9 @@ struct CurvatureStep
         const double alpha = Dx2 * (Dyy + Dzz) + Dy2 * (Dxx + Dzz) + Dz2 * (Dxx + Dyy)
                              - 2 * (Dx * (Dy * Dxy + Dz * Dxz) + Dy * Dz * Dyz);
         const double normGrad = std::sqrt(normGrad2);
-        const float speed = float(alpha * invDx2 / (2 * (normGrad * normGrad)));
+        // No flow where the gradient vanishes (selected, not branched, so rows vectorise).
+        const bool flat = normGrad2 <= openvdb::math::Tolerance<double>::value();
+        const float speed = flat ? 0.0f : float(alpha * invDx2 / (2 * (normGrad * normGrad)));
         return v0 + dt * speed;
     }
 };
@@ -163,16 +175,14 @@ struct RenormaliseStep
         const float zm = c - p[i - 1], zp = p[i + 1] - c;
         const float zero = 0.0f;
         auto sq = [](float s) { return s * s; };
-        float norm2;
-        if (c > 0) {
-            norm2 = std::max(sq(std::max(xm, zero)), sq(std::min(xp, zero)));
-            norm2 += std::max(sq(std::max(ym, zero)), sq(std::min(yp, zero)));
-            norm2 += std::max(sq(std::max(zm, zero)), sq(std::min(zp, zero)));
-        } else {
-            norm2 = std::max(sq(std::min(xm, zero)), sq(std::max(xp, zero)));
-            norm2 += std::max(sq(std::min(ym, zero)), sq(std::max(yp, zero)));
-            norm2 += std::max(sq(std::min(zm, zero)), sq(std::max(zp, zero)));
-        }
+        // Both sides' upwind norms, then a select (no branch, so rows vectorise).
+        float outside = std::max(sq(std::max(xm, zero)), sq(std::min(xp, zero)));
+        outside += std::max(sq(std::max(ym, zero)), sq(std::min(yp, zero)));
+        outside += std::max(sq(std::max(zm, zero)), sq(std::min(zp, zero)));
+        float inside = std::max(sq(std::min(xm, zero)), sq(std::max(xp, zero)));
+        inside += std::max(sq(std::min(ym, zero)), sq(std::max(yp, zero)));
+        inside += std::max(sq(std::min(zm, zero)), sq(std::max(zp, zero)));
+        const float norm2 = c > 0 ? outside : inside;
         float s = c / (std::sqrt(sq(c) + norm2) + openvdb::math::Tolerance<float>::value());
         return c - dt * s * (std::sqrt(norm2) * invDx - 1.0f);
     }
