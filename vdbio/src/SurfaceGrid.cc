@@ -64,6 +64,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 namespace ghostfx {
@@ -75,6 +76,9 @@ namespace {
 using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 constexpr int LEAF_DIM = int(FloatLeaf::DIM);           // 8 voxels per leaf edge
 constexpr int LEAF_VOXELS = int(FloatLeaf::NUM_VALUES); // 512
+
+/// Four doubles, for the rasterisation's row minima.
+using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
 
 /// Index-space voxel nearest to world position x (voxel (i,j,k) is centred at (i,j,k) * dx).
 inline openvdb::Coord nearestVoxel(const sph::Vec3& x, double invDx)
@@ -221,11 +225,24 @@ void rasterizeUnion(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& posi
                 db2[k] = db * db;
                 dc2[k] = dc * dc;
             }
+            // A row as two four-lane vectors (GCC's vector extension, lowered to SSE2 where
+            // AVX is not enabled): GCC left the scalar minima unvectorised.
+            Lanes dcLow, dcHigh;
+            std::memcpy(&dcLow, dc2, sizeof(Lanes));
+            std::memcpy(&dcHigh, dc2 + 4, sizeof(Lanes));
             for (int a = lo[0]; a <= hi[0]; ++a) {
                 for (int b = lo[1]; b <= hi[1]; ++b) {
                     const double dab2 = da2[a] + db2[b];
+                    const Lanes base = {dab2, dab2, dab2, dab2};
                     double* row = d2 + ((a << 6) | (b << 3));
-                    for (int c = 0; c < LEAF_DIM; ++c) row[c] = std::min(row[c], dab2 + dc2[c]);
+                    Lanes low, high;
+                    std::memcpy(&low, row, sizeof(Lanes));
+                    std::memcpy(&high, row + 4, sizeof(Lanes));
+                    const Lanes low2 = base + dcLow, high2 = base + dcHigh;
+                    low = low2 < low ? low2 : low; // std::min(row, d^2), lane by lane
+                    high = high2 < high ? high2 : high;
+                    std::memcpy(row, &low, sizeof(Lanes));
+                    std::memcpy(row + 4, &high, sizeof(Lanes));
                 }
             }
         });
