@@ -15,9 +15,10 @@
 ///          so the grids are identical at any thread count (DESIGN.md, Parallelism).
 ///          The surface is OpenVDB's particle surfacing (tools::ParticlesToLevelSet, after
 ///          Zhu and Bridson 2005, "Animating sand as a fluid", union-of-spheres variant) followed
-///          by a morphological closing and mean-curvature smoothing (tools::LevelSetFilter,
-///          [Osher and Fedkiw 2003, Ch. 4]), the recipe of Houdini's "VDB from Particles" +
-///          "VDB Smooth SDF".
+///          by a morphological closing and mean-curvature smoothing (tools::LevelSetFilter's
+///          arithmetic, computed by NarrowBandFlow in LevelSetFlow.h with the same result bit
+///          for bit, [Osher and Fedkiw 2003, Ch. 4]), the recipe of Houdini's "VDB from
+///          Particles" + "VDB Smooth SDF".
 ///
 ///          The heavy OpenVDB headers (points, particle surfacing, level-set filters) stay in
 ///          the .cc files (STACK.md: minutes of compile time each); this header needs only
@@ -149,7 +150,7 @@ struct VolumeOptions
     // 1. Union of spheres of radius `surfaceRadiusSpacings` h (ParticlesToLevelSet).
     // 2. Closing: dilate by `surfaceClosingSpacings` h, `surfaceSmoothingIterations` passes
     //    of mean-curvature flow, erode by the closing distance plus the sphere radius minus
-    //    `surfaceOffsetSpacings` h (LevelSetFilter::offset / meanCurvature).
+    //    `surfaceOffsetSpacings` h (LevelSetFilter::offset / meanCurvature, as NarrowBandFlow).
     // On a flat free surface the zero crossing ends about `surfaceOffsetSpacings` h outside the
     // outermost particle centres (measured 0.42 h for 0.5 on a lattice block: the smoothing
     // averages the remaining dips in), on a sphere of radius 6 h 0.37 h (curvature flow shrinks
