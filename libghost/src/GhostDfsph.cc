@@ -45,7 +45,8 @@
 ///             resampled air and the emitters' new particles carry density errors of a few
 ///             percent; asking each step to remove them in full (beta = 1) turns them into
 ///             velocity kicks of error x h / dt that grew without bound in every violent test.
-///           - a liquid particle with fewer than MIN_NEIGHBOURS liquid and solid neighbours is
+///           - a liquid particle with fewer than MIN_NEIGHBOURS liquid and solid neighbours (at
+///             [SB12]'s 3 h support; in proportion to the support's volume at another) is
 ///             spray (a thin stream's edge, a drop): too little to push against; it takes no
 ///             part in the solve.
 ///
@@ -75,10 +76,20 @@ using namespace detail;
 namespace {
 
 /// Liquid and solid neighbours (self included) below which a liquid particle is spray, about a
-/// fifth of a full neighbourhood at [SB12]'s 3 h support. Measured: with 10 (liquid only) the
+/// fifth of a full neighbourhood at [SB12]'s 3 h support; another support scales it with the
+/// neighbourhood's volume (see minimumNeighbours). Measured: with 10 (liquid only) the
 /// tomato's stream blew up at frame 8; with 20 liquid only, the still tank's corner particles
 /// went unsolved and were pushed into the walls; 20 with the solids holds both.
 constexpr int MIN_NEIGHBOURS = 20;
+
+/// MIN_NEIGHBOURS for a kernel support of `supportFactor` h: the same share of a full
+/// neighbourhood (20 at 3 h, 6 at 2 h). Kept at 20 for 2 h, the top layer of a still tank went
+/// unsolved (Dfsph.StillTankAtTwoSpacingsSupportHoldsTheDensityLimit).
+int minimumNeighbours(Real supportFactor)
+{
+    const double ratio = double(supportFactor) / 3.0;
+    return int(std::lround(MIN_NEIGHBOURS * ratio * ratio * ratio));
+}
 
 /// A density solve whose warm start fits the step with a share below this iterates at least
 /// once (see solvePressure). Measured on the column tank at CFL 0.1, 30 frames: 0.8, 0.9 and
@@ -103,6 +114,7 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
         [&](std::size_t j) { mLiquidMass[j] = kind[j] == ParticleKind::Liquid ? M : Real(0); },
         4096);
     const Real* halo = haloFlags();
+    const int minNeighbours = minimumNeighbours(mSettings.supportFactor);
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
@@ -139,7 +151,7 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
             // The particle's own pressure term moves it by its liquid and solid gradient sums
             // and each liquid neighbour by its own term.
             const Real a = (sum + solid).lengthSqr() + squares;
-            mAlpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= MIN_NEIGHBOURS
+            mAlpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= minNeighbours
                             ? Real(1) / a
                             : Real(0);
             mSolidGradient[i] = solid;
