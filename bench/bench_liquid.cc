@@ -61,6 +61,7 @@ struct Options
     int warmup = 20;               ///< steps before the measurement (>= 1)
     double cfl = 0;                ///< > 0: CFL-limited dt with this number instead of PAPER_DT
     double stiffness = 0;          ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
+    double kernelSupport = 0;      ///< > 0: kernel support / h instead of the default ([SB12]: 3)
     double shifting = -1;          ///< >= 0: particle shifting coefficient instead of the default
     std::string airWeights;        ///< "matched" or "complete" instead of the default
     double lennardJones = 0;       ///< > 0: Basic SPH wall strength D (m^2/s^2) instead of 5 g H
@@ -507,6 +508,7 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     settings.seed = opt.seed;
     if (opt.cfl > 0) settings.cflNumber = Real(opt.cfl);
     if (opt.stiffness > 0) settings.stiffness = Real(opt.stiffness);
+    if (opt.kernelSupport > 0) settings.supportFactor = Real(opt.kernelSupport);
     if (opt.shifting >= 0) settings.shiftingCoefficient = Real(opt.shifting);
     if (!opt.airWeights.empty()) {
         settings.airWeights =
@@ -583,6 +585,9 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember({"matched", "complete"}));
     app.add_option("--stiffness", opt.stiffness, "Tait stiffness k (Pa; default: [SB12] 2000)")
         ->check(CLI::PositiveNumber);
+    app.add_option("--kernel-support", opt.kernelSupport,
+                   "kernel support radius / h (default: [SB12] 3; SPlisHSPlasH uses 2)")
+        ->check(CLI::Range(1.5, 6.0));
     app.add_option("--lj", opt.lennardJones,
                    "Basic SPH Lennard-Jones strength D (m^2/s^2; "
                    "default: 5 g H)")
