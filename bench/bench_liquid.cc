@@ -630,7 +630,10 @@ int main(int argc, char** argv)
         std::printf("threads: %d, Real = %s, dt = %s; DFSPH reports the pressure on the steps "
                     "that end a frame (%g fps), as a run does\n",
                     parallel::maxThreads(), sizeof(Real) == 4 ? "float" : "double",
-                    opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str() : "1/600 s (fixed)",
+                    opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str()
+                    : opt.pressure == "dfsph"
+                        ? "CFL steps at the default number (DFSPH; Basic SPH: 1/600 s fixed)"
+                        : "1/600 s (fixed)",
                     double(GhostSettings().frameRate));
 
         std::vector<RunResult> all;
