@@ -67,23 +67,30 @@ Word dilateZ(Word lo, Word c, Word hi, int k)
     return r;
 }
 
+/// Adds to `tree` (empty) leaves beside every leaf of `input`, at +-steps[0..count): the
+/// leaves a pass's bits may reach (the pass prunes those left empty).
+void touchNeighbours(openvdb::MaskTree& tree, const openvdb::MaskTree& input,
+                     const openvdb::Coord* steps, int count)
+{
+    std::vector<openvdb::Coord> origins;
+    origins.reserve(input.leafCount());
+    for (auto it = input.cbeginLeaf(); it; ++it) origins.push_back(it->origin());
+    openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(tree);
+    for (const openvdb::Coord& o : origins) {
+        for (int s = 0; s < count; ++s) {
+            acc.touchLeaf(o - steps[s]);
+            acc.touchLeaf(o + steps[s]);
+        }
+    }
+}
+
 /// One separable pass: every voxel within k (<= DIM) of an active voxel along `axis`.
 void dilateAlong(openvdb::MaskTree& tree, int axis, int k)
 {
     const openvdb::MaskTree input(tree); // the old bits; `tree` receives the new ones
     openvdb::Coord step(0);
     step[axis] = DIM;
-    {
-        // Leaves the bits may reach: each leaf's two neighbours along the axis.
-        std::vector<openvdb::Coord> origins;
-        origins.reserve(input.leafCount());
-        for (auto it = input.cbeginLeaf(); it; ++it) origins.push_back(it->origin());
-        openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(tree);
-        for (const openvdb::Coord& o : origins) {
-            acc.touchLeaf(o - step);
-            acc.touchLeaf(o + step);
-        }
-    }
+    touchNeighbours(tree, input, &step, 1);
     openvdb::tree::LeafManager<openvdb::MaskTree> leaves(tree);
     leaves.foreach ([&](MaskLeaf& leaf, std::size_t) {
         openvdb::tree::ValueAccessor<const openvdb::MaskTree> acc(input);
@@ -119,18 +126,7 @@ void dilateFacesOnce(openvdb::MaskTree& tree)
     const openvdb::MaskTree input(tree);
     const openvdb::Coord steps[3] = {openvdb::Coord(DIM, 0, 0), openvdb::Coord(0, DIM, 0),
                                      openvdb::Coord(0, 0, DIM)};
-    {
-        std::vector<openvdb::Coord> origins;
-        origins.reserve(input.leafCount());
-        for (auto it = input.cbeginLeaf(); it; ++it) origins.push_back(it->origin());
-        openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(tree);
-        for (const openvdb::Coord& o : origins) {
-            for (const openvdb::Coord& step : steps) {
-                acc.touchLeaf(o - step);
-                acc.touchLeaf(o + step);
-            }
-        }
-    }
+    touchNeighbours(tree, input, steps, 3);
     openvdb::tree::LeafManager<openvdb::MaskTree> leaves(tree);
     leaves.foreach ([&](MaskLeaf& leaf, std::size_t) {
         openvdb::tree::ValueAccessor<const openvdb::MaskTree> acc(input);
