@@ -4,7 +4,8 @@
 ///         [BK17] the TVCG 2017 version) over [SB12]'s ghost air and ghost solids.
 /// @details One step, with one neighbour search (the lists of GhostStep.cc):
 ///           1. density (Eq. 1, every kind of neighbour) and the factor alpha_i of each liquid
-///              particle;
+///              particle, keeping each liquid pair's m_j grad W_ij for the solves' passes
+///              (DfsphSettings::keepGradients; the positions do not move until step 4);
 ///           2. the divergence solve on the velocities the last step left ([BK15] Algorithm 2,
 ///              moved from the end of the last step to the start of this one, where the new
 ///              neighbourhood is known: the same sequence with one search);
@@ -113,21 +114,56 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
         0, n,
         [&](std::size_t j) { mLiquidMass[j] = kind[j] == ParticleKind::Liquid ? M : Real(0); },
         4096);
+    // Where each liquid particle's pairs start in mPairGradient (a halo copy's too: the
+    // gradient pass gives it G k).
+    const bool keep = mSettings.dfsph.keepGradients;
+    std::size_t pairs = 0;
+    if (keep) {
+        resizeStepArray(mPairStart, n + 1);
+        for (std::size_t i = 0; i < n; ++i) {
+            mPairStart[i] = pairs;
+            if (kind[i] == ParticleKind::Liquid) pairs += mFluidLists[i].size();
+        }
+        mPairStart[n] = pairs;
+    } else {
+        std::vector<std::size_t>().swap(mPairStart);
+    }
+    for (auto& c : mPairGradient) {
+        if (keep) resizeStepArray(c, pairs);
+        else std::vector<Real>().swap(c);
+    }
     const Real* halo = haloFlags();
     const int minNeighbours = minimumNeighbours(mSettings.supportFactor);
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
         for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) continue;
             // A halo copy is solved by its owner (alpha 0 here: not an unknown of this one).
-            if (kind[i] != ParticleKind::Liquid || (halo && halo[i] != Real(0))) continue;
+            const bool copy = halo && halo[i] != Real(0);
             const Vec3 xi = x[i];
             Vec3 sum(0), all(0);
             Real squares = 0;
             int liquidNeighbours = 0;
+            const std::size_t at = keep ? mPairStart[i] : 0;
+            Real* gx = keep ? mPairGradient[0].data() + at : nullptr;
+            Real* gy = keep ? mPairGradient[1].data() + at : nullptr;
+            Real* gz = keep ? mPairGradient[2].data() + at : nullptr;
+            if (copy && !keep) continue;
             batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
                 for (int k = 0; k < b.n; ++k) b.g[k] = kernel.gradFactor(b.r[k]);
                 for (int k = 0; k < b.n; ++k) b.f[k] = mLiquidMass[b.j[k]] * b.g[k];
+                if (keep) {
+                    for (int k = 0; k < b.n; ++k) {
+                        gx[k] = b.f[k] * b.dx[k];
+                        gy[k] = b.f[k] * b.dy[k];
+                        gz[k] = b.f[k] * b.dz[k];
+                    }
+                    gx += b.n;
+                    gy += b.n;
+                    gz += b.n;
+                }
+                if (copy) return;
                 sum += b.sumScaledOffsets(b.f);
                 for (int k = 0; k < b.n; ++k) {
                     liquidNeighbours += mLiquidMass[b.j[k]] > Real(0);
@@ -139,6 +175,7 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
                     all += b.sumScaledOffsets(b.f);
                 }
             });
+            if (copy) continue;
             Vec3 solid(0);
             for (const SolidBlock* block : {&mStatic, &mMoving}) {
                 batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
@@ -211,20 +248,33 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
 
     // G k (see the file comment), zero for air and spray.
     std::vector<Vec3> u(n, Vec3(0));
+    // m_j grad W_ij of the liquid's pairs, when kept (computeDfsphFactors); else each pass
+    // evaluates the kernel at the gathered positions.
+    const bool kept = opt.keepGradients;
+    const Real* gx = mPairGradient[0].data();
+    const Real* gy = mPairGradient[1].data();
+    const Real* gz = mPairGradient[2].data();
     auto gradient = [&](const std::vector<Real>& k) {
         forRangeWithBatch(
             n, mKernel,
             [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
             for (std::size_t i = lo; i < hi; ++i) {
                 if (lm[i] == Real(0)) continue;
-                const Vec3 xi = x[i];
                 const Real ki = k[i];
                 Vec3 sum(0);
-                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                    for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * (ki + k[b.j[c]]);
-                    for (int c = 0; c < b.n; ++c) b.f[c] *= kernel.gradFactor(b.r[c]);
-                    sum += b.sumScaledOffsets(b.f);
-                });
+                if (kept) {
+                    const std::size_t at = mPairStart[i];
+                    batch.forEachIndexBatch(mFluidLists[i], [&](PairBatch& b, std::size_t first) {
+                        for (int c = 0; c < b.n; ++c) b.f[c] = ki + k[b.j[c]];
+                        sum += b.sumScaled(b.f, gx + at + first, gy + at + first, gz + at + first);
+                    });
+                } else {
+                    batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
+                        for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * (ki + k[b.j[c]]);
+                        for (int c = 0; c < b.n; ++c) b.f[c] *= kernel.gradFactor(b.r[c]);
+                        sum += b.sumScaledOffsets(b.f);
+                    });
+                }
                 // The solids' part, k_i sum_s M grad W_is, from the step's sum.
                 u[i] = sum + ki * mSolidGradient[i];
             }
@@ -245,15 +295,24 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
             [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
             for (std::size_t i = lo; i < hi; ++i) {
                 if (!solved(i)) continue;
-                const Vec3 xi = x[i], vi = vel[i];
+                const Vec3 vi = vel[i];
                 Real sum = vi.dot(mSolidGradient[i]);
-                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                    for (int c = 0; c < b.n; ++c) b.f[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
-                    sum += b.sumScaledApproach(b.f, vel.data(), vi);
-                });
+                if (kept) {
+                    const std::size_t at = mPairStart[i];
+                    batch.forEachIndexBatch(mFluidLists[i], [&](PairBatch& b, std::size_t first) {
+                        sum += b.sumApproach(vel.data(), vi, gx + at + first, gy + at + first,
+                                             gz + at + first);
+                    });
+                } else {
+                    batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
+                        for (int c = 0; c < b.n; ++c)
+                            b.f[c] = lm[b.j[c]] * kernel.gradFactor(b.r[c]);
+                        sum += b.sumScaledApproach(b.f, vel.data(), vi);
+                    });
+                }
                 if (solidMoves && movingSolids) {
                     const ParticleSet& set = mMoving.block.particles();
-                    batch.forEachBatch(xi, set.positions().data(), mMoving.lists[i],
+                    batch.forEachBatch(x[i], set.positions().data(), mMoving.lists[i],
                                        [&](PairBatch& b) {
                         for (int c = 0; c < b.n; ++c) b.f[c] = M * kernel.gradFactor(b.r[c]);
                         sum -= b.sumScaledApproach(b.f, movingV, Vec3(0));

@@ -655,8 +655,10 @@ GhostSolver::MemoryUse GhostSolver::memoryUse() const
     use.lists = mFluidLists.memoryBytes();
     use.solidParticles = mPendingSolids.memoryBytes();
     use.stepArrays =
-        mQueryMask.capacity() + (mScratch.capacity() + mAlpha.capacity() + mLiquidMass.capacity()) * sizeof(Real)
-        + mSolidGradient.capacity() * sizeof(Vec3);
+        mQueryMask.capacity()
+        + (mScratch.capacity() + mAlpha.capacity() + mLiquidMass.capacity()) * sizeof(Real)
+        + mSolidGradient.capacity() * sizeof(Vec3) + mPairStart.capacity() * sizeof(std::size_t);
+    for (const auto& c : mPairGradient) use.stepArrays += c.capacity() * sizeof(Real);
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
         use.solidParticles += b->block.particles().memoryBytes();
         use.solidGrids += b->block.grid().memoryBytes();

@@ -75,6 +75,12 @@ struct DfsphSettings
     Real maxTimeStep = Real(5e-3);
     /// Start each solve from the last step's pressure ([BK15] Sec. 4.3).
     bool warmStart = true;
+    /// Keep each liquid pair's m_j grad W_ij for the step (12 bytes a pair in float, about
+    /// 1 kB a liquid particle at [SB12]'s 3 h support), so the solves' passes read them instead
+    /// of gathering positions and evaluating the kernel again: the dam break's pressure phase
+    /// takes a third less time (bench/RESULTS.md, "DFSPH: the pairs' kernel gradients kept for
+    /// the step"). Off: the same solve, recomputed each pass, for scenes memory bounds.
+    bool keepGradients = true;
 };
 
 /// Boundary condition at solids for Ghost SPH ([SB12] Sec. 4.4).

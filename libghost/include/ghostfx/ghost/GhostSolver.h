@@ -422,6 +422,12 @@ private:
     /// particle's mass if liquid, else 0.
     std::vector<Real> mAlpha, mLiquidMass;
     std::vector<Vec3> mSolidGradient; ///< DFSPH: sum_solid M grad W_is of each liquid particle
+    /// DFSPH, this step: m_j grad W_ij of each liquid particle i's fluid neighbours j, in its
+    /// list's order from mPairStart[i] on, one array a component. The solves' passes read
+    /// them instead of gathering positions and evaluating the kernel again (computeDfsphFactors
+    /// fills them; bench/RESULTS.md, "DFSPH: the pairs' kernel gradients kept for the step").
+    std::vector<std::size_t> mPairStart;
+    std::vector<Real> mPairGradient[3];
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;

@@ -110,6 +110,34 @@ struct PairBatch
         }
     }
 
+    /// Call fn(*this, first) for each batch of SIZE consecutive neighbours of a list, with
+    /// j[0, n) the list's entries first .. first + n and nothing gathered (dx, dy, dz and r
+    /// are not set): for passes that read per-pair values stored in the list's order.
+    template <typename List, typename Fn>
+    void forEachIndexBatch(const List& list, Fn&& fn)
+    {
+        const std::size_t size = std::size(list);
+        if constexpr (HasRuns<List>::value) {
+            if (list.raw() || size > std::size_t(CAPACITY)) {
+                forEachRareBatch(Vec3(0), nullptr, list, fn);
+                return;
+            }
+            decodeRuns(list);
+            for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+                n = int(std::min<std::size_t>(size - k0, SIZE));
+                std::copy(decoded + k0, decoded + k0 + n, j);
+                fn(*this, k0);
+            }
+        } else {
+            const Index* idx = std::data(list);
+            for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
+                n = int(std::min<std::size_t>(size - k0, SIZE));
+                std::copy(idx + k0, idx + k0 + n, j);
+                fn(*this, k0);
+            }
+        }
+    }
+
     /// decoded[0, list.size()) = the neighbours of a list kept in runs (at most CAPACITY).
     template <typename List>
     __attribute__((noinline)) void decodeRuns(const List& list)
@@ -122,18 +150,27 @@ struct PairBatch
     }
 
     /// forEachBatch over a list of 32-bit indices, or one longer than CAPACITY (decoded batch
-    /// by batch).
+    /// by batch); for forEachIndexBatch's fn(*this, first), the same without the gather.
     template <typename List, typename Fn>
     __attribute__((noinline)) void forEachRareBatch(const Vec3& xi, const Vec3* x, const List& list,
                                                     Fn& fn)
     {
+        std::size_t first = 0;
+        auto call = [&] {
+            if constexpr (std::is_invocable_v<Fn&, PairBatch&>) {
+                gather(xi, x);
+                fn(*this);
+            } else {
+                fn(*this, first);
+            }
+            first += std::size_t(n);
+        };
         if (const std::uint8_t* raw = list.raw()) {
             const std::size_t size = list.size();
             for (std::size_t k0 = 0; k0 < size; k0 += SIZE) {
                 n = int(std::min<std::size_t>(size - k0, SIZE));
                 std::memcpy(j, raw + k0 * sizeof(Index), std::size_t(n) * sizeof(Index));
-                gather(xi, x);
-                fn(*this);
+                call();
             }
             return;
         }
@@ -144,18 +181,14 @@ struct PairBatch
                 for (int k0 = 0; k0 < take; k0 += BLOCK) decode(start, offset + k0, j + n + k0);
                 n += take;
                 if (n < SIZE) return;
-                gather(xi, x);
-                fn(*this);
+                call();
                 n = 0;
                 count -= std::size_t(take);
                 if (count == 0) return;
                 offset += take;
             }
         });
-        if (n > 0) {
-            gather(xi, x);
-            fn(*this);
-        }
+        if (n > 0) call();
     }
 
     /// to[k] = start | offset[k] for k < BLOCK.
@@ -250,24 +283,50 @@ struct PairBatch
     }
 
     /// sum_k a[k] (x_i - x_j) over the batch, each component as in sum().
-    Vec3 sumScaledOffsets(const Real* a) const
+    Vec3 sumScaledOffsets(const Real* a) const { return sumScaled(a, dx, dy, dz); }
+
+    /// sum_k a[k] (x[k], y[k], z[k]) over the batch, each component as in sum().
+    Vec3 sumScaled(const Real* a, const Real* x, const Real* y, const Real* z) const
     {
         Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
             for (int l = 0; l < LANES; ++l) {
-                lx[l] += a[k + l] * dx[k + l];
-                ly[l] += a[k + l] * dy[k + l];
-                lz[l] += a[k + l] * dz[k + l];
+                lx[l] += a[k + l] * x[k + l];
+                ly[l] += a[k + l] * y[k + l];
+                lz[l] += a[k + l] * z[k + l];
             }
         }
         for (int l = 0; l < LANES && k < n; ++k, ++l) {
-            lx[l] += a[k] * dx[k];
-            ly[l] += a[k] * dy[k];
-            lz[l] += a[k] * dz[k];
+            lx[l] += a[k] * x[k];
+            ly[l] += a[k] * y[k];
+            lz[l] += a[k] * z[k];
         }
         Vec3 total(0);
         for (int l = 0; l < LANES; ++l) total += Vec3(lx[l], ly[l], lz[l]);
+        return total;
+    }
+
+    /// sum_k (vi - values[j[k]]) . (x[k], y[k], z[k]) over the batch, as in sum(): with the
+    /// pair vectors m_j grad W_ij, the rate of density change sum_j m_j (v_i - v_j) . grad W_ij.
+    Real sumApproach(const Vec3* values, const Vec3& vi, const Real* x, const Real* y,
+                     const Real* z) const
+    {
+        Real lane[LANES] = {};
+        int k = 0;
+        for (; k + LANES <= n; k += LANES) {
+            for (int l = 0; l < LANES; ++l) {
+                const Vec3& v = values[j[k + l]];
+                lane[l] += (vi[0] - v[0]) * x[k + l] + (vi[1] - v[1]) * y[k + l]
+                           + (vi[2] - v[2]) * z[k + l];
+            }
+        }
+        for (int l = 0; l < LANES && k < n; ++k, ++l) {
+            const Vec3& v = values[j[k]];
+            lane[l] += (vi[0] - v[0]) * x[k] + (vi[1] - v[1]) * y[k] + (vi[2] - v[2]) * z[k];
+        }
+        Real total = 0;
+        for (int l = 0; l < LANES; ++l) total += lane[l];
         return total;
     }
 };
