@@ -47,6 +47,9 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
                         "expected at least min_dt (" + std::to_string(o.minTimeStep) + " s)");
         o.warmStart = d.get<bool>("warm_start", o.warmStart);
         o.keepGradients = d.get<bool>("keep_gradients", o.keepGradients);
+        constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
+        o.keptGradientLimit =
+            GiB * d.inRange("kept_gradients_gb", o.keptGradientLimit / GiB, 0, 1e6);
         d.finish();
     }
     g.stiffness = Real(s.positive("stiffness", g.stiffness));

@@ -51,8 +51,21 @@ public:
     void advanceFrame() override
     {
         const std::uint64_t unconverged = mSolver->pressureSolveStats().unconverged;
+        const std::uint64_t recomputed = mSolver->pressureSolveStats().recomputedSteps;
         mSolver->advanceFrame();
         const ghost::PressureSolveStats& st = mSolver->pressureSolveStats();
+        if (st.recomputedSteps > recomputed && !mWarnedRecomputed) {
+            // Once a run: from here on the steps are slower, not wrong.
+            mWarnedRecomputed = true;
+            std::fprintf(stderr,
+                         "ghostfx: warning: scene '%s', frame %d: the DFSPH solves recompute "
+                         "their kernel gradients: keeping them would take %.3g GiB, above "
+                         "dfsph.kept_gradients_gb = %g (the same solve, its pressure phase "
+                         "about a third slower); raise the limit if memory allows\n",
+                         mScene.file.c_str(), mSolver->frame(),
+                         st.lastGradientBytes / (1024.0 * 1024.0 * 1024.0),
+                         mSolver->settings().dfsph.keptGradientLimit / (1024.0 * 1024.0 * 1024.0));
+        }
         if (st.unconverged > unconverged) {
             const ghost::DfsphSettings& d = mSolver->settings().dfsph;
             std::fprintf(stderr,
@@ -186,6 +199,7 @@ private:
     std::unique_ptr<GhostSolver> mSolver;
     ghost::PhaseTimings mBefore;
     ghost::PressureSolveStats mSolveBefore;
+    bool mWarnedRecomputed = false; ///< the kept-gradient limit's warning was printed
 };
 
 } // namespace

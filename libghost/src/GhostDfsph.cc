@@ -116,17 +116,29 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
         [&](std::size_t j) { mLiquidMass[j] = kind[j] == ParticleKind::Liquid ? M : Real(0); },
         4096);
     // Where each liquid particle's pairs start in mPairGradient (a halo copy's too: the
-    // gradient pass gives it G k).
-    const bool keep = mSettings.dfsph.keepGradients;
+    // gradient pass gives it G k), if they fit in the limit.
+    const DfsphSettings& opt = mSettings.dfsph;
     std::size_t pairs = 0;
-    if (keep) {
-        resizeStepArray(mPairStart, n + 1);
+    if (opt.keepGradients) {
         for (std::size_t i = 0; i < n; ++i) {
-            mPairStart[i] = pairs;
             if (kind[i] == ParticleKind::Liquid) pairs += mFluidLists[i].size();
         }
-        mPairStart[n] = pairs;
+    }
+    const double bytes = double(pairs) * (3 * sizeof(Real)) + double(n + 1) * sizeof(std::size_t);
+    const bool keep = opt.keepGradients && bytes <= opt.keptGradientLimit;
+    mGradientsKept = keep;
+    mSolveStats.lastGradientBytes = opt.keepGradients ? bytes : 0;
+    if (opt.keepGradients && !keep) ++mSolveStats.recomputedSteps;
+    if (keep) {
+        resizeStepArray(mPairStart, n + 1);
+        std::size_t at = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            mPairStart[i] = at;
+            if (kind[i] == ParticleKind::Liquid) at += mFluidLists[i].size();
+        }
+        mPairStart[n] = at;
     } else {
+        pairs = 0;
         std::vector<std::size_t>().swap(mPairStart);
     }
     for (auto& c : mPairGradient) {
@@ -251,7 +263,7 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     std::vector<Vec3> u(n, Vec3(0));
     // m_j grad W_ij of the liquid's pairs, when kept (computeDfsphFactors); else each pass
     // evaluates the kernel at the gathered positions.
-    const bool kept = opt.keepGradients;
+    const bool kept = mGradientsKept;
     const Real* gx = mPairGradient[0].data();
     const Real* gy = mPairGradient[1].data();
     const Real* gz = mPairGradient[2].data();

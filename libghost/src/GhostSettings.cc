@@ -130,6 +130,9 @@ void GhostSettings::validate() const
                       "dfsph.divergenceError", dfsph.divergenceError, "1e-7 to 1 (a fraction)");
         check.require(dfsph.densityRelaxation > 0 && dfsph.densityRelaxation <= 1,
                       "dfsph.densityRelaxation", dfsph.densityRelaxation, "in (0, 1]");
+        check.require(dfsph.keptGradientLimit >= 0 && check.finite(dfsph.keptGradientLimit),
+                      "dfsph.keptGradientLimit", dfsph.keptGradientLimit,
+                      "a finite value >= 0 (bytes)");
         check.require(dfsph.maxIterations >= 1 && dfsph.maxIterations <= 100000,
                       "dfsph.maxIterations", dfsph.maxIterations, "1 to 100000");
         check.require(dfsph.minTimeStep > 0 && check.finite(dfsph.minTimeStep), "dfsph.minTimeStep",

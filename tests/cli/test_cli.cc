@@ -260,6 +260,8 @@ TEST_F(Cli, BadInputGetsOneClearLine)
          "settings.dfsph.density_eror: unknown key (did you mean 'density_error'?)"},
         {" -D settings.dfsph.density_relaxation=0", "settings.dfsph.density_relaxation = 0: "
                                                     "expected a number in [1e-06, 1]"},
+        {" -D settings.dfsph.kept_gradients_gb=-1",
+         "settings.dfsph.kept_gradients_gb = -1: expected a number in [0, 1e+06]"},
         {" -D settings.method=basic -D settings.pressure=dfsph",
          "settings.pressure = \"dfsph\": expected 'tait' with method 'basic'"},
         {" -D settings.method=gas", "liquids: a 'gas' scene simulates gas only: liquids, emitters "
@@ -329,6 +331,31 @@ TEST_F(Cli, DfsphSolvesStoppedAtTheIterationCapAreWarnedAbout)
     EXPECT_CONTAINS(r.err, "DFSPH solves stopped at dfsph.max_iterations = 1 above their error "
                            "limit (last: density mean ");
     EXPECT_CONTAINS(r.err, "against 1e-05 and 30 x that; divergence ");
+}
+
+TEST_F(Cli, DfsphGradientsOverTheirMemoryLimitAreWarnedAboutOnce)
+{
+    // A limit of about 1 kB cannot hold the small scene's kept gradients (hundreds of kB): the
+    // run recomputes them, finishes, and says so once, with the size it would have needed.
+    const std::string path = write(smallScene());
+    const Result r = run("run " + path + " --out " + (mDir / "out").string()
+                         + " -q --frames 1-2 -D settings.pressure=dfsph -D settings.substeps=0"
+                           " -D settings.dfsph.kept_gradients_gb=1e-6");
+    EXPECT_EQ(r.code, 0) << r.err;
+    const std::string warning = "ghostfx: warning: scene '" + path
+                                + "', frame 1: the DFSPH solves recompute their kernel "
+                                  "gradients: keeping them would take ";
+    EXPECT_CONTAINS(r.err, warning);
+    EXPECT_CONTAINS(r.err, "above dfsph.kept_gradients_gb = 1e-06");
+    EXPECT_EQ(r.err.find("the DFSPH solves recompute", r.err.find(warning) + warning.size()),
+              std::string::npos)
+        << "warned more than once: " << r.err;
+    // At the default limit: no warning.
+    const Result quiet = run("run " + path + " --out " + (mDir / "out2").string()
+                             + " -q --frames 1-1 -D settings.pressure=dfsph -D "
+                               "settings.substeps=0");
+    EXPECT_EQ(quiet.code, 0) << quiet.err;
+    EXPECT_EQ(quiet.err.find("recompute"), std::string::npos) << quiet.err;
 }
 
 TEST_F(Cli, SolidThinnerThanTheKernelSupportIsWarnedAbout)

@@ -388,6 +388,65 @@ TEST(Dfsph, KeptKernelGradientsGiveTheRecomputedSolve)
     EXPECT_LE(perPair, 3.2 * sizeof(Real));
 }
 
+// settings.dfsph.kept_gradients_gb: a step whose kept gradients would take more than the limit
+// recomputes them, the same code as keep_gradients false, so the run equals one with the
+// gradients off bit for bit; it is counted, reports the bytes it would have needed, and holds
+// none of the arrays. Under the limit nothing changes: bit for bit the default run.
+TEST(Dfsph, KeptGradientsOverTheirMemoryLimitAreRecomputed)
+{
+    const Collapse scene;
+    GhostSettings over = dfsphSettings(), off = dfsphSettings(), kept = dfsphSettings(),
+                  under = dfsphSettings();
+    off.dfsph.keepGradients = false;
+    under.dfsph.keptGradientLimit = 1e9; // 1 GB: far above this scene's few MB
+    GhostSolver a(kept), b(under), c(off);
+    // The limit for the over-limit run: half what the first step keeps.
+    for (GhostSolver* s : {&a, &b, &c}) {
+        s->addSolid(scene.tank);
+        s->addLiquid(scene.water);
+    }
+    const Real first = a.stableTimeStep();
+    a.step(first);
+    const double needed = a.pressureSolveStats().lastGradientBytes;
+    ASSERT_GT(needed, 0.0);
+    over.dfsph.keptGradientLimit = 0.5 * needed;
+    GhostSolver d(over);
+    d.addSolid(scene.tank);
+    d.addLiquid(scene.water);
+    b.step(first);
+    c.step(first);
+    d.step(first);
+    const int steps = 5;
+    for (int k = 0; k < steps; ++k) {
+        const Real dt = a.stableTimeStep();
+        for (GhostSolver* s : {&a, &b, &c, &d}) s->step(dt);
+    }
+    const PressureSolveStats& sd = d.pressureSolveStats();
+    std::printf("[measured] kept gradients over their limit: %llu of %llu steps recomputed, "
+                "%.0f bytes needed against a limit of %.0f; step arrays %.2f MB against %.2f "
+                "MB kept\n",
+                (unsigned long long)sd.recomputedSteps, (unsigned long long)sd.steps,
+                sd.lastGradientBytes, over.dfsph.keptGradientLimit,
+                double(d.memoryUse().stepArrays) / 1e6, double(a.memoryUse().stepArrays) / 1e6);
+    EXPECT_EQ(sd.recomputedSteps, sd.steps);
+    EXPECT_EQ(a.pressureSolveStats().recomputedSteps, 0u);
+    EXPECT_EQ(b.pressureSolveStats().recomputedSteps, 0u);
+    EXPECT_EQ(c.pressureSolveStats().recomputedSteps, 0u);
+    EXPECT_EQ(c.pressureSolveStats().lastGradientBytes, 0.0);
+    EXPECT_GT(sd.lastGradientBytes, over.dfsph.keptGradientLimit);
+    // The kept arrays are 3 sizeof(Real) a liquid pair, most of the step arrays here
+    // (measured in float: 0.11 MB against 1.02 MB); over the limit none are held.
+    EXPECT_LT(double(d.memoryUse().stepArrays), 0.5 * double(a.memoryUse().stepArrays));
+    EXPECT_LT(double(d.memoryUse().stepArrays), 1.1 * double(c.memoryUse().stepArrays));
+    auto same = [](const GhostSolver& x, const GhostSolver& y) {
+        return x.particles().ids() == y.particles().ids()
+               && x.particles().positions() == y.particles().positions()
+               && x.particles().velocities() == y.particles().velocities();
+    };
+    EXPECT_TRUE(same(d, c)) << "over the limit: not the recomputing solve";
+    EXPECT_TRUE(same(b, a)) << "under the limit: not the kept solve";
+}
+
 // A frame's inner steps skip the reported pressure's pass (only output reads it): within a
 // frame the liquid's pressures stay as the last frame left them, the frame's last step sets
 // them, and they are then the ones a driver reporting every step gets, bit for bit, with the

@@ -81,6 +81,12 @@ struct DfsphSettings
     /// takes a third less time (bench/RESULTS.md, "DFSPH: the pairs' kernel gradients kept for
     /// the step"). Off: the same solve, recomputed each pass, for scenes memory bounds.
     bool keepGradients = true;
+    /// The most memory (bytes) one process's kept gradients may take in a step: 4 GiB, about
+    /// 360M pairs, 4M liquid particles at [SB12]'s 3 h support. A step whose pairs would need
+    /// more recomputes them in every pass, the same solve as keepGradients false, and is
+    /// counted in PressureSolveStats::recomputedSteps: a run that outgrows the limit (an
+    /// emitter filling a tank) gets slower instead of running out of memory. 0: never keep.
+    double keptGradientLimit = 4.0 * 1024 * 1024 * 1024;
 };
 
 /// Boundary condition at solids for Ghost SPH ([SB12] Sec. 4.4).

@@ -90,6 +90,11 @@ struct PressureSolveStats
     std::uint64_t divergenceIterations = 0; ///< divergence iterations, all steps
     std::uint64_t unconverged = 0;          ///< solves that stopped short of either limit
                                             ///< (DfsphSettings::maxIterations)
+    /// Steps that recomputed their kernel gradients because keeping them would have taken
+    /// more than DfsphSettings::keptGradientLimit, and the bytes the last step's would have
+    /// taken (DfsphSettings::keepGradients on; 0 when off).
+    std::uint64_t recomputedSteps = 0;
+    double lastGradientBytes = 0;
     int lastDensityIterations = 0, lastDivergenceIterations = 0;
     double lastDensityError = 0; ///< mean |rho* / rho0 - 1| the last density solve reached
     double lastDivergenceError =
@@ -428,6 +433,9 @@ private:
     /// fills them; bench/RESULTS.md, "DFSPH: the pairs' kernel gradients kept for the step").
     std::vector<std::size_t> mPairStart;
     std::vector<Real> mPairGradient[3];
+    /// Whether this step's solves read mPairGradient (DfsphSettings::keepGradients and
+    /// keptGradientLimit) or recompute the gradients.
+    bool mGradientsKept = false;
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;
