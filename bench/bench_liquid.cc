@@ -69,6 +69,7 @@ struct Options
     std::string scenes = "all";    ///< dam, sphere, all or splish_dam
     std::string methods = "both";  ///< ghost, basic or both
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
+    bool divergenceWarmStart = true; ///< DFSPH: the divergence solve starts from its last pressure
     std::uint64_t seed = 1;
     bool halo = false;  ///< print the halos of domain decompositions of the state
     bool trace = false; ///< print one line per measured step (stderr)
@@ -515,6 +516,7 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
             opt.airWeights == "matched" ? AirWeights::Matched : AirWeights::Complete;
     }
     if (opt.lennardJones > 0) settings.lennardJonesStrength = Real(opt.lennardJones);
+    settings.dfsph.divergenceWarmStart = opt.divergenceWarmStart;
     const PressureModel pressure = pressureFromName(opt.pressure);
 
     std::vector<RunResult> results;
@@ -605,6 +607,10 @@ int main(int argc, char** argv)
                    "speed)")
         ->capture_default_str()
         ->check(CLI::IsMember({"tait", "dfsph"}));
+    app.add_option("--divergence-warm-start", opt.divergenceWarmStart,
+                   "DFSPH: the divergence solve starts from its last pressure (settings.dfsph."
+                   "divergence_warm_start)")
+        ->capture_default_str();
     app.add_option("--method", opt.methods, "ghost, basic or both")
         ->capture_default_str()
         ->check(CLI::IsMember({"ghost", "basic", "both"}));

@@ -46,6 +46,7 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
             d.failValue("max_dt",
                         "expected at least min_dt (" + std::to_string(o.minTimeStep) + " s)");
         o.warmStart = d.get<bool>("warm_start", o.warmStart);
+        o.divergenceWarmStart = d.get<bool>("divergence_warm_start", o.divergenceWarmStart);
         o.keepGradients = d.get<bool>("keep_gradients", o.keepGradients);
         constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
         o.keptGradientLimit =

@@ -415,9 +415,10 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
 
     // Warm start: the last step's pressure terms first ([BK15] Sec. 4.3). Nothing to apply on
     // the first step, or after a restart from rest.
-    const bool warm = opt.warmStart && everywhere(parallel::sum(0, n, [&](std::size_t i) {
-                                           return solved(i) && total[i] != Real(0) ? 1.0 : 0.0;
-                                       })) > 0;
+    const bool startWarm = opt.warmStart && (density || opt.divergenceWarmStart);
+    const bool warm = startWarm && everywhere(parallel::sum(0, n, [&](std::size_t i) {
+                                       return solved(i) && total[i] != Real(0) ? 1.0 : 0.0;
+                                   })) > 0;
     // The density solve applies the share s of the last pressure that best fits this step,
     // the s in [0, 1] minimising the error left in the norm of D G:
     //     s = (k . r) / (k . D G k),
@@ -475,7 +476,7 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     }
     parallel::forEach(
         0, n,
-        [&](std::size_t i) { total[i] = solved(i) && opt.warmStart ? share * total[i] : Real(0); },
+        [&](std::size_t i) { total[i] = solved(i) && startWarm ? share * total[i] : Real(0); },
         4096);
     if (!residualKnown) residual();
     error = meanError(r);

@@ -75,6 +75,15 @@ struct DfsphSettings
     Real maxTimeStep = Real(5e-3);
     /// Start each solve from the last step's pressure ([BK15] Sec. 4.3).
     bool warmStart = true;
+    /// With warmStart: the divergence solve starts from its last pressure too. Off, it starts
+    /// from zero. Here the divergence solve only sees what advection left, which has little to
+    /// do with the last step's correction, and it almost never iterates: the column tank's
+    /// pressure phase is 28 % cheaper (193 -> 33 divergence iterations over 216 -> 212 steps).
+    /// The cost is a noisier still tank: interior density error 0.32 -> 0.46 %, worst layer
+    /// 3.5 -> 5.1 % of rho0 g D, fastest interior particle 0.15 -> 0.19 m/s in float, 0.17 ->
+    /// 0.32 in double (bench/RESULTS.md, "DFSPH: the divergence solve from zero"). A
+    /// look-development trade, not the default.
+    bool divergenceWarmStart = true;
     /// Keep each liquid pair's m_j grad W_ij for the step (12 bytes a pair in float, about
     /// 1 kB a liquid particle at [SB12]'s 3 h support), so the solves' passes read them instead
     /// of gathering positions and evaluating the kernel again: the dam break's pressure phase
