@@ -120,24 +120,19 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
     const DfsphSettings& opt = mSettings.dfsph;
     std::size_t pairs = 0;
     if (opt.keepGradients) {
+        resizeStepArray(mPairStart, n + 1);
         for (std::size_t i = 0; i < n; ++i) {
+            mPairStart[i] = pairs;
             if (kind[i] == ParticleKind::Liquid) pairs += mFluidLists[i].size();
         }
+        mPairStart[n] = pairs;
     }
     const double bytes = double(pairs) * (3 * sizeof(Real)) + double(n + 1) * sizeof(std::size_t);
     const bool keep = opt.keepGradients && bytes <= opt.keptGradientLimit;
     mGradientsKept = keep;
     mSolveStats.lastGradientBytes = opt.keepGradients ? bytes : 0;
     if (opt.keepGradients && !keep) ++mSolveStats.recomputedSteps;
-    if (keep) {
-        resizeStepArray(mPairStart, n + 1);
-        std::size_t at = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            mPairStart[i] = at;
-            if (kind[i] == ParticleKind::Liquid) at += mFluidLists[i].size();
-        }
-        mPairStart[n] = at;
-    } else {
+    if (!keep) {
         pairs = 0;
         std::vector<std::size_t>().swap(mPairStart);
     }
