@@ -372,6 +372,69 @@ TEST(PairBatch, SumsEqualPlainSumsOverLongLists)
     EXPECT_NEAR((bDifferences - differences).length(), 0.0, 1e-5 * differences.length());
 }
 
+TEST(PairBatch, SumsAddInLaneOrderBitForBitAtEveryBatchSize)
+{
+    // PairBatch's sums are defined by their order: term k goes to partial sum k mod LANES, and
+    // the partial sums are added in lane order from zero (the SIMD versions under AVX2 must
+    // give the scalar loops' results bit for bit, or runs would change with the build). Each
+    // sum is checked against that order written out here, at every batch size from 1 to SIZE
+    // (full lane groups and every partial last group), with gathered values.
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(-1, 1);
+    constexpr int L = PairBatch::LANES;
+    std::vector<Vec3> values(300);
+    for (Vec3& v : values) v = Vec3(Real(u(rng)), Real(u(rng)), Real(u(rng)));
+    const Vec3 vi(Real(0.3), Real(-0.2), Real(0.7));
+    PairBatch b;
+    Real x[PairBatch::SIZE], y[PairBatch::SIZE], z[PairBatch::SIZE];
+    for (int n = 1; n <= PairBatch::SIZE; ++n) {
+        b.n = n;
+        for (int k = 0; k < n; ++k) {
+            b.j[k] = Index(std::uniform_int_distribution<int>(0, 299)(rng));
+            b.f[k] = Real(u(rng));
+            b.dx[k] = Real(u(rng));
+            b.dy[k] = Real(u(rng));
+            b.dz[k] = Real(u(rng));
+            x[k] = Real(u(rng));
+            y[k] = Real(u(rng));
+            z[k] = Real(u(rng));
+        }
+        // term(k) into lane k mod L, then the lanes from zero in order.
+        auto ordered = [&](auto term) {
+            Real lane[L] = {};
+            for (int k = 0; k < n; ++k) lane[k % L] += term(k);
+            Real total = 0;
+            for (int l = 0; l < L; ++l) total += lane[l];
+            return total;
+        };
+        auto gathered = [&](int k) { return values[b.j[k]]; };
+        EXPECT_EQ(b.sum(b.f), ordered([&](int k) { return b.f[k]; })) << n;
+        const Vec3 scaled = b.sumScaled(b.f, x, y, z);
+        EXPECT_EQ(scaled[0], ordered([&](int k) { return b.f[k] * x[k]; })) << n;
+        EXPECT_EQ(scaled[1], ordered([&](int k) { return b.f[k] * y[k]; })) << n;
+        EXPECT_EQ(scaled[2], ordered([&](int k) { return b.f[k] * z[k]; })) << n;
+        const Vec3 differences = b.sumScaledDifferences(b.f, values.data(), vi);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(differences[c], ordered(
+                                          [&](int k) {
+                return b.f[k] * (gathered(k)[c] - vi[c]);
+            })) << n;
+        }
+        EXPECT_EQ(b.sumApproach(values.data(), vi, x, y, z), ordered(
+                                                                 [&](int k) {
+            const Vec3 v = gathered(k);
+            return (vi[0] - v[0]) * x[k] + (vi[1] - v[1]) * y[k] + (vi[2] - v[2]) * z[k];
+        })) << n;
+        EXPECT_EQ(b.sumScaledApproach(b.f, values.data(), vi), ordered(
+                                                                   [&](int k) {
+            const Vec3 v = gathered(k);
+            return b.f[k]
+                   * ((vi[0] - v[0]) * b.dx[k] + (vi[1] - v[1]) * b.dy[k]
+                      + (vi[2] - v[2]) * b.dz[k]);
+        })) << n;
+    }
+}
+
 TEST(PairBatch, ListsLongerThanItsBufferGiveTheSameBatches)
 {
     // A dense sorted block and a radius that reaches about 3,000 neighbours: lists past

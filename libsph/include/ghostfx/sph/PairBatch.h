@@ -9,6 +9,12 @@
 ///          are taken over `LANES` interleaved partial sums. The order of every addition is
 ///          fixed by the list, so results are the same at any thread count.
 ///
+///          In a float build with AVX2 the sums run in one register a component, with the
+///          neighbours' values gathered into it: GCC vectorised the lane loops with shuffles
+///          and spilled the lanes to the stack, and the solve passes spent most of their time
+///          there. Each lane adds the same terms in the same order as the scalar loops, so
+///          both give the same bits (bench/RESULTS.md, "Pair sums in AVX2 registers").
+///
 ///          Use (forEachBatch walks a list batch by batch):
 ///          @code
 ///          PairBatch batch;
@@ -206,6 +212,54 @@ struct PairBatch
 #endif
     }
 
+#if defined(__AVX2__)
+    /// Lanes [0, count) set, for the masked loads of a batch's last count < LANES terms.
+    static __m256i tailMask(int count)
+    {
+        return _mm256_cmpgt_epi32(_mm256_set1_epi32(count),
+                                  _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    }
+
+    /// fn(load, vx, vy, vz) for each group of LANES neighbours, with values[j[k + l]] gathered
+    /// into the lanes and load(a) giving a[k + l] (the group's first neighbour k). In a last,
+    /// partial group the lanes past the batch hold 0 in both, so the terms fn adds from them
+    /// must be 0.
+    template <typename Fn>
+    void forEachLaneGroup(const Vec3* values, Fn&& fn) const
+    {
+        const float* base = values[0].asPointer();
+        const __m256i three = _mm256_set1_epi32(3);
+        int k = 0;
+        for (; k + LANES <= n; k += LANES) {
+            const __m256i at = _mm256_mullo_epi32(
+                _mm256_loadu_si256(reinterpret_cast<const __m256i*>(j + k)), three);
+            fn([k](const float* a) { return _mm256_loadu_ps(a + k); },
+               _mm256_i32gather_ps(base, at, 4), _mm256_i32gather_ps(base + 1, at, 4),
+               _mm256_i32gather_ps(base + 2, at, 4));
+        }
+        if (k < n) {
+            const __m256i m = tailMask(n - k);
+            const __m256i at = _mm256_mullo_epi32(
+                _mm256_maskload_epi32(reinterpret_cast<const int*>(j + k), m), three);
+            const __m256 mf = _mm256_castsi256_ps(m), zero = _mm256_setzero_ps();
+            fn([k, m](const float* a) { return _mm256_maskload_ps(a + k, m); },
+               _mm256_mask_i32gather_ps(zero, base, at, mf, 4),
+               _mm256_mask_i32gather_ps(zero, base + 1, at, mf, 4),
+               _mm256_mask_i32gather_ps(zero, base + 2, at, mf, 4));
+        }
+    }
+
+    /// The lanes' partial sums added in lane order from zero, as the scalar loops add theirs.
+    static float reduceLanes(__m256 lanes)
+    {
+        alignas(32) float lane[LANES];
+        _mm256_store_ps(lane, lanes);
+        float total = 0;
+        for (int l = 0; l < LANES; ++l) total += lane[l];
+        return total;
+    }
+#endif
+
     /// x_i - x_j and r for the n indices in j[].
     void gather(const Vec3& xi, const Vec3* x)
     {
@@ -221,6 +275,15 @@ struct PairBatch
     /// sum_k a[k] over the batch, in LANES interleaved partial sums (fixed order).
     Real sum(const Real* a) const
     {
+#if defined(__AVX2__)
+        if constexpr (std::is_same_v<Real, float>) {
+            __m256 acc = _mm256_setzero_ps();
+            int k = 0;
+            for (; k + LANES <= n; k += LANES) acc = _mm256_add_ps(acc, _mm256_loadu_ps(a + k));
+            if (k < n) acc = _mm256_add_ps(acc, _mm256_maskload_ps(a + k, tailMask(n - k)));
+            return reduceLanes(acc);
+        }
+#endif
         Real lane[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -237,6 +300,20 @@ struct PairBatch
     /// sum_k a[k] (values[j[k]] - vi) over the batch, each component as in sum().
     Vec3 sumScaledDifferences(const Real* a, const Vec3* values, const Vec3& vi) const
     {
+#if defined(__AVX2__)
+        if constexpr (std::is_same_v<Real, float>) {
+            const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
+                         iz = _mm256_set1_ps(vi[2]);
+            __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
+            forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
+                const __m256 w = load(a);
+                lx = _mm256_add_ps(lx, _mm256_mul_ps(w, _mm256_sub_ps(vx, ix)));
+                ly = _mm256_add_ps(ly, _mm256_mul_ps(w, _mm256_sub_ps(vy, iy)));
+                lz = _mm256_add_ps(lz, _mm256_mul_ps(w, _mm256_sub_ps(vz, iz)));
+            });
+            return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
+        }
+#endif
         Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -262,6 +339,21 @@ struct PairBatch
     /// m_j gradFactor(r), the rate of density change sum_j m_j (v_i - v_j) . grad W_ij.
     Real sumScaledApproach(const Real* a, const Vec3* values, const Vec3& vi) const
     {
+#if defined(__AVX2__)
+        if constexpr (std::is_same_v<Real, float>) {
+            const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
+                         iz = _mm256_set1_ps(vi[2]);
+            __m256 acc = _mm256_setzero_ps();
+            forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
+                const __m256 t =
+                    _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(ix, vx), load(dx)),
+                                                _mm256_mul_ps(_mm256_sub_ps(iy, vy), load(dy))),
+                                  _mm256_mul_ps(_mm256_sub_ps(iz, vz), load(dz)));
+                acc = _mm256_add_ps(acc, _mm256_mul_ps(load(a), t));
+            });
+            return reduceLanes(acc);
+        }
+#endif
         Real lane[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -288,6 +380,27 @@ struct PairBatch
     /// sum_k a[k] (x[k], y[k], z[k]) over the batch, each component as in sum().
     Vec3 sumScaled(const Real* a, const Real* x, const Real* y, const Real* z) const
     {
+#if defined(__AVX2__)
+        if constexpr (std::is_same_v<Real, float>) {
+            __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
+            auto add = [&](__m256 w, __m256 vx, __m256 vy, __m256 vz) {
+                lx = _mm256_add_ps(lx, _mm256_mul_ps(w, vx));
+                ly = _mm256_add_ps(ly, _mm256_mul_ps(w, vy));
+                lz = _mm256_add_ps(lz, _mm256_mul_ps(w, vz));
+            };
+            int k = 0;
+            for (; k + LANES <= n; k += LANES) {
+                add(_mm256_loadu_ps(a + k), _mm256_loadu_ps(x + k), _mm256_loadu_ps(y + k),
+                    _mm256_loadu_ps(z + k));
+            }
+            if (k < n) {
+                const __m256i m = tailMask(n - k);
+                add(_mm256_maskload_ps(a + k, m), _mm256_maskload_ps(x + k, m),
+                    _mm256_maskload_ps(y + k, m), _mm256_maskload_ps(z + k, m));
+            }
+            return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
+        }
+#endif
         Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -312,6 +425,22 @@ struct PairBatch
     Real sumApproach(const Vec3* values, const Vec3& vi, const Real* x, const Real* y,
                      const Real* z) const
     {
+#if defined(__AVX2__)
+        if constexpr (std::is_same_v<Real, float>) {
+            const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
+                         iz = _mm256_set1_ps(vi[2]);
+            __m256 acc = _mm256_setzero_ps();
+            // (vi - v_j) . (x, y, z) in the scalar loop's order: ((dx x + dy y) + dz z).
+            forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
+                const __m256 t =
+                    _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(ix, vx), load(x)),
+                                                _mm256_mul_ps(_mm256_sub_ps(iy, vy), load(y))),
+                                  _mm256_mul_ps(_mm256_sub_ps(iz, vz), load(z)));
+                acc = _mm256_add_ps(acc, t);
+            });
+            return reduceLanes(acc);
+        }
+#endif
         Real lane[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
