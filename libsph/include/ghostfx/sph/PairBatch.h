@@ -41,6 +41,13 @@
 #include <type_traits>
 #include <utility>
 
+/// The pair sums in AVX2 registers: float builds for AVX2 processors (see the file comment).
+#if defined(__AVX2__) && !defined(GHOSTFX_DOUBLE)
+#define GHOSTFX_PAIR_SUMS_AVX2 1
+#else
+#define GHOSTFX_PAIR_SUMS_AVX2 0
+#endif
+
 namespace ghostfx {
 namespace sph {
 
@@ -212,7 +219,7 @@ struct PairBatch
 #endif
     }
 
-#if defined(__AVX2__)
+#if GHOSTFX_PAIR_SUMS_AVX2
     /// Lanes [0, count) set, for the masked loads of a batch's last count < LANES terms.
     static __m256i tailMask(int count)
     {
@@ -275,8 +282,8 @@ struct PairBatch
     /// sum_k a[k] over the batch, in LANES interleaved partial sums (fixed order).
     Real sum(const Real* a) const
     {
-#if defined(__AVX2__)
-        if constexpr (std::is_same_v<Real, float>) {
+#if GHOSTFX_PAIR_SUMS_AVX2
+        {
             __m256 acc = _mm256_setzero_ps();
             int k = 0;
             for (; k + LANES <= n; k += LANES) acc = _mm256_add_ps(acc, _mm256_loadu_ps(a + k));
@@ -300,8 +307,8 @@ struct PairBatch
     /// sum_k a[k] (values[j[k]] - vi) over the batch, each component as in sum().
     Vec3 sumScaledDifferences(const Real* a, const Vec3* values, const Vec3& vi) const
     {
-#if defined(__AVX2__)
-        if constexpr (std::is_same_v<Real, float>) {
+#if GHOSTFX_PAIR_SUMS_AVX2
+        {
             const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
                          iz = _mm256_set1_ps(vi[2]);
             __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
@@ -339,8 +346,8 @@ struct PairBatch
     /// m_j gradFactor(r), the rate of density change sum_j m_j (v_i - v_j) . grad W_ij.
     Real sumScaledApproach(const Real* a, const Vec3* values, const Vec3& vi) const
     {
-#if defined(__AVX2__)
-        if constexpr (std::is_same_v<Real, float>) {
+#if GHOSTFX_PAIR_SUMS_AVX2
+        {
             const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
                          iz = _mm256_set1_ps(vi[2]);
             __m256 acc = _mm256_setzero_ps();
@@ -380,8 +387,8 @@ struct PairBatch
     /// sum_k a[k] (x[k], y[k], z[k]) over the batch, each component as in sum().
     Vec3 sumScaled(const Real* a, const Real* x, const Real* y, const Real* z) const
     {
-#if defined(__AVX2__)
-        if constexpr (std::is_same_v<Real, float>) {
+#if GHOSTFX_PAIR_SUMS_AVX2
+        {
             __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
             auto add = [&](__m256 w, __m256 vx, __m256 vy, __m256 vz) {
                 lx = _mm256_add_ps(lx, _mm256_mul_ps(w, vx));
@@ -425,8 +432,8 @@ struct PairBatch
     Real sumApproach(const Vec3* values, const Vec3& vi, const Real* x, const Real* y,
                      const Real* z) const
     {
-#if defined(__AVX2__)
-        if constexpr (std::is_same_v<Real, float>) {
+#if GHOSTFX_PAIR_SUMS_AVX2
+        {
             const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
                          iz = _mm256_set1_ps(vi[2]);
             __m256 acc = _mm256_setzero_ps();
