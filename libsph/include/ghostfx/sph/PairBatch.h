@@ -63,6 +63,7 @@ struct PairBatch
 {
     static constexpr int SIZE = 64; ///< pairs per batch
     static constexpr int LANES = 8; ///< interleaved partial sums
+    static_assert(SIZE % LANES == 0, "a batch's arrays hold whole groups of LANES");
 
     /// Run entries decoded at a time (NeighborLists::List::READ_PAST bytes may be read past a
     /// list).
@@ -234,26 +235,43 @@ struct PairBatch
     template <typename Fn>
     void forEachLaneGroup(const Vec3* values, Fn&& fn) const
     {
-        const float* base = values[0].asPointer();
-        const __m256i three = _mm256_set1_epi32(3);
+        __m256 vx, vy, vz;
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
-            const __m256i at = _mm256_mullo_epi32(
-                _mm256_loadu_si256(reinterpret_cast<const __m256i*>(j + k)), three);
-            fn([k](const float* a) { return _mm256_loadu_ps(a + k); },
-               _mm256_i32gather_ps(base, at, 4), _mm256_i32gather_ps(base + 1, at, 4),
-               _mm256_i32gather_ps(base + 2, at, 4));
+            loadLanes(values, j + k, LANES, vx, vy, vz);
+            fn([k](const float* a) { return _mm256_loadu_ps(a + k); }, vx, vy, vz);
         }
         if (k < n) {
             const __m256i m = tailMask(n - k);
-            const __m256i at = _mm256_mullo_epi32(
-                _mm256_maskload_epi32(reinterpret_cast<const int*>(j + k), m), three);
-            const __m256 mf = _mm256_castsi256_ps(m), zero = _mm256_setzero_ps();
-            fn([k, m](const float* a) { return _mm256_maskload_ps(a + k, m); },
-               _mm256_mask_i32gather_ps(zero, base, at, mf, 4),
-               _mm256_mask_i32gather_ps(zero, base + 1, at, mf, 4),
-               _mm256_mask_i32gather_ps(zero, base + 2, at, mf, 4));
+            loadLanes(values, j + k, n - k, vx, vy, vz);
+            fn([k, m](const float* a) { return _mm256_maskload_ps(a + k, m); }, vx, vy, vz);
         }
+    }
+
+    /// The components of values[idx[l]], l < count (<= LANES), in three registers (0 in the
+    /// lanes from count on): each Vec3 read with an 8-byte and a 4-byte load, then the eight
+    /// transposed. Measured cheaper than three vgatherdps a group on this project's machine
+    /// (bench/RESULTS.md, "Pair sums in AVX2 registers").
+    static void loadLanes(const Vec3* values, const Index* idx, int count, __m256& vx, __m256& vy,
+                          __m256& vz)
+    {
+        auto one = [&](int l) {
+            if (l >= count) return _mm_setzero_ps();
+            const float* p = values[idx[l]].asPointer();
+            const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)));
+            return _mm_insert_ps(xy, _mm_load_ss(p + 2), 0x20);
+        };
+        auto pair = [&](int l) {
+            return _mm256_insertf128_ps(_mm256_castps128_ps256(one(l)), one(l + 4), 1);
+        };
+        const __m256 r0 = pair(0), r1 = pair(1), r2 = pair(2), r3 = pair(3);
+        const __m256 t0 = _mm256_unpacklo_ps(r0, r1); // x0 x1 y0 y1 | x4 x5 y4 y5
+        const __m256 t1 = _mm256_unpacklo_ps(r2, r3); // x2 x3 y2 y3 | x6 x7 y6 y7
+        const __m256 t2 = _mm256_unpackhi_ps(r0, r1); // z0 z1 0 0 | z4 z5 0 0
+        const __m256 t3 = _mm256_unpackhi_ps(r2, r3); // z2 z3 0 0 | z6 z7 0 0
+        vx = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0));
+        vy = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2));
+        vz = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0));
     }
 
     /// The lanes' partial sums added in lane order from zero, as the scalar loops add theirs.
@@ -270,6 +288,25 @@ struct PairBatch
     /// x_i - x_j and r for the n indices in j[].
     void gather(const Vec3& xi, const Vec3* x)
     {
+#if GHOSTFX_PAIR_SUMS_AVX2
+        // Eight neighbours at a time (the arrays hold SIZE, a multiple of LANES, so the last
+        // group's stores stay inside them; entries past n are not read).
+        const __m256 ix = _mm256_set1_ps(xi[0]), iy = _mm256_set1_ps(xi[1]),
+                     iz = _mm256_set1_ps(xi[2]);
+        for (int k = 0; k < n; k += LANES) {
+            __m256 vx, vy, vz;
+            loadLanes(x, j + k, std::min(LANES, n - k), vx, vy, vz);
+            const __m256 ox = _mm256_sub_ps(ix, vx), oy = _mm256_sub_ps(iy, vy),
+                         oz = _mm256_sub_ps(iz, vz);
+            _mm256_storeu_ps(dx + k, ox);
+            _mm256_storeu_ps(dy + k, oy);
+            _mm256_storeu_ps(dz + k, oz);
+            _mm256_storeu_ps(r + k, _mm256_sqrt_ps(_mm256_add_ps(
+                                        _mm256_add_ps(_mm256_mul_ps(ox, ox), _mm256_mul_ps(oy, oy)),
+                                        _mm256_mul_ps(oz, oz))));
+        }
+        return;
+#endif
         for (int k = 0; k < n; ++k) {
             const Index q = j[k];
             dx[k] = xi[0] - x[q][0];
