@@ -274,6 +274,15 @@ struct PairBatch
         vz = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0));
     }
 
+    /// (vi - v) . p lane by lane, in the scalar loops' order ((dx px + dy py) + dz pz).
+    static __m256 approach(__m256 ix, __m256 iy, __m256 iz, __m256 vx, __m256 vy, __m256 vz,
+                           __m256 px, __m256 py, __m256 pz)
+    {
+        return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(ix, vx), px),
+                                           _mm256_mul_ps(_mm256_sub_ps(iy, vy), py)),
+                             _mm256_mul_ps(_mm256_sub_ps(iz, vz), pz));
+    }
+
     /// The lanes' partial sums added in lane order from zero, as the scalar loops add theirs.
     static float reduceLanes(__m256 lanes)
     {
@@ -389,10 +398,7 @@ struct PairBatch
                          iz = _mm256_set1_ps(vi[2]);
             __m256 acc = _mm256_setzero_ps();
             forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
-                const __m256 t =
-                    _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(ix, vx), load(dx)),
-                                                _mm256_mul_ps(_mm256_sub_ps(iy, vy), load(dy))),
-                                  _mm256_mul_ps(_mm256_sub_ps(iz, vz), load(dz)));
+                const __m256 t = approach(ix, iy, iz, vx, vy, vz, load(dx), load(dy), load(dz));
                 acc = _mm256_add_ps(acc, _mm256_mul_ps(load(a), t));
             });
             return reduceLanes(acc);
@@ -474,13 +480,9 @@ struct PairBatch
             const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
                          iz = _mm256_set1_ps(vi[2]);
             __m256 acc = _mm256_setzero_ps();
-            // (vi - v_j) . (x, y, z) in the scalar loop's order: ((dx x + dy y) + dz z).
             forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
-                const __m256 t =
-                    _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(ix, vx), load(x)),
-                                                _mm256_mul_ps(_mm256_sub_ps(iy, vy), load(y))),
-                                  _mm256_mul_ps(_mm256_sub_ps(iz, vz), load(z)));
-                acc = _mm256_add_ps(acc, t);
+                acc =
+                    _mm256_add_ps(acc, approach(ix, iy, iz, vx, vy, vz, load(x), load(y), load(z)));
             });
             return reduceLanes(acc);
         }
