@@ -314,8 +314,7 @@ struct PairBatch
                                         _mm256_add_ps(_mm256_mul_ps(ox, ox), _mm256_mul_ps(oy, oy)),
                                         _mm256_mul_ps(oz, oz))));
         }
-        return;
-#endif
+#else
         for (int k = 0; k < n; ++k) {
             const Index q = j[k];
             dx[k] = xi[0] - x[q][0];
@@ -323,20 +322,19 @@ struct PairBatch
             dz[k] = xi[2] - x[q][2];
         }
         for (int k = 0; k < n; ++k) r[k] = std::sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
+#endif
     }
 
     /// sum_k a[k] over the batch, in LANES interleaved partial sums (fixed order).
     Real sum(const Real* a) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        {
-            __m256 acc = _mm256_setzero_ps();
-            int k = 0;
-            for (; k + LANES <= n; k += LANES) acc = _mm256_add_ps(acc, _mm256_loadu_ps(a + k));
-            if (k < n) acc = _mm256_add_ps(acc, _mm256_maskload_ps(a + k, tailMask(n - k)));
-            return reduceLanes(acc);
-        }
-#endif
+        __m256 acc = _mm256_setzero_ps();
+        int k = 0;
+        for (; k + LANES <= n; k += LANES) acc = _mm256_add_ps(acc, _mm256_loadu_ps(a + k));
+        if (k < n) acc = _mm256_add_ps(acc, _mm256_maskload_ps(a + k, tailMask(n - k)));
+        return reduceLanes(acc);
+#else
         Real lane[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -348,25 +346,24 @@ struct PairBatch
         Real total = 0;
         for (int l = 0; l < LANES; ++l) total += lane[l];
         return total;
+#endif
     }
 
     /// sum_k a[k] (values[j[k]] - vi) over the batch, each component as in sum().
     Vec3 sumScaledDifferences(const Real* a, const Vec3* values, const Vec3& vi) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        {
-            const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
-                         iz = _mm256_set1_ps(vi[2]);
-            __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
-            forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
-                const __m256 w = load(a);
-                lx = _mm256_add_ps(lx, _mm256_mul_ps(w, _mm256_sub_ps(vx, ix)));
-                ly = _mm256_add_ps(ly, _mm256_mul_ps(w, _mm256_sub_ps(vy, iy)));
-                lz = _mm256_add_ps(lz, _mm256_mul_ps(w, _mm256_sub_ps(vz, iz)));
-            });
-            return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
-        }
-#endif
+        const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
+                     iz = _mm256_set1_ps(vi[2]);
+        __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
+        forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
+            const __m256 w = load(a);
+            lx = _mm256_add_ps(lx, _mm256_mul_ps(w, _mm256_sub_ps(vx, ix)));
+            ly = _mm256_add_ps(ly, _mm256_mul_ps(w, _mm256_sub_ps(vy, iy)));
+            lz = _mm256_add_ps(lz, _mm256_mul_ps(w, _mm256_sub_ps(vz, iz)));
+        });
+        return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
+#else
         Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -386,6 +383,7 @@ struct PairBatch
         Vec3 total(0);
         for (int l = 0; l < LANES; ++l) total += Vec3(lx[l], ly[l], lz[l]);
         return total;
+#endif
     }
 
     /// sum_k a[k] (vi - values[j[k]]) . (x_i - x_j) over the batch, as in sum(): with a[k] =
@@ -393,17 +391,15 @@ struct PairBatch
     Real sumScaledApproach(const Real* a, const Vec3* values, const Vec3& vi) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        {
-            const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
-                         iz = _mm256_set1_ps(vi[2]);
-            __m256 acc = _mm256_setzero_ps();
-            forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
-                const __m256 t = approach(ix, iy, iz, vx, vy, vz, load(dx), load(dy), load(dz));
-                acc = _mm256_add_ps(acc, _mm256_mul_ps(load(a), t));
-            });
-            return reduceLanes(acc);
-        }
-#endif
+        const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
+                     iz = _mm256_set1_ps(vi[2]);
+        __m256 acc = _mm256_setzero_ps();
+        forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
+            const __m256 t = approach(ix, iy, iz, vx, vy, vz, load(dx), load(dy), load(dz));
+            acc = _mm256_add_ps(acc, _mm256_mul_ps(load(a), t));
+        });
+        return reduceLanes(acc);
+#else
         Real lane[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -422,6 +418,7 @@ struct PairBatch
         Real total = 0;
         for (int l = 0; l < LANES; ++l) total += lane[l];
         return total;
+#endif
     }
 
     /// sum_k a[k] (x_i - x_j) over the batch, each component as in sum().
@@ -431,26 +428,24 @@ struct PairBatch
     Vec3 sumScaled(const Real* a, const Real* x, const Real* y, const Real* z) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        {
-            __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
-            auto add = [&](__m256 w, __m256 vx, __m256 vy, __m256 vz) {
-                lx = _mm256_add_ps(lx, _mm256_mul_ps(w, vx));
-                ly = _mm256_add_ps(ly, _mm256_mul_ps(w, vy));
-                lz = _mm256_add_ps(lz, _mm256_mul_ps(w, vz));
-            };
-            int k = 0;
-            for (; k + LANES <= n; k += LANES) {
-                add(_mm256_loadu_ps(a + k), _mm256_loadu_ps(x + k), _mm256_loadu_ps(y + k),
-                    _mm256_loadu_ps(z + k));
-            }
-            if (k < n) {
-                const __m256i m = tailMask(n - k);
-                add(_mm256_maskload_ps(a + k, m), _mm256_maskload_ps(x + k, m),
-                    _mm256_maskload_ps(y + k, m), _mm256_maskload_ps(z + k, m));
-            }
-            return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
+        __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
+        auto add = [&](__m256 w, __m256 vx, __m256 vy, __m256 vz) {
+            lx = _mm256_add_ps(lx, _mm256_mul_ps(w, vx));
+            ly = _mm256_add_ps(ly, _mm256_mul_ps(w, vy));
+            lz = _mm256_add_ps(lz, _mm256_mul_ps(w, vz));
+        };
+        int k = 0;
+        for (; k + LANES <= n; k += LANES) {
+            add(_mm256_loadu_ps(a + k), _mm256_loadu_ps(x + k), _mm256_loadu_ps(y + k),
+                _mm256_loadu_ps(z + k));
         }
-#endif
+        if (k < n) {
+            const __m256i m = tailMask(n - k);
+            add(_mm256_maskload_ps(a + k, m), _mm256_maskload_ps(x + k, m),
+                _mm256_maskload_ps(y + k, m), _mm256_maskload_ps(z + k, m));
+        }
+        return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
+#else
         Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -468,6 +463,7 @@ struct PairBatch
         Vec3 total(0);
         for (int l = 0; l < LANES; ++l) total += Vec3(lx[l], ly[l], lz[l]);
         return total;
+#endif
     }
 
     /// sum_k (vi - values[j[k]]) . (x[k], y[k], z[k]) over the batch, as in sum(): with the
@@ -476,17 +472,14 @@ struct PairBatch
                      const Real* z) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        {
-            const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
-                         iz = _mm256_set1_ps(vi[2]);
-            __m256 acc = _mm256_setzero_ps();
-            forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
-                acc =
-                    _mm256_add_ps(acc, approach(ix, iy, iz, vx, vy, vz, load(x), load(y), load(z)));
-            });
-            return reduceLanes(acc);
-        }
-#endif
+        const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
+                     iz = _mm256_set1_ps(vi[2]);
+        __m256 acc = _mm256_setzero_ps();
+        forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
+            acc = _mm256_add_ps(acc, approach(ix, iy, iz, vx, vy, vz, load(x), load(y), load(z)));
+        });
+        return reduceLanes(acc);
+#else
         Real lane[LANES] = {};
         int k = 0;
         for (; k + LANES <= n; k += LANES) {
@@ -503,6 +496,7 @@ struct PairBatch
         Real total = 0;
         for (int l = 0; l < LANES; ++l) total += lane[l];
         return total;
+#endif
     }
 };
 
