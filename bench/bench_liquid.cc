@@ -70,6 +70,7 @@ struct Options
     std::string methods = "both";  ///< ghost, basic or both
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     bool divergenceWarmStart = true; ///< DFSPH: the divergence solve starts from its last pressure
+    std::string wallPressure = "mirror"; ///< DFSPH: settings.dfsph.wall_pressure
     std::uint64_t seed = 1;
     bool halo = false;  ///< print the halos of domain decompositions of the state
     bool trace = false; ///< print one line per measured step (stderr)
@@ -517,6 +518,9 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     }
     if (opt.lennardJones > 0) settings.lennardJonesStrength = Real(opt.lennardJones);
     settings.dfsph.divergenceWarmStart = opt.divergenceWarmStart;
+    settings.dfsph.wallPressure = opt.wallPressure == "own"
+                                      ? ghost::DfsphSettings::WallPressure::Own
+                                      : ghost::DfsphSettings::WallPressure::Mirror;
     const PressureModel pressure = pressureFromName(opt.pressure);
 
     std::vector<RunResult> results;
@@ -611,6 +615,11 @@ int main(int argc, char** argv)
                    "DFSPH: the divergence solve starts from its last pressure (settings.dfsph."
                    "divergence_warm_start)")
         ->capture_default_str();
+    app.add_option("--wall-pressure", opt.wallPressure,
+                   "DFSPH: ghost solids as the liquid's mirror images or with its own pressure "
+                   "term (settings.dfsph.wall_pressure)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"mirror", "own"}));
     app.add_option("--method", opt.methods, "ghost, basic or both")
         ->capture_default_str()
         ->check(CLI::IsMember({"ghost", "basic", "both"}));

@@ -48,6 +48,9 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
         o.warmStart = d.get<bool>("warm_start", o.warmStart);
         o.divergenceWarmStart = d.get<bool>("divergence_warm_start", o.divergenceWarmStart);
         o.keepGradients = d.get<bool>("keep_gradients", o.keepGradients);
+        o.wallPressure = d.choice("wall_pressure", "mirror", {"mirror", "own"}) == "mirror"
+                             ? ghost::DfsphSettings::WallPressure::Mirror
+                             : ghost::DfsphSettings::WallPressure::Own;
         constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
         o.keptGradientLimit =
             GiB * d.inRange("kept_gradients_gb", o.keptGradientLimit / GiB, 0, 1e6);

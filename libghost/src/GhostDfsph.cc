@@ -16,9 +16,10 @@
 ///          Both solves find pressure terms k_i = p_i / rho_i^2 (m^5 / (kg s^2)) whose velocity
 ///          change is the symmetric pressure force of [SB12]'s Tait step,
 ///              v_i -= dt (G k)_i,   (G k)_i = sum_liquid j m_j (k_i + k_j) grad W_ij
-///                                             + sum_solid s M k_i grad W_is,
-///          such that the rate of density change (D v)_i = sum_j m_j (v_i - v_j) . grad W_ij
-///          meets the solve's target. D G is symmetric and positive semi-definite (for equal
+///                                             + c sum_solid s M k_i grad W_is,
+///          such that the rate of density change (D v)_i = sum_liquid j m_j (v_i - v_j) .
+///          grad W_ij + c sum_solid s M (v_i - v_s) . grad W_is meets the solve's target (c: the
+///          wall's share, below). D G is symmetric and positive semi-definite (for equal
 ///          masses sum_i k_i (D u)_i = sum_i u_i . (G k)_i when solids are held still), so the
 ///          solve is preconditioned conjugate gradients with [BK15]'s alpha_i as the inverse
 ///          diagonal. [BK15]'s Jacobi iteration (k_i = alpha_i e_i / dt^2) diverges at [SB12]'s
@@ -33,12 +34,32 @@
 ///             walls the liquid in (a falling ball's solve pressed it against its own air); air
 ///             following its nearest liquid particle makes an isolated particle's density
 ///             unchangeable (the system singular).
-///           - a ghost solid adds its mass to rho_i and pushes with the liquid particle's own
-///             pressure term (k_i: the liquid's pressure mirrored onto the wall, in the form
-///             that keeps D G symmetric); in D it moves with the solid's velocity (its normal
-///             velocity is what the wall imposes). Taking [SB12]'s Eq. 3 velocity there (the
-///             tangential velocity of the nearest liquid) fed the liquid's corrections back
-///             into the walls' velocities and a still tank blew up at the corners.
+///           - a ghost solid adds its mass to rho_i and, as seen from liquid particle i, is
+///             i's mirror image in the wall (DfsphSettings::WallPressure::Mirror, the default):
+///             its pressure term is i's, extrapolated down the hydrostatic gradient,
+///                 k_s = k_i + g . (x_s - x_i) / rho0      (Adami et al. 2012, p_s = p_i +
+///                                                          rho0 g . (x_s - x_i), over rho0^2),
+///             and its velocity relative to the wall is i's reflected, so i closes on it twice
+///             as fast as on a fixed particle. The pair's symmetric force M (k_i + k_s) grad
+///             W_is then splits into c = 2 times the unknown k_i, in G, and the known
+///             hydrostatic part, applied with gravity before the density solve; and D's solid
+///             term takes the same c = 2 (the mirror's approach rate), so D G stays symmetric.
+///             For a linear pressure field the sum over liquid and ghosts then gives grad k
+///             times the full moment of the kernel: without the mirror, the solid term leaves
+///             a force proportional to k_i itself, which at depth outweighs the pressure
+///             gradient. Measured (bench/RESULTS.md, "DFSPH: ghost solids as mirror images"):
+///             with WallPressure::Own (c = 1, no extrapolation, the previous model) a still
+///             tank's pressure rose 0.6 to 1.4 % too fast with depth and a slab under a ceiling
+///             slid 1.2-1.8 cm in 0.1 s (the top layer packed against the layer below under
+///             tension); mirrored, -0.1 to +0.4 % and 0.2 mm. The factor alone (c = 2 without
+///             the extrapolation) compressed the tank by 2.6 %; c = 2 in G but not in D (D
+///             the exact rate of the density sum) is not symmetric, and the conjugate
+///             gradients blew up. Moving solids extrapolate with g only, not g minus their own
+///             acceleration (Adami's full form).
+///             The solid's velocity in D is its own (the wall's normal velocity is what it
+///             imposes): taking [SB12]'s Eq. 3 velocity there (the tangential velocity of the
+///             nearest liquid) fed the liquid's corrections back into the walls' velocities
+///             and a still tank blew up at the corners.
 ///           - the density-invariance target is relaxed (Asai et al. 2012's stabilised
 ///             incompressible SPH): the density solve asks for rho + dt D rho / Dt = rho0 +
 ///             (1 - beta) (rho - rho0), beta = DfsphSettings::densityRelaxation per step, while
@@ -99,6 +120,13 @@ int minimumNeighbours(Real supportFactor)
 /// at 0.9 the still tank's solves never fall below it (the hydrostatic pressure fits whole).
 constexpr Real WARM_SHARE_RENEWED = Real(0.9);
 
+/// The wall's share c of the file comment: 2 for mirrored ghost solids, 1 for the liquid
+/// particle's own pressure term.
+Real wallShare(const DfsphSettings& opt)
+{
+    return opt.wallPressure == DfsphSettings::WallPressure::Mirror ? Real(2) : Real(1);
+}
+
 } // namespace
 
 void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
@@ -142,6 +170,7 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
     }
     const Real* halo = haloFlags();
     const int minNeighbours = minimumNeighbours(mSettings.supportFactor);
+    const Real wall = wallShare(opt);
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
@@ -192,6 +221,8 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
                     solid += b.sumScaledOffsets(b.f);
                 });
             }
+            if (gradMass) (*gradMass)[i] = all + solid;
+            solid *= wall; // the wall's share c (file comment)
             const int solidNeighbours = int(mStatic.lists[i].size() + mMoving.lists[i].size());
             // The particle's own pressure term moves it by its liquid and solid gradient sums
             // and each liquid neighbour by its own term.
@@ -200,7 +231,6 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
                             ? Real(1) / a
                             : Real(0);
             mSolidGradient[i] = solid;
-            if (gradMass) (*gradMass)[i] = all + solid;
         }
         },
         512);
@@ -303,9 +333,10 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // D v for the solved particles: liquid velocities `vel`, solids at their own velocity
     // (`solidMoves`) or still.
     std::vector<Real> rate(n, Real(0));
-    // sum_s M (v_i - v_s) . grad W_is = v_i . (the step's solid gradient sum) - the moving
-    // block's sum_s M v_s . grad W_is (static solids have v_s = 0).
+    // c sum_s M (v_i - v_s) . grad W_is = v_i . (the step's solid gradient sum, c included) -
+    // c times the moving block's sum_s M v_s . grad W_is (static solids have v_s = 0).
     const bool movingSolids = !mMoving.block.empty();
+    const Real wall = wallShare(opt);
     const Vec3* movingV =
         movingSolids ? mMoving.block.particles().vectorChannel(SOLID_VELOCITY).data() : nullptr;
     auto divergence = [&](const std::vector<Vec3>& vel, bool solidMoves) {
@@ -337,7 +368,7 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
                         batch.forEachBatch(x[i], set.positions().data(), mMoving.lists[i],
                                            [&](PairBatch& b) {
                             for (int c = 0; c < b.n; ++c) b.f[c] = M * kernel.gradFactor(b.r[c]);
-                            sum -= b.sumScaledApproach(b.f, movingV, Vec3(0));
+                            sum -= wall * b.sumScaledApproach(b.f, movingV, Vec3(0));
                         });
                     }
                     rate[i] = sum;
@@ -587,6 +618,40 @@ void GhostSolver::reportDfsphPressure()
     }
 }
 
+void GhostSolver::applyWallHydrostatics(Real dt)
+{
+    // The known part of the mirrored ghosts' pressure force (file comment): each solved
+    // particle i, v_i -= dt sum_s M (k_s - k_i) grad W_is with k_s - k_i = g . (x_s - x_i) /
+    // rho0, over the solids of both blocks. A halo copy has alpha 0: its owner applies it.
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    auto& w = mParticles.vectorChannel(VSTAR);
+    const Vec3 g = mSettings.gravity;
+    const Real M = mMass, rho0 = mSettings.restDensity;
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (!(mAlpha[i] > Real(0))) continue;
+            Vec3 sum(0);
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                batch.forEachBatch(x[i], block->block.particles().positions().data(),
+                                   block->lists[i],
+                                   [&](PairBatch& b) {
+                    // (x_s - x_i) = -(dx, dy, dz)
+                    for (int c = 0; c < b.n; ++c) {
+                        const Real dk = -(g[0] * b.dx[c] + g[1] * b.dy[c] + g[2] * b.dz[c]) / rho0;
+                        b.f[c] = M * kernel.gradFactor(b.r[c]) * dk;
+                    }
+                    sum += b.sumScaledOffsets(b.f);
+                });
+            }
+            w[i] -= dt * sum;
+        }
+        },
+        512);
+}
+
 void GhostSolver::stepDfsph(Real dt)
 {
     // Line 1 and the density of lines 2-7, as in the Tait step (GhostStep.cc).
@@ -630,6 +695,8 @@ void GhostSolver::stepDfsph(Real dt)
         w[i] += dt * g;
         },
         4096);
+    if (mSettings.dfsph.wallPressure == DfsphSettings::WallPressure::Mirror)
+        applyWallHydrostatics(dt);
     double densityError = 0;
     double densityPeak = 0;
     const int densityIterations = solvePressure(dt, true, kappaDensity, densityError, densityPeak);

@@ -260,6 +260,9 @@ TEST_F(Cli, BadInputGetsOneClearLine)
          "settings.dfsph.density_eror: unknown key (did you mean 'density_error'?)"},
         {" -D settings.dfsph.density_relaxation=0", "settings.dfsph.density_relaxation = 0: "
                                                     "expected a number in [1e-06, 1]"},
+        {" -D settings.dfsph.wall_pressure=mirrored",
+         "settings.dfsph.wall_pressure = \"mirrored\": expected one of 'mirror', 'own' (did you "
+         "mean 'mirror'?)"},
         {" -D settings.dfsph.kept_gradients_gb=-1",
          "settings.dfsph.kept_gradients_gb = -1: expected a number in [0, 1e+06]"},
         {" -D settings.method=basic -D settings.pressure=dfsph",

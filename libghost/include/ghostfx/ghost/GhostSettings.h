@@ -51,15 +51,19 @@ struct DfsphSettings
     Real divergenceError = Real(1e-3);
     /// Share beta of the density error rho - rho0 the density solve removes in one step
     /// (Asai et al. 2012's relaxed density invariance; the velocity divergence is removed in
-    /// full). 1 is [BK15]'s solve; above about 0.05 the few-percent errors of sampled and
-    /// emitted particles become velocity kicks that grow (bench/RESULTS.md, "DFSPH").
+    /// full). 1 is [BK15]'s solve; at 0.2 the few-percent errors of emitted particles become
+    /// velocity kicks (a tap poured 29 % more at CFL 0.4 than at 0.1, its fastest particle at
+    /// 4.1 m/s), and larger shares grow without bound (bench/RESULTS.md, "DFSPH"). 0.1 since
+    /// the mirrored walls: at 0.05 a still tank's settled density error stayed at 0.5-0.7 %
+    /// (a solve that stops at its limit leaves up to limit / beta; bench/RESULTS.md, "DFSPH:
+    /// ghost solids as mirror images").
     /// This share is per step of the length that CFL number RELAXATION_CFL (the default, 0.4)
     /// gives; a shorter step (a smaller CFL number, a frame's last step) takes a share in
     /// proportion, dt / that step (0.0125 at CFL 0.1), so that the velocity its correction asks
     /// for, about beta (rho - rho0) h / (rho0 dt), does not grow as the steps shrink: at CFL
     /// 0.1 the whole share ran away (bench/RESULTS.md, "DFSPH at small steps"). Steps held at
     /// dfsph.max_dt by a calm scene keep the whole share at any CFL number.
-    Real densityRelaxation = Real(0.05);
+    Real densityRelaxation = Real(0.1);
     static constexpr Real RELAXATION_CFL = Real(0.4);
     /// Besides its mean error, a solve must bring every particle's error within this many times
     /// its limit (3 % at the default 0.1 %): on the mean alone a few particles in 100k can be
@@ -67,6 +71,20 @@ struct DfsphSettings
     /// the 98k dam break (bench/RESULTS.md, "DFSPH: a peak limit"): 10 and 20 also hold the
     /// landing but cost 45 % and 17 % more per step; 30 costs nothing measurable.
     static constexpr double PEAK_FACTOR = 30;
+    /// How a ghost solid's pressure enters the solves (GhostDfsph.cc, file comment). Chosen by
+    /// name in scenes (settings.dfsph.wall_pressure).
+    enum class WallPressure : std::uint8_t {
+        /// The liquid particle's mirror image: its pressure term, extrapolated down the
+        /// hydrostatic gradient, and its reflected velocity (Adami et al. 2012's wall pressure
+        /// in the symmetric form): a still tank's pressure within 1 % of rho0 g d, and tension
+        /// that holds liquid under a ceiling.
+        Mirror,
+        /// The liquid particle's own pressure term, once (SPlisHSPlasH's DFSPH boundary
+        /// term): the model until 2026-11-29, kept for comparison; pressure 0.6-1.4 % too
+        /// steep in a still tank, and a slab under a ceiling slides a spacing or two.
+        Own
+    };
+    WallPressure wallPressure = WallPressure::Mirror;
     /// Iteration cap of each solve; a solve that reaches it is counted as unconverged
     /// (GhostSolver::pressureSolveStats) and the step goes on with the velocity it reached.
     int maxIterations = 100;

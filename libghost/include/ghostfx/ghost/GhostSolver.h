@@ -373,6 +373,9 @@ private:
     void finishGhostStep(Real dt, const std::vector<Vec3>& gradMass);
     /// The Ghost method with the DFSPH pressure solves (GhostDfsph.cc).
     void stepDfsph(Real dt);
+    /// DFSPH with mirrored walls: the known hydrostatic part of the ghost solids' pressure force
+    /// on v* (GhostDfsph.cc).
+    void applyWallHydrostatics(Real dt);
     /// DFSPH factor 1 / (|sum_j m_j grad W_ij|^2 + sum_liquid j |m_j grad W_ij|^2), liquid
     /// and solid neighbours, of each liquid particle into mAlpha, and with gradMass the sum
     /// of m_j grad W_ij over every neighbour (particle shifting).
