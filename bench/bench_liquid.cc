@@ -71,6 +71,7 @@ struct Options
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     bool divergenceWarmStart = true; ///< DFSPH: the divergence solve starts from its last pressure
     std::string wallPressure = "mirror"; ///< DFSPH: settings.dfsph.wall_pressure
+    double densityRelaxation = -1;       ///< DFSPH: settings.dfsph.density_relaxation (< 0: default)
     std::uint64_t seed = 1;
     bool halo = false;  ///< print the halos of domain decompositions of the state
     bool trace = false; ///< print one line per measured step (stderr)
@@ -518,6 +519,7 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     }
     if (opt.lennardJones > 0) settings.lennardJonesStrength = Real(opt.lennardJones);
     settings.dfsph.divergenceWarmStart = opt.divergenceWarmStart;
+    if (opt.densityRelaxation > 0) settings.dfsph.densityRelaxation = Real(opt.densityRelaxation);
     settings.dfsph.wallPressure = opt.wallPressure == "own"
                                       ? ghost::DfsphSettings::WallPressure::Own
                                       : ghost::DfsphSettings::WallPressure::Mirror;
@@ -620,6 +622,9 @@ int main(int argc, char** argv)
                    "term (settings.dfsph.wall_pressure)")
         ->capture_default_str()
         ->check(CLI::IsMember({"mirror", "own"}));
+    app.add_option("--density-relaxation", opt.densityRelaxation,
+                   "DFSPH: settings.dfsph.density_relaxation (default: DfsphSettings')")
+        ->check(CLI::Range(1e-6, 1.0));
     app.add_option("--method", opt.methods, "ghost, basic or both")
         ->capture_default_str()
         ->check(CLI::IsMember({"ghost", "basic", "both"}));
