@@ -816,8 +816,9 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
     // 0.4 mm). Pulling with the particle's own pressure term once (WallPressure::Own, the
     // model until 2026-11-29) the ceiling holds the top layer with half the force the layer
     // below pulls it down with: it slides 1.5-1.7 cm, the layers packing together under
-    // tension (bench/RESULTS.md, "DFSPH: ghost solids as mirror images"). Bounds: 3 mm
-    // mirrored, and more than 1 cm with the own term (that the test tells the two apart).
+    // tension (bench/RESULTS.md, "DFSPH: ghost solids as mirror images"; 1.16 cm in the
+    // double build). Bounds: 3 mm mirrored, and more than half a spacing with the own term
+    // (that the test tells the two apart).
     auto drop = [](DfsphSettings::WallPressure wall) {
         GhostSettings s = dfsphSettings();
         s.seed = 4;
@@ -838,7 +839,7 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
         return d;
     };
     EXPECT_LT(std::abs(drop(DfsphSettings::WallPressure::Mirror)), 0.3 * double(H));
-    EXPECT_GT(drop(DfsphSettings::WallPressure::Own), double(H));
+    EXPECT_GT(drop(DfsphSettings::WallPressure::Own), 0.5 * double(H));
 }
 
 TEST(Dfsph, SettingsAreValidatedWithFieldAndValue)
