@@ -57,5 +57,14 @@ inline openvdb::FloatGrid::Ptr invertedCupGrid(sph::Real spacing)
                                 spacing / 2);
 }
 
+/// The liquid of the cohesion tests: a 4 cm slab filling the top of invertedCupGrid (its
+/// ceiling at y = 0, its walls at |x|, |z| = 6 cm), at voxels of half the spacing.
+inline openvdb::FloatGrid::Ptr ceilingSlabGrid(sph::Real spacing)
+{
+    // (float literals, as the tests had them: the same slab in the double build)
+    return sph::makeBoxLevelSet(sph::Vec3(-0.06f, -0.04f, -0.06f), sph::Vec3(0.06f, 0, 0.06f),
+                                spacing / 2);
+}
+
 } // namespace testing
 } // namespace ghostfx

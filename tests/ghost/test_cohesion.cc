@@ -44,8 +44,7 @@ double hangingDrop(Method method)
     solver.addSolid(makeLevelSet(ghostfx::testing::invertedCupGrid(H), "cup"));
     // A 4 cm slab filling the top of the cup: hydrostatic tension at the top -rho0 g d =
     // -390 Pa, well within what the Tait equation holds (down to -k = -2000 Pa).
-    solver.addLiquid(makeLevelSet(
-        makeBoxLevelSet(Vec3(-0.06f, -0.04f, -0.06f), Vec3(0.06f, 0, 0.06f), H / 2), "slab"));
+    solver.addLiquid(makeLevelSet(ghostfx::testing::ceilingSlabGrid(H), "slab"));
     auto topLayer = [&] { return ghostfx::testing::topLayerHeight(solver.particles()); };
     const double start = topLayer();
     for (int f = 0; f < 3; ++f) solver.advanceFrame(); // 0.1 s at 30 frames/s

@@ -825,8 +825,7 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
         s.dfsph.wallPressure = wall;
         GhostSolver solver(s);
         solver.addSolid(makeLevelSet(ghostfx::testing::invertedCupGrid(H), "cup"));
-        solver.addLiquid(makeLevelSet(
-            makeBoxLevelSet(Vec3(-0.06f, -0.04f, -0.06f), Vec3(0.06f, 0, 0.06f), H / 2), "slab"));
+        solver.addLiquid(makeLevelSet(ghostfx::testing::ceilingSlabGrid(H), "slab"));
         auto topLayer = [&] { return ghostfx::testing::topLayerHeight(solver.particles()); };
         const double start = topLayer();
         while (solver.time() < 0.1) solver.step(solver.stableTimeStep());
