@@ -51,15 +51,15 @@
 ///             with WallPressure::Own (c = 1, no extrapolation, the previous model) a still
 ///             tank's pressure rose 0.6 to 1.4 % too fast with depth and a slab under a ceiling
 ///             slid 1.2-1.8 cm in 0.1 s (the top layer packed against the layer below under
-///             tension); mirrored, -0.1 to +0.4 % and 0.2 mm. The factor alone (c = 2 without
-///             the extrapolation) compressed the tank by 2.6 %; c = 2 in G but not in D (D
-///             the exact rate of the density sum) is not symmetric, and the conjugate
+///             tension); mirrored, -0.1 to +0.4 % and within 1 mm. The factor alone (c = 2
+///             without the extrapolation) compressed the tank by 2.6 %; c = 2 in G but not in
+///             D (D the exact rate of the density sum) is not symmetric, and the conjugate
 ///             gradients blew up. Moving solids extrapolate with g only, not g minus their own
 ///             acceleration (Adami's full form).
-///             The solid's velocity in D is its own (the wall's normal velocity is what it
-///             imposes): taking [SB12]'s Eq. 3 velocity there (the tangential velocity of the
-///             nearest liquid) fed the liquid's corrections back into the walls' velocities
-///             and a still tank blew up at the corners.
+///             The reflection is about the solid's own velocity (the wall's normal velocity is
+///             what it imposes): taking [SB12]'s Eq. 3 velocity there (the tangential velocity
+///             of the nearest liquid) fed the liquid's corrections back into the walls'
+///             velocities and a still tank blew up at the corners.
 ///           - the density-invariance target is relaxed (Asai et al. 2012's stabilised
 ///             incompressible SPH): the density solve asks for rho + dt D rho / Dt = rho0 +
 ///             (1 - beta) (rho - rho0), beta = DfsphSettings::densityRelaxation per step, while
