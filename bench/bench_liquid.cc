@@ -71,7 +71,7 @@ struct Options
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     bool divergenceWarmStart = true; ///< DFSPH: the divergence solve starts from its last pressure
     std::string wallPressure = "mirror"; ///< DFSPH: settings.dfsph.wall_pressure
-    double densityRelaxation = -1;       ///< DFSPH: settings.dfsph.density_relaxation (< 0: default)
+    double densityRelaxation = -1;       ///< DFSPH: dfsph.density_relaxation (< 0: default)
     std::uint64_t seed = 1;
     bool halo = false;  ///< print the halos of domain decompositions of the state
     bool trace = false; ///< print one line per measured step (stderr)
