@@ -171,6 +171,11 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
     const Real* halo = haloFlags();
     const int minNeighbours = minimumNeighbours(mSettings.supportFactor);
     const Real wall = wallShare(opt);
+    const bool mirror = opt.wallPressure == DfsphSettings::WallPressure::Mirror;
+    const Vec3 g = mSettings.gravity;
+    const Real rho0 = mSettings.restDensity;
+    if (mirror) assignStepArray(mWallHydrostatic, n, Vec3(0));
+    else std::vector<Vec3>().swap(mWallHydrostatic);
     forRangeWithBatch(
         n, mKernel,
         [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
@@ -213,14 +218,21 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
                 }
             });
             if (copy) continue;
-            Vec3 solid(0);
+            Vec3 solid(0), hydrostatic(0);
             for (const SolidBlock* block : {&mStatic, &mMoving}) {
                 batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
                                    [&](PairBatch& b) {
                     for (int k = 0; k < b.n; ++k) b.f[k] = M * kernel.gradFactor(b.r[k]);
                     solid += b.sumScaledOffsets(b.f);
+                    if (!mirror) return;
+                    // The mirrored ghosts' known part, sum_s M (k_s - k_i) grad W_is with
+                    // k_s - k_i = g . (x_s - x_i) / rho0 (file comment); (dx, dy, dz) = x_i - x_s.
+                    for (int k = 0; k < b.n; ++k)
+                        b.f[k] *= -(g[0] * b.dx[k] + g[1] * b.dy[k] + g[2] * b.dz[k]) / rho0;
+                    hydrostatic += b.sumScaledOffsets(b.f);
                 });
             }
+            if (mirror) mWallHydrostatic[i] = hydrostatic;
             if (gradMass) (*gradMass)[i] = all + solid;
             solid *= wall; // the wall's share c (file comment)
             const int solidNeighbours = int(mStatic.lists[i].size() + mMoving.lists[i].size());
@@ -620,36 +632,16 @@ void GhostSolver::reportDfsphPressure()
 
 void GhostSolver::applyWallHydrostatics(Real dt)
 {
-    // The known part of the mirrored ghosts' pressure force (file comment): each solved
-    // particle i, v_i -= dt sum_s M (k_s - k_i) grad W_is with k_s - k_i = g . (x_s - x_i) /
-    // rho0, over the solids of both blocks. A halo copy has alpha 0: its owner applies it.
-    const std::size_t n = mParticles.size();
-    const auto& x = mParticles.positions();
+    // The known part of the mirrored ghosts' pressure force (file comment), summed by
+    // computeDfsphFactors over the solids of both blocks, on each solved particle. A halo copy
+    // has alpha 0: its owner applies it.
     auto& w = mParticles.vectorChannel(VSTAR);
-    const Vec3 g = mSettings.gravity;
-    const Real M = mMass, rho0 = mSettings.restDensity;
-    forRangeWithBatch(
-        n, mKernel,
-        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (!(mAlpha[i] > Real(0))) continue;
-            Vec3 sum(0);
-            for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                batch.forEachBatch(x[i], block->block.particles().positions().data(),
-                                   block->lists[i],
-                                   [&](PairBatch& b) {
-                    // (x_s - x_i) = -(dx, dy, dz)
-                    for (int c = 0; c < b.n; ++c) {
-                        const Real dk = -(g[0] * b.dx[c] + g[1] * b.dy[c] + g[2] * b.dz[c]) / rho0;
-                        b.f[c] = M * kernel.gradFactor(b.r[c]) * dk;
-                    }
-                    sum += b.sumScaledOffsets(b.f);
-                });
-            }
-            w[i] -= dt * sum;
-        }
+    parallel::forEach(
+        0, mParticles.size(),
+        [&](std::size_t i) {
+        if (mAlpha[i] > Real(0)) w[i] -= dt * mWallHydrostatic[i];
         },
-        512);
+        4096);
 }
 
 void GhostSolver::stepDfsph(Real dt)

@@ -374,7 +374,7 @@ private:
     /// The Ghost method with the DFSPH pressure solves (GhostDfsph.cc).
     void stepDfsph(Real dt);
     /// DFSPH with mirrored walls: the known hydrostatic part of the ghost solids' pressure force
-    /// on v* (GhostDfsph.cc).
+    /// (computeDfsphFactors' mWallHydrostatic) on v* (GhostDfsph.cc).
     void applyWallHydrostatics(Real dt);
     /// DFSPH factor 1 / (|sum_j m_j grad W_ij|^2 + sum_liquid j |m_j grad W_ij|^2), liquid
     /// and solid neighbours, of each liquid particle into mAlpha, and with gradMass the sum
@@ -430,6 +430,9 @@ private:
     /// particle's mass if liquid, else 0.
     std::vector<Real> mAlpha, mLiquidMass;
     std::vector<Vec3> mSolidGradient; ///< DFSPH: sum_solid M grad W_is of each liquid particle
+    /// DFSPH with mirrored walls: sum_solid M (k_s - k_i) grad W_is, the walls' known
+    /// hydrostatic push on each liquid particle (GhostDfsph.cc)
+    std::vector<Vec3> mWallHydrostatic;
     /// DFSPH, this step: m_j grad W_ij of each liquid particle i's fluid neighbours j, in its
     /// list's order from mPairStart[i] on, one array a component. The solves' passes read
     /// them instead of gathering positions and evaluating the kernel again (computeDfsphFactors
