@@ -271,8 +271,8 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
                        : 0.0;
         });
         if (mExchange) fastest = mExchange->maxOf(fastest);
-        const Real reference = dfsphTimeStep(mSettings, Real(fastest), mRun.maxAcceleration,
-                                             DfsphSettings::RELAXATION_CFL);
+        const Real reference =
+            dfsphTimeStep(mSettings, Real(fastest), DfsphSettings::RELAXATION_CFL);
         scale = std::min(Real(1), dt / reference);
     }
     const Real beta = density ? opt.densityRelaxation * scale : Real(0);
@@ -661,7 +661,6 @@ void GhostSolver::stepDfsph(Real dt)
         mParticles.addScalarChannel(DFSPH_SYNC, Real(0));
         mParticles.addVectorChannel(DFSPH_SYNC_VECTOR, Vec3(0));
     }
-    const auto& kind = mParticles.kinds();
     const auto& v = mParticles.velocities();
     auto& w = mParticles.vectorChannel(VSTAR);
     auto& kappaDensity = mParticles.scalarChannel(DENSITY_KAPPA);
@@ -679,14 +678,8 @@ void GhostSolver::stepDfsph(Real dt)
     // Lines 11-14 with the implicit pressure: v* = v + dt g for liquid and air (air falls with
     // the liquid it surrounds), then the constant-density solve on v*.
     const Vec3 g = mSettings.gravity;
-    std::vector<Vec3> start(n);
     parallel::forEach(
-        0, n,
-        [&](std::size_t i) {
-        if (kind[i] == ParticleKind::Liquid) start[i] = w[i];
-        w[i] += dt * g;
-        },
-        4096);
+        0, n, [&](std::size_t i) { w[i] += dt * g; }, 4096);
     if (mSettings.dfsph.wallPressure == DfsphSettings::WallPressure::Mirror)
         applyWallHydrostatics(dt);
     double densityError = 0;
@@ -694,22 +687,15 @@ void GhostSolver::stepDfsph(Real dt)
     const int densityIterations = solvePressure(dt, true, kappaDensity, densityError, densityPeak);
 
     // The pressure terms of both solves act on the velocities (dt G (k_density +
-    // k_divergence) a step).
-    const Real* halo = haloFlags();
+    // k_divergence) a step). The pressure's acceleration does not bound the next step
+    // (dfsphTimeStep): gravity alone counts.
+    mRun.maxAcceleration = 0;
     if (mExchange) {
         // The halo copies' v* (XSPH reads it) and pressure terms (the reported pressure).
         mExchange->refresh(mParticles, {VSTAR, DENSITY_KAPPA, DIVERGENCE_KAPPA});
         mParticles.removeChannel(DFSPH_SYNC);
         mParticles.removeChannel(DFSPH_SYNC_VECTOR);
     }
-    // The largest acceleration of the pressure and gravity bounds the next step
-    // (dfsphTimeStep).
-    mRun.maxAcceleration = Real(parallel::maximum(0, n, [&](std::size_t i) {
-        return kind[i] == ParticleKind::Liquid && (!halo || halo[i] == Real(0))
-                   ? double((w[i] - start[i]).length() / dt)
-                   : 0.0;
-    }));
-    if (mExchange) mRun.maxAcceleration = Real(mExchange->maxOf(double(mRun.maxAcceleration)));
     // Only output and checkpoints read the pressure (the solves and forces use k): a frame's
     // inner steps skip its pass (advanceFrame, mReportPressure).
     if (mReportPressure) reportDfsphPressure();

@@ -811,8 +811,8 @@ Real GhostSolver::stableTimeStep() const
     const Real h = mSettings.spacing;
     if (mSettings.pressure == PressureModel::Dfsph) {
         // The implicit pressure has no sound speed to resolve: dt <= cfl h / |v|max
-        // ([BK15] Sec. 4.4), the force limit, and [minTimeStep, maxTimeStep].
-        return detail::dfsphTimeStep(mSettings, vmax, mRun.maxAcceleration, mSettings.cflNumber);
+        // ([BK15] Sec. 4.4), gravity's force limit, and [minTimeStep, maxTimeStep].
+        return detail::dfsphTimeStep(mSettings, vmax, mSettings.cflNumber);
     }
     Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
     // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration
