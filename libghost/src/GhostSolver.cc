@@ -657,7 +657,8 @@ GhostSolver::MemoryUse GhostSolver::memoryUse() const
     use.stepArrays =
         mQueryMask.capacity()
         + (mScratch.capacity() + mAlpha.capacity() + mLiquidMass.capacity()) * sizeof(Real)
-        + (mSolidGradient.capacity() + mWallHydrostatic.capacity()) * sizeof(Vec3)
+        + (mSolidGradient.capacity() + mWallHydrostatic.capacity() + mMovingWallGravity.capacity())
+              * sizeof(Vec3)
         + mPairStart.capacity() * sizeof(std::size_t);
     for (const auto& c : mPairGradient) use.stepArrays += c.capacity() * sizeof(Real);
     for (const SolidBlock* b : {&mStatic, &mMoving}) {

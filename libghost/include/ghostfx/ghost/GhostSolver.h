@@ -376,6 +376,8 @@ private:
     /// DFSPH with mirrored walls: the known hydrostatic part of the ghost solids' pressure force
     /// (computeDfsphFactors' mWallHydrostatic) on v* (GhostDfsph.cc).
     void applyWallHydrostatics(Real dt);
+    /// DFSPH with mirrored walls: mMovingWallGravity for the step from now to now + dt.
+    void computeMovingWallGravity(Real dt);
     /// DFSPH factor 1 / (|sum_j m_j grad W_ij|^2 + sum_liquid j |m_j grad W_ij|^2), liquid
     /// and solid neighbours, of each liquid particle into mAlpha, and with gradMass the sum
     /// of m_j grad W_ij over every neighbour (particle shifting).
@@ -433,6 +435,9 @@ private:
     /// DFSPH with mirrored walls: sum_solid M (k_s - k_i) grad W_is, the walls' known
     /// hydrostatic push on each liquid particle (GhostDfsph.cc)
     std::vector<Vec3> mWallHydrostatic;
+    /// DFSPH with mirrored walls, this step: g - a_s of each moving solid particle, a_s its
+    /// acceleration over the step (the gravity its mirrored pressure is extrapolated with).
+    std::vector<Vec3> mMovingWallGravity;
     /// DFSPH, this step: m_j grad W_ij of each liquid particle i's fluid neighbours j, in its
     /// list's order from mPairStart[i] on, one array a component. The solves' passes read
     /// them instead of gathering positions and evaluating the kernel again (computeDfsphFactors
