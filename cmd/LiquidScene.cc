@@ -6,6 +6,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
@@ -140,6 +141,7 @@ struct ProcessSampleCache
 {
     std::mutex mutex;
     bool chosen = false;
+    bool byDefault = false; ///< the per-user folder, not one the user named
     std::string folder;
     std::unique_ptr<vdbio::SampleCache> cache;
 };
@@ -150,14 +152,51 @@ ProcessSampleCache& processCache()
     return c;
 }
 
+/// The default folder's size limit: $GHOSTFX_SAMPLE_CACHE_LIMIT_MB, else DEFAULT_LIMIT_MB.
+std::uint64_t defaultSampleCacheLimit()
+{
+    constexpr std::uint64_t DEFAULT_LIMIT_MB = 2048;
+    const char* env = std::getenv("GHOSTFX_SAMPLE_CACHE_LIMIT_MB");
+    if (!env || !*env) return DEFAULT_LIMIT_MB << 20;
+    char* end = nullptr;
+    const unsigned long long mb = std::strtoull(env, &end, 10);
+    if (*end != '\0' || mb == 0 || mb > (1ULL << 30) || env[0] == '-') {
+        throw ValueError(msg("GHOSTFX_SAMPLE_CACHE_LIMIT_MB = '", env,
+                             "': expected a whole number of MiB, at least 1"));
+    }
+    return std::uint64_t(mb) << 20;
+}
+
 } // namespace
+
+bool isSampleCacheOff(const std::string& folder) { return folder.empty() || folder == "off"; }
+
+std::string defaultSampleCacheFolder()
+{
+    namespace fs = std::filesystem;
+    const char* xdg = std::getenv("XDG_CACHE_HOME");
+    const char* home = std::getenv("HOME");
+    // The XDG base directory specification: a relative XDG_CACHE_HOME is to be ignored.
+    if (xdg && *xdg && fs::path(xdg).is_absolute())
+        return (fs::path(xdg) / "ghostfx" / "samples").string();
+    if (home && *home) return (fs::path(home) / ".cache" / "ghostfx" / "samples").string();
+    return std::string();
+}
+
+vdbio::SampleCache* processSampleCacheIfMade()
+{
+    ProcessSampleCache& c = processCache();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    return c.cache.get();
+}
 
 void setProcessSampleCache(const std::string& folder)
 {
     ProcessSampleCache& c = processCache();
     std::lock_guard<std::mutex> lock(c.mutex);
     c.chosen = true;
-    c.folder = folder;
+    c.byDefault = false;
+    c.folder = isSampleCacheOff(folder) ? std::string() : folder;
     c.cache.reset();
 }
 
@@ -167,10 +206,28 @@ vdbio::SampleCache* processSampleCache()
     std::lock_guard<std::mutex> lock(c.mutex);
     if (!c.chosen) {
         const char* env = std::getenv("GHOSTFX_SAMPLE_CACHE");
-        c.folder = env ? env : "";
+        c.byDefault = env == nullptr;
+        c.folder = c.byDefault             ? defaultSampleCacheFolder()
+                   : isSampleCacheOff(env) ? std::string()
+                                           : std::string(env);
         c.chosen = true;
     }
-    if (!c.cache && !c.folder.empty()) c.cache = std::make_unique<vdbio::SampleCache>(c.folder);
+    if (c.cache || c.folder.empty()) return c.cache.get();
+    if (!c.byDefault) {
+        c.cache = std::make_unique<vdbio::SampleCache>(c.folder);
+        return c.cache.get();
+    }
+    const std::uint64_t limit = defaultSampleCacheLimit();
+    try {
+        c.cache = std::make_unique<vdbio::SampleCache>(c.folder, limit);
+    } catch (const IoError& e) {
+        // Nobody asked for this folder: say why it is not used, once, and go on without.
+        std::fprintf(stderr,
+                     "ghostfx: warning: %s; running without a sample cache "
+                     "(GHOSTFX_SAMPLE_CACHE=DIR chooses another folder, =off none)\n",
+                     e.what());
+        c.folder.clear();
+    }
     return c.cache.get();
 }
 

@@ -25,12 +25,23 @@ std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
                                                      const sph::SolverState* restored = nullptr);
 
 /// This process's sample cache (vdbio::SampleCache): the folder of `--sample-cache`, else of
-/// $GHOSTFX_SAMPLE_CACHE, else none (null). Liquid solvers made by makeLiquidSolver take their
-/// solids' and liquid bodies' samples from it. Made on first use; an IoError names the folder
-/// when it cannot be written.
+/// $GHOSTFX_SAMPLE_CACHE, else the per-user defaultSampleCacheFolder(); "off" (or empty) in
+/// either place: none (null). Liquid solvers made by makeLiquidSolver take their solids' and
+/// liquid bodies' samples from it, as SPlisHSPlasH keeps its boundary volume maps: a scene run
+/// again skips sampling its unchanged shapes, with the same results bit for bit. Made on
+/// first use. A folder the user named that cannot be written is an IoError naming it; the
+/// default folder then gives a warning and the run goes on without a cache. The default
+/// folder is kept within $GHOSTFX_SAMPLE_CACHE_LIMIT_MB (default 2048) MiB, least recently
+/// used shapes removed first; a named folder is the user's and is never trimmed.
 vdbio::SampleCache* processSampleCache();
-/// Use `folder` (empty: none, and not the environment's either) from now on.
+/// The cache processSampleCache() has made, or null: asks nothing and makes no folder.
+vdbio::SampleCache* processSampleCacheIfMade();
+/// Use `folder` ("off" or empty: none, and not the environment's either) from now on.
 void setProcessSampleCache(const std::string& folder);
+/// $XDG_CACHE_HOME/ghostfx/samples, else $HOME/.cache/ghostfx/samples; empty without either.
+std::string defaultSampleCacheFolder();
+/// Whether a folder given for the sample cache means none: "off" or empty.
+bool isSampleCacheOff(const std::string& folder);
 
 /// The solver-side motion of keys read from a scene (rotation R = Rz Ry Rx, then translation).
 sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed);

@@ -403,9 +403,12 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         mode = Progress::Mode::Bar;
     Progress progress(mode, std::max(first, startFrame + 1), last);
     if (!resumeNote.empty()) progress.message(resumeNote);
-    if (const vdbio::SampleCache* cache = processSampleCache()) {
+    if (const vdbio::SampleCache* cache = processSampleCacheIfMade()) {
         progress.message(msg("sample cache '", cache->folder(), "': ", cache->hits(),
-                             " shapes loaded, ", cache->stored(), " sampled and kept"));
+                             " shapes loaded, ", cache->stored(), " sampled and kept",
+                             cache->evicted() > 0
+                                 ? msg(", ", cache->evicted(), " least recently used removed")
+                                 : std::string()));
         if (cache->failures() > 0 && writes) {
             std::fprintf(stderr,
                          "ghostfx: warning: sample cache: %llu shapes could not be kept "
@@ -607,7 +610,9 @@ Command addRunCommand(CLI::App& parent)
     c->add_option("--sample-cache", o->sampleCache,
                   "keep the samples of solids and liquid bodies in this folder and take them "
                   "from it when the same shape is sampled again (default: "
-                  "$GHOSTFX_SAMPLE_CACHE, or none); results are the same bit for bit");
+                  "$GHOSTFX_SAMPLE_CACHE, else $XDG_CACHE_HOME/ghostfx/samples or "
+                  "~/.cache/ghostfx/samples, kept within $GHOSTFX_SAMPLE_CACHE_LIMIT_MB, 2048 MiB; "
+                  "'off': none); results are the same bit for bit");
     return {c, [o] { return runScene(*o); }};
 }
 

@@ -25,7 +25,7 @@ struct RunOptions
     /// Progress display: "auto" (bar on a terminal, log lines otherwise), "bar", "log", "none".
     std::string progress = "auto";
     /// Folder of sampled shapes kept between runs (LiquidScene.h, processSampleCache); empty:
-    /// $GHOSTFX_SAMPLE_CACHE, or none.
+    /// $GHOSTFX_SAMPLE_CACHE, else the per-user default; "off": none.
     std::string sampleCache;
 };
 

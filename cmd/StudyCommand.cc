@@ -1153,7 +1153,8 @@ int runStudy(const StudyOptions& options)
     // environment) and the farm commands' (--list, --emit), by its absolute path.
     StudyOptions o = options;
     if (!o.sampleCache.empty()) {
-        o.sampleCache = fs::absolute(o.sampleCache).lexically_normal().string();
+        if (!isSampleCacheOff(o.sampleCache))
+            o.sampleCache = fs::absolute(o.sampleCache).lexically_normal().string();
         setProcessSampleCache(o.sampleCache);
         ::setenv("GHOSTFX_SAMPLE_CACHE", o.sampleCache.c_str(), 1);
     }
@@ -1248,7 +1249,7 @@ Command addStudyCommand(CLI::App& parent)
     c->add_option("--sample-cache", o->sampleCache,
                   "one sample cache folder for every case (ghostfx run --sample-cache): a shape "
                   "sampled by one case is loaded by the others; also written into the commands "
-                  "of --list and --emit");
+                  "of --list and --emit (default: as ghostfx run; 'off': none)");
     return {c, [o] { return runStudy(*o); }};
 }
 

@@ -525,8 +525,10 @@ PYBIND11_MODULE(_ghostfx, m)
         py::arg("folder"),
         "Keep the Poisson-disk samples of solids and liquid bodies in `folder` and take them from "
         "it when the same shape is sampled again (as `ghostfx run --sample-cache`): the same "
-        "results, bit for bit, without sampling again. \"\" turns it off (also "
-        "$GHOSTFX_SAMPLE_CACHE, read when no folder was set).");
+        "results, bit for bit, without sampling again. \"off\" or \"\" turns it off. When no "
+        "folder was set: $GHOSTFX_SAMPLE_CACHE, else the per-user folder "
+        "($XDG_CACHE_HOME/ghostfx/samples or ~/.cache/ghostfx/samples, kept within "
+        "$GHOSTFX_SAMPLE_CACHE_LIMIT_MB, 2048 MiB).");
     m.def(
         "sample_cache_counts",
         []() {

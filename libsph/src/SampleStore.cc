@@ -33,6 +33,27 @@ private:
     std::uint64_t mHash = 0xcbf29ce484222325ULL;
 };
 
+/// What else decides the samples' last bits: the compiler and the instructions it was allowed
+/// (fused multiply-adds round once where a multiply and an add round twice). Builds that differ
+/// here (an AVX2 build beside a portable one, both using the per-user cache) keep apart files.
+constexpr char BUILD[] = "compiler "
+#ifdef __VERSION__
+    __VERSION__
+#endif
+#ifdef __FMA__
+                         " fma"
+#endif
+#ifdef __AVX2__
+                         " avx2"
+#endif
+#ifdef __AVX512F__
+                         " avx512f"
+#endif
+#ifdef __FAST_MATH__
+                         " fast-math"
+#endif
+    ;
+
 } // namespace
 
 std::uint64_t sampleKey(const LevelSet& shape, const PoissonSettings& s)
@@ -40,6 +61,7 @@ std::uint64_t sampleKey(const LevelSet& shape, const PoissonSettings& s)
     Fnv h;
     h.value(SAMPLER_VERSION);
     h.value(std::uint32_t(sizeof(Real)));
+    h.bytes(BUILD, sizeof BUILD);
     h.value(shape.contentHash());
     h.value(s.radius);
     h.value(s.surfaceAttempts);

@@ -27,6 +27,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <spawn.h>
 #include <sstream>
 #include <sys/wait.h>
@@ -771,6 +772,74 @@ TEST_F(Cli, AnimatedSolidsFollowKeysAndFileSequences)
                               + "' does not exist");
 }
 
+/// Sets an environment variable (or unsets it, for null) for one scope.
+class ScopedEnv
+{
+public:
+    ScopedEnv(const char* name, const char* value) : mName(name)
+    {
+        if (const char* old = std::getenv(name)) mOld = old;
+        if (value) ::setenv(name, value, 1);
+        else ::unsetenv(name);
+    }
+    ~ScopedEnv()
+    {
+        if (mOld) ::setenv(mName.c_str(), mOld->c_str(), 1);
+        else ::unsetenv(mName.c_str());
+    }
+
+private:
+    std::string mName;
+    std::optional<std::string> mOld;
+};
+
+TEST_F(Cli, SampleCacheIsPerUserByDefault)
+{
+    // With neither --sample-cache nor $GHOSTFX_SAMPLE_CACHE, runs share the per-user folder
+    // $XDG_CACHE_HOME/ghostfx/samples (as SPlisHSPlasH keeps its volume maps): a scene run
+    // again loads its shapes. "off" in either place runs without one.
+    const std::string path = write(smallScene());
+    const fs::path xdg = mDir / "xdg", folder = xdg / "ghostfx" / "samples";
+    ScopedEnv noFolder("GHOSTFX_SAMPLE_CACHE", nullptr);
+    ScopedEnv cacheHome("XDG_CACHE_HOME", xdg.string().c_str());
+    const std::string args = "run " + path + " --frames 1-1 --progress log --out ";
+    const Result first = run(args + (mDir / "a").string());
+    ASSERT_EQ(first.code, 0) << first.err;
+    EXPECT_CONTAINS(first.err,
+                    "sample cache '" + folder.string() + "': 0 shapes loaded, 2 sampled");
+    const Result second = run(args + (mDir / "b").string());
+    ASSERT_EQ(second.code, 0) << second.err;
+    EXPECT_CONTAINS(second.err, "2 shapes loaded, 0 sampled and kept");
+    EXPECT_EQ(gridBytes(mDir / "a" / "liquid_points.0001.vdb"),
+              gridBytes(mDir / "b" / "liquid_points.0001.vdb"));
+    {
+        const Result off = run(args + (mDir / "c").string() + " --sample-cache off");
+        ASSERT_EQ(off.code, 0) << off.err;
+        EXPECT_EQ(off.err.find("sample cache"), std::string::npos) << off.err;
+        ScopedEnv envOff("GHOSTFX_SAMPLE_CACHE", "off");
+        const Result alsoOff = run(args + (mDir / "d").string());
+        ASSERT_EQ(alsoOff.code, 0) << alsoOff.err;
+        EXPECT_EQ(alsoOff.err.find("sample cache"), std::string::npos) << alsoOff.err;
+    }
+    // The folder is kept within $GHOSTFX_SAMPLE_CACHE_LIMIT_MB: a bad value is one clear line.
+    {
+        ScopedEnv limit("GHOSTFX_SAMPLE_CACHE_LIMIT_MB", "lots");
+        EXPECT_CONTAINS(errorLine(args + (mDir / "e").string()),
+                        "GHOSTFX_SAMPLE_CACHE_LIMIT_MB = 'lots': expected a whole number of MiB");
+        EXPECT_FALSE(fs::exists(mDir / "e" / "liquid_points.0001.vdb"));
+    }
+    // A default folder that cannot be made is not the user's doing: a warning, and the run
+    // goes on without a cache (a folder the user names is an error, see the test below).
+    std::ofstream(mDir / "file") << "not a folder";
+    ScopedEnv badHome("XDG_CACHE_HOME", (mDir / "file").string().c_str());
+    const Result unwritable = run(args + (mDir / "f").string());
+    ASSERT_EQ(unwritable.code, 0) << unwritable.err;
+    EXPECT_CONTAINS(unwritable.err, "ghostfx: warning: sample cache folder '"
+                                        + (mDir / "file" / "ghostfx" / "samples").string());
+    EXPECT_CONTAINS(unwritable.err, "running without a sample cache");
+    EXPECT_TRUE(fs::exists(mDir / "f" / "liquid_points.0001.vdb"));
+}
+
 TEST_F(Cli, SampleCacheGivesTheSameRunWithoutSamplingAgain)
 {
     // `--sample-cache DIR` (or $GHOSTFX_SAMPLE_CACHE): the first run samples the tank and the
@@ -790,7 +859,7 @@ TEST_F(Cli, SampleCacheGivesTheSameRunWithoutSamplingAgain)
     ::setenv("GHOSTFX_SAMPLE_CACHE", cache.string().c_str(), 1);
     const Result third =
         run("run " + path + " --frames 1-1 --progress log --out " + (mDir / "c").string());
-    ::unsetenv("GHOSTFX_SAMPLE_CACHE");
+    ::setenv("GHOSTFX_SAMPLE_CACHE", "off", 1); // as tests/main.cc left it
     EXPECT_EQ(third.code, 0) << third.err;
     EXPECT_CONTAINS(third.err, "2 shapes loaded, 0 sampled and kept");
 

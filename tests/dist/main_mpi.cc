@@ -7,8 +7,11 @@
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
 
+#include <cstdlib>
+
 int main(int argc, char** argv)
 {
+    ::setenv("GHOSTFX_SAMPLE_CACHE", "off", 1); // as tests/main.cc: no per-user cache in tests
     ghostfx::dist::MpiSession mpi(&argc, &argv);
     openvdb::initialize();
     ::testing::InitGoogleTest(&argc, argv);

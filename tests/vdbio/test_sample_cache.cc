@@ -1,8 +1,8 @@
 /// @file   test_sample_cache.cc
 /// @brief  The sample cache (vdbio::SampleCache, sph::sampleVolumeStored): a shape sampled again
 ///         comes from the cache, bit for bit; another shape, other settings or a damaged file
-///         are sampled afresh; and a liquid solver set up through the cache steps exactly as one
-///         set up without.
+///         are sampled afresh; a liquid solver set up through the cache steps exactly as one
+///         set up without; and a folder with a size limit drops its least recently used shapes.
 #include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/vdbio/SampleCache.h>
@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 
@@ -122,4 +124,53 @@ TEST(SampleCache, ALiquidSolverSetUpThroughTheCacheStepsAsOneWithout)
         EXPECT_EQ(p->positions(), without.positions());
         EXPECT_EQ(p->velocities(), without.velocities());
     }
+}
+
+TEST(SampleCache, ALimitedFolderRemovesTheLeastRecentlyUsedShapes)
+{
+    // Three shapes through a folder that holds two: the one neither written nor loaded most
+    // recently goes. File times are set by hand (a clock tick is coarser than three writes).
+    const fs::path dir = ghostfx::testing::freshDir("sample_cache_limit");
+    const PoissonSettings settings = PoissonSettings::forSpacing(H);
+    const LevelSet a = sphere(Real(0.1)), b = sphere(Real(0.1) + H / 8),
+                   c = sphere(Real(0.1) + H / 4);
+    std::uint64_t bytes = 0;
+    {
+        vdbio::SampleCache unlimited(dir.string());
+        sampleVolumeStored(settings, a, &unlimited);
+        sampleVolumeStored(settings, b, &unlimited);
+        for (const LevelSet* s : {&a, &b}) {
+            bytes = std::max<std::uintmax_t>(
+                bytes, fs::file_size(unlimited.pathOf(sampleKey(*s, settings))));
+        }
+    }
+    // Room for two files of the largest size, not three.
+    vdbio::SampleCache cache(dir.string(), 2 * bytes + bytes / 2);
+    const auto now = fs::file_time_type::clock::now();
+    fs::last_write_time(cache.pathOf(sampleKey(a, settings)), now - std::chrono::hours(2));
+    fs::last_write_time(cache.pathOf(sampleKey(b, settings)), now - std::chrono::hours(1));
+    // Loading a makes it the most recently used, so b is now the oldest.
+    const SampleSet loaded = sampleVolumeStored(settings, a, &cache);
+    EXPECT_EQ(cache.hits(), 1u);
+    EXPECT_GT(fs::last_write_time(cache.pathOf(sampleKey(a, settings))),
+              fs::last_write_time(cache.pathOf(sampleKey(b, settings))));
+    sampleVolumeStored(settings, c, &cache);
+    EXPECT_EQ(cache.stored(), 1u);
+    EXPECT_EQ(cache.evicted(), 1u);
+    EXPECT_TRUE(fs::exists(cache.pathOf(sampleKey(a, settings))));
+    EXPECT_FALSE(fs::exists(cache.pathOf(sampleKey(b, settings))));
+    EXPECT_TRUE(fs::exists(cache.pathOf(sampleKey(c, settings))));
+    // What is left still loads bit for bit.
+    EXPECT_TRUE(sameSamples(sampleVolumeStored(settings, a, &cache), loaded));
+    EXPECT_EQ(cache.hits(), 2u);
+
+    // A limit smaller than one shape keeps the shape just written, and only it.
+    vdbio::SampleCache tiny(dir.string(), 1);
+    sampleVolumeStored(settings, b, &tiny);
+    std::size_t files = 0;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir))
+        files += e.path().extension() == ".gfxsamples";
+    EXPECT_EQ(files, 1u);
+    EXPECT_TRUE(fs::exists(tiny.pathOf(sampleKey(b, settings))));
+    EXPECT_EQ(tiny.evicted(), 2u);
 }

@@ -5,11 +5,14 @@
 
 #include <ghostfx/sph/Exceptions.h>
 
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
+#include <vector>
 
 namespace ghostfx {
 namespace vdbio {
@@ -18,7 +21,9 @@ namespace {
 constexpr char MAGIC[8] = {'G', 'F', 'X', 'S', 'M', 'P', '0', '1'};
 } // namespace
 
-SampleCache::SampleCache(std::string folder) : mFolder(std::move(folder))
+SampleCache::SampleCache(std::string folder, std::uint64_t maxBytes)
+    : mFolder(std::move(folder))
+    , mMaxBytes(maxBytes)
 {
     try {
         ensureWritableDirectory(mFolder);
@@ -61,6 +66,13 @@ std::optional<sph::SampleSet> SampleCache::load(std::uint64_t key)
     in.read(reinterpret_cast<char*>(samples.onSurface.data()), std::streamsize(count));
     // Nothing may follow: a longer file is not one this version wrote.
     if (!in || in.peek() != std::char_traits<char>::eof()) return std::nullopt;
+    in.close();
+    if (mMaxBytes > 0) {
+        // Used now: the limit removes the least recently used first. Best effort.
+        std::error_code ec;
+        std::filesystem::last_write_time(pathOf(key), std::filesystem::file_time_type::clock::now(),
+                                         ec);
+    }
     ++mHits;
     return samples;
 }
@@ -91,6 +103,36 @@ void SampleCache::store(std::uint64_t key, const sph::SampleSet& samples)
         return;
     }
     ++mStored;
+    if (mMaxBytes > 0) trim(path);
+}
+
+void SampleCache::trim(const std::string& keep)
+{
+    namespace fs = std::filesystem;
+    std::lock_guard<std::mutex> lock(mMutex);
+    // Other processes may add or remove files meanwhile: every step is best effort.
+    std::vector<std::tuple<fs::file_time_type, std::uint64_t, fs::path>> files;
+    std::uint64_t total = 0;
+    std::error_code ec;
+    for (fs::directory_iterator it(mFolder, ec), end; !ec && it != end; it.increment(ec)) {
+        const fs::path& p = it->path();
+        std::error_code e1, e2;
+        if (p.extension() != ".gfxsamples" || !it->is_regular_file(e1)) continue;
+        const std::uint64_t size = it->file_size(e1);
+        const fs::file_time_type time = it->last_write_time(e2);
+        if (e1 || e2) continue;
+        total += size;
+        files.emplace_back(time, size, p);
+    }
+    if (total <= mMaxBytes) return;
+    std::sort(files.begin(), files.end()); // oldest first
+    for (const auto& [time, size, p] : files) {
+        if (total <= mMaxBytes) break;
+        if (p == fs::path(keep)) continue;
+        std::error_code e;
+        if (fs::remove(p, e)) ++mEvicted;
+        total -= size; // gone, by this process or another
+    }
 }
 
 std::string SampleCache::firstFailure() const

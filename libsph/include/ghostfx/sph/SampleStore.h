@@ -3,8 +3,9 @@
 ///         a shot re-run after a stiffness tweak) takes its unchanged solids' and liquid bodies'
 ///         samples from the store instead of sampling them again.
 /// @details The store is keyed by sampleKey(): everything sampleVolume() reads (every value,
-///          tile and the transform of the level set, every PoissonSettings field) and
-///          SAMPLER_VERSION. Samples from the store are the ones the sampler would make, bit
+///          tile and the transform of the level set, every PoissonSettings field),
+///          SAMPLER_VERSION and the build (compiler and instruction set, whose rounding the
+///          samples' last bits follow). Samples from the store are the ones the sampler would make, bit
 ///          for bit, so a run gives the same results with or without one. libsph opens no
 ///          files: vdbio::SampleCache is the store on disk (a folder of files).
 #pragma once
@@ -33,7 +34,7 @@ public:
 };
 
 /// The key of `PoissonDiskSampler(settings).sampleVolume(shape)` (64-bit FNV-1a over the
-/// level set's contents, the settings and SAMPLER_VERSION).
+/// level set's contents, the settings, SAMPLER_VERSION and the build).
 std::uint64_t sampleKey(const LevelSet& shape, const PoissonSettings& settings);
 
 /// `PoissonDiskSampler(settings).sampleVolume(shape)`, loaded from `store` when it holds the

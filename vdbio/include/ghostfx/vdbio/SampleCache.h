@@ -7,6 +7,9 @@
 ///          not match (another precision, a short or damaged file) is not used and is written
 ///          again. Files are written atomically, so runs sharing a folder (a study's cases on
 ///          a farm) never read half a file; the folder can be deleted at any time.
+///          With a size limit (the per-user default folder has one, cmd/LiquidScene.h), the
+///          files least recently used (written or loaded: a load touches its file's time) are
+///          removed after each store until the folder's files fit.
 #pragma once
 
 #include <ghostfx/sph/SampleStore.h>
@@ -22,8 +25,9 @@ namespace vdbio {
 class SampleCache : public sph::SampleStore
 {
 public:
-    /// Creates `folder` if needed; IoError naming it when it cannot be written.
-    explicit SampleCache(std::string folder);
+    /// Creates `folder` if needed; IoError naming it when it cannot be written. `maxBytes`:
+    /// the most the folder's .gfxsamples files may hold together (0: no limit).
+    explicit SampleCache(std::string folder, std::uint64_t maxBytes = 0);
 
     std::optional<sph::SampleSet> load(std::uint64_t key) override;
     /// Best effort: a file that cannot be written (a full disk, a folder gone) is counted in
@@ -31,6 +35,7 @@ public:
     void store(std::uint64_t key, const sph::SampleSet& samples) override;
 
     const std::string& folder() const { return mFolder; }
+    std::uint64_t maxBytes() const { return mMaxBytes; }
     std::string pathOf(std::uint64_t key) const;
     /// Shapes loaded, and shapes sampled and stored, so far.
     std::uint64_t hits() const { return mHits; }
@@ -38,10 +43,16 @@ public:
     /// Shapes that could not be kept, and why the first could not.
     std::uint64_t failures() const { return mFailures; }
     std::string firstFailure() const;
+    /// Files removed to keep the folder within maxBytes().
+    std::uint64_t evicted() const { return mEvicted; }
 
 private:
+    /// Removes the least recently used files (never `keep`) until the rest fit maxBytes().
+    void trim(const std::string& keep);
+
     std::string mFolder;
-    std::atomic<std::uint64_t> mHits{0}, mStored{0}, mFailures{0};
+    std::uint64_t mMaxBytes = 0;
+    std::atomic<std::uint64_t> mHits{0}, mStored{0}, mFailures{0}, mEvicted{0};
     mutable std::mutex mMutex;
     std::string mFirstFailure;
 };
