@@ -1,18 +1,21 @@
 /// @file   test_mask_dilation.cc
 /// @brief  dilateMaxNorm (vdbio/MaskDilation.h) against OpenVDB's own k iterations of
-///         26-neighbour dilation: the same active voxels, for k below, at and above a leaf.
+///         26-neighbour dilation: the same active voxels, for k below, at and above a leaf;
+///         dilateFaces against NN_FACE, on masks and, in place, on a level set's band.
 /// @details The masks: scattered single voxels (every bit position of a word exercised,
 ///          leaves apart and adjacent, negative coordinates) and a thick spherical shell like
 ///          the surface's band (SurfaceGrid.cc dilates such shells by 1, 3, 5 and 8).
 #include <ghostfx/sph/Random.h>
 #include <ghostfx/vdbio/MaskDilation.h>
 
+#include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/Morphology.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 using namespace ghostfx;
 
@@ -113,4 +116,36 @@ TEST(MaskDilation, OneVoxelBecomesACube)
     EXPECT_EQ(box.min(), openvdb::Coord(3, -4, -5));
     EXPECT_EQ(box.max(), openvdb::Coord(11, 4, 3));
     EXPECT_THROW(vdbio::dilateMaxNorm(mask, -1), openvdb::ValueError);
+}
+
+TEST(MaskDilation, ALevelSetsBandGrowsInPlaceAsByTopologyUnion)
+{
+    // dilateFaces on a float tree (NarrowBandFlow::track's band growth) against the copy it
+    // replaces: its topology dilated as a mask, then united into the tree. Same active voxels,
+    // same leaves, and every value the same bit for bit (new voxels keep their inactive values;
+    // leaves added over a tile take the tile's value, inside -background, outside +background).
+    // A sphere about the origin, so the band crosses the signs of every axis (eight upper nodes).
+    openvdb::FloatGrid::Ptr sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        3.0f, openvdb::Vec3f(0.1f), 0.1f, 3.0f);
+    const openvdb::FloatTree& input = sphere->tree();
+    openvdb::FloatTree reference(input), ours(input);
+    openvdb::MaskTree band(reference, false, openvdb::TopologyCopy());
+    openvdb::tools::dilateActiveValues(band, 1, openvdb::tools::NN_FACE,
+                                       openvdb::tools::IGNORE_TILES);
+    reference.topologyUnion(band);
+    vdbio::dilateFaces(ours);
+    EXPECT_GT(ours.activeVoxelCount(), input.activeVoxelCount());
+    EXPECT_EQ(ours.activeVoxelCount(), reference.activeVoxelCount());
+    EXPECT_EQ(ours.leafCount(), reference.leafCount());
+    std::size_t differ = 0, leaves = 0;
+    for (auto leaf = reference.cbeginLeaf(); leaf; ++leaf, ++leaves) {
+        const openvdb::FloatTree::LeafNodeType* other = ours.probeConstLeaf(leaf->origin());
+        ASSERT_NE(other, nullptr) << leaf->origin();
+        differ += leaf->getValueMask() != other->getValueMask();
+        differ +=
+            std::memcmp(leaf->buffer().data(), other->buffer().data(), leaf->SIZE * sizeof(float))
+            != 0;
+    }
+    std::printf("[measured] level-set sphere: %zu leaves, %zu differ\n", leaves, differ);
+    EXPECT_EQ(differ, 0u);
 }

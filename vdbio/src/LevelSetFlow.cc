@@ -246,9 +246,7 @@ void NarrowBandFlow::track()
     Tree& tree = mGrid.tree();
     // Grow the band by its face neighbours (LevelSetTracker::track's NN_FACE dilation): new
     // voxels keep their inactive values, and leaves added over a tile take the tile's value.
-    openvdb::MaskTree band(tree, false, openvdb::TopologyCopy());
-    dilateFaces(band);
-    tree.topologyUnion(band);
+    dilateFaces(tree);
     renormalise();
     // Voxels that left the band become inactive at +-background, as LevelSetTracker trims.
     const float gamma = mGrid.background();

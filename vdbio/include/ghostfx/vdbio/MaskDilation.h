@@ -25,5 +25,11 @@ void dilateMaxNorm(openvdb::MaskTree& mask, int k);
 /// and z of the same input.
 void dilateFaces(openvdb::MaskTree& mask);
 
+/// The same dilation of a float tree's active voxels, in place: voxels activated keep their
+/// (inactive) values, and leaves added take the value of the tile they replace, as
+/// Tree::topologyUnion with the dilated mask would (a level set's band grown by one voxel,
+/// LevelSetTracker::track's NN_FACE step), without copying the tree.
+void dilateFaces(openvdb::FloatTree& tree);
+
 } // namespace vdbio
 } // namespace ghostfx
