@@ -82,7 +82,7 @@ void dilateInPlace(TreeT& tree, const openvdb::Coord* steps, int count, const Wo
     tree.getNodes(leaves);
     const std::size_t n = leaves.size();
     std::vector<Word> grown(n * DIM);
-    // Existing leaves' new words, and the missing leaves beside them (per range, then merged).
+    // Existing leaves' new words, and the missing leaves beside them (per thread, merged).
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> missingPerThread;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
                       [&](const tbb::blocked_range<std::size_t>& range) {
