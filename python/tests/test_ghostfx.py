@@ -417,4 +417,7 @@ def test_sample_cache_gives_the_same_particles_without_sampling_again(tmp_path):
         ghostfx.set_sample_cache("")
     with pytest.raises(OSError, match="sample cache folder"):
         ghostfx.set_sample_cache("/proc/version/cache")
+    # "off", as on the command line: no cache, so nothing loaded or kept.
+    ghostfx.set_sample_cache("off")
+    assert ghostfx.sample_cache_counts() == (0, 0)
     ghostfx.set_sample_cache("")
