@@ -229,7 +229,8 @@ void NarrowBandFlow::offset(float distance)
         const float shift = std::copysign(delta, distance);
         LeafManager leaves(mGrid.tree());
         leaves.foreach ([shift](Leaf& leaf, std::size_t) {
-            for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(*it + shift);
+            float* values = leaf.buffer().data();
+            forEachActive(leaf, [&](int v) { values[v] += shift; });
         });
         track();
     }
@@ -252,14 +253,16 @@ void NarrowBandFlow::track()
     const float gamma = mGrid.background();
     LeafManager leaves(tree);
     leaves.foreach ([gamma](Leaf& leaf, std::size_t) {
-        for (auto it = leaf.beginValueOn(); it; ++it) {
-            const float value = *it;
+        const float* values = leaf.buffer().data();
+        // forEachActive walks a copy of each mask word, so turning voxels off is safe.
+        forEachActive(leaf, [&](int v) {
+            const float value = values[v];
             if (value <= -gamma) {
-                leaf.setValueOff(it.pos(), -gamma);
+                leaf.setValueOff(openvdb::Index(v), -gamma);
             } else if (value >= gamma) {
-                leaf.setValueOff(it.pos(), gamma);
+                leaf.setValueOff(openvdb::Index(v), gamma);
             }
-        }
+        });
     });
     openvdb::tools::pruneLevelSet(tree);
 }
