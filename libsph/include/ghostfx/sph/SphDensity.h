@@ -38,9 +38,16 @@ Real massForRestDensity(const std::vector<Vec3>& positions, const Kernel& kernel
 {
     NeighborGrid grid(kernel.supportRadius());
     grid.build(positions);
-    const std::vector<Real> unitMass(positions.size(), Real(1));
-    const std::vector<Real> rho = densitySum(positions, unitMass, grid, kernel);
     const bool all = measure.empty();
+    // Sums for the measured particles only: a liquid's solver measures its liquid among all the
+    // ghosts, and a tank's ghost solids can outnumber the liquid several times.
+    std::vector<Real> rho(positions.size(), Real(0));
+    parallel::forEach(0, positions.size(), [&](std::size_t i) {
+        if (!all && !measure[i]) return;
+        Real sum = 0;
+        grid.forEachNeighbor(Index(i), [&](Index, const Vec3&, Real r) { sum += kernel.W(r); });
+        rho[i] = sum;
+    });
     const double total = parallel::sum(
         0, rho.size(), [&](std::size_t i) { return all || measure[i] ? double(rho[i]) : 0.0; });
     const double count =
