@@ -4,6 +4,7 @@
 
 #include "ghostfx/sph/Exceptions.h"
 
+#include <openvdb/math/Maps.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/Prune.h>
@@ -26,6 +27,19 @@ struct LevelSet::Impl
         , accessors(grid->getConstAccessor())
         , map(grid->transform().baseMap())
     {
+        // An axis-aligned map (the usual level set's: scale, or scale and translation) is
+        // inverted inline with its own arithmetic: the virtual calls cost as much as the
+        // arithmetic they wrap in the sampler's projections.
+        if (const auto* scale = dynamic_cast<const openvdb::math::ScaleMap*>(map.get())) {
+            axisAligned = true;
+            inverseScale = scale->getInvScale();
+        } else if (const auto* shifted =
+                       dynamic_cast<const openvdb::math::ScaleTranslateMap*>(map.get())) {
+            axisAligned = true;
+            inverseScale = shifted->getInvScale();
+            translation = shifted->getTranslation();
+            translated = true;
+        }
         voxelSize = Real(grid->voxelSize()[0]);
         bandWidth = Real(grid->background());
         const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
@@ -132,10 +146,32 @@ struct LevelSet::Impl
         openvdb::tools::BoxSampler::getValues(f, accessor(), c);
     }
 
+    /// map->applyInverseMap(x), the same arithmetic (ScaleMap and ScaleTranslateMap).
+    openvdb::Vec3d worldToIndex(const Vec3& x) const
+    {
+        const openvdb::Vec3d w(x[0], x[1], x[2]);
+        if (!axisAligned) return map->applyInverseMap(w);
+        if (!translated) {
+            return openvdb::Vec3d(w.x() * inverseScale.x(), w.y() * inverseScale.y(),
+                                  w.z() * inverseScale.z());
+        }
+        return openvdb::Vec3d((w.x() - translation.x()) * inverseScale.x(),
+                              (w.y() - translation.y()) * inverseScale.y(),
+                              (w.z() - translation.z()) * inverseScale.z());
+    }
+
+    /// map->applyIJT(g): an index-space gradient in world space, the same arithmetic.
+    openvdb::Vec3d gradientToWorld(const openvdb::Vec3d& g) const
+    {
+        if (!axisAligned) return map->applyIJT(g);
+        return openvdb::Vec3d(g.x() * inverseScale.x(), g.y() * inverseScale.y(),
+                              g.z() * inverseScale.z());
+    }
+
     /// BoxSampler::sample (the same interpolation, so the same value), with corners() above.
     Real sample(const Vec3& x) const
     {
-        const openvdb::Vec3d ijk = map->applyInverseMap(openvdb::Vec3d(x[0], x[1], x[2]));
+        const openvdb::Vec3d ijk = worldToIndex(x);
         const openvdb::Vec3i i = openvdb::tools::local_util::floorVec3(ijk);
         float f[2][2][2];
         corners(openvdb::Coord(i), f);
@@ -151,6 +187,9 @@ struct LevelSet::Impl
     /// The transform's map, held once: Transform::baseMap() returns a shared pointer by value,
     /// and copying it (two atomic operations) per call cost 6 % of a run in the projection.
     openvdb::math::MapBase::ConstPtr map;
+    bool axisAligned = false; ///< map is a ScaleMap or ScaleTranslateMap (worldToIndex())
+    bool translated = false;  ///< ... a ScaleTranslateMap
+    openvdb::Vec3d inverseScale{1.0}, translation{0.0};
     std::vector<const float*> leafTable; ///< see buildLeafTable()
     int tableMin[3] = {0, 0, 0}, tableDims[3] = {0, 0, 0};
 };
@@ -222,7 +261,7 @@ Vec3 LevelSet::gradient(const Vec3& x) const
 
 Real LevelSet::phiAndGradient(const Vec3& x, Vec3& grad) const
 {
-    const openvdb::Vec3d ijk = mImpl->map->applyInverseMap(openvdb::Vec3d(x[0], x[1], x[2]));
+    const openvdb::Vec3d ijk = mImpl->worldToIndex(x);
     const openvdb::Coord c = openvdb::Coord::floor(ijk);
     const double u = ijk.x() - c.x(), v = ijk.y() - c.y(), w = ijk.z() - c.z();
     float values[2][2][2];
@@ -242,7 +281,7 @@ Real LevelSet::phiAndGradient(const Vec3& x, Vec3& grad) const
     const double du = lerp(lerp(f[1][0][0] - f[0][0][0], f[1][1][0] - f[0][1][0], v),
                            lerp(f[1][0][1] - f[0][0][1], f[1][1][1] - f[0][1][1], v), w);
     // Index-space gradient to world space: the inverse Jacobian transpose of the map.
-    grad = toVec3(mImpl->map->applyIJT(openvdb::Vec3d(du, dv, dw)));
+    grad = toVec3(mImpl->gradientToWorld(openvdb::Vec3d(du, dv, dw)));
     return Real(value);
 }
 
