@@ -71,6 +71,7 @@ struct Options
     std::string pressure = "tait"; ///< Ghost SPH pressure model: tait or dfsph
     bool divergenceWarmStart = true; ///< DFSPH: the divergence solve starts from its last pressure
     std::string wallPressure = "mirror"; ///< DFSPH: settings.dfsph.wall_pressure
+    std::string airDensity = "full";     ///< DFSPH: settings.dfsph.air_density
     double densityRelaxation = -1;       ///< DFSPH: dfsph.density_relaxation (< 0: default)
     std::uint64_t seed = 1;
     bool halo = false;  ///< print the halos of domain decompositions of the state
@@ -523,6 +524,8 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     settings.dfsph.wallPressure = opt.wallPressure == "own"
                                       ? ghost::DfsphSettings::WallPressure::Own
                                       : ghost::DfsphSettings::WallPressure::Mirror;
+    settings.dfsph.airDensity = opt.airDensity == "fill" ? ghost::DfsphSettings::AirDensity::Fill
+                                                         : ghost::DfsphSettings::AirDensity::Full;
     const PressureModel pressure = pressureFromName(opt.pressure);
 
     std::vector<RunResult> results;
@@ -622,6 +625,11 @@ int main(int argc, char** argv)
                    "term (settings.dfsph.wall_pressure)")
         ->capture_default_str()
         ->check(CLI::IsMember({"mirror", "own"}));
+    app.add_option("--air-density", opt.airDensity,
+                   "DFSPH: the ghost air's whole mass in the liquid's density, or only what fills "
+                   "it to rest density (settings.dfsph.air_density)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"full", "fill"}));
     app.add_option("--density-relaxation", opt.densityRelaxation,
                    "DFSPH: settings.dfsph.density_relaxation (default: DfsphSettings')")
         ->check(CLI::Range(1e-6, 1.0));

@@ -52,6 +52,9 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
         o.wallPressure = d.choice("wall_pressure", "mirror", {"mirror", "own"}) == "mirror"
                              ? ghost::DfsphSettings::WallPressure::Mirror
                              : ghost::DfsphSettings::WallPressure::Own;
+        o.airDensity = d.choice("air_density", "full", {"full", "fill"}) == "fill"
+                           ? ghost::DfsphSettings::AirDensity::Fill
+                           : ghost::DfsphSettings::AirDensity::Full;
         constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
         o.keptGradientLimit =
             GiB * d.inRange("kept_gradients_gb", o.keptGradientLimit / GiB, 0, 1e6);

@@ -150,6 +150,9 @@ void GhostSolver::computeDensity()
     auto& rho = mParticles.densities();
     const Real rho0 = mSettings.restDensity;
     const bool ghost = mSettings.method == Method::Ghost;
+    // DFSPH's air fills a liquid particle's density up to rho0 and no further (AirDensity).
+    const bool fill = ghost && mSettings.pressure == PressureModel::Dfsph
+                      && mSettings.dfsph.airDensity == DfsphSettings::AirDensity::Fill;
     SolidBlock* blocks[2] = {&mStatic, &mMoving};
 
     // Eq. 1 for liquid particles: Ghost SPH sums over every kind, Basic SPH over liquid only
@@ -183,11 +186,15 @@ void GhostSolver::computeDensity()
             }
             const Vec3 xi = x[i];
             const NeighborLists::List fluid = mFluidLists[i];
-            Real sum = 0;
+            Real sum = 0, air = 0;
             batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
                 for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
                 for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
                 sum += b.sum(b.f);
+                if (!fill) return;
+                for (int k = 0; k < b.n; ++k)
+                    b.g[k] = kind[b.j[k]] == ParticleKind::GhostAir ? b.f[k] : Real(0);
+                air += b.sum(b.g);
             });
             std::size_t count = fluid.size();
             for (int k = 0; ghost && k < 2; ++k) {
@@ -206,6 +213,10 @@ void GhostSolver::computeDensity()
                 });
                 sum += mMass * w;
                 count += solid.size();
+            }
+            if (fill) {
+                const Real own = sum - air; // liquid and solids
+                sum = own + std::min(air, std::max(Real(0), rho0 - own));
             }
             rho[i] = sum;
             neighbours[i] = std::uint32_t(count);

@@ -264,6 +264,8 @@ TEST_F(Cli, BadInputGetsOneClearLine)
         {" -D settings.dfsph.wall_pressure=mirrored",
          "settings.dfsph.wall_pressure = \"mirrored\": expected one of 'mirror', 'own' (did you "
          "mean 'mirror'?)"},
+        {" -D settings.dfsph.air_density=half",
+         "settings.dfsph.air_density = \"half\": expected one of 'full', 'fill'"},
         {" -D settings.dfsph.kept_gradients_gb=-1",
          "settings.dfsph.kept_gradients_gb = -1: expected a number in [0, 1e+06]"},
         {" -D settings.method=basic -D settings.pressure=dfsph",

@@ -85,6 +85,23 @@ struct DfsphSettings
         Own
     };
     WallPressure wallPressure = WallPressure::Mirror;
+    /// How much of the ghost air's mass a liquid particle's density counts. Chosen by name in
+    /// scenes (settings.dfsph.air_density).
+    enum class AirDensity : std::uint8_t {
+        /// All of it ([SB12] Eq. 1). The default.
+        Full,
+        /// Only what the liquid and solids around the particle lack of rho0: the air completes
+        /// a surface particle's neighbourhood and never compresses it. Air moves with the
+        /// liquid and crowds where a sheet lands or runs up a wall; between resamplings it
+        /// raised such particles to 1.3-1.5 rho0, and the solves threw them at up to 8.6 m/s
+        /// off a 0.77 m/s landing at 2.5 h support (3.5 m/s at 3 h); with Fill 2.2-2.7 m/s
+        /// (1.6-2.2 at 3 h). Not the default yet: it raises a still tank's pressure offset
+        /// from 1.8 to 2.2 % of rho0 g D (bench/RESULTS.md, "DFSPH: ghost air that fills and
+        /// never compresses"). The Tait step does not take it: there the air's excess
+        /// balances the surface's pull, and without it a zero-gravity cube shrinks 4 % in 2 s.
+        Fill
+    };
+    AirDensity airDensity = AirDensity::Full;
     /// Iteration cap of each solve; a solve that reaches it is counted as unconverged
     /// (GhostSolver::pressureSolveStats) and the step goes on with the velocity it reached.
     int maxIterations = 100;
