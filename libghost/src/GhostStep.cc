@@ -292,10 +292,11 @@ void GhostSolver::relaxInitialLiquid()
     // Every other pass keeps the last pass's lists (Verlet lists without a skin). A pass moves
     // a particle by at most 0.05 h, so a pair's distance changes by at most 0.1 h while a list
     // is kept: a pair that leaves the support weighs nothing (the kernel's gradient is zero
-    // beyond R), and one that enters is missed where it weighs under 1 % of the gradient's peak
-    // (r > R - 0.1 h: 0.3 % at R = 3 h, 0.75 % at 2 h). Keeping lists for four passes (to the next resampling)
-    // missed pairs up to 5 % of the peak, and left the stiff collapse's relaxed error 15 %
-    // higher (bench/RESULTS.md); every other pass leaves it as it was.
+    // beyond R), and one that enters is missed where it weighs under 1 % of the gradient's
+    // peak (r > R - 0.1 h: 0.3 % at R = 3 h, 0.75 % at 2 h). Keeping lists for four passes
+    // (to the next resampling) missed pairs up to 5 % of the peak, and left the stiff
+    // collapse's relaxed error 15 % higher (bench/RESULTS.md); every other pass leaves it as
+    // it was.
     std::vector<Vec3> shift;
     for (int pass = 0; pass <= passes; ++pass) {
         const bool resample = pass > 0 && (pass % 5 == 0 || pass == passes);
