@@ -72,6 +72,7 @@ struct Options
     bool divergenceWarmStart = true; ///< DFSPH: the divergence solve starts from its last pressure
     std::string wallPressure = "mirror"; ///< DFSPH: settings.dfsph.wall_pressure
     std::string airDensity = "full";     ///< DFSPH: settings.dfsph.air_density
+    std::string airResampling = "step";  ///< DFSPH: settings.dfsph.air_resampling
     double densityRelaxation = -1;       ///< DFSPH: dfsph.density_relaxation (< 0: default)
     std::uint64_t seed = 1;
     bool halo = false;  ///< print the halos of domain decompositions of the state
@@ -526,6 +527,9 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
                                       : ghost::DfsphSettings::WallPressure::Mirror;
     settings.dfsph.airDensity = opt.airDensity == "fill" ? ghost::DfsphSettings::AirDensity::Fill
                                                          : ghost::DfsphSettings::AirDensity::Full;
+    settings.dfsph.airResampling = opt.airResampling == "step"
+                                       ? ghost::DfsphSettings::AirResampling::Step
+                                       : ghost::DfsphSettings::AirResampling::Time;
     const PressureModel pressure = pressureFromName(opt.pressure);
 
     std::vector<RunResult> results;
@@ -630,6 +634,11 @@ int main(int argc, char** argv)
                    "it to rest density (settings.dfsph.air_density)")
         ->capture_default_str()
         ->check(CLI::IsMember({"full", "fill"}));
+    app.add_option("--air-resampling", opt.airResampling,
+                   "DFSPH: the ghost air resampled one phase a step, or as far per second as "
+                   "[SB12]'s steps take it (settings.dfsph.air_resampling)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"step", "time"}));
     app.add_option("--density-relaxation", opt.densityRelaxation,
                    "DFSPH: settings.dfsph.density_relaxation (default: DfsphSettings')")
         ->check(CLI::Range(1e-6, 1.0));

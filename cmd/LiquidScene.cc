@@ -55,6 +55,9 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
         o.airDensity = d.choice("air_density", "full", {"full", "fill"}) == "fill"
                            ? ghost::DfsphSettings::AirDensity::Fill
                            : ghost::DfsphSettings::AirDensity::Full;
+        o.airResampling = d.choice("air_resampling", "step", {"step", "time"}) == "time"
+                              ? ghost::DfsphSettings::AirResampling::Time
+                              : ghost::DfsphSettings::AirResampling::Step;
         constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
         o.keptGradientLimit =
             GiB * d.inRange("kept_gradients_gb", o.keptGradientLimit / GiB, 0, 1e6);

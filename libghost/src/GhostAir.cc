@@ -15,6 +15,8 @@
 ///          s resamples the blocks of phase s mod airResampleSteps. Every
 ///          part of the layer is still resampled every airResampleSteps steps ([SB12] Sec. 4.3),
 ///          but each step does a tenth of the work, so no step is much slower than the others.
+///          DFSPH's steps are several of [SB12]'s long, so a DFSPH step resamples as many
+///          consecutive phases as [SB12]'s steps it spans (GhostSettings::airResampleSpan).
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "GhostInternal.h"
@@ -44,17 +46,19 @@ constexpr Real SURFACE_SEED_FRACTION = Real(0.97);
 
 } // namespace
 
-/// The region of one resampling phase: blocks of side 4R whose coordinates (i, j, k) give
-/// (i + 3 j + 5 k) mod N == phase. With N = 10 no two blocks that touch (even at a corner)
-/// share a phase, and the phases take turns evenly through space.
+/// The region of `count` consecutive resampling phases from `phase` on: blocks of side 4R
+/// whose coordinates (i, j, k) give (i + 3 j + 5 k) mod N in phase, ..., phase + count - 1
+/// (mod N). With N = 10 no two blocks that touch (even at a corner) share a phase, and the
+/// phases take turns evenly through space.
 class AirRegion
 {
 public:
-    AirRegion(Real supportRadius, int phases, int phase)
+    AirRegion(Real supportRadius, int phases, int phase, int count)
         : mBlock(Real(4) * supportRadius)
         , mInvBlock(Real(1) / mBlock)
         , mPhases(phases)
         , mPhase(phase)
+        , mCount(count)
     {}
 
     bool everywhere() const { return mPhase < 0; }
@@ -64,7 +68,7 @@ public:
         const std::int64_t c = block(x[0]) + 3 * block(x[1]) + 5 * block(x[2]);
         return int(((c % mPhases) + mPhases) % mPhases);
     }
-    bool contains(const Vec3& x) const { return mPhase < 0 || phaseOf(x) == mPhase; }
+    bool contains(const Vec3& x) const { return mPhase < 0 || inPhases(phaseOf(x)); }
     /// Whether x lies within `margin` (at most half a block) of the region: the blocks the box
     /// x +- margin touches are the own block and, per axis, the neighbour on the side where x
     /// is closer than the margin to the face.
@@ -86,7 +90,7 @@ public:
             for (int j = lo[1]; j <= hi[1]; ++j) {
                 for (int k = lo[2]; k <= hi[2]; ++k) {
                     const std::int64_t c = base + i + 3 * j + 5 * k;
-                    if (int(((c % mPhases) + mPhases) % mPhases) == mPhase) return true;
+                    if (inPhases(int(((c % mPhases) + mPhases) % mPhases))) return true;
                 }
             }
         }
@@ -95,14 +99,15 @@ public:
 
 private:
     std::int64_t block(Real v) const { return std::int64_t(std::floor(v * mInvBlock)); }
+    bool inPhases(int p) const { return (p - mPhase + mPhases) % mPhases < mCount; }
     Real mBlock, mInvBlock;
-    int mPhases, mPhase;
+    int mPhases, mPhase, mCount;
 };
 
 /// Where a particle lies relative to the region resampled now (bit flags).
 enum Zone : std::uint8_t { IN_REGION = 1, NEAR_SEEDING = 2, NEAR_BODY = 4 };
 
-void GhostSolver::resampleAir(int phase)
+void GhostSolver::resampleAir(int phase, int count)
 {
     // Needs the grid and lists of searchNeighbors() for the current positions.
     const auto start = std::chrono::steady_clock::now();
@@ -115,7 +120,7 @@ void GhostSolver::resampleAir(int phase)
     // The region resampled now (phase < 0: everywhere) and, per particle, whether it lies in
     // it, within 2r of it (what new air there keeps away from, where its seeds are) or within
     // R (the body particles its air and candidates look for).
-    const AirRegion region(R, mSettings.airResampleSteps, phase);
+    const AirRegion region(R, mSettings.airResampleSteps, phase, count);
     std::vector<std::uint8_t> zone(n, 0);
     parallel::forEach(
         0, n,
@@ -507,11 +512,12 @@ void GhostSolver::resampleAir(int phase)
     mTimings.airResampling += secondsSince(start);
 }
 
-void GhostSolver::fadeAir()
+void GhostSolver::fadeAir(Real span)
 {
     auto& weight = mParticles.scalarChannel(AIR_WEIGHT);
     const auto& target = mParticles.scalarChannel(AIR_TARGET);
-    const Real rate = Real(1) / Real(mSettings.airResampleSteps);
+    // Faded in or out over one round of the phases.
+    const Real rate = span / Real(mSettings.airResampleSteps);
     std::vector<std::uint8_t> remove(mParticles.size(), 0);
     bool anyRemoved = false;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {

@@ -688,7 +688,7 @@ void GhostSolver::computeMovingWallGravity(Real dt)
 void GhostSolver::stepDfsph(Real dt)
 {
     // Line 1 and the density of lines 2-7, as in the Tait step (GhostStep.cc).
-    searchAndDensity();
+    searchAndDensity(dt);
     auto t0 = std::chrono::steady_clock::now();
     computeMovingWallGravity(dt);
     const bool shifting = mSettings.shifting() > Real(0);

@@ -6,6 +6,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/SettingCheck.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace ghostfx {
@@ -49,6 +50,14 @@ Real GhostSettings::solidDragReferenceStep(Real vmax) const
     const Real referenceStiffness = Real(2000), referenceCfl = Real(0.4);
     const Real c = std::sqrt(Real(7) * referenceStiffness / restDensity);
     return referenceCfl * spacing / (c + vmax);
+}
+
+Real GhostSettings::airResampleSpan(Real dt, Real vmax) const
+{
+    if (pressure != PressureModel::Dfsph
+        || dfsph.airResampling != DfsphSettings::AirResampling::Time)
+        return Real(1);
+    return std::min(Real(airResampleSteps), dt / solidDragReferenceStep(vmax));
 }
 
 Real GhostSettings::shifting() const

@@ -687,6 +687,8 @@ SolverState GhostSolver::saveState() const
     state.integers["emitters"] = std::int64_t(mEmitters.size());
     state.integers["pressure_dfsph"] = mSettings.pressure == PressureModel::Dfsph;
     state.integers["air_weights_complete"] = mSettings.airWeights == AirWeights::Complete;
+    state.integers["air_phase"] = std::int64_t(mAirPhase);
+    state.reals["air_phase_credit"] = mAirPhaseCredit;
     return state;
 }
 
@@ -772,6 +774,12 @@ void GhostSolver::restoreState(const SolverState& state)
         mParticles.addScalarChannel(DIVERGENCE_KAPPA);
     }
     mRun = run;
+    // States from before DFSPH's steps spanned several air phases took one a step.
+    const auto airPhase = state.integers.find("air_phase");
+    const auto airCredit = state.reals.find("air_phase_credit");
+    mAirPhase = airPhase != state.integers.end() ? std::uint64_t(airPhase->second)
+                                                 : std::max<std::uint64_t>(1, run.step);
+    mAirPhaseCredit = airCredit != state.reals.end() ? airCredit->second : 0.0;
     mMass = Real(mass);
     mLennardJones = Real(lennardJones);
     mRestoredSolids = std::size_t(solids);

@@ -379,14 +379,28 @@ void GhostSolver::extrapolateSolidVelocity()
     }
 }
 
-void GhostSolver::searchAndDensity()
+void GhostSolver::searchAndDensity(Real dt)
 {
     // Line 1: resample the air every airResampleSteps steps (the first step always has air),
-    // then move every fading air particle's weight one step towards its target.
+    // then move every fading air particle's weight one step towards its target; a DFSPH step
+    // does as much of both as [SB12]'s steps it spans (GhostSettings::airResampleSpan), its
+    // fraction of a phase carried to the next step.
     // Fading runs first: it removes the air that has faded out, before the sort. New air is
     // sampled after the search (reusing it) with weight 0, so it has no part in this step's sums.
     prepareSolidBlocks();
-    fadeAir();
+    Real span = 1;
+    if (mSettings.pressure == PressureModel::Dfsph
+        && mSettings.dfsph.airResampling == DfsphSettings::AirResampling::Time) {
+        const auto& v = mParticles.velocities();
+        const auto& kind = mParticles.kinds();
+        const Real* halo = haloFlags();
+        const double vmax = parallel::maximum(0, mParticles.size(), [&](std::size_t i) {
+            const bool owned = !halo || halo[i] == Real(0);
+            return kind[i] == ParticleKind::Liquid && owned ? double(v[i].length()) : 0.0;
+        });
+        span = mSettings.airResampleSpan(dt, Real(mExchange ? mExchange->maxOf(vmax) : vmax));
+    }
+    fadeAir(span);
     if (mExchange) {
         const auto t = std::chrono::steady_clock::now();
         mExchange->exchange(mParticles, mSettings.supportRadius());
@@ -397,7 +411,18 @@ void GhostSolver::searchAndDensity()
     searchNeighbors();
     const double search = secondsSince(t0);
     mTimings.sortAndSearch += search;
-    if (mRun.step > 0) resampleAir(int(mRun.step % std::uint64_t(mSettings.airResampleSteps)));
+    const auto N = std::uint64_t(mSettings.airResampleSteps);
+    if (mSettings.pressure != PressureModel::Dfsph) {
+        if (mRun.step > 0) resampleAir(int(mRun.step % N));
+    } else if (mRun.step > 0) { // (the first step has fresh air)
+        mAirPhaseCredit += double(span);
+        const double phases = std::floor(mAirPhaseCredit);
+        mAirPhaseCredit -= phases;
+        if (phases > 0) {
+            resampleAir(int(mAirPhase % N), int(phases));
+            mAirPhase += std::uint64_t(phases);
+        }
+    }
     t0 = std::chrono::steady_clock::now();
     computeDensity();
     mTimings.neighborsAndDensity += search + secondsSince(t0);
@@ -405,7 +430,7 @@ void GhostSolver::searchAndDensity()
 
 void GhostSolver::stepGhost(Real dt)
 {
-    searchAndDensity();
+    searchAndDensity(dt);
 
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();

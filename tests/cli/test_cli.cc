@@ -266,6 +266,8 @@ TEST_F(Cli, BadInputGetsOneClearLine)
          "mean 'mirror'?)"},
         {" -D settings.dfsph.air_density=half",
          "settings.dfsph.air_density = \"half\": expected one of 'full', 'fill'"},
+        {" -D settings.dfsph.air_resampling=frame",
+         "settings.dfsph.air_resampling = \"frame\": expected one of 'step', 'time'"},
         {" -D settings.dfsph.kept_gradients_gb=-1",
          "settings.dfsph.kept_gradients_gb = -1: expected a number in [0, 1e+06]"},
         {" -D settings.method=basic -D settings.pressure=dfsph",

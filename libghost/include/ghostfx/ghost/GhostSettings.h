@@ -95,13 +95,34 @@ struct DfsphSettings
         /// liquid and crowds where a sheet lands or runs up a wall; between resamplings it
         /// raised such particles to 1.3-1.5 rho0, and the solves threw them at up to 8.6 m/s
         /// off a 0.77 m/s landing at 2.5 h support (3.5 m/s at 3 h); with Fill 2.2-2.7 m/s
-        /// (1.6-2.2 at 3 h). Not the default yet: it raises a still tank's pressure offset
-        /// from 1.8 to 2.2 % of rho0 g D (bench/RESULTS.md, "DFSPH: ghost air that fills and
-        /// never compresses"). The Tait step does not take it: there the air's excess
-        /// balances the surface's pull, and without it a zero-gravity cube shrinks 4 % in 2 s.
+        /// (1.6-2.2 at 3 h). Not the default: with the air filling to rho0 whatever the
+        /// spacing, the density solve no longer sees a surface layer pressed into the one
+        /// below (only the divergence solve holds it), and under load it compacts: its
+        /// liquid-only density rose from 0.82-0.84 to 0.86-0.91 rho0 in a still tank and to
+        /// 0.99 in one accelerating at g / 2, whose pressure offset grew from 1.8 to 3.9 % of
+        /// rho0 g D (bench/RESULTS.md, "DFSPH: ghost air that fills and never compresses",
+        /// and "DFSPH: the air resampled as often as [SB12]'s steps"). The Tait step does not
+        /// take it: there the air's excess balances the surface's pull, and without it a
+        /// zero-gravity cube shrinks 4 % in 2 s.
         Fill
     };
     AirDensity airDensity = AirDensity::Full;
+    /// How often the ghost air is resampled and faded (GhostSettings::airResampleSpan). Chosen
+    /// by name in scenes (settings.dfsph.air_resampling).
+    enum class AirResampling : std::uint8_t {
+        /// One phase of the layer a step, as in the Tait step. The default.
+        Step,
+        /// As far per second as [SB12]'s steps take it: a DFSPH step spans 2 to 5 of them at
+        /// the defaults and resamples that many phases. Between the longer steps' resamplings
+        /// the air crowds where a sheet lands or runs up a wall: the landing block of
+        /// test_tank.cc threw particles at 2.0-3.5 m/s with Step and 1.5-2.0 with Time (2.5 h
+        /// support: 3.6-8.6 against 2.2-2.6). Not the default: about 7 % of a dam-break step
+        /// and 10 % of the column tank's run, and the tank accelerating at g / 2 (test_dfsph.cc)
+        /// has a pressure slope of -1.7 to +0.5 % over six sample realisations against -0.9 to
+        /// +0.5 % (bench/RESULTS.md, "DFSPH: the air resampled as often as [SB12]'s steps").
+        Time
+    };
+    AirResampling airResampling = AirResampling::Step;
     /// Iteration cap of each solve; a solve that reaches it is counted as unconverged
     /// (GhostSolver::pressureSolveStats) and the step goes on with the velocity it reached.
     int maxIterations = 100;
@@ -242,6 +263,13 @@ struct GhostSettings
     /// The relaxation passes in use: initialRelaxation, or when automatic 20 above k = 2e4 Pa
     /// (where a 13 % density error is a 2 x k pressure kick) and 0 below.
     int relaxationPasses() const;
+    /// How many of [SB12]'s steps a step of dt spans for the air's resampling and fading,
+    /// with the fastest liquid at vmax: 1 with the Tait step ([SB12]: the layer resampled
+    /// every airResampleSteps steps) and with DfsphSettings::AirResampling::Step. With Time,
+    /// dt / solidDragReferenceStep(vmax), at most airResampleSteps: a DFSPH step is 2 to 5 of
+    /// [SB12]'s at the defaults, and resamples and fades the air as far as [SB12] would in
+    /// the same time, so the liquid moves as far between two resamplings of a region.
+    Real airResampleSpan(Real dt, Real vmax) const;
     /// The step at which solidEpsilon is the per-step wall drag: the acoustic step of [SB12]'s
     /// k = 2000 Pa at CFL 0.4 (the defaults), 0.4 h / (c(2000 Pa) + vmax) (s).
     Real solidDragReferenceStep(Real vmax) const;

@@ -356,17 +356,21 @@ private:
     void applyKillBox();
     bool blockedBySolid(const Vec3& x) const;
     void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;
-    /// Resample the air in the blocks of one phase (phase < 0: everywhere), see GhostAir.cc.
-    void resampleAir(int phase);
-    void fadeAir();
+    /// Resample the air in the blocks of `count` phases from `phase` on (phase < 0:
+    /// everywhere), see GhostAir.cc.
+    void resampleAir(int phase, int count = 1);
+    /// Move every fading air particle's weight towards its target by span / airResampleSteps
+    /// (span: GhostSettings::airResampleSpan).
+    void fadeAir(Real span);
     void searchNeighbors();
     void computeDensity();
     /// Move the liquid towards rest density before the first step (GhostSettings::
     /// initialRelaxation), recording the density error before and after.
     void relaxInitialLiquid();
     void extrapolateSolidVelocity();
-    /// Algorithm 3 lines 1-7: air fading, the search, air resampling and the density.
-    void searchAndDensity();
+    /// Algorithm 3 lines 1-7 for a step of dt: air fading, the search, air resampling and
+    /// the density.
+    void searchAndDensity(Real dt);
     void stepGhost(Real dt);
     /// Algorithm 3 lines 15-28 after the pressure: ghost solid velocity, XSPH, air velocity,
     /// positions and (with gradMass) particle shifting. Reads VSTAR.
@@ -424,6 +428,11 @@ private:
     Real mMaxSolidSpeed = 0; ///< fastest moving-solid particle (m/s), for the collision test
     bool mProjectAll = true; ///< a solid changed shape: test every liquid particle for collision
     sph::RunCounters mRun;   ///< clock and counters (maxAcceleration: of the liquid)
+    /// DFSPH: the air's next resampling phase, counted without the modulus (the Tait step
+    /// takes phase step mod airResampleSteps), and the fraction of a phase the steps so far
+    /// have spanned beyond the phases resampled.
+    std::uint64_t mAirPhase = 1;
+    double mAirPhaseCredit = 0;
     PhaseTimings mTimings;
     PressureSolveStats mSolveStats;
     /// DFSPH: whether this step sets the pressure channel (step()'s reportPressure).
