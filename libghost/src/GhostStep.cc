@@ -411,10 +411,9 @@ void GhostSolver::searchAndDensity(Real dt)
     searchNeighbors();
     const double search = secondsSince(t0);
     mTimings.sortAndSearch += search;
-    const auto N = std::uint64_t(mSettings.airResampleSteps);
-    if (mSettings.pressure != PressureModel::Dfsph) {
-        if (mRun.step > 0) resampleAir(int(mRun.step % N));
-    } else if (mRun.step > 0) { // (the first step has fresh air)
+    if (mRun.step > 0) { // (the first step has fresh air)
+        // With a span of 1 a step (the Tait step, DFSPH's default) step s resamples phase s.
+        const auto N = std::uint64_t(mSettings.airResampleSteps);
         mAirPhaseCredit += double(span);
         const double phases = std::floor(mAirPhaseCredit);
         mAirPhaseCredit -= phases;

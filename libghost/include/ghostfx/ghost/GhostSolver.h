@@ -428,9 +428,9 @@ private:
     Real mMaxSolidSpeed = 0; ///< fastest moving-solid particle (m/s), for the collision test
     bool mProjectAll = true; ///< a solid changed shape: test every liquid particle for collision
     sph::RunCounters mRun;   ///< clock and counters (maxAcceleration: of the liquid)
-    /// DFSPH: the air's next resampling phase, counted without the modulus (the Tait step
-    /// takes phase step mod airResampleSteps), and the fraction of a phase the steps so far
-    /// have spanned beyond the phases resampled.
+    /// The air's next resampling phase, counted without the modulus (the step's index while
+    /// every step spans one phase), and the fraction of a phase the steps so far have spanned
+    /// beyond the phases resampled (GhostSettings::airResampleSpan).
     std::uint64_t mAirPhase = 1;
     double mAirPhaseCredit = 0;
     PhaseTimings mTimings;
