@@ -5,7 +5,8 @@
 /// @details One step, with one neighbour search (the lists of GhostStep.cc):
 ///           1. density (Eq. 1, every kind of neighbour) and the factor alpha_i of each liquid
 ///              particle, keeping each liquid pair's m_j grad W_ij for the solves' passes
-///              (DfsphSettings::keepGradients; the positions do not move until step 4);
+///              (DfsphSettings::keepGradients; the positions do not move until step 4), all
+///              in one pass over the pairs (GhostSolver::computeDensity);
 ///           2. the divergence solve on the velocities the last step left ([BK15] Algorithm 2,
 ///              moved from the end of the last step to the start of this one, where the new
 ///              neighbourhood is known: the same sequence with one search);
@@ -100,42 +101,17 @@ using namespace detail;
 
 namespace {
 
-/// Liquid and solid neighbours (self included) below which a liquid particle is spray, about a
-/// fifth of a full neighbourhood at [SB12]'s 3 h support; another support scales it with the
-/// neighbourhood's volume (see minimumNeighbours). Measured: with 10 (liquid only) the
-/// tomato's stream blew up at frame 8; with 20 liquid only, the still tank's corner particles
-/// went unsolved and were pushed into the walls; 20 with the solids holds both.
-constexpr int MIN_NEIGHBOURS = 20;
-
-/// MIN_NEIGHBOURS for a kernel support of `supportFactor` h: the same share of a full
-/// neighbourhood (20 at 3 h, 6 at 2 h). Kept at 20 for 2 h, the top layer of a still tank went
-/// unsolved (Dfsph.StillTankAtTwoSpacingsSupportHoldsTheDensityLimit).
-int minimumNeighbours(Real supportFactor)
-{
-    const double ratio = double(supportFactor) / 3.0;
-    return int(std::lround(MIN_NEIGHBOURS * ratio * ratio * ratio));
-}
-
 /// A density solve whose warm start fits the step with a share below this iterates at least
 /// once (see solvePressure). Measured on the column tank at CFL 0.1, 30 frames: 0.8, 0.9 and
 /// 0.95 all keep its fastest particles at 1.3 to 2.3 m/s; 0.5 let one reach 83 m/s by frame 16;
 /// at 0.9 the still tank's solves never fall below it (the hydrostatic pressure fits whole).
 constexpr Real WARM_SHARE_RENEWED = Real(0.9);
 
-/// The wall's share c of the file comment: 2 for mirrored ghost solids, 1 for the liquid
-/// particle's own pressure term.
-Real wallShare(const DfsphSettings& opt)
-{
-    return opt.wallPressure == DfsphSettings::WallPressure::Mirror ? Real(2) : Real(1);
-}
-
 } // namespace
 
-void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
+void GhostSolver::prepareDfsphFactors()
 {
     const std::size_t n = mParticles.size();
-    const auto& x = mParticles.positions();
-    const auto& m = mParticles.masses();
     const auto& kind = mParticles.kinds();
     const Real M = mMass;
     assignStepArray(mAlpha, n, Real(0));
@@ -170,93 +146,11 @@ void GhostSolver::computeDfsphFactors(std::vector<Vec3>* gradMass)
         if (keep) resizeStepArray(c, pairs);
         else std::vector<Real>().swap(c);
     }
-    const Real* halo = haloFlags();
-    const int minNeighbours = minimumNeighbours(mSettings.supportFactor);
-    const Real wall = wallShare(opt);
-    const bool mirror = opt.wallPressure == DfsphSettings::WallPressure::Mirror;
-    const Vec3 g = mSettings.gravity;
-    const Real rho0 = mSettings.restDensity;
-    if (mirror) assignStepArray(mWallHydrostatic, n, Vec3(0));
-    else std::vector<Vec3>().swap(mWallHydrostatic);
-    forRangeWithBatch(
-        n, mKernel,
-        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) continue;
-            // A halo copy is solved by its owner (alpha 0 here: not an unknown of this one).
-            const bool copy = halo && halo[i] != Real(0);
-            const Vec3 xi = x[i];
-            Vec3 sum(0), all(0);
-            Real squares = 0;
-            int liquidNeighbours = 0;
-            const std::size_t at = keep ? mPairStart[i] : 0;
-            Real* gx = keep ? mPairGradient[0].data() + at : nullptr;
-            Real* gy = keep ? mPairGradient[1].data() + at : nullptr;
-            Real* gz = keep ? mPairGradient[2].data() + at : nullptr;
-            if (copy && !keep) continue;
-            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                for (int k = 0; k < b.n; ++k) b.g[k] = kernel.gradFactor(b.r[k]);
-                for (int k = 0; k < b.n; ++k) b.f[k] = mLiquidMass[b.j[k]] * b.g[k];
-                if (keep) {
-                    for (int k = 0; k < b.n; ++k) {
-                        gx[k] = b.f[k] * b.dx[k];
-                        gy[k] = b.f[k] * b.dy[k];
-                        gz[k] = b.f[k] * b.dz[k];
-                    }
-                    gx += b.n;
-                    gy += b.n;
-                    gz += b.n;
-                }
-                if (copy) return;
-                sum += b.sumScaledOffsets(b.f);
-                for (int k = 0; k < b.n; ++k) {
-                    liquidNeighbours += mLiquidMass[b.j[k]] > Real(0);
-                    b.f[k] = sqr(b.f[k] * b.r[k]);
-                }
-                squares += b.sum(b.f);
-                if (gradMass) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * b.g[k];
-                    all += b.sumScaledOffsets(b.f);
-                }
-            });
-            if (copy) continue;
-            Vec3 solid(0), hydrostatic(0);
-            for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                const bool moving = block == &mMoving;
-                batch.forEachBatch(xi, block->block.particles().positions().data(), block->lists[i],
-                                   [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = M * kernel.gradFactor(b.r[k]);
-                    solid += b.sumScaledOffsets(b.f);
-                    if (!mirror) return;
-                    // The mirrored ghosts' known part, sum_s M (k_s - k_i) grad W_is with
-                    // k_s - k_i = (g - a_s) . (x_s - x_i) / rho0 (file comment; a_s = 0 for a
-                    // static solid); (dx, dy, dz) = x_i - x_s.
-                    if (moving) {
-                        for (int k = 0; k < b.n; ++k) {
-                            const Vec3& e = mMovingWallGravity[b.j[k]];
-                            b.f[k] *= -(e[0] * b.dx[k] + e[1] * b.dy[k] + e[2] * b.dz[k]) / rho0;
-                        }
-                    } else {
-                        for (int k = 0; k < b.n; ++k)
-                            b.f[k] *= -(g[0] * b.dx[k] + g[1] * b.dy[k] + g[2] * b.dz[k]) / rho0;
-                    }
-                    hydrostatic += b.sumScaledOffsets(b.f);
-                });
-            }
-            if (mirror) mWallHydrostatic[i] = hydrostatic;
-            if (gradMass) (*gradMass)[i] = all + solid;
-            solid *= wall; // the wall's share c (file comment)
-            const int solidNeighbours = int(mStatic.lists[i].size() + mMoving.lists[i].size());
-            // The particle's own pressure term moves it by its liquid and solid gradient sums
-            // and each liquid neighbour by its own term.
-            const Real a = (sum + solid).lengthSqr() + squares;
-            mAlpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= minNeighbours
-                            ? Real(1) / a
-                            : Real(0);
-            mSolidGradient[i] = solid;
-        }
-        },
-        512);
+    if (opt.wallPressure == DfsphSettings::WallPressure::Mirror) {
+        assignStepArray(mWallHydrostatic, n, Vec3(0));
+    } else {
+        std::vector<Vec3>().swap(mWallHydrostatic);
+    }
 }
 
 int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, double& error,
@@ -309,8 +203,8 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
 
     // G k (see the file comment), zero for air and spray.
     std::vector<Vec3> u(n, Vec3(0));
-    // m_j grad W_ij of the liquid's pairs, when kept (computeDfsphFactors); else each pass
-    // evaluates the kernel at the gathered positions.
+    // m_j grad W_ij of the liquid's pairs, when kept (the factor pass, computeDensity); else
+    // each pass evaluates the kernel at the gathered positions.
     const bool kept = mGradientsKept;
     const Real* gx = mPairGradient[0].data();
     const Real* gy = mPairGradient[1].data();
@@ -643,9 +537,9 @@ void GhostSolver::reportDfsphPressure()
 
 void GhostSolver::applyWallHydrostatics(Real dt)
 {
-    // The known part of the mirrored ghosts' pressure force (file comment), summed by
-    // computeDfsphFactors over the solids of both blocks, on each solved particle. A halo copy
-    // has alpha 0: its owner applies it.
+    // The known part of the mirrored ghosts' pressure force (file comment), summed by the
+    // factor pass (computeDensity) over the solids of both blocks, on each solved particle. A
+    // halo copy has alpha 0: its owner applies it.
     auto& w = mParticles.vectorChannel(VSTAR);
     parallel::forEach(
         0, mParticles.size(),
@@ -687,16 +581,13 @@ void GhostSolver::computeMovingWallGravity(Real dt)
 
 void GhostSolver::stepDfsph(Real dt)
 {
-    // Line 1 and the density of lines 2-7, as in the Tait step (GhostStep.cc).
-    searchAndDensity(dt);
-    auto t0 = std::chrono::steady_clock::now();
-    computeMovingWallGravity(dt);
+    // Line 1 and the density of lines 2-7, as in the Tait step (GhostStep.cc), with step 1's
+    // factors found in the density's pass.
     const bool shifting = mSettings.shifting() > Real(0);
     std::vector<Vec3> gradMass(shifting ? mParticles.size() : 0, Vec3(0));
-    computeDfsphFactors(shifting ? &gradMass : nullptr);
-    mTimings.neighborsAndDensity += secondsSince(t0);
+    searchAndDensity(dt, true, shifting ? &gradMass : nullptr);
 
-    t0 = std::chrono::steady_clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     const std::size_t n = mParticles.size();
     if (mExchange) {
         // What the solves hand to the halo copies (removed again at the end of the step).

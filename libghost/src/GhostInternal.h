@@ -92,6 +92,31 @@ void forRangeWithBatch(std::size_t n, const sph::CubicSplineKernel& kernel, Body
         grain);
 }
 
+// DFSPH (GhostDfsph.cc; its factors are found in the density's pass, GhostStep.cc) ---------
+
+/// Liquid and solid neighbours (self included) below which a liquid particle is spray, about a
+/// fifth of a full neighbourhood at [SB12]'s 3 h support; another support scales it with the
+/// neighbourhood's volume (see minimumNeighbours; GhostDfsph.cc). Measured: with 10 (liquid
+/// only) the tomato's stream blew up at frame 8; with 20 liquid only, the still tank's corner
+/// particles went unsolved and were pushed into the walls; 20 with the solids holds both.
+constexpr int MIN_NEIGHBOURS = 20;
+
+/// MIN_NEIGHBOURS for a kernel support of `supportFactor` h: the same share of a full
+/// neighbourhood (20 at 3 h, 6 at 2 h). Kept at 20 for 2 h, the top layer of a still tank went
+/// unsolved (Dfsph.StillTankAtTwoSpacingsSupportHoldsTheDensityLimit).
+inline int minimumNeighbours(sph::Real supportFactor)
+{
+    const double ratio = double(supportFactor) / 3.0;
+    return int(std::lround(MIN_NEIGHBOURS * ratio * ratio * ratio));
+}
+
+/// The wall's share c of GhostDfsph.cc's file comment: 2 for mirrored ghost solids, 1 for the
+/// liquid particle's own pressure term.
+inline sph::Real wallShare(const DfsphSettings& opt)
+{
+    return opt.wallPressure == DfsphSettings::WallPressure::Mirror ? sph::Real(2) : sph::Real(1);
+}
+
 /// Tait equation of state ([SB12] Sec. 3, Monaghan 1994): p = k ((rho / rho0)^7 - 1).
 inline Real taitPressure(Real rho, Real rho0, Real k)
 {

@@ -141,7 +141,7 @@ std::size_t GhostSolver::NearestKeys::memoryBytes() const
     return mPage.capacity() * sizeof(std::uint32_t) + mKeys.capacity() * sizeof(std::uint64_t);
 }
 
-void GhostSolver::computeDensity()
+void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
 {
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
@@ -155,81 +155,184 @@ void GhostSolver::computeDensity()
                       && mSettings.dfsph.airDensity == DfsphSettings::AirDensity::Fill;
     SolidBlock* blocks[2] = {&mStatic, &mMoving};
 
+    // DFSPH's factors (GhostDfsph.cc, step 1) read the same pairs at the same positions: they
+    // are found in this pass, so the pairs are gathered and their distances taken once.
+    if (dfsphFactors) prepareDfsphFactors();
+    const DfsphSettings& opt = mSettings.dfsph;
+    const bool keep = dfsphFactors && mGradientsKept;
+    const bool mirror = opt.wallPressure == DfsphSettings::WallPressure::Mirror;
+    const int minNeighbours = minimumNeighbours(mSettings.supportFactor);
+    const Real wall = wallShare(opt);
+    const Vec3 g = mSettings.gravity;
+    const Real M = mMass;
+
     // Eq. 1 for liquid particles: Ghost SPH sums over every kind, Basic SPH over liquid only
     // (it has no air, and its boundary particles act through Lennard-Jones forces instead).
     // Ghost SPH also finds each solid particle's nearest liquid particle (lines 5-7).
     std::vector<std::uint32_t> neighbours(n, 0);
     std::mutex touchedMutex;
     const Real* halo = haloFlags();
-    forRangeWithBatch(
-        n, mKernel,
-        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
-        std::vector<Index> firstTouch[2];
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid) {
-                rho[i] = rho0;
-                continue;
-            }
-            if (halo && halo[i] != Real(0)) {
-                // A halo copy: its density comes from its owner (refresh below); it only
-                // offers itself as the nearest liquid particle of the solid particles it sees.
-                for (int k = 0; k < 2; ++k) {
-                    SolidBlock& block = *blocks[k];
-                    const Vec3* xs = block.block.particles().positions().data();
-                    for (Index j : block.lists[i]) {
-                        const Real r = (x[i] - xs[j]).length();
-                        if (atomicMin(&block.nearest[j], nearestKey(r, Index(i))))
-                            firstTouch[k].push_back(j);
-                    }
+    // Instantiated once with and once without the factors (as solvePressure's passes).
+    auto pass = [&](auto withFactors) {
+        constexpr bool factors = decltype(withFactors)::value;
+        forRangeWithBatch(
+            n, mKernel,
+            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+            std::vector<Index> firstTouch[2];
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (kind[i] != ParticleKind::Liquid) {
+                    rho[i] = rho0;
+                    continue;
                 }
-                continue;
-            }
-            const Vec3 xi = x[i];
-            const NeighborLists::List fluid = mFluidLists[i];
-            Real sum = 0, air = 0;
-            batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
-                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
-                for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                sum += b.sum(b.f);
-                if (!fill) return;
-                for (int k = 0; k < b.n; ++k)
-                    b.g[k] = kind[b.j[k]] == ParticleKind::GhostAir ? b.f[k] : Real(0);
-                air += b.sum(b.g);
-            });
-            std::size_t count = fluid.size();
-            for (int k = 0; ghost && k < 2; ++k) {
-                SolidBlock& block = *blocks[k];
-                const NeighborLists::List solid = block.lists[i];
-                Real w = 0;
-                batch.forEachBatch(xi, block.block.particles().positions().data(), solid,
-                                   [&](PairBatch& b) {
-                    for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
-                    w += b.sum(b.f);
-                    for (int c = 0; c < b.n; ++c) {
-                        if (atomicMin(&block.nearest[b.j[c]], nearestKey(b.r[c], Index(i)))) {
-                            firstTouch[k].push_back(b.j[c]);
+                // Where this particle's m_j grad W_ij go (DfsphSettings::keepGradients).
+                Real *gx = nullptr, *gy = nullptr, *gz = nullptr;
+                if (factors && keep) {
+                    gx = mPairGradient[0].data() + mPairStart[i];
+                    gy = mPairGradient[1].data() + mPairStart[i];
+                    gz = mPairGradient[2].data() + mPairStart[i];
+                }
+                auto keepGradients = [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) {
+                        gx[k] = b.f[k] * b.dx[k];
+                        gy[k] = b.f[k] * b.dy[k];
+                        gz[k] = b.f[k] * b.dz[k];
+                    }
+                    gx += b.n;
+                    gy += b.n;
+                    gz += b.n;
+                };
+                if (halo && halo[i] != Real(0)) {
+                    // A halo copy: its density comes from its owner (refresh below); it only
+                    // offers itself as the nearest liquid particle of the solid particles it
+                    // sees. With DFSPH it is solved by its owner (alpha 0 here), but the
+                    // gradient pass gives it G k from its kept pairs.
+                    for (int k = 0; k < 2; ++k) {
+                        SolidBlock& block = *blocks[k];
+                        const Vec3* xs = block.block.particles().positions().data();
+                        for (Index j : block.lists[i]) {
+                            const Real r = (x[i] - xs[j]).length();
+                            if (atomicMin(&block.nearest[j], nearestKey(r, Index(i))))
+                                firstTouch[k].push_back(j);
                         }
                     }
+                    if (factors && keep) {
+                        batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
+                            for (int k = 0; k < b.n; ++k)
+                                b.f[k] = mLiquidMass[b.j[k]] * kernel.gradFactor(b.r[k]);
+                            keepGradients(b);
+                        });
+                    }
+                    continue;
+                }
+                const Vec3 xi = x[i];
+                const NeighborLists::List fluid = mFluidLists[i];
+                Real sum = 0, air = 0;
+                // The factor's sums: sum_liquid j m_j grad W_ij, over every neighbour (particle
+                // shifting), sum_liquid j |m_j grad W_ij|^2 and the liquid neighbours.
+                Vec3 liquid(0), all(0);
+                Real squares = 0;
+                int liquidNeighbours = 0;
+                batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
+                    if constexpr (factors) {
+                        for (int k = 0; k < b.n; ++k) b.g[k] = kernel.gradFactor(b.r[k]);
+                        for (int k = 0; k < b.n; ++k) b.f[k] = mLiquidMass[b.j[k]] * b.g[k];
+                        if (keep) keepGradients(b);
+                        liquid += b.sumScaledOffsets(b.f);
+                        for (int k = 0; k < b.n; ++k) {
+                            liquidNeighbours += mLiquidMass[b.j[k]] > Real(0);
+                            b.f[k] = sqr(b.f[k] * b.r[k]);
+                        }
+                        squares += b.sum(b.f);
+                        if (gradMass) {
+                            for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * b.g[k];
+                            all += b.sumScaledOffsets(b.f);
+                        }
+                    }
+                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
+                    for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
+                    sum += b.sum(b.f);
+                    if (!fill) return;
+                    for (int k = 0; k < b.n; ++k)
+                        b.g[k] = kind[b.j[k]] == ParticleKind::GhostAir ? b.f[k] : Real(0);
+                    air += b.sum(b.g);
                 });
-                sum += mMass * w;
-                count += solid.size();
+                std::size_t count = fluid.size();
+                // The factor's solid sum_s M grad W_is and, for mirrored walls, the ghosts'
+                // known hydrostatic part (GhostDfsph.cc's file comment).
+                Vec3 solid(0), hydrostatic(0);
+                for (int k = 0; ghost && k < 2; ++k) {
+                    SolidBlock& block = *blocks[k];
+                    const bool moving = k == 1;
+                    const NeighborLists::List list = block.lists[i];
+                    Real w = 0;
+                    batch.forEachBatch(xi, block.block.particles().positions().data(), list,
+                                       [&](PairBatch& b) {
+                        if constexpr (factors) {
+                            for (int c = 0; c < b.n; ++c) b.f[c] = M * kernel.gradFactor(b.r[c]);
+                            solid += b.sumScaledOffsets(b.f);
+                            if (mirror) {
+                                // sum_s M (k_s - k_i) grad W_is with k_s - k_i = (g - a_s) .
+                                // (x_s - x_i) / rho0 (a_s = 0 for a static solid); (dx, dy,
+                                // dz) = x_i - x_s.
+                                if (moving) {
+                                    for (int c = 0; c < b.n; ++c) {
+                                        const Vec3& e = mMovingWallGravity[b.j[c]];
+                                        b.f[c] *=
+                                            -(e[0] * b.dx[c] + e[1] * b.dy[c] + e[2] * b.dz[c])
+                                            / rho0;
+                                    }
+                                } else {
+                                    for (int c = 0; c < b.n; ++c)
+                                        b.f[c] *=
+                                            -(g[0] * b.dx[c] + g[1] * b.dy[c] + g[2] * b.dz[c])
+                                            / rho0;
+                                }
+                                hydrostatic += b.sumScaledOffsets(b.f);
+                            }
+                        }
+                        for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
+                        w += b.sum(b.f);
+                        for (int c = 0; c < b.n; ++c) {
+                            if (atomicMin(&block.nearest[b.j[c]], nearestKey(b.r[c], Index(i)))) {
+                                firstTouch[k].push_back(b.j[c]);
+                            }
+                        }
+                    });
+                    sum += mMass * w;
+                    count += list.size();
+                }
+                if (fill) {
+                    const Real own = sum - air; // liquid and solids
+                    sum = own + std::min(air, std::max(Real(0), rho0 - own));
+                }
+                rho[i] = sum;
+                neighbours[i] = std::uint32_t(count);
+                if constexpr (factors) {
+                    if (mirror) mWallHydrostatic[i] = hydrostatic;
+                    if (gradMass) (*gradMass)[i] = all + solid;
+                    solid *= wall; // the wall's share c
+                    const int solidNeighbours = int(count - fluid.size());
+                    // The particle's own pressure term moves it by its liquid and solid
+                    // gradient sums and each liquid neighbour by its own term.
+                    const Real a = (liquid + solid).lengthSqr() + squares;
+                    mAlpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= minNeighbours
+                                    ? Real(1) / a
+                                    : Real(0);
+                    mSolidGradient[i] = solid;
+                }
             }
-            if (fill) {
-                const Real own = sum - air; // liquid and solids
-                sum = own + std::min(air, std::max(Real(0), rho0 - own));
+            if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
+                std::lock_guard<std::mutex> lock(touchedMutex);
+                for (int k = 0; k < 2; ++k) {
+                    blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(),
+                                              firstTouch[k].end());
+                }
             }
-            rho[i] = sum;
-            neighbours[i] = std::uint32_t(count);
-        }
-        if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
-            std::lock_guard<std::mutex> lock(touchedMutex);
-            for (int k = 0; k < 2; ++k) {
-                blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(),
-                                          firstTouch[k].end());
-            }
-        }
-        },
-        512);
+            },
+            512);
+    };
+    if (dfsphFactors) pass(std::true_type());
+    else pass(std::false_type());
     const double liquidCount = parallel::sum(0, n, [&](std::size_t i) {
         return kind[i] == ParticleKind::Liquid && !(halo && halo[i] != Real(0)) ? 1.0 : 0.0;
     });
@@ -379,7 +482,7 @@ void GhostSolver::extrapolateSolidVelocity()
     }
 }
 
-void GhostSolver::searchAndDensity(Real dt)
+void GhostSolver::searchAndDensity(Real dt, bool dfsphFactors, std::vector<Vec3>* gradMass)
 {
     // Line 1: resample the air every airResampleSteps steps (the first step always has air),
     // then move every fading air particle's weight one step towards its target; a DFSPH step
@@ -423,7 +526,8 @@ void GhostSolver::searchAndDensity(Real dt)
         }
     }
     t0 = std::chrono::steady_clock::now();
-    computeDensity();
+    if (dfsphFactors) computeMovingWallGravity(dt);
+    computeDensity(dfsphFactors, gradMass);
     mTimings.neighborsAndDensity += search + secondsSince(t0);
 }
 

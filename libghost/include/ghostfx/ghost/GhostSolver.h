@@ -363,14 +363,18 @@ private:
     /// (span: GhostSettings::airResampleSpan).
     void fadeAir(Real span);
     void searchNeighbors();
-    void computeDensity();
+    /// Eq. 1's density of every liquid particle (ghost solids: their nearest liquid's), and
+    /// with dfsphFactors DFSPH's factors in the same pass (prepareDfsphFactors, GhostDfsph.cc)
+    /// and, with gradMass, the sum of m_j grad W_ij over every neighbour (particle shifting).
+    void computeDensity(bool dfsphFactors = false, std::vector<Vec3>* gradMass = nullptr);
     /// Move the liquid towards rest density before the first step (GhostSettings::
     /// initialRelaxation), recording the density error before and after.
     void relaxInitialLiquid();
     void extrapolateSolidVelocity();
     /// Algorithm 3 lines 1-7 for a step of dt: air fading, the search, air resampling and
-    /// the density.
-    void searchAndDensity(Real dt);
+    /// the density (with DFSPH's factors: computeDensity).
+    void searchAndDensity(Real dt, bool dfsphFactors = false,
+                          std::vector<Vec3>* gradMass = nullptr);
     void stepGhost(Real dt);
     /// Algorithm 3 lines 15-28 after the pressure: ghost solid velocity, XSPH, air velocity,
     /// positions and (with gradMass) particle shifting. Reads VSTAR.
@@ -378,14 +382,15 @@ private:
     /// The Ghost method with the DFSPH pressure solves (GhostDfsph.cc).
     void stepDfsph(Real dt);
     /// DFSPH with mirrored walls: the known hydrostatic part of the ghost solids' pressure force
-    /// (computeDfsphFactors' mWallHydrostatic) on v* (GhostDfsph.cc).
+    /// (mWallHydrostatic, from the factor pass) on v* (GhostDfsph.cc).
     void applyWallHydrostatics(Real dt);
     /// DFSPH with mirrored walls: mMovingWallGravity for the step from now to now + dt.
     void computeMovingWallGravity(Real dt);
-    /// DFSPH factor 1 / (|sum_j m_j grad W_ij|^2 + sum_liquid j |m_j grad W_ij|^2), liquid
-    /// and solid neighbours, of each liquid particle into mAlpha, and with gradMass the sum
-    /// of m_j grad W_ij over every neighbour (particle shifting).
-    void computeDfsphFactors(std::vector<Vec3>* gradMass);
+    /// The arrays of DFSPH's factor pass, sized for this step: the factor 1 / (|sum_j m_j grad
+    /// W_ij|^2 + sum_liquid j |m_j grad W_ij|^2) (liquid and solid neighbours) of each liquid
+    /// particle in mAlpha, its solid sum, the kept pair gradients and the walls' hydrostatic
+    /// part. computeDensity(true) fills them.
+    void prepareDfsphFactors();
     /// One DFSPH solve on the VSTAR velocities (preconditioned conjugate gradients): the
     /// density solve (density = true) drives rho + dt D rho / Dt to rho0, the divergence solve
     /// D rho / Dt to 0. `total` is the
@@ -449,7 +454,7 @@ private:
     std::vector<Vec3> mMovingWallGravity;
     /// DFSPH, this step: m_j grad W_ij of each liquid particle i's fluid neighbours j, in its
     /// list's order from mPairStart[i] on, one array a component. The solves' passes read
-    /// them instead of gathering positions and evaluating the kernel again (computeDfsphFactors
+    /// them instead of gathering positions and evaluating the kernel again (the factor pass
     /// fills them; bench/RESULTS.md, "DFSPH: the pairs' kernel gradients kept for the step").
     std::vector<std::size_t> mPairStart;
     std::vector<Real> mPairGradient[3];
