@@ -58,17 +58,27 @@ public:
         , mInvBlock(Real(1) / mBlock)
         , mPhases(phases)
         , mPhase(phase)
-        , mCount(count)
-    {}
+    {
+        // Whether the block of weighted sum c0 + d is in the region, for c0 mod N in [0, N)
+        // and the offsets d = i + 3 j + 5 k in [-9, 9] of the blocks next to it: a table
+        // indexed by (c0 mod N) + d + 9, so a neighbour's test takes no division.
+        mInRegion.resize(std::size_t(phases) + 2 * MAX_OFFSET);
+        for (std::size_t t = 0; t < mInRegion.size(); ++t) {
+            const int p = ((int(t) - MAX_OFFSET) % phases + phases) % phases;
+            mInRegion[t] = phase < 0 || (p - phase + phases) % phases < count;
+        }
+    }
 
     bool everywhere() const { return mPhase < 0; }
+    /// The largest margin near() takes: half a block.
+    Real largestMargin() const { return Real(0.5) * mBlock; }
 
     int phaseOf(const Vec3& x) const
     {
         const std::int64_t c = block(x[0]) + 3 * block(x[1]) + 5 * block(x[2]);
         return int(((c % mPhases) + mPhases) % mPhases);
     }
-    bool contains(const Vec3& x) const { return mPhase < 0 || inPhases(phaseOf(x)); }
+    bool contains(const Vec3& x) const { return mPhase < 0 || mInRegion[phaseOf(x) + MAX_OFFSET]; }
     /// Whether x lies within `margin` (at most half a block) of the region: the blocks the box
     /// x +- margin touches are the own block and, per axis, the neighbour on the side where x
     /// is closer than the margin to the face.
@@ -77,7 +87,7 @@ public:
         if (mPhase < 0) return true;
         std::int64_t base = 0;
         int lo[3], hi[3];
-        const std::int64_t weight[3] = {1, 3, 5};
+        const int weight[3] = {1, 3, 5};
         for (int a = 0; a < 3; ++a) {
             const Real u = x[a] * mInvBlock;
             const Real c = std::floor(u);
@@ -86,11 +96,12 @@ public:
             lo[a] = f < m ? -1 : 0;
             hi[a] = f > Real(1) - m ? 1 : 0;
         }
+        const std::uint8_t* in =
+            mInRegion.data() + ((base % mPhases) + mPhases) % mPhases + MAX_OFFSET;
         for (int i = lo[0]; i <= hi[0]; ++i) {
             for (int j = lo[1]; j <= hi[1]; ++j) {
                 for (int k = lo[2]; k <= hi[2]; ++k) {
-                    const std::int64_t c = base + i + 3 * j + 5 * k;
-                    if (inPhases(int(((c % mPhases) + mPhases) % mPhases))) return true;
+                    if (in[i + 3 * j + 5 * k]) return true;
                 }
             }
         }
@@ -98,10 +109,12 @@ public:
     }
 
 private:
+    /// The largest |i + 3 j + 5 k| of a neighbouring block.
+    static constexpr int MAX_OFFSET = 9;
     std::int64_t block(Real v) const { return std::int64_t(std::floor(v * mInvBlock)); }
-    bool inPhases(int p) const { return (p - mPhase + mPhases) % mPhases < mCount; }
     Real mBlock, mInvBlock;
-    int mPhases, mPhase, mCount;
+    int mPhases, mPhase;
+    std::vector<std::uint8_t> mInRegion; ///< see the constructor
 };
 
 /// Where a particle lies relative to the region resampled now (bit flags).
@@ -242,16 +255,20 @@ void GhostSolver::resampleAir(int phase, int count)
         std::nth_element(sums.begin(), sums.begin() + sums.size() * 3 / 4, sums.end());
         n0 = sums[sums.size() * 3 / 4];
     }
+    //    The sum only grows (W >= 0, and a float sum of non-negative terms never falls), so
+    //    once the liquid alone passes the half level the solids are not summed.
     auto insideLiquid = [&](const Vec3& q) {
+        const Real half = Real(0.5) * n0;
         Real sum = 0;
         mGrid.forEachInRadius(q, R, [&](Index j, const Vec3&, Real rij) {
             if (kind[j] == ParticleKind::Liquid) sum += mKernel.W(rij);
         });
         for (const SolidBlock* b : {&mStatic, &mMoving}) {
+            if (sum > half) return true;
             b->block.grid().forEachInRadius(
                 q, R, [&](Index, const Vec3&, Real rij) { sum += mKernel.W(rij); });
         }
-        return sum > Real(0.5) * n0;
+        return sum > half;
     };
 
     // 3. Keep the air that is still where the layer should be: within a kernel radius of the
@@ -333,12 +350,38 @@ void GhostSolver::resampleAir(int phase, int count)
             obstacles.push_back(x[i]);
         }
     }
-    {
-        std::vector<Vec3> solids;
-        appendSolidPositionsInBox(near, solids);
-        for (const Vec3& q : solids) {
+    //    The solids: those within 2r of the region, in the body's box. The solid grid's cells
+    //    are tested whole first: a cell none of whose points lies within 2r of the region holds
+    //    no obstacle (most of a tank's cells), and its particles are never read.
+    for (const SolidBlock* b : {&mStatic, &mMoving}) {
+        if (b->block.empty()) continue;
+        auto add = [&](const Vec3& q) {
             if (region.near(q, Real(2) * r)) obstacles.push_back(q);
+        };
+        if (b->block.stale()) {
+            // Not yet sorted (added since the last step): every particle.
+            for (const Vec3& q : b->block.particles().positions()) {
+                if (near.contains(q)) add(q);
+            }
+            continue;
         }
+        const NeighborGrid& grid = b->block.grid();
+        const Real side = grid.cellSize();
+        // The box centre +- (side / 2 + 2r) holds the cell's box grown by 2r (AirRegion::near
+        // tests boxes); the slack covers a point that rounding put in the next cell.
+        const Real reach = Real(0.5) * side + Real(2) * r + Real(1e-3) * side;
+        grid.forEachInBox(
+            near,
+            [&](const NeighborGrid::Cell& c) {
+            const Vec3 centre((Real(c.i) + Real(0.5)) * side, (Real(c.j) + Real(0.5)) * side,
+                              (Real(c.k) + Real(0.5)) * side);
+            const Real margin =
+                reach
+                + Real(1e-5)
+                      * std::max({std::abs(centre[0]), std::abs(centre[1]), std::abs(centre[2])});
+            return margin > region.largestMargin() || region.near(centre, margin);
+            },
+            [&](Index, const Vec3& q) { add(q); });
     }
 
     auto accept = [&](const Vec3& q) {

@@ -151,7 +151,16 @@ public:
     /// within each cell: visits the cells the box overlaps, or sweeps every particle when that
     /// is cheaper.
     template <typename Fn>
-    void forEachInBox(const Aabb& box, Fn&& fn) const;
+    void forEachInBox(const Aabb& box, Fn&& fn) const
+    {
+        forEachInBox(
+            box, [](const Cell&) { return true; }, fn);
+    }
+
+    /// The same, over the cells c with cellWanted(c) true only: a filter on whole cells (the
+    /// particles of the other cells are never read), in the same order.
+    template <typename CellPred, typename Fn>
+    void forEachInBox(const Aabb& box, CellPred&& cellWanted, Fn&& fn) const;
 
     /// Index of the particle closest to x among those with pred(j) true and distance below
     /// maxRadius (m), or INVALID_INDEX. Searches rings of cells outward and stops as soon as no
@@ -287,8 +296,8 @@ inline void NeighborGrid::forEachInRadius(const Vec3& x, Real radius, Fn&& fn) c
     }
 }
 
-template <typename Fn>
-inline void NeighborGrid::forEachInBox(const Aabb& box, Fn&& fn) const
+template <typename CellPred, typename Fn>
+inline void NeighborGrid::forEachInBox(const Aabb& box, CellPred&& cellWanted, Fn&& fn) const
 {
     if (mSize == 0 || box.empty() || !isFinite(box.min) || !isFinite(box.max)) return;
     const Cell lo = cellOf(box.min), hi = cellOf(box.max);
@@ -297,13 +306,14 @@ inline void NeighborGrid::forEachInBox(const Aabb& box, Fn&& fn) const
     if (cells > double(cellCount())) {
         for (std::uint32_t s = 0; s < mSize; ++s) {
             const Vec3 x = sortedPosition(s);
-            if (box.contains(x)) fn(particleAt(s), x);
+            if (box.contains(x) && cellWanted(cellOf(x))) fn(particleAt(s), x);
         }
         return;
     }
     for (std::int32_t i = lo.i; i <= hi.i; ++i) {
         for (std::int32_t j = lo.j; j <= hi.j; ++j) {
             for (std::int32_t k = lo.k; k <= hi.k; ++k) {
+                if (!cellWanted(Cell{i, j, k})) continue;
                 const SlotRange r = cellSlots(Cell{i, j, k});
                 for (std::uint32_t s = r.begin; s < r.end; ++s) {
                     const Vec3 x = sortedPosition(s);
