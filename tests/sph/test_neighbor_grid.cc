@@ -261,6 +261,48 @@ TEST(NeighborGrid, ForEachInRadiusMatchesBruteForceForSmallAndLargeRadii)
     }
 }
 
+// A box query visits exactly the particles inside the box, whether it walks the box's cells
+// (a small box) or sweeps the whole set (a box with more cells than the set occupies); with a
+// cell filter it visits the particles of the wanted cells only, in the order of the unfiltered
+// query (the air resampling's obstacles rely on this: GhostAir.cc).
+TEST(NeighborGrid, ForEachInBoxVisitsTheBoxAndAFilterKeepsItsCellsInOrder)
+{
+    const Real cellSize = Real(0.05);
+    const std::vector<Vec3> xs = uniformPoints(4000, Vec3(-0.2f), Vec3(0.2f), 11);
+    NeighborGrid grid(cellSize);
+    grid.build(xs);
+    auto wanted = [](const NeighborGrid::Cell& c) { return ((c.i + 2 * c.j + 3 * c.k) & 3) == 0; };
+    const Aabb boxes[2] = {Aabb{Vec3(-0.12f, -0.1f, -0.05f), Vec3(0.1f, 0.12f, 0.1f)},
+                           Aabb{Vec3(-5.0f), Vec3(5.0f)}};
+    for (const Aabb& box : boxes) {
+        std::vector<Index> all, filtered;
+        grid.forEachInBox(box, [&](Index j, const Vec3& x) {
+            EXPECT_EQ(x, xs[j]);
+            all.push_back(j);
+        });
+        grid.forEachInBox(box, wanted, [&](Index j, const Vec3&) { filtered.push_back(j); });
+        std::vector<Index> expected, expectedFiltered;
+        for (Index j = 0; j < Index(xs.size()); ++j) {
+            if (!box.contains(xs[j])) continue;
+            expected.push_back(j);
+            if (wanted(grid.cellOf(xs[j]))) expectedFiltered.push_back(j);
+        }
+        std::vector<Index> inOrder;
+        for (Index j : all) {
+            if (wanted(grid.cellOf(xs[j]))) inOrder.push_back(j);
+        }
+        EXPECT_EQ(filtered, inOrder) << "box " << box.min << " - " << box.max;
+        std::sort(all.begin(), all.end());
+        std::sort(filtered.begin(), filtered.end());
+        EXPECT_EQ(all, expected) << "box " << box.min << " - " << box.max;
+        EXPECT_EQ(filtered, expectedFiltered) << "box " << box.min << " - " << box.max;
+        // Enough to mean something, and the filter removed most but not all of them.
+        EXPECT_GT(expected.size(), 100u);
+        EXPECT_GT(expectedFiltered.size(), expected.size() / 8);
+        EXPECT_LT(expectedFiltered.size(), expected.size() / 2);
+    }
+}
+
 namespace {
 
 /// 400 query points: half near particles of `xs` (5 cm normal offsets), half anywhere in a box
