@@ -3,6 +3,7 @@
 #include "ghostfx/sph/LevelSetGrid.h"
 
 #include "ghostfx/sph/Exceptions.h"
+#include "ghostfx/sph/Parallel.h"
 
 #include <openvdb/math/Maps.h>
 #include <openvdb/tools/Interpolation.h>
@@ -13,6 +14,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <limits>
 
 namespace ghostfx {
 namespace sph {
@@ -502,6 +504,49 @@ double LevelSet::fractionThinnerThan(Real depth) const
         thin += double(phi(x - depth * n)) > half;
     }
     return surface == 0 ? 0.0 : double(thin) / double(surface);
+}
+
+double LevelSet::shadowArea(const Vec3& direction, Real resolution) const
+{
+    const Real length = direction.length();
+    if (!(length > Real(0)) || !(resolution > Real(0))) {
+        throw ValueError(msg("level set '", name(), "': shadow area along (", direction[0], ", ",
+                             direction[1], ", ", direction[2], ") at resolution ", resolution,
+                             ": expected a non-zero direction and a resolution > 0"));
+    }
+    const Aabb box = bounds();
+    if (box.empty()) return 0.0;
+    // An orthonormal frame (u, w, d) with d along the direction.
+    const Vec3 d = direction / length;
+    const Vec3 helper = std::abs(d[0]) < Real(0.9) ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+    const Vec3 u = d.cross(helper).unitSafe(), w = d.cross(u);
+    Real uLo = std::numeric_limits<Real>::max(), uHi = -uLo, wLo = uLo, wHi = -uLo, dLo = uLo,
+         dHi = -uLo;
+    for (int c = 0; c < 8; ++c) {
+        const Vec3 x((c & 1) ? box.max[0] : box.min[0], (c & 2) ? box.max[1] : box.min[1],
+                     (c & 4) ? box.max[2] : box.min[2]);
+        uLo = std::min(uLo, x.dot(u)), uHi = std::max(uHi, x.dot(u));
+        wLo = std::min(wLo, x.dot(w)), wHi = std::max(wHi, x.dot(w));
+        dLo = std::min(dLo, x.dot(d)), dHi = std::max(dHi, x.dot(d));
+    }
+    const std::size_t nu = std::size_t(std::ceil((uHi - uLo) / resolution)),
+                      nw = std::size_t(std::ceil((wHi - wLo) / resolution));
+    const Real minStep = Real(0.25) * resolution;
+    const double hits = parallel::sum(
+        0, nu * nw,
+        [&](std::size_t k) -> double {
+            const Real a = uLo + (Real(k % nu) + Real(0.5)) * resolution;
+            const Real b = wLo + (Real(k / nu) + Real(0.5)) * resolution;
+            const Vec3 origin = a * u + b * w;
+            for (Real t = dLo; t <= dHi;) {
+                const Real f = phi(origin + t * d);
+                if (f < Real(0)) return 1.0;
+                t += std::max(f, minStep);
+            }
+            return 0.0;
+        },
+        64);
+    return hits * double(resolution) * double(resolution);
 }
 
 double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo,

@@ -75,6 +75,12 @@ public:
     /// thinner than `depth` (m): the point `depth` inward along the normal lies outside again.
     /// A boundary layer of particles one kernel radius deep does not fit there.
     double fractionThinnerThan(Real depth) const;
+    /// Area (m^2) of the shadow the shape casts along `direction` (any length but zero): the
+    /// cross-section through which a body translating along it sweeps. Rays along `direction`
+    /// through the centres of a square grid of `resolution` (m) over the projected bounds,
+    /// each sphere-traced through phi (steps of at least resolution / 4), count resolution^2
+    /// if they meet phi < 0. Features thinner than resolution / 4 may be missed.
+    double shadowArea(const Vec3& direction, Real resolution) const;
     /// Whether x is far enough inside the narrow band for phi and its gradient to be exact
     /// (one voxel short of the clamp).
     bool inBand(const Vec3& x) const;
