@@ -28,6 +28,14 @@ struct GhostSolver::Emitter
     sph::LevelSet shape;
     sph::Vec3 velocity;
     double start, end;
+    /// The shape's shadow along the velocity (m^2; 0 without velocity): the emitted volume
+    /// per second is |velocity| crossSection.
+    double crossSection = 0;
+    /// Mass (kg) the emitter owes: rho0 |velocity| crossSection per second of its steps,
+    /// less the mass of the particles it added (GhostSolver::emit()).
+    double credit = 0;
+    /// The fills' Poisson radius, in the sampler's radii r (GhostSolver::limitToCredit).
+    double fillScale = 1;
 };
 
 /// A solid: its level set (in its local frame), its rigid motion, and whether it moves (a

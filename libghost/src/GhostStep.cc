@@ -776,6 +776,7 @@ void GhostSolver::step(Real dt, bool reportPressure)
     else stepGhost(dt);
 
     const double t1 = mRun.time + double(dt);
+    accrueEmission(mRun.time, t1);
     moveSolids(t1);
     mRun.time = t1;
     ++mRun.step;
