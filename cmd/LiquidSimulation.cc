@@ -95,6 +95,16 @@ public:
     {
         return double(mSolver->settings().supportRadius());
     }
+    std::vector<EmitterRate> emitterRates() const override
+    {
+        std::vector<EmitterRate> rates;
+        for (std::size_t e = 0; e < mScene.emitters.size(); ++e) {
+            const double area = mSolver->emitterCrossSections().at(e);
+            rates.push_back({area, double(mSolver->settings().restDensity)
+                                       * mScene.emitters[e].velocity.length() * area});
+        }
+        return rates;
+    }
     void setSolidMotion(std::size_t index, sph::RigidMotion motion) override
     {
         mSolver->setSolidMotion(index, std::move(motion));

@@ -450,6 +450,15 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
                              .c_str());
         }
     }
+    // What each emitter pours, so a wrong velocity or shape shows before the run.
+    const std::vector<Simulation::EmitterRate> rates = sim->emitterRates();
+    for (std::size_t e = 0; e < rates.size() && e < scene.emitters.size(); ++e) {
+        const vdbio::SceneEmitter& em = scene.emitters[e];
+        progress.message(msg("emitter '", em.name, "': ", em.velocity.length(), " m/s through ",
+                             std::round(rates[e].crossSection * 1e6) / 100, " cm^2 = ",
+                             std::round(rates[e].massRate * 100) / 100, " kg/s from ", em.start,
+                             " s", std::isfinite(em.end) ? msg(" to ", em.end, " s") : ""));
+    }
     // A solid thinner than the kernel support holds too few ghost solids (or boundary
     // particles): liquid beside it is under-dense, and a stiff liquid sticks to it (issue 18).
     if (const double depth = sim->boundaryLayerDepth(); depth > 0) {

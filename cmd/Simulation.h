@@ -56,6 +56,13 @@ public:
     /// How deep (m) the boundary particles inside a solid must reach: the kernel support of a
     /// liquid with ghost solids or boundary particles; 0 where solids are not sampled so.
     virtual double boundaryLayerDepth() const { return 0; }
+    /// Each liquid emitter's cross-section (m^2) and mass rate (kg/s) in the scene's order;
+    /// empty where the scene's solver has no liquid emitters.
+    struct EmitterRate
+    {
+        double crossSection, massRate;
+    };
+    virtual std::vector<EmitterRate> emitterRates() const { return {}; }
 
     /// Called after every step with its dt (s).
     virtual void setStepObserver(std::function<void(double dt)> observer) = 0;

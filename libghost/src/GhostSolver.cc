@@ -442,6 +442,13 @@ void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double
     mEmitters.push_back(std::move(emitter));
 }
 
+std::vector<double> GhostSolver::emitterCrossSections() const
+{
+    std::vector<double> areas;
+    for (const auto& em : mEmitters) areas.push_back(em->crossSection);
+    return areas;
+}
+
 void GhostSolver::accrueEmission(double t0, double t1)
 {
     for (const auto& em : mEmitters) {

@@ -155,6 +155,9 @@ public:
     /// its shape full.
     void addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime = 0,
                     double endTime = std::numeric_limits<double>::infinity());
+    /// Each emitter's cross-section (m^2, the shadow of its shape along its velocity; 0 without
+    /// velocity), in the order added: its mass rate is rho0 |velocity| times this.
+    std::vector<double> emitterCrossSections() const;
 
     /// Add liquid particles at given positions (m), e.g. a lattice for a test. Throws
     /// ValueError after restoreState(), like addLiquid().
