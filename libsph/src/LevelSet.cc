@@ -531,22 +531,28 @@ double LevelSet::shadowArea(const Vec3& direction, Real resolution) const
     }
     const std::size_t nu = std::size_t(std::ceil((uHi - uLo) / resolution)),
                       nw = std::size_t(std::ceil((wHi - wLo) / resolution));
-    const Real minStep = Real(0.25) * resolution;
-    const double hits = parallel::sum(
+    // A ray's cell counts in part by the ray's closest approach to the shape, the least phi
+    // along it: for a ray parallel to the surface that is its distance from the shadow's
+    // outline, so a cell the outline cuts counts the share 1/2 - phi_min / resolution of a
+    // straight edge through it. Counting whole cells by their centres alone was off by up to
+    // a cell's width along each side (3 % on a 6 cm box at 3.75 mm cells).
+    const Real minStep = Real(0.25) * resolution, full = Real(-0.5) * resolution;
+    const double covered = parallel::sum(
         0, nu * nw,
         [&](std::size_t k) -> double {
             const Real a = uLo + (Real(k % nu) + Real(0.5)) * resolution;
             const Real b = wLo + (Real(k / nu) + Real(0.5)) * resolution;
             const Vec3 origin = a * u + b * w;
-            for (Real t = dLo; t <= dHi;) {
+            Real least = std::numeric_limits<Real>::max();
+            for (Real t = dLo; t <= dHi && least > full;) {
                 const Real f = phi(origin + t * d);
-                if (f < Real(0)) return 1.0;
-                t += std::max(f, minStep);
+                least = std::min(least, f);
+                t += std::max(std::abs(f), minStep);
             }
-            return 0.0;
+            return std::clamp(0.5 - double(least) / double(resolution), 0.0, 1.0);
         },
         64);
-    return hits * double(resolution) * double(resolution);
+    return covered * double(resolution) * double(resolution);
 }
 
 double boxSignedDistance(const openvdb::Vec3d& x, const openvdb::Vec3d& lo,

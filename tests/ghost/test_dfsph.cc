@@ -759,9 +759,9 @@ TEST(Dfsph, SmallCflStepsStayBounded)
 // Asserted: the CFL 0.1 run pours what the CFL 0.4 run pours within 5 % (a step-size
 // property; Emitter.TapUnderGravityPoursItsRateAtAnyStep checks the rate itself), and no
 // particle faster than 1.5 x the free-fall speed 1 m/s + g t. Measured since the fills are
-// paid from the emitter's rate (2026-11-30): 3 h: 5,441 against 5,446 particles (-0.1 %; in
-// mass +7.4 % over the nozzle's volume and 6.4 L/s, nearly all of it the first fill's surface
-// layer: the body sampler puts particles on the nozzle's faces), 1.96 m/s; 2.5 h: 5,479
+// paid from the emitter's rate (2026-11-30): 3 h: 5,445 against 5,434 particles (+0.2 %; in
+// mass +7.5 % over the nozzle's volume and 6.4 L/s, nearly all of it the first fill's surface
+// layer: the body sampler puts particles on the nozzle's faces), 1.96 m/s; 2.5 h: 5,485
 // against 5,477, 2.00 m/s. Before: 5,908 against 5,830 (+16.7 / +15.1 % in mass).
 TEST(Dfsph, AnEmitterAtSmallCflStepsPoursAsAtTheDefaultStep)
 {

@@ -446,8 +446,12 @@ TEST(LevelSet, BoxFacesAreExactAndInsideHoldsBeyondTheBand)
 // An emitter's rate is rho0 |v| times the shadow of its shape along v (GhostSolver::
 // addEmitter). Analytic shadows: a box along an axis casts its face; along the diagonal of two
 // axes, a box a x b x c casts c (a + b) / sqrt(2); a ball of radius R casts pi R^2 in every
-// direction. Rays through cell centres miss or hit whole cells along the shadow's outline,
-// an error of about a cell's share of the perimeter: bounds 1 % at 1 mm cells.
+// direction. The rays' cells along the outline count in part, by the rays' least phi: exact
+// where the outline comes from faces parallel to the rays (the box along an axis: 0.03 %, and
+// a misaligned 6 cm box at 3.75 mm cells within 0.2 %, where whole cells were 3 % off), and a
+// little short where it comes from edges seen across (the diagonal: a ray just inside crosses
+// a wedge shallower than its distance from the outline, -0.8 %). Bounds 0.5 % along the axis,
+// 1.5 % on the diagonal and 0.5 % on the ball, at 1 mm cells.
 TEST(LevelSet, ShadowAreaIsTheCrossSectionAlongADirection)
 {
     const double a = 0.08, b = 0.05, c = 0.03, cell = 1e-3;
@@ -464,10 +468,10 @@ TEST(LevelSet, ShadowAreaIsTheCrossSectionAlongADirection)
                 "(%.4e); ball %.4e (%.4e) m^2\n",
                 down, a * b, side, b * c, diagonal, c * (a + b) / std::sqrt(2.0), round,
                 std::acos(-1.0) * 0.05 * 0.05);
-    EXPECT_NEAR(down / (a * b), 1.0, 0.01);
-    EXPECT_NEAR(side / (b * c), 1.0, 0.01);
-    EXPECT_NEAR(diagonal / (c * (a + b) / std::sqrt(2.0)), 1.0, 0.01);
-    EXPECT_NEAR(round / (std::acos(-1.0) * 0.05 * 0.05), 1.0, 0.01);
+    EXPECT_NEAR(down / (a * b), 1.0, 0.005);
+    EXPECT_NEAR(side / (b * c), 1.0, 0.005);
+    EXPECT_NEAR(diagonal / (c * (a + b) / std::sqrt(2.0)), 1.0, 0.015);
+    EXPECT_NEAR(round / (std::acos(-1.0) * 0.05 * 0.05), 1.0, 0.005);
     EXPECT_THROW(box.shadowArea(Vec3(0), Real(cell)), ghostfx::ValueError);
     EXPECT_THROW(box.shadowArea(Vec3(0, 1, 0), Real(0)), ghostfx::ValueError);
 }

@@ -77,9 +77,10 @@ public:
     double fractionThinnerThan(Real depth) const;
     /// Area (m^2) of the shadow the shape casts along `direction` (any length but zero): the
     /// cross-section through which a body translating along it sweeps. Rays along `direction`
-    /// through the centres of a square grid of `resolution` (m) over the projected bounds,
-    /// each sphere-traced through phi (steps of at least resolution / 4), count resolution^2
-    /// if they meet phi < 0. Features thinner than resolution / 4 may be missed.
+    /// through the centres of a square grid of `resolution` (m) over the projected bounds are
+    /// sphere-traced through phi (steps of at least resolution / 4); each counts the share
+    /// of its cell that its least phi puts inside the outline (all of it once phi reaches
+    /// -resolution / 2). Features thinner than resolution / 4 may be missed.
     double shadowArea(const Vec3& direction, Real resolution) const;
     /// Whether x is far enough inside the narrow band for phi and its gradient to be exact
     /// (one voxel short of the clamp).
