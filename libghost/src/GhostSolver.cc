@@ -433,8 +433,13 @@ void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double
     }
     auto emitter = std::make_unique<Emitter>(Emitter{shape, velocity, startTime, endTime});
     if (velocity.lengthSqr() > Real(0)) {
-        emitter->crossSection =
-            shape.shadowArea(velocity, Real(0.5) * std::min(mSettings.spacing, shape.voxelSize()));
+        // Half the finer of the spacing and the voxel, but at most 512 cells across the shape
+        // (a metre-wide emitter at 5 mm would otherwise trace 640k rays): the outline's cells
+        // count in part, so a coarser grid loses little (LevelSet::shadowArea).
+        const Vec3 extent = shape.bounds().extent();
+        const Real resolution = std::max(Real(0.5) * std::min(mSettings.spacing, shape.voxelSize()),
+                                         std::max({extent[0], extent[1], extent[2]}) / Real(512));
+        emitter->crossSection = shape.shadowArea(velocity, resolution);
     }
     if (mEmitters.size() < mRestoredEmitterFills.size()) {
         std::tie(emitter->credit, emitter->fillScale) = mRestoredEmitterFills[mEmitters.size()];
