@@ -98,11 +98,7 @@ public:
     std::vector<EmitterRate> emitterRates() const override
     {
         std::vector<EmitterRate> rates;
-        for (std::size_t e = 0; e < mScene.emitters.size(); ++e) {
-            const double area = mSolver->emitterCrossSections().at(e);
-            rates.push_back({area, double(mSolver->settings().restDensity)
-                                       * mScene.emitters[e].velocity.length() * area});
-        }
+        for (const auto& r : mSolver->emitterRates()) rates.push_back({r.crossSection, r.massRate});
         return rates;
     }
     void setSolidMotion(std::size_t index, sph::RigidMotion motion) override

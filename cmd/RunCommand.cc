@@ -451,7 +451,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         }
     }
     // What each emitter pours, so a wrong velocity or shape shows before the run.
-    const std::vector<Simulation::EmitterRate> rates = sim->emitterRates();
+    const auto rates = sim->emitterRates();
     for (std::size_t e = 0; e < rates.size() && e < scene.emitters.size(); ++e) {
         const vdbio::SceneEmitter& em = scene.emitters[e];
         progress.message(msg("emitter '", em.name, "': ", em.velocity.length(), " m/s through ",

@@ -447,21 +447,23 @@ void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double
     mEmitters.push_back(std::move(emitter));
 }
 
-std::vector<double> GhostSolver::emitterCrossSections() const
+std::vector<GhostSolver::EmitterRate> GhostSolver::emitterRates() const
 {
-    std::vector<double> areas;
-    for (const auto& em : mEmitters) areas.push_back(em->crossSection);
-    return areas;
+    std::vector<EmitterRate> rates;
+    for (const auto& em : mEmitters) {
+        rates.push_back({em->crossSection, double(mSettings.restDensity)
+                                               * double(em->velocity.length()) * em->crossSection});
+    }
+    return rates;
 }
 
 void GhostSolver::accrueEmission(double t0, double t1)
 {
-    for (const auto& em : mEmitters) {
-        const double active = std::min(t1, em->end) - std::max(t0, em->start);
-        if (active > 0) {
-            em->credit += double(mSettings.restDensity) * double(em->velocity.length())
-                          * em->crossSection * active;
-        }
+    const std::vector<EmitterRate> rates = emitterRates();
+    for (std::size_t e = 0; e < mEmitters.size(); ++e) {
+        const Emitter& em = *mEmitters[e];
+        const double active = std::min(t1, em.end) - std::max(t0, em.start);
+        if (active > 0) mEmitters[e]->credit += rates[e].massRate * active;
     }
 }
 

@@ -156,8 +156,13 @@ public:
     void addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime = 0,
                     double endTime = std::numeric_limits<double>::infinity());
     /// Each emitter's cross-section (m^2, the shadow of its shape along its velocity; 0 without
-    /// velocity), in the order added: its mass rate is rho0 |velocity| times this.
-    std::vector<double> emitterCrossSections() const;
+    /// velocity) and the mass it pours per second (kg/s, rho0 |velocity| times that), in the
+    /// order added.
+    struct EmitterRate
+    {
+        double crossSection, massRate;
+    };
+    std::vector<EmitterRate> emitterRates() const;
 
     /// Add liquid particles at given positions (m), e.g. a lattice for a test. Throws
     /// ValueError after restoreState(), like addLiquid().
