@@ -165,6 +165,11 @@ public:
         copyVisibleGas(mGas->particles(), mVisible);
         return {liquidMedium(*mLiquid), gasMedium(*mGas, mVisible)};
     }
+    std::vector<MediumCount> mediumCounts() const override
+    {
+        return {{"liquid", mLiquid->count(ParticleKind::Liquid)},
+                {"gas", mGas->visibleGasCount()}};
+    }
 
     std::vector<sph::SolverState> saveStates() const override
     {

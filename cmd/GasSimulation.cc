@@ -126,6 +126,10 @@ public:
         copyVisibleGas(mSolver->particles(), mVisible);
         return {gasMedium(*mSolver, mVisible)};
     }
+    std::vector<MediumCount> mediumCounts() const override
+    {
+        return {{"gas", mSolver->visibleGasCount()}};
+    }
 
     std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
 

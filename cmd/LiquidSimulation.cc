@@ -179,6 +179,10 @@ public:
     std::size_t memoryBytes() const override { return mSolver->memoryBytes(); }
 
     std::vector<OutputMedium> media() const override { return {liquidMedium(*mSolver)}; }
+    std::vector<MediumCount> mediumCounts() const override
+    {
+        return {{"liquid", mSolver->count(ParticleKind::Liquid)}};
+    }
 
     std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
 

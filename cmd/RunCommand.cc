@@ -6,6 +6,7 @@
 #include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "Simulation.h"
+#include "StopSignals.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
@@ -27,6 +28,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <unistd.h>
@@ -38,35 +40,7 @@ namespace fs = std::filesystem;
 using sph::ParticleKind;
 using Clock = std::chrono::steady_clock;
 
-// Ctrl-C -----------------------------------------------------------------------------------------
-// The first SIGINT asks the run to stop after the current frame (its outputs and a checkpoint are
-// written); the handler then restores the default action, so a second Ctrl-C abandons the frame
-// at once. Every file is written atomically, so nothing is left half-written either way.
-
 namespace {
-
-std::atomic<bool> gInterrupted{false};
-
-extern "C" void onInterrupt(int)
-{
-    gInterrupted.store(true);
-    std::signal(SIGINT, SIG_DFL);
-}
-
-/// Installs the handler for the life of a run and restores the previous one.
-class InterruptGuard
-{
-public:
-    InterruptGuard()
-    {
-        gInterrupted.store(false);
-        mPrevious = std::signal(SIGINT, onInterrupt);
-    }
-    ~InterruptGuard() { std::signal(SIGINT, mPrevious); }
-
-private:
-    void (*mPrevious)(int) = SIG_DFL;
-};
 
 double seconds(Clock::time_point a, Clock::time_point b)
 {
@@ -168,6 +142,86 @@ private:
     int mFirst, mLast;
     std::uint64_t mSteps = 0;
     Clock::time_point mStart = Clock::now(), mLastDraw{};
+};
+
+/// `text` as one shell word: as it is when it holds only characters no shell treats specially,
+/// else in single quotes.
+std::string shellWord(const std::string& text)
+{
+    const bool plain = !text.empty() && text.find_first_not_of("abcdefghijklmnopqrstuvwxyz"
+                                                               "ABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                               "0123456789_./=:,+-@%^")
+                                            == std::string::npos;
+    if (plain) return text;
+    std::string quoted = "'";
+    for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
+/// The command that continues this run from `checkpoint`: the same scene, output folder,
+/// frames and overrides (a checkpoint is refused under other settings), on `ranks` processes.
+std::string resumeCommand(const RunOptions& o, const std::string& checkpoint, int ranks)
+{
+    std::string command = ranks > 1 ? msg("mpirun -np ", ranks, " ") : std::string();
+    command += "ghostfx run " + shellWord(o.scene);
+    if (!o.out.empty()) command += " --out " + shellWord(o.out);
+    if (!o.frames.empty()) command += " --frames " + shellWord(o.frames);
+    for (const std::string& define : o.defines) command += " -D " + shellWord(define);
+    if (!o.sampleCache.empty()) command += " --sample-cache " + shellWord(o.sampleCache);
+    return command + " --resume " + shellWord(checkpoint);
+}
+
+/// The media's particles, summed over the processes of a distributed run (collective).
+std::vector<Simulation::MediumCount> mediumCounts(const Simulation& sim,
+                                                  DistributedRun* distributed)
+{
+    std::vector<Simulation::MediumCount> counts = sim.mediumCounts();
+    if (distributed) {
+        for (auto& c : counts) c.count = std::size_t(distributed->sumOf(double(c.count)));
+    }
+    return counts;
+}
+
+/// Says once, when it happens, that a medium has no particles left (all through the kill box,
+/// boiled away or at the end of their life): the run goes on and writes empty frames.
+class EmptyMediaWatch
+{
+public:
+    /// `start`: the media's particles before the first step.
+    EmptyMediaWatch(const vdbio::Scene& scene, bool prints,
+                    const std::vector<Simulation::MediumCount>& start)
+        : mScene(scene)
+        , mPrints(prints)
+    {
+        for (const Simulation::MediumCount& c : start) mLast[c.name] = c.count;
+    }
+
+    /// After `frame`: `counts` are the media's particles (over several processes, summed).
+    void check(const std::vector<Simulation::MediumCount>& counts, int frame)
+    {
+        for (const Simulation::MediumCount& c : counts) {
+            std::size_t& last = mLast[c.name];
+            const bool emptied = last > 0 && c.count == 0;
+            last = c.count;
+            if (!emptied || !mPrints) continue;
+            const bool liquid = c.name == "liquid";
+            std::fprintf(stderr, "%s\n",
+                         msg("ghostfx: warning: scene '", mScene.file, "', frame ", frame,
+                             ": no ", c.name, " particles are left (",
+                             liquid ? (mScene.heaters.empty()
+                                           ? "all left the kill box"
+                                           : "all left the kill box or boiled away")
+                                    : "all left the kill box or reached their life_strength",
+                             "); the run goes on and its ", c.name, " frames are empty until ",
+                             liquid ? "an emitter pours" : "a source emits", " again")
+                             .c_str());
+        }
+    }
+
+private:
+    const vdbio::Scene& mScene;
+    bool mPrints;
+    std::map<std::string, std::size_t> mLast;
 };
 
 } // namespace
@@ -509,7 +563,8 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         }
     });
 
-    InterruptGuard interruptGuard;
+    StopSignals stopSignals;
+    EmptyMediaWatch emptyMedia(scene, writes, mediumCounts(*sim, distributed));
     // Frame N's files are written while frame N + 1 simulates (FrameWriter.h).
     FrameWriter writer(scene, folder, !o.serialOutput);
     auto writeCheckpoint = [&](int f) {
@@ -537,11 +592,13 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
             writer.submit(snapshotFrame(out, *sim, frame));
         }
         if (stats) stats->flush();
-        // Every process stops at the same frame, whichever saw the interrupt.
-        const bool interrupted =
-            distributed ? distributed->any(gInterrupted.load()) : gInterrupted.load();
+        // Every process stops at the same frame, whichever saw the signal, and all report the
+        // same one.
+        const int stopSignal = distributed
+                                   ? int(distributed->maxOf(double(StopSignals::received())))
+                                   : StopSignals::received();
         std::string checkpoint;
-        if (interrupted || frame == last
+        if (stopSignal != 0 || frame == last
             || (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
             writer.finish(); // the frames on disk reach at least as far as the checkpoint
             checkpoint = writeCheckpoint(frame);
@@ -550,16 +607,19 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         progress.frame(*sim, distributed ? distributed->counts(*sim) : sim->counts(), frame,
                        int(sim->stepCount() - stepsBefore), seconds(frameStart, Clock::now()),
                        write);
-        if (interrupted) {
-            std::fprintf(stderr, "ghostfx: interrupted after frame %d%s\n", frame,
-                         checkpoint.empty()
-                             ? " (no checkpoint: nothing to resume from)"
-                             : ("; resume with: "
-                                + (distributed ? msg("mpirun -np ", distributed->ranks(), " ")
-                                               : std::string())
-                                + "ghostfx run " + o.scene + " --resume " + checkpoint)
-                                   .c_str());
-            return EXIT_INTERRUPTED;
+        emptyMedia.check(mediumCounts(*sim, distributed), frame);
+        if (stopSignal != 0) {
+            if (writes) {
+                std::fprintf(stderr, "ghostfx: stopped by %s after frame %d%s\n",
+                             StopSignals::describe(stopSignal), frame,
+                             checkpoint.empty()
+                                 ? " (no checkpoint: nothing to resume from)"
+                                 : ("; resume with: "
+                                    + resumeCommand(o, checkpoint,
+                                                    distributed ? distributed->ranks() : 1))
+                                       .c_str());
+            }
+            return StopSignals::exitCode(stopSignal);
         }
     }
     writer.finish();
@@ -609,7 +669,8 @@ Command addRunCommand(CLI::App& parent)
     c->add_option("-D,--define", o->defines, "override a scene key: -D settings.stiffness=5000")
         ->allow_extra_args(false);
     c->add_option("--resume", o->resume, "continue from this checkpoint (.h5)");
-    c->add_flag("-q,--quiet", o->quiet, "print errors only");
+    c->add_flag("-q,--quiet", o->quiet,
+                "no progress or log lines: print warnings and errors only");
     c->add_flag("--serial-output", o->serialOutput,
                 "write each frame's files before simulating the next (by default they are "
                 "written while the next frame simulates, holding up to two copies of the "

@@ -29,10 +29,9 @@ struct RunOptions
     std::string sampleCache;
 };
 
-/// Exit code of a run stopped by Ctrl-C after writing its checkpoint (128 + SIGINT).
-constexpr int EXIT_INTERRUPTED = 130;
-
-/// Run a scene; returns the exit code. Throws ghostfx::Error on bad input.
+/// Run a scene; returns the exit code: 0, or 128 + the signal's number for a run that SIGINT,
+/// SIGTERM or SIGUSR1 stopped after a frame and its checkpoint (StopSignals.h). Throws
+/// ghostfx::Error on bad input.
 int runScene(const RunOptions& options);
 
 } // namespace cmd

@@ -74,6 +74,14 @@ public:
     virtual std::size_t memoryBytes() const = 0;
 
     virtual std::vector<OutputMedium> media() const = 0;
+    /// The particles of each medium of media(), by its name ("liquid": liquid particles, no
+    /// ghosts; "gas": the visible gas), without copying them.
+    struct MediumCount
+    {
+        std::string name;
+        std::size_t count;
+    };
+    virtual std::vector<MediumCount> mediumCounts() const = 0;
 
     /// Solver states for a checkpoint (one per solver), and their restoration; the order is the
     /// simulation's own. `restore` is called on a simulation built from the same scene.

@@ -9,6 +9,7 @@
 #include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "Simulation.h"
+#include "StopSignals.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
@@ -282,15 +283,41 @@ public:
     }
 
     /// Advance `frames` frames (default: to the scene's last frame), calling on_frame(self)
-    /// after each; Ctrl-C (KeyboardInterrupt) is raised at the end of a frame.
-    void run(py::object frames, py::object onFrame, py::object self)
+    /// after each. Ctrl-C (KeyboardInterrupt) is raised at the end of a frame; so is
+    /// ghostfx.Interrupted for SIGTERM and SIGUSR1 (where the script has not set handlers of
+    /// its own), after the frame's checkpoint is written to `checkpoint` (a $F4 pattern) if given.
+    void run(py::object frames, py::object onFrame, py::object checkpoint, py::object self)
     {
         const int last = frames.is_none() ? mScene->lastFrame : mSim->frame() + frames.cast<int>();
+        const cmd::StopSignals stopSignals(/*leaveHandled=*/true);
         while (mSim->frame() < last) {
             advanceFrame();
             if (!onFrame.is_none()) onFrame(self);
             if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+            if (const int signal = cmd::StopSignals::received()) stop(signal, checkpoint);
         }
+    }
+
+    /// After a stop signal: the frame's checkpoint (where asked for), one line on stderr as the
+    /// command line prints it, and ghostfx.Interrupted (a SystemExit with code 128 + signal).
+    [[noreturn]] void stop(int signal, const py::object& checkpoint) const
+    {
+        std::string path;
+        if (!checkpoint.is_none()) {
+            path = vdbio::expandFramePattern(py::str(checkpoint).cast<std::string>(), frame());
+            saveCheckpoint(path);
+        }
+        const std::string line =
+            msg("ghostfx: stopped by ", cmd::StopSignals::describe(signal), " after frame ",
+                frame(),
+                path.empty() ? std::string(" (no checkpoint asked for)")
+                             : "; resume with ghostfx.Simulation.resume(scene, '" + path + "')");
+        PySys_WriteStderr("%s\n", line.c_str());
+        const py::object interrupted = py::module_::import("ghostfx").attr("Interrupted");
+        const py::object where = path.empty() ? py::object(py::none()) : py::object(py::str(path));
+        const py::object error = interrupted(signal, frame(), where);
+        PyErr_SetObject(interrupted.ptr(), error.ptr());
+        throw py::error_already_set();
     }
 
     int frame() const { return mSim->frame(); }
@@ -422,12 +449,16 @@ PYBIND11_MODULE(_ghostfx, m)
              "Simulate one frame (the scene's substeps or CFL steps); releases the GIL")
         .def(
             "run",
-            [](py::object self, py::object frames, py::object onFrame) {
-        self.cast<PySimulation&>().run(frames, onFrame, self);
+            [](py::object self, py::object frames, py::object onFrame, py::object checkpoint) {
+        self.cast<PySimulation&>().run(frames, onFrame, checkpoint, self);
             },
             py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
+            py::arg("checkpoint") = py::none(),
             "Advance `frames` frames (default: to the scene's last), calling on_frame(sim) after "
-            "each; Ctrl-C stops at the end of a frame with KeyboardInterrupt")
+            "each. Ctrl-C stops at the end of a frame with KeyboardInterrupt. SIGTERM and SIGUSR1 "
+            "(a render farm's stop) finish the frame, call on_frame, write the frame's checkpoint "
+            "to `checkpoint` (a path pattern such as 'out/checkpoint.$F4.h5') if given, and raise "
+            "ghostfx.Interrupted, a SystemExit whose code is 128 + the signal (143, 138)")
         .def("write_frame", &PySimulation::writeFrame, py::arg("folder") = py::none(),
              "Write the scene's outputs for the current frame (files named by the scene's "
              "`outputs`, as `ghostfx run` writes them) into `folder` (default: "

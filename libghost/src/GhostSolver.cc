@@ -352,7 +352,7 @@ void GhostSolver::moveSolids(double time)
         v[i] = solidV[i];
         speed[i] = solidV[i].length();
     });
-    mMaxSolidSpeed = *std::max_element(speed.begin(), speed.end());
+    mMaxSolidSpeed = speed.empty() ? Real(0) : *std::max_element(speed.begin(), speed.end());
     // Re-sorted at the start of the next step (after its scratch is reset).
     mMoving.block.touch();
 }
@@ -603,10 +603,15 @@ void GhostSolver::applyKillBox()
     std::vector<std::uint8_t> remove(mParticles.size(), 0);
     std::size_t killed = 0;
     bool any = false;
+    // Ghost air is not removed: it completes the neighbourhoods of the liquid still inside,
+    // and the resampling keeps it within a layer of the liquid. Cut at the box, it left the
+    // last particles of a liquid pouring out with half a neighbourhood, and they were flung
+    // back up into the box.
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        if (!box.contains(mParticles.positions()[i])) {
+        const ParticleKind kind = mParticles.kinds()[i];
+        if (kind != ParticleKind::GhostAir && !box.contains(mParticles.positions()[i])) {
             remove[i] = any = true;
-            killed += mParticles.kinds()[i] == ParticleKind::Liquid;
+            killed += kind == ParticleKind::Liquid;
         }
     }
     if (any) mParticles.removeIf(remove);

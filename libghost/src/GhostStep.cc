@@ -603,7 +603,8 @@ void GhostSolver::stepGhost(Real dt)
         }
         },
         512);
-    mRun.maxAcceleration = *std::max_element(accel.begin(), accel.end());
+    // A process whose slab has no particles left still takes part in the exchange below.
+    mRun.maxAcceleration = n ? *std::max_element(accel.begin(), accel.end()) : Real(0);
     mTimings.pressureForce += secondsSince(t0);
     if (mExchange) {
         const auto t = std::chrono::steady_clock::now();
@@ -754,14 +755,9 @@ void GhostSolver::step(Real dt, bool reportPressure)
     const bool fresh = !mRun.initialized;
     const auto start = std::chrono::steady_clock::now();
     if (!initialize()) {
-        // Waiting for an emitter that starts later: only time and the solids move.
-        const double t1 = mRun.time + double(dt);
-        moveSolids(t1);
-        mRun.time = t1;
-        ++mRun.step;
-        mTimings.total += secondsSince(start);
-        ++mTimings.steps;
-        if (mObserver) mObserver(*this, dt);
+        // Waiting for an emitter that starts later: only time and the solids move (its first
+        // fill owes nothing).
+        stepWithoutLiquid(dt, start, false);
         return;
     }
     // Algorithm 3 line 1: new liquid from the emitters (the first step's was added by
@@ -770,6 +766,13 @@ void GhostSolver::step(Real dt, bool reportPressure)
         const auto t0 = std::chrono::steady_clock::now();
         emit();
         mTimings.emission += secondsSince(t0);
+    }
+    if (liquidIsGone()) {
+        // Every liquid particle has left through the kill box: the air around it goes too,
+        // and the solids and emitters go on until an emitter pours again.
+        dropAir();
+        stepWithoutLiquid(dt, start, true);
+        return;
     }
     if (mSettings.method == Method::Basic) stepBasic(dt);
     else if (mSettings.pressure == PressureModel::Dfsph) stepDfsph(dt);
@@ -784,6 +787,36 @@ void GhostSolver::step(Real dt, bool reportPressure)
     if (mExchange) mExchange->dropHalo(mParticles);
     applyKillBox();
     checkBlowUp();
+    mTimings.total += secondsSince(start);
+    ++mTimings.steps;
+    if (mObserver) mObserver(*this, dt);
+}
+
+bool GhostSolver::liquidIsGone() const
+{
+    const double here = double(mParticles.count(ParticleKind::Liquid));
+    // Over several processes all of them decide together (each takes part in every exchange).
+    return (mExchange ? mExchange->maxOf(here) : here) == 0.0;
+}
+
+void GhostSolver::dropAir()
+{
+    if (mParticles.count(ParticleKind::GhostAir) == 0) return;
+    std::vector<std::uint8_t> remove(mParticles.size(), 0);
+    for (std::size_t i = 0; i < mParticles.size(); ++i)
+        remove[i] = mParticles.kinds()[i] == ParticleKind::GhostAir;
+    mParticles.removeIf(remove);
+}
+
+void GhostSolver::stepWithoutLiquid(Real dt, std::chrono::steady_clock::time_point start,
+                                    bool accrue)
+{
+    const double t1 = mRun.time + double(dt);
+    if (accrue) accrueEmission(mRun.time, t1);
+    moveSolids(t1);
+    mRun.time = t1;
+    ++mRun.step;
+    mRun.maxAcceleration = 0;
     mTimings.total += secondsSince(start);
     ++mTimings.steps;
     if (mObserver) mObserver(*this, dt);

@@ -19,8 +19,23 @@ from ._ghostfx import LevelSet, Scene, Simulation, sample, __version__
 from ._ghostfx import load_scene as _load_scene_file
 from ._ghostfx import sample_cache_counts, set_sample_cache
 
-__all__ = ["LevelSet", "Scene", "Simulation", "load_scene", "sample", "sample_cache_counts",
-           "set_sample_cache", "study", "__version__"]
+__all__ = ["Interrupted", "LevelSet", "Scene", "Simulation", "load_scene", "sample",
+           "sample_cache_counts", "set_sample_cache", "study", "__version__"]
+
+
+class Interrupted(SystemExit):
+    """Raised by Simulation.run() at the end of a frame after SIGTERM or SIGUSR1, the signals a
+    render farm sends before it pre-empts a job. A SystemExit: left uncaught, the script exits
+    with code 128 + the signal (143 for SIGTERM, 138 for SIGUSR1), as `ghostfx run` does.
+
+    signal: the signal's number; frame: the last frame simulated; checkpoint: the checkpoint
+    run(checkpoint=...) wrote for it, or None."""
+
+    def __init__(self, signal, frame, checkpoint=None):
+        super().__init__(128 + int(signal))
+        self.signal = int(signal)
+        self.frame = int(frame)
+        self.checkpoint = checkpoint
 
 
 def load_scene(scene, overrides=None, folder=None):

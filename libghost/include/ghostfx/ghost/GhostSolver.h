@@ -49,6 +49,7 @@
 
 #include <openvdb/math/Mat3.h>
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -372,6 +373,12 @@ private:
     /// sequence, the first of its ids at or above `next`).
     void continueIdsFrom(sph::ParticleId next);
     void applyKillBox();
+    /// No liquid particle is left (over several processes: on any of them).
+    bool liquidIsGone() const;
+    /// Remove every ghost air particle (the liquid they surrounded is gone).
+    void dropAir();
+    /// A step with no liquid: time, the solids and (`accrue`) the emitters' credit advance.
+    void stepWithoutLiquid(Real dt, std::chrono::steady_clock::time_point start, bool accrue);
     bool blockedBySolid(const Vec3& x) const;
     void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;
     /// Resample the air in the blocks of `count` phases from `phase` on (phase < 0:
