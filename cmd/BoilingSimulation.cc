@@ -53,11 +53,15 @@ double vapourSpacing(const vdbio::Scene& scene, const ghost::GhostSettings& liqu
 class BoilingSimulation : public Simulation
 {
 public:
-    BoilingSimulation(const vdbio::Scene& scene, ghost::Method method) : mScene(scene)
+    /// `restored`: the liquid's, the vapour's and the phase transition's states, as
+    /// saveStates() gives them, or null for a fresh start.
+    BoilingSimulation(const vdbio::Scene& scene, ghost::Method method,
+                      const std::vector<sph::SolverState>* restored)
+        : mScene(scene)
     {
         const Settings settings = readSettings(scene, method);
-        mLiquid = makeLiquidSolver(scene, settings.liquid);
-        mGas = makeGasSolver(scene, settings.gas, nullptr);
+        mLiquid = makeLiquidSolver(scene, settings.liquid, restored ? &(*restored)[0] : nullptr);
+        mGas = makeGasSolver(scene, settings.gas, restored ? &(*restored)[1] : nullptr);
         mSide = std::make_unique<coupling::GhostLiquidSide>(*mLiquid);
         double band = std::numeric_limits<double>::max();
         for (const vdbio::SceneHeater& h : scene.heaters)
@@ -66,8 +70,10 @@ public:
             *mGas, *mSide, phaseSettings(scene.phaseTransition, scene.spacing, band));
         for (const vdbio::SceneHeater& h : scene.heaters)
             mPhase->addHeater(h.shape, Real(h.temperature));
+        if (restored) mPhase->restoreState((*restored)[2]);
         mFrameRate = settings.liquid.frameRate;
         mSubsteps = settings.liquid.substeps;
+        mFrame = mLiquid->frame();
     }
 
     struct Settings
@@ -173,9 +179,11 @@ public:
 
     std::vector<sph::SolverState> saveStates() const override
     {
-        // The phase transition's own counters and merge schedule are not part of the solver
-        // states yet, so a boiling run cannot be resumed bit for bit: no checkpoint is offered.
-        return {};
+        sph::SolverState liquid = mLiquid->saveState();
+        // The liquid solver counts frames by its own advanceFrame(); this simulation steps it
+        // through the phase transition, so the frame is this simulation's.
+        liquid.integers["frame"] = mFrame;
+        return {std::move(liquid), mGas->saveState(), mPhase->saveState()};
     }
 
 private:
@@ -201,9 +209,10 @@ private:
 
 } // namespace
 
-std::unique_ptr<Simulation> makeBoilingSimulation(const vdbio::Scene& scene, ghost::Method method)
+std::unique_ptr<Simulation> makeBoilingSimulation(const vdbio::Scene& scene, ghost::Method method,
+                                                  const std::vector<sph::SolverState>* restored)
 {
-    return std::make_unique<BoilingSimulation>(scene, method);
+    return std::make_unique<BoilingSimulation>(scene, method, restored);
 }
 
 void checkBoilingSimulation(const vdbio::Scene& scene, ghost::Method method)

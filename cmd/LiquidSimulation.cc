@@ -215,10 +215,11 @@ private:
 } // namespace
 
 std::unique_ptr<Simulation> makeLiquidSimulation(const vdbio::Scene& scene, ghost::Method method,
-                                                 const sph::SolverState* restored)
+                                                 const std::vector<sph::SolverState>* restored)
 {
-    if (!scene.heaters.empty()) return makeBoilingSimulation(scene, method);
-    return std::make_unique<LiquidSimulation>(scene, method, restored);
+    if (!scene.heaters.empty()) return makeBoilingSimulation(scene, method, restored);
+    return std::make_unique<LiquidSimulation>(scene, method,
+                                              restored ? &restored->front() : nullptr);
 }
 
 void checkLiquidSimulation(const vdbio::Scene& scene, ghost::Method method)

@@ -7,6 +7,8 @@
 
 #include <ghostfx/sph/Exceptions.h>
 
+#include <type_traits>
+
 namespace ghostfx {
 namespace cmd {
 
@@ -19,18 +21,18 @@ const sph::SolverState* first(const Restored* restored)
     return restored && !restored->empty() ? &restored->front() : nullptr;
 }
 
-/// An entry whose simulation is `make(scene, solverMethod, state)` and whose check is
+/// An entry whose simulation is `make(scene, solverMethod, states)` and whose check is
 /// `check(scene, solverMethod)`.
-template <typename SolverMethod>
+template <typename SolverMethod, typename Restore>
 Method entry(std::string name, Medium medium, std::string baselineOf, std::string summary,
              SolverMethod m, void (*check)(const vdbio::Scene&, SolverMethod),
-             std::unique_ptr<Simulation> (*make)(const vdbio::Scene&, SolverMethod,
-                                                 const sph::SolverState*))
+             std::unique_ptr<Simulation> (*make)(const vdbio::Scene&, SolverMethod, Restore))
 {
     Method method{std::move(name), medium, std::move(baselineOf), std::move(summary), {}, {}};
     method.check = [m, check](const vdbio::Scene& scene) { check(scene, m); };
     method.make = [m, make](const vdbio::Scene& scene, const Restored* restored) {
-        return make(scene, m, first(restored));
+        if constexpr (std::is_same_v<Restore, const Restored*>) return make(scene, m, restored);
+        else return make(scene, m, first(restored));
     };
     return method;
 }

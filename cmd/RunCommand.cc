@@ -406,10 +406,6 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     std::optional<DistributedManifest> manifest; // resuming on the count that wrote it
     std::string resumeNote;
     if (!o.resume.empty()) {
-        if (stateCount(scene) == 0) {
-            throw SceneError(msg("scene '", scene.file,
-                                 "': a boiling scene (with heaters) cannot be resumed yet"));
-        }
         // A run over several processes resumes from its manifest: on as many processes, each
         // from its own file, with the saved regions (bit for bit); on another count (one
         // process included), every process reads every file and the domain is cut anew. A
@@ -435,7 +431,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
                 manifest.reset();
             }
         } else {
-            states.push_back(vdbio::readCheckpoint(o.resume, fingerprint));
+            states = vdbio::readCheckpointStates(o.resume, fingerprint);
         }
         sim = makeSimulation(scene, &states);
     } else {
@@ -529,11 +525,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
                              .c_str());
         }
     }
-    const bool checkpoints = !out.checkpointFile.empty() && stateCount(scene) > 0;
-    if (!out.checkpointFile.empty() && !checkpoints) {
-        progress.message("note: boiling scenes write no checkpoints yet (the phase transition's "
-                         "state is not saved)");
-    }
+    const bool checkpoints = !out.checkpointFile.empty();
 
     // Statistics.
     // Over several processes, rank 0 writes the rows combined from every process's.
@@ -572,7 +564,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         const std::string path = inFolder(out.checkpointFile, f);
         // Over several processes: a file per process and a manifest to resume from.
         if (distributed) return distributed->writeCheckpoint(path, *sim, fingerprint, f);
-        vdbio::writeCheckpoint(path, sim->saveStates().front(), fingerprint, f);
+        vdbio::writeCheckpoint(path, sim->saveStates(), fingerprint, f);
         return path;
     };
 

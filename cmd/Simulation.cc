@@ -64,7 +64,7 @@ std::size_t Simulation::addLiquid(const sph::LevelSet& shape, const Vec3& /*velo
                      + "': adding liquid from a script is supported in liquid scenes only");
 }
 
-std::size_t stateCount(const vdbio::Scene& scene) { return scene.heaters.empty() ? 1 : 0; }
+std::size_t stateCount(const vdbio::Scene& scene) { return scene.heaters.empty() ? 1 : 3; }
 
 void checkSimulationSettings(const vdbio::Scene& scene) { methodOf(scene).check(scene); }
 
@@ -73,11 +73,10 @@ std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
 {
     const Method& method = methodOf(scene);
     if (restored && restored->size() != stateCount(scene)) {
-        throw SceneError(msg("scene '", scene.file, "': ",
-                             scene.heaters.empty()
-                                 ? "the checkpoint holds " + std::to_string(restored->size())
-                                       + " solver states, the scene needs 1"
-                                 : "a boiling scene (with heaters) cannot be resumed yet"));
+        throw SceneError(msg("scene '", scene.file, "': the checkpoint holds ", restored->size(),
+                             " solver states, the scene needs ", stateCount(scene),
+                             scene.heaters.empty() ? "" : " (a boiling liquid, its vapour and "
+                                                          "the phase transition)"));
     }
     return method.make(scene, restored);
 }

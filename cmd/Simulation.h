@@ -115,7 +115,8 @@ std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
 /// building a solver or sampling a particle: a cheap check of a scene before a long job.
 void checkSimulationSettings(const vdbio::Scene& scene);
 
-/// How many solver states a checkpoint of this scene holds (1, or 2 for boiling).
+/// How many solver states a checkpoint of this scene holds (1, or 3 for boiling: the liquid,
+/// its vapour and the phase transition).
 std::size_t stateCount(const vdbio::Scene& scene);
 
 } // namespace cmd

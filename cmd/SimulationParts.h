@@ -49,7 +49,7 @@ std::size_t liquidParticleCount(const ghost::GhostSolver& s);
 OutputMedium liquidMedium(const ghost::GhostSolver& s);
 /// A liquid scene's simulation ([SB12] `method`); with heaters, the boiling simulation.
 std::unique_ptr<Simulation> makeLiquidSimulation(const vdbio::Scene& scene, ghost::Method method,
-                                                 const sph::SolverState* restored);
+                                                 const std::vector<sph::SolverState>* restored);
 /// Read and check a liquid scene's keys (boiling ones too, with heaters).
 void checkLiquidSimulation(const vdbio::Scene& scene, ghost::Method method);
 
@@ -66,7 +66,9 @@ std::unique_ptr<Simulation> makeGasSimulation(const vdbio::Scene& scene, gas::Me
 void checkGasSimulation(const vdbio::Scene& scene, gas::Method method);
 
 // Boiling: a liquid with heaters, its vapour a fast gas ([RYY15] Sec. 4).
-std::unique_ptr<Simulation> makeBoilingSimulation(const vdbio::Scene& scene, ghost::Method method);
+/// `restored`: the three states saveStates() gives (liquid, vapour, phase transition), or null.
+std::unique_ptr<Simulation> makeBoilingSimulation(const vdbio::Scene& scene, ghost::Method method,
+                                                  const std::vector<sph::SolverState>* restored);
 void checkBoilingSimulation(const vdbio::Scene& scene, ghost::Method method);
 
 } // namespace cmd

@@ -179,13 +179,8 @@ public:
     /// checkpoint is refused otherwise, naming the first differing key).
     static PySimulation resume(const PyScene& scene, const std::string& path)
     {
-        if (cmd::stateCount(*scene.scene) == 0) {
-            throw ValueError("scene '" + scene.scene->file
-                             + "': a boiling scene (with heaters) cannot "
-                               "be resumed yet");
-        }
-        const std::vector<sph::SolverState> states{
-            vdbio::readCheckpoint(path, scene.scene->simulationFingerprint())};
+        const std::vector<sph::SolverState> states =
+            vdbio::readCheckpointStates(path, scene.scene->simulationFingerprint());
         return PySimulation(scene.scene, cmd::makeSimulation(*scene.scene, &states));
     }
 
@@ -267,11 +262,7 @@ public:
     /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames.
     void saveCheckpoint(const std::string& path) const
     {
-        if (cmd::stateCount(*mScene) == 0) {
-            throw ValueError("scene '" + mScene->file
-                             + "': boiling scenes write no checkpoints yet");
-        }
-        vdbio::writeCheckpoint(path, mSim->saveStates().front(), mScene->simulationFingerprint(),
+        vdbio::writeCheckpoint(path, mSim->saveStates(), mScene->simulationFingerprint(),
                                mSim->frame());
     }
 

@@ -377,6 +377,43 @@ void PhaseTransition::updateBoundary()
     mGas.setExternalBoundary(xs, vs, mGas.referenceParticleMass());
 }
 
+// Checkpoints ----------------------------------------------------------------------------------------
+
+namespace {
+constexpr const char* PHASE_SOLVER = "phase_transition";
+}
+
+sph::SolverState PhaseTransition::saveState() const
+{
+    sph::SolverState state;
+    state.solver = PHASE_SOLVER;
+    state.integers["boiled"] = std::int64_t(mBoiled);
+    state.integers["evaporated"] = std::int64_t(mEvaporated);
+    state.integers["merges"] = std::int64_t(mMerges);
+    state.integers["vapour_created"] = std::int64_t(mVapourCreated);
+    state.integers["boundary_count"] = std::int64_t(mBoundaryCount);
+    state.integers["step"] = std::int64_t(mStep);
+    state.reals["vapour_mass"] = mVapourMass;
+    state.reals["gas_removed"] = mGasRemoved;
+    return state;
+}
+
+void PhaseTransition::restoreState(const sph::SolverState& state)
+{
+    if (state.solver != PHASE_SOLVER) {
+        throw ValueError(msg("phase transition: the state was saved by '", state.solver,
+                             "', expected '", PHASE_SOLVER, "'"));
+    }
+    mBoiled = std::size_t(state.count("boiled"));
+    mEvaporated = std::size_t(state.count("evaporated"));
+    mMerges = std::size_t(state.count("merges"));
+    mVapourCreated = std::size_t(state.count("vapour_created"));
+    mBoundaryCount = std::size_t(state.count("boundary_count"));
+    mStep = std::uint64_t(state.count("step"));
+    mVapourMass = state.real("vapour_mass");
+    mGasRemoved = state.real("gas_removed");
+}
+
 // The coupled step ----------------------------------------------------------------------------------
 
 double PhaseTransition::gasMass() const

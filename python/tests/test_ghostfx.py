@@ -165,6 +165,61 @@ except KeyboardInterrupt:
     assert word == "interrupted" and 1 <= int(frame) < 200 and at_boundary == "True"
 
 
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGUSR1"])
+def test_a_farms_stop_signal_writes_the_frames_checkpoint_and_exits_with_its_code(tmp_path, name):
+    # A render farm sends SIGTERM (or Slurm's --signal=USR1) before it pre-empts a job. The
+    # script's run() must finish the frame, call on_frame for it, write the checkpoint it was
+    # given and end the script with 128 + the signal, as `ghostfx run` does; the checkpoint then
+    # resumes the run.
+    import signal
+    import time
+    number = int(getattr(signal, name))
+    script = tmp_path / "run.py"
+    script.write_text(f"""
+import ghostfx
+sim = ghostfx.Simulation(ghostfx.load_scene({DAM!r}, {{"settings.frame_range": [1, 400]}}))
+print("ready", flush=True)
+sim.run(on_frame=lambda s: print("frame", s.frame, flush=True),
+        checkpoint={str(tmp_path / "state.$F4.h5")!r})
+""")
+    child = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+    assert child.stdout.readline().strip() == "ready"
+    assert child.stdout.readline().startswith("frame")
+    time.sleep(0.3)
+    child.send_signal(number)
+    out, err = child.communicate(timeout=120)
+    assert child.returncode == 128 + number, err
+    last = int(out.split()[-1])
+    checkpoint = tmp_path / f"state.{last:04d}.h5"
+    assert checkpoint.exists(), (out, err)
+    assert f"ghostfx: stopped by {name} after frame {last}" in err
+    resumed = ghostfx.Simulation.resume(ghostfx.load_scene(DAM), str(checkpoint))
+    assert resumed.frame == last
+
+
+def test_a_boiling_scene_checkpoints_and_resumes_bit_for_bit(tmp_path):
+    # The liquid, its vapour and the phase transition's counters are all in the checkpoint: the
+    # resumed pan equals the uninterrupted one particle for particle.
+    scene = ghostfx.load_scene(os.path.join(SOURCE, "examples", "boiling_pan", "scene.json"),
+                               {"settings.spacing": 0.03, "settings.frame_range": [1, 4]})
+    straight = ghostfx.Simulation(scene)
+    straight.run()
+    first = ghostfx.Simulation(scene)
+    first.run(frames=2)
+    checkpoint = str(tmp_path / "pan.0002.h5")
+    first.save_checkpoint(checkpoint)
+    resumed = ghostfx.Simulation.resume(scene, checkpoint)
+    resumed.run()
+    assert resumed.frame == straight.frame == 4
+    assert len(straight.positions("gas")) > 0
+    for kind in ("liquid", "gas"):
+        assert np.array_equal(resumed.positions(kind), straight.positions(kind))
+        assert np.array_equal(resumed.velocities(kind), straight.velocities(kind))
+    assert np.array_equal(resumed.channel("liquid", "temperature"),
+                          straight.channel("liquid", "temperature"))
+
+
 def test_write_frame_writes_the_files_the_command_line_writes(tmp_path):
     scene = ghostfx.load_scene(DAM, {"settings.frame_range": [1, 1], "outputs.preview": False})
     sim = ghostfx.Simulation(scene)

@@ -199,8 +199,8 @@ TEST_F(Methods, ABoilingScenePicksItsVapourMethodBySettingsGasMethod)
     b["settings"]["gas"]["method"] = "gas_ambient";
     EXPECT_CONTAINS(checkError(b), "settings.gas.method = \"gas_ambient\": the ambient-air "
                                    "baseline fills a box with air: expected domain.kill_box");
-    // Boiling cannot be resumed yet: the registry's simulations say so for a checkpoint.
+    // A boiling checkpoint holds the liquid, the vapour and the phase transition.
     b["settings"]["gas"]["method"] = "gas";
     const vdbio::Scene scene = read(b);
-    EXPECT_EQ(cmd::stateCount(scene), 0u);
+    EXPECT_EQ(cmd::stateCount(scene), 3u);
 }

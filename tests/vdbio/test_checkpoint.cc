@@ -168,15 +168,52 @@ TEST(Checkpoint, HeaderFields)
     fs::remove_all(dir);
 }
 
+TEST(Checkpoint, SeveralStatesRoundTripInOrder)
+{
+    // A boiling scene's checkpoint: the liquid, its vapour and the phase transition (a state
+    // with no particles), each read back bit for bit and in order.
+    const fs::path dir = freshDir("states");
+    const std::string path = (dir / "boiling.h5").string();
+    SolverState gas = awkwardState();
+    gas.solver = "gas";
+    gas.particles.addScalarChannel("h", Real(0.03));
+    SolverState phase;
+    phase.solver = "phase_transition";
+    phase.integers["boiled"] = 12;
+    phase.reals["vapour_mass"] = 0.1 + 0.2;
+    const std::vector<SolverState> states = {awkwardState(), gas, phase};
+    writeCheckpoint(path, states, SETTINGS, 3);
+    EXPECT_EQ(readCheckpointHeader(path).stateCount, 3);
+    const std::vector<SolverState> back = readCheckpointStates(path, SETTINGS);
+    ASSERT_EQ(back.size(), 3u);
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(firstDifference(states[k], back[k]), "") << k;
+    // The one-state reader refuses it rather than drop two states.
+    EXPECT_EQ(readRefusal<IoError>("several", path, SETTINGS),
+              "checkpoint '" + path
+                  + "': holds 3 solver states (a boiling scene's), expected one");
+    // A damaged count is refused with its value.
+    vdbio::detail::patchCheckpointAttribute(path, "state_count", std::int64_t(5));
+    EXPECT_EQ(ghostfx::testing::errorOf<IoError>([&] { readCheckpointStates(path, SETTINGS); }),
+              "checkpoint '" + path + "': missing group '/state_3'");
+    fs::remove_all(dir);
+}
+
 TEST(Checkpoint, RefusesOtherSchemaAndPrecision)
 {
     const fs::path dir = freshDir("schema");
     const std::string path = (dir / "x.h5").string();
     writeCheckpoint(path, awkwardState(), SETTINGS, 1);
-    vdbio::detail::patchCheckpointAttribute(path, "schema_version", std::int64_t(2));
-    EXPECT_EQ(readCheckpointHeader(path).schemaVersion, 2); // reported, not refused
+    vdbio::detail::patchCheckpointAttribute(path, "schema_version", std::int64_t(3));
+    EXPECT_EQ(readCheckpointHeader(path).schemaVersion, 3); // reported, not refused
     EXPECT_EQ(readRefusal<IoError>("schema", path, SETTINGS),
-              "checkpoint '" + path + "': schema version 2, this ghostfx reads 1");
+              "checkpoint '" + path + "': schema version 3, this ghostfx reads 1 to 2");
+
+    // Schema 1 is schema 2 with one state and no state count: read as that.
+    writeCheckpoint(path, awkwardState(), SETTINGS, 1);
+    vdbio::detail::patchCheckpointAttribute(path, "schema_version", std::int64_t(1));
+    vdbio::detail::patchCheckpointAttribute(path, "state_count", std::int64_t(7));
+    EXPECT_EQ(readCheckpointHeader(path).stateCount, 1);
+    EXPECT_EQ(firstDifference(awkwardState(), readCheckpoint(path, SETTINGS)), "");
 
     // Written by a build of the other precision (float vs double).
     writeCheckpoint(path, awkwardState(), SETTINGS, 1);

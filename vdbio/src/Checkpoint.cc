@@ -80,34 +80,17 @@ void writeDataset(H5::Group& group, const std::string& name, const H5::PredType&
     if (rows > 0) set.write(data, type); // nothing to write for an empty set
 }
 
-void writeState(const std::string& file, const SolverState& state, const std::string& settingsJson,
-                int frame)
+/// One state's particles and scalars into `group` (the file's root for the first state):
+/// `solver`, `particle_count`, `next_id`, and the groups particles, reals and integers.
+void writeStateGroup(H5::Group& group, const SolverState& state)
 {
     const ParticleSet& p = state.particles;
     const std::size_t n = p.size();
-    H5::H5File h5(file, H5F_ACC_TRUNC);
+    writeStringAttribute(group, "solver", state.solver);
+    writeScalarAttribute(group, "particle_count", H5::PredType::NATIVE_UINT64, std::uint64_t(n));
+    writeScalarAttribute(group, "next_id", H5::PredType::NATIVE_INT64, std::int64_t(p.nextId()));
 
-    writeStringAttribute(h5, "format", FORMAT);
-    writeScalarAttribute(h5, "schema_version", H5::PredType::NATIVE_INT, CHECKPOINT_SCHEMA_VERSION);
-    writeStringAttribute(h5, "real", realName());
-    writeStringAttribute(h5, "solver", state.solver);
-    writeStringAttribute(h5, "settings", settingsJson);
-    writeScalarAttribute(h5, "frame", H5::PredType::NATIVE_INT, frame);
-    const auto time = state.reals.find("time");
-    writeScalarAttribute(h5, "time", H5::PredType::NATIVE_DOUBLE,
-                         time == state.reals.end() ? 0.0 : time->second);
-    const auto step = state.integers.find("step");
-    writeScalarAttribute(h5, "step", H5::PredType::NATIVE_INT64,
-                         step == state.integers.end() ? std::int64_t(0) : step->second);
-    for (int k = 0; k < KIND_COUNT; ++k) {
-        const std::uint64_t count = p.count(ParticleKind(k));
-        writeScalarAttribute(h5, std::string("count_") + sph::kindName(ParticleKind(k)),
-                             H5::PredType::NATIVE_UINT64, count);
-    }
-    writeScalarAttribute(h5, "particle_count", H5::PredType::NATIVE_UINT64, std::uint64_t(n));
-    writeScalarAttribute(h5, "next_id", H5::PredType::NATIVE_INT64, std::int64_t(p.nextId()));
-
-    H5::Group particles = h5.createGroup(PARTICLES);
+    H5::Group particles = group.createGroup(PARTICLES);
     writeDataset(particles, "position", realType(), p.positions().data(), n, 3);
     writeDataset(particles, "velocity", realType(), p.velocities().data(), n, 3);
     writeDataset(particles, "mass", realType(), p.masses().data(), n, 1);
@@ -132,14 +115,61 @@ void writeState(const std::string& file, const SolverState& state, const std::st
         attr.write(realType(), value.asPointer());
     }
 
-    H5::Group reals = h5.createGroup(REALS);
+    H5::Group reals = group.createGroup(REALS);
     for (const auto& [key, value] : state.reals) {
         writeScalarAttribute(reals, key, H5::PredType::NATIVE_DOUBLE, value);
     }
-    H5::Group integers = h5.createGroup(INTEGERS);
+    H5::Group integers = group.createGroup(INTEGERS);
     for (const auto& [key, value] : state.integers) {
         writeScalarAttribute(integers, key, H5::PredType::NATIVE_INT64, value);
     }
+}
+
+/// The file's root attributes (Checkpoint.h), from the first state.
+void writeHeader(H5::H5File& h5, const SolverState& state, std::size_t stateCount,
+                 const std::string& settingsJson, int frame)
+{
+    writeStringAttribute(h5, "format", FORMAT);
+    writeScalarAttribute(h5, "schema_version", H5::PredType::NATIVE_INT, CHECKPOINT_SCHEMA_VERSION);
+    writeStringAttribute(h5, "real", realName());
+    writeStringAttribute(h5, "settings", settingsJson);
+    writeScalarAttribute(h5, "frame", H5::PredType::NATIVE_INT, frame);
+    writeScalarAttribute(h5, "state_count", H5::PredType::NATIVE_INT, int(stateCount));
+    const auto time = state.reals.find("time");
+    writeScalarAttribute(h5, "time", H5::PredType::NATIVE_DOUBLE,
+                         time == state.reals.end() ? 0.0 : time->second);
+    const auto step = state.integers.find("step");
+    writeScalarAttribute(h5, "step", H5::PredType::NATIVE_INT64,
+                         step == state.integers.end() ? std::int64_t(0) : step->second);
+    for (int k = 0; k < KIND_COUNT; ++k) {
+        const std::uint64_t count = state.particles.count(ParticleKind(k));
+        writeScalarAttribute(h5, std::string("count_") + sph::kindName(ParticleKind(k)),
+                             H5::PredType::NATIVE_UINT64, count);
+    }
+}
+
+/// The group of state `k` >= 1 ("state_1", ...); the first state is the root.
+std::string stateGroupName(std::size_t k) { return msg("state_", k); }
+
+/// `count` states from `states` on into a new checkpoint at `path` (atomically).
+void writeStates(const std::string& path, const SolverState* states, std::size_t count,
+                 const std::string& settingsJson, int frame)
+{
+    if (count == 0) throw ValueError(msg("checkpoint '", path, "': no solver state to write"));
+    quietHdf5();
+    writeAtomically(path, [&](const std::string& tmp) {
+        try {
+            H5::H5File h5(tmp, H5F_ACC_TRUNC);
+            writeHeader(h5, states[0], count, settingsJson, frame);
+            writeStateGroup(h5, states[0]);
+            for (std::size_t k = 1; k < count; ++k) {
+                H5::Group group = h5.createGroup(stateGroupName(k));
+                writeStateGroup(group, states[k]);
+            }
+        } catch (const H5::Exception& e) {
+            throw IoError(msg("checkpoint '", path, "': cannot write it (", detailOf(e), ")"));
+        }
+    });
 }
 
 // Reading -----------------------------------------------------------------------------------
@@ -276,6 +306,9 @@ CheckpointHeader readHeader(const Reader& r)
     if (present("frame")) header.frame = int(r.readInteger(r.file, "frame"));
     if (present("time")) header.time = r.readDouble(r.file, "time");
     if (present("step")) header.step = r.readInteger(r.file, "step");
+    // Schema 1 held one state and no count: it is read as schema 2 with one state.
+    if (header.schemaVersion == 1) header.stateCount = 1;
+    else if (present("state_count")) header.stateCount = int(r.readInteger(r.file, "state_count"));
     for (int k = 0; k < KIND_COUNT; ++k) {
         const std::string kind = sph::kindName(ParticleKind(k));
         if (present(("count_" + kind).c_str())) {
@@ -349,21 +382,151 @@ bool firstDifference(const nlohmann::json& there, const nlohmann::json& here,
     return true;
 }
 
+/// The most solver states one checkpoint holds (a boiling scene has three).
+constexpr int MAX_STATES = 16;
+
+/// The schema, the precision and (unless `expectedSettingsJson` is empty) the settings.
+void checkCompatible(const Reader& r, const CheckpointHeader& header,
+                     const std::string& expectedSettingsJson)
+{
+    if (header.schemaVersion < 1 || header.schemaVersion > CHECKPOINT_SCHEMA_VERSION) {
+        r.fail(msg("schema version ", header.schemaVersion, ", this ghostfx reads 1 to ",
+                   CHECKPOINT_SCHEMA_VERSION));
+    }
+    const std::string real = r.readString(r.file, "real");
+    if (real != realName()) {
+        r.fail(msg("written by a build with Real = ", real, ", this ghostfx uses Real = ",
+                   realName(), "; resume with a build of the same precision (GHOSTFX_DOUBLE ",
+                   real == "double" ? "ON" : "OFF", ")"));
+    }
+    if (expectedSettingsJson.empty()) return;
+    nlohmann::json there;
+    try {
+        there = nlohmann::json::parse(header.settings);
+    } catch (const nlohmann::json::exception&) {
+        r.fail("its settings attribute is not valid JSON");
+    }
+    nlohmann::json here;
+    try {
+        here = nlohmann::json::parse(expectedSettingsJson);
+    } catch (const nlohmann::json::exception& e) {
+        throw ValueError(msg("readCheckpoint('", r.path,
+                             "'): the expected settings are not valid JSON: ", e.what()));
+    }
+    std::string difference;
+    if (firstDifference(there, here, "", difference)) {
+        throw SceneError(
+            msg("checkpoint '", r.path, "' was written with different settings: ", difference));
+    }
+}
+
+/// The named channels of `particles` (`where`: its path, for messages) into `p`.
+void readChannels(const Reader& r, const H5::Group& particles, const std::string& where,
+                  std::size_t n, ParticleSet& p)
+{
+    const H5::PredType& rt = realType();
+    for (const char* group : {SCALARS, VECTORS}) {
+        const bool vector = group == VECTORS;
+        const std::string groupPath = where + "/" + group;
+        if (!particles.nameExists(group)) r.fail(msg("missing group '", groupPath, "'"));
+        const H5::Group channels = particles.openGroup(group);
+        for (hsize_t c = 0; c < channels.getNumObjs(); ++c) {
+            const std::string name = channels.getObjnameByIdx(c);
+            const H5::DataSet set = channels.openDataSet(name);
+            if (!set.attrExists("default")) {
+                r.fail(msg("dataset '", groupPath, "/", name, "' has no 'default' attribute"));
+            }
+            H5::Attribute attr = set.openAttribute("default");
+            const hssize_t values = attr.getSpace().getSimpleExtentNpoints();
+            if (attr.getTypeClass() != H5T_FLOAT || attr.getDataType().getSize() != sizeof(Real)
+                || values != (vector ? 3 : 1)) {
+                r.fail(msg("dataset '", groupPath, "/", name, "': attribute 'default' is not ",
+                           vector ? "3 values" : "one value", " of the build's Real"));
+            }
+            if (vector) {
+                Vec3 value;
+                attr.read(rt, value.asPointer());
+                auto& data = p.addVectorChannel(name, value);
+                r.readDataset(channels, groupPath, name, rt, H5T_FLOAT, data.data(), n, 3);
+            } else {
+                Real value = 0;
+                attr.read(rt, &value);
+                auto& data = p.addScalarChannel(name, value);
+                r.readDataset(channels, groupPath, name, rt, H5T_FLOAT, data.data(), n, 1);
+            }
+        }
+    }
+}
+
+/// The particles of `group` (`prefix`: its path, "" for the root).
+ParticleSet readParticles(const Reader& r, const H5::Group& group, const std::string& prefix)
+{
+    const std::int64_t count = r.readInteger(group, "particle_count");
+    if (count < 0) r.fail(msg(prefix, "/particle_count = ", count, ": expected >= 0"));
+    const std::size_t n = std::size_t(count);
+    const std::string where = prefix + "/" + PARTICLES;
+    if (!group.nameExists(PARTICLES)) r.fail(msg("missing group '", where, "'"));
+    const H5::Group particles = group.openGroup(PARTICLES);
+    const H5::PredType& rt = realType();
+
+    ParticleSet p;
+    std::vector<Vec3> positions(n);
+    r.readDataset(particles, where, "position", rt, H5T_FLOAT, positions.data(), n, 3);
+    p.addBatch(positions, Real(0), ParticleKind::Liquid);
+    r.readDataset(particles, where, "velocity", rt, H5T_FLOAT, p.velocities().data(), n, 3);
+    r.readDataset(particles, where, "mass", rt, H5T_FLOAT, p.masses().data(), n, 1);
+    r.readDataset(particles, where, "density", rt, H5T_FLOAT, p.densities().data(), n, 1);
+    r.readDataset(particles, where, "pressure", rt, H5T_FLOAT, p.pressures().data(), n, 1);
+    r.readDataset(particles, where, "kind", H5::PredType::NATIVE_UINT8, H5T_INTEGER,
+                  p.kinds().data(), n, 1);
+    r.readDataset(particles, where, "id", H5::PredType::NATIVE_INT64, H5T_INTEGER,
+                  p.ids().data(), n, 1);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (std::uint8_t(p.kinds()[i]) >= KIND_COUNT) {
+            r.fail(msg(where, ": particle ", i, " has unknown kind ", int(p.kinds()[i])));
+        }
+    }
+    readChannels(r, particles, where, n, p);
+    try {
+        p.setNextId(r.readInteger(group, "next_id"));
+    } catch (const ValueError& e) {
+        r.fail(e.what());
+    }
+    return p;
+}
+
+/// One solver state from `group` (the root, or "/state_k": `prefix`).
+SolverState readStateGroup(const Reader& r, const H5::Group& group, const std::string& prefix)
+{
+    SolverState state;
+    state.solver = r.readString(group, "solver");
+    state.particles = readParticles(r, group, prefix);
+    for (const char* name : {REALS, INTEGERS}) {
+        if (!group.nameExists(name)) r.fail(msg("missing group '", prefix, "/", name, "'"));
+        const H5::Group values = group.openGroup(name);
+        for (int a = 0; a < values.getNumAttrs(); ++a) {
+            const std::string key = values.openAttribute(unsigned(a)).getName();
+            if (name == REALS) state.reals[key] = r.readDouble(values, key);
+            else state.integers[key] = r.readInteger(values, key);
+        }
+    }
+    return state;
+}
+
 } // namespace
 
 // Public API ------------------------------------------------------------------------------------
 
+void writeCheckpoint(const std::string& path, const std::vector<SolverState>& states,
+                     const std::string& settingsJson, int frame)
+{
+    writeStates(path, states.data(), states.size(), settingsJson, frame);
+}
+
 void writeCheckpoint(const std::string& path, const SolverState& state,
                      const std::string& settingsJson, int frame)
 {
-    quietHdf5();
-    writeAtomically(path, [&](const std::string& tmp) {
-        try {
-            writeState(tmp, state, settingsJson, frame);
-        } catch (const H5::Exception& e) {
-            throw IoError(msg("checkpoint '", path, "': cannot write it (", detailOf(e), ")"));
-        }
-    });
+    writeStates(path, &state, 1, settingsJson, frame);
 }
 
 CheckpointHeader readCheckpointHeader(const std::string& path)
@@ -388,122 +551,35 @@ std::string firstSettingsDifference(const std::string& thereJson, const std::str
     return out;
 }
 
-SolverState readCheckpoint(const std::string& path, const std::string& expectedSettingsJson)
+std::vector<SolverState> readCheckpointStates(const std::string& path,
+                                              const std::string& expectedSettingsJson)
 {
     const Reader r = openCheckpoint(path);
     return guarded(path, [&] {
         const CheckpointHeader header = readHeader(r);
-        if (header.schemaVersion != CHECKPOINT_SCHEMA_VERSION) {
-            r.fail(msg("schema version ", header.schemaVersion, ", this ghostfx reads ",
-                       CHECKPOINT_SCHEMA_VERSION));
+        checkCompatible(r, header, expectedSettingsJson);
+        if (header.stateCount < 1 || header.stateCount > MAX_STATES) {
+            r.fail(msg("state_count = ", header.stateCount, ": expected 1 to ", MAX_STATES));
         }
-        const std::string real = r.readString(r.file, "real");
-        if (real != realName()) {
-            r.fail(msg("written by a build with Real = ", real, ", this ghostfx uses Real = ",
-                       realName(), "; resume with a build of the same precision (GHOSTFX_DOUBLE ",
-                       real == "double" ? "ON" : "OFF", ")"));
+        std::vector<SolverState> states;
+        states.push_back(readStateGroup(r, r.file, ""));
+        for (int k = 1; k < header.stateCount; ++k) {
+            const std::string name = stateGroupName(std::size_t(k));
+            if (!r.file.nameExists(name)) r.fail(msg("missing group '/", name, "'"));
+            states.push_back(readStateGroup(r, r.file.openGroup(name), "/" + name));
         }
-        if (!expectedSettingsJson.empty()) {
-            nlohmann::json there;
-            try {
-                there = nlohmann::json::parse(header.settings);
-            } catch (const nlohmann::json::exception&) {
-                r.fail("its settings attribute is not valid JSON");
-            }
-            nlohmann::json here;
-            try {
-                here = nlohmann::json::parse(expectedSettingsJson);
-            } catch (const nlohmann::json::exception& e) {
-                throw ValueError(msg("readCheckpoint('", path,
-                                     "'): the expected settings are "
-                                     "not valid JSON: ",
-                                     e.what()));
-            }
-            std::string difference;
-            if (firstDifference(there, here, "", difference)) {
-                throw SceneError(msg("checkpoint '", path,
-                                     "' was written with different "
-                                     "settings: ",
-                                     difference));
-            }
-        }
-
-        SolverState state;
-        state.solver = header.solver;
-        const std::int64_t count = r.readInteger(r.file, "particle_count");
-        if (count < 0) r.fail(msg("particle_count = ", count, ": expected >= 0"));
-        const std::size_t n = std::size_t(count);
-        const std::string where = std::string("/") + PARTICLES;
-        if (!r.file.nameExists(PARTICLES)) r.fail(msg("missing group '", where, "'"));
-        const H5::Group particles = r.file.openGroup(PARTICLES);
-        const H5::PredType& rt = realType();
-
-        ParticleSet& p = state.particles;
-        std::vector<Vec3> positions(n);
-        r.readDataset(particles, where, "position", rt, H5T_FLOAT, positions.data(), n, 3);
-        p.addBatch(positions, Real(0), ParticleKind::Liquid);
-        r.readDataset(particles, where, "velocity", rt, H5T_FLOAT, p.velocities().data(), n, 3);
-        r.readDataset(particles, where, "mass", rt, H5T_FLOAT, p.masses().data(), n, 1);
-        r.readDataset(particles, where, "density", rt, H5T_FLOAT, p.densities().data(), n, 1);
-        r.readDataset(particles, where, "pressure", rt, H5T_FLOAT, p.pressures().data(), n, 1);
-        r.readDataset(particles, where, "kind", H5::PredType::NATIVE_UINT8, H5T_INTEGER,
-                      p.kinds().data(), n, 1);
-        r.readDataset(particles, where, "id", H5::PredType::NATIVE_INT64, H5T_INTEGER,
-                      p.ids().data(), n, 1);
-        for (std::size_t i = 0; i < n; ++i) {
-            if (std::uint8_t(p.kinds()[i]) >= KIND_COUNT) {
-                r.fail(msg("particle ", i, " has unknown kind ", int(p.kinds()[i])));
-            }
-        }
-
-        for (const char* group : {SCALARS, VECTORS}) {
-            const bool vector = group == VECTORS;
-            const std::string groupPath = where + "/" + group;
-            if (!particles.nameExists(group)) r.fail(msg("missing group '", groupPath, "'"));
-            const H5::Group channels = particles.openGroup(group);
-            for (hsize_t c = 0; c < channels.getNumObjs(); ++c) {
-                const std::string name = channels.getObjnameByIdx(c);
-                const H5::DataSet set = channels.openDataSet(name);
-                if (!set.attrExists("default")) {
-                    r.fail(msg("dataset '", groupPath, "/", name, "' has no 'default' attribute"));
-                }
-                H5::Attribute attr = set.openAttribute("default");
-                const hssize_t values = attr.getSpace().getSimpleExtentNpoints();
-                if (attr.getTypeClass() != H5T_FLOAT || attr.getDataType().getSize() != sizeof(Real)
-                    || values != (vector ? 3 : 1)) {
-                    r.fail(msg("dataset '", groupPath, "/", name, "': attribute 'default' is not ",
-                               vector ? "3 values" : "one value", " of the build's Real"));
-                }
-                if (vector) {
-                    Vec3 value;
-                    attr.read(rt, value.asPointer());
-                    auto& data = p.addVectorChannel(name, value);
-                    r.readDataset(channels, groupPath, name, rt, H5T_FLOAT, data.data(), n, 3);
-                } else {
-                    Real value = 0;
-                    attr.read(rt, &value);
-                    auto& data = p.addScalarChannel(name, value);
-                    r.readDataset(channels, groupPath, name, rt, H5T_FLOAT, data.data(), n, 1);
-                }
-            }
-        }
-        try {
-            p.setNextId(r.readInteger(r.file, "next_id"));
-        } catch (const ValueError& e) {
-            r.fail(e.what());
-        }
-
-        for (const char* group : {REALS, INTEGERS}) {
-            if (!r.file.nameExists(group)) r.fail(msg("missing group '/", group, "'"));
-            const H5::Group values = r.file.openGroup(group);
-            for (int a = 0; a < values.getNumAttrs(); ++a) {
-                const std::string key = values.openAttribute(unsigned(a)).getName();
-                if (group == REALS) state.reals[key] = r.readDouble(values, key);
-                else state.integers[key] = r.readInteger(values, key);
-            }
-        }
-        return state;
+        return states;
     });
+}
+
+SolverState readCheckpoint(const std::string& path, const std::string& expectedSettingsJson)
+{
+    std::vector<SolverState> states = readCheckpointStates(path, expectedSettingsJson);
+    if (states.size() != 1) {
+        throw IoError(msg("checkpoint '", path, "': holds ", states.size(),
+                          " solver states (a boiling scene's), expected one"));
+    }
+    return std::move(states.front());
 }
 
 namespace detail {

@@ -66,6 +66,7 @@
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborLists.h>
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/SolverState.h>
 
 #include <cstdint>
 #include <optional>
@@ -223,6 +224,14 @@ public:
     std::size_t boundaryCount() const { return mBoundaryCount; }
 
     MassBudget massBudget() const;
+
+    /// The coupler's own state for a checkpoint (solver "phase_transition", no particles): its
+    /// counters, mass sums and merge schedule. The liquid's channels travel with the liquid
+    /// solver's state, the vapour with the gas solver's.
+    sph::SolverState saveState() const;
+    /// Continue from saveState()'s state, on a coupler built with the same settings, heaters
+    /// and restored solvers. Throws ValueError for another solver's state or a missing key.
+    void restoreState(const sph::SolverState& state);
 
     const PhaseTransitionTimings& timings() const { return mTimings; }
     void resetTimings() { mTimings = PhaseTransitionTimings(); }

@@ -1,0 +1,269 @@
+/// @file   test_run_robustness.cc
+/// @brief  `ghostfx run` against what production throws at it: a medium that drains out of the
+///         kill box (liquid, gas, a pan that boils away), a render farm's SIGTERM and SIGUSR1,
+///         a second signal, the printed resume command pasted as it is, and a boiling pan
+///         resumed from its checkpoint bit for bit.
+#include "CliHarness.h"
+
+#include <ghostfx/vdbio/Checkpoint.h>
+
+#include <csignal>
+#include <cstdio>
+
+namespace fs = std::filesystem;
+using namespace ghostfx;
+using ghostfx::testing::csvColumn;
+using ghostfx::testing::gridBytes;
+using ghostfx::testing::pointCount;
+using ghostfx::testing::Result;
+using ghostfx::testing::slurp;
+using vdbio::Json;
+
+namespace {
+
+class Robustness : public ghostfx::testing::CliTest
+{
+protected:
+    void SetUp() override { mDir = ghostfx::testing::freshTestDir("robust"); }
+
+    /// A 10 x 7 x 10 cm block of water 5 cm above the kill box's floor (y = 0.3), no solids:
+    /// it falls out of the box in free fall, its top crossing y = 0.3 at t = sqrt(2 0.12 / g)
+    /// = 0.156 s (frame 4.7 at 30 fps).
+    static Json fallingBlock()
+    {
+        return Json::parse(R"({
+            "ghostfx_scene": 1,
+            "settings": { "method": "ghost", "spacing": 0.02, "substeps": 0, "frame_range": [1, 10] },
+            "liquids": [ { "name": "water", "geometry": { "box": { "min": [0, 0.35, 0], "max": [0.1, 0.42, 0.1] } } } ],
+            "domain": { "kill_box": { "min": [-0.3, 0.3, -0.3], "max": [0.4, 1.0, 0.4] } }
+        })");
+    }
+
+    /// A pan of water on a 500 K plate that boils away in about three frames.
+    static Json boilingPan(double latentHeat)
+    {
+        Json scene = Json::parse(R"({
+            "ghostfx_scene": 1,
+            "settings": { "method": "ghost", "spacing": 0.02, "substeps": 10, "frame_range": [1, 4] },
+            "solids": [ { "name": "pan", "geometry": { "container": { "min": [0, 0, 0], "max": [0.2, 0.3, 0.2], "wall": 0.04 } } } ],
+            "liquids": [ { "name": "water", "geometry": { "box": { "min": [0, 0, 0], "max": [0.2, 0.08, 0.2] } } } ],
+            "heaters": [ { "name": "plate", "geometry": { "box": { "min": [-0.04, -0.04, -0.04], "max": [0.24, 0.0, 0.24] } },
+                           "temperature": 500 } ],
+            "phase_transition": { "initial_temperature": 372, "heating_time": 0.02 },
+            "domain": { "kill_box": { "min": [-0.1, -0.1, -0.1], "max": [0.3, 1.0, 0.3] } },
+            "outputs": { "checkpoint": { "every": 2 } }
+        })");
+        scene["phase_transition"]["latent_heat"] = latentHeat;
+        return scene;
+    }
+
+    /// How often `part` occurs in `text`.
+    static std::size_t occurrences(const std::string& text, const std::string& part)
+    {
+        std::size_t n = 0;
+        for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1))
+            ++n;
+        return n;
+    }
+
+    /// A run that a signal stops: the small tank scene for 400 frames, `substeps` a frame, with
+    /// overrides and an output folder the resume command must keep. Returns the pid.
+    pid_t startLongRun(const fs::path& out, int substeps, const fs::path& err)
+    {
+        Json scene = Json::parse(R"({
+            "ghostfx_scene": 1,
+            "settings": { "method": "ghost", "spacing": 0.015, "substeps": 10, "frame_range": [1, 400], "seed": 7 },
+            "solids": [ { "name": "tank", "geometry": { "container": { "min": [0, 0, 0], "max": [0.3, 0.3, 0.3], "wall": 0.05 } } } ],
+            "liquids": [ { "name": "water", "geometry": { "box": { "min": [0, 0, 0], "max": [0.12, 0.12, 0.3] } } } ],
+            "outputs": { "checkpoint": { "every": 100 } }
+        })");
+        mScene = write(scene);
+        return spawn({"run", mScene, "--out", out.string(), "--progress", "none", "-D",
+                      "settings.substeps=" + std::to_string(substeps), "-D",
+                      "outputs.checkpoint.file=state.$F4.h5"},
+                     err);
+    }
+
+    std::string mScene;
+};
+
+// Draining ---------------------------------------------------------------------------------------
+
+TEST_F(Robustness, LiquidDrainingOutOfTheKillBoxRunsToTheEndWithEmptyFrames)
+{
+    const fs::path out = mDir / "out";
+    const Result r = run("run " + write(fallingBlock()) + " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(occurrences(r.err, "ghostfx: warning:"), 1u) << r.err;
+    EXPECT_CONTAINS(r.err, "no liquid particles are left (all left the kill box)");
+    // Every particle leaves in free fall: none is flung back up into the box by an air layer
+    // the box cut in half (6-10 of the block's 129 particles hovered there for 0.2 s).
+    const std::vector<double> frame = csvColumn(out / "stats.csv", "frame");
+    const std::vector<double> liquid = csvColumn(out / "stats.csv", "count_liquid");
+    ASSERT_EQ(frame.size(), liquid.size());
+    EXPECT_GT(liquid.front(), 100);
+    for (std::size_t k = 0; k < frame.size(); ++k) {
+        if (frame[k] >= 6) EXPECT_EQ(liquid[k], 0) << "frame " << frame[k];
+    }
+    // The empty frames are valid files with the grids of a full one, and no points.
+    EXPECT_EQ(pointCount(out / "liquid_points.0010.vdb"), 0u);
+    const auto full = gridBytes(out / "liquid.0001.vdb");
+    const auto empty = gridBytes(out / "liquid.0010.vdb");
+    ASSERT_EQ(full.size(), empty.size());
+    for (const auto& [name, bytes] : full) EXPECT_EQ(empty.count(name), 1u) << name;
+    EXPECT_TRUE(fs::exists(out / "checkpoint.0010.h5"));
+}
+
+TEST_F(Robustness, LiquidAllOutsideTheKillBoxAtTheStartRunsToTheEnd)
+{
+    Json scene = fallingBlock();
+    scene["domain"]["kill_box"]["min"] = {-0.3, 0.5, -0.3};
+    scene["settings"]["frame_range"] = {1, 3};
+    const fs::path out = mDir / "out";
+    const Result r = run("run " + write(scene) + " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_CONTAINS(r.err, "frame 1: no liquid particles are left");
+    EXPECT_EQ(pointCount(out / "liquid_points.0003.vdb"), 0u);
+    EXPECT_EQ(csvColumn(out / "stats.csv", "count_liquid").back(), 0);
+}
+
+TEST_F(Robustness, GasDrainingOutOfTheKillBoxRunsToTheEnd)
+{
+    // A puff rising at 2 m/s from 0.3 m, its source closing at 0.05 s: it leaves the box's top
+    // (y = 0.4) within a few frames.
+    const Json scene = Json::parse(R"({
+        "ghostfx_scene": 1,
+        "settings": { "method": "gas", "spacing": 0.03, "frame_range": [1, 12], "gas": { "substeps": 2, "seed": 1 } },
+        "domain": { "kill_box": { "min": [-0.3, -0.05, -0.3], "max": [0.3, 0.4, 0.3] } },
+        "gas_sources": [ { "name": "puff", "geometry": { "sphere": { "center": [0, 0.3, 0], "radius": 0.06 } },
+                           "temperature": 600, "velocity": [0, 2, 0], "end": 0.05 } ],
+        "outputs": { "gas_points": { "file": "gas_points.$F4.vdb" } }
+    })");
+    const fs::path out = mDir / "out";
+    const Result r = run("run " + write(scene) + " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(occurrences(r.err, "no gas particles are left"), 1u) << r.err;
+    EXPECT_GT(pointCount(out / "gas_points.0001.vdb"), 0u);
+    EXPECT_EQ(pointCount(out / "gas_points.0012.vdb"), 0u);
+    EXPECT_TRUE(fs::exists(out / "gas.0012.vdb"));
+    EXPECT_EQ(csvColumn(out / "stats.csv", "count_gas").back(), 0);
+}
+
+TEST_F(Robustness, PanThatBoilsAwayRunsToTheEnd)
+{
+    // Latent heat 5 K: the whole pan boils within three frames; the vapour goes on rising.
+    const fs::path out = mDir / "out";
+    const Result r = run("run " + write(boilingPan(5)) + " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(occurrences(r.err, "no liquid particles are left (all left the kill box or boiled "
+                                 "away)"),
+              1u)
+        << r.err;
+    EXPECT_EQ(csvColumn(out / "stats.csv", "count_liquid").back(), 0);
+    EXPECT_GT(csvColumn(out / "stats.csv", "count_gas").back(), 1000);
+    EXPECT_EQ(pointCount(out / "liquid_points.0004.vdb"), 0u);
+    EXPECT_TRUE(fs::exists(out / "checkpoint.0004.h5"));
+}
+
+// Checkpoints of a boiling scene -----------------------------------------------------------------
+
+TEST_F(Robustness, BoilingPanResumesBitForBit)
+{
+    // Latent heat 40 K: at frame 2 the pan is part boiled, part evaporating, with merges done,
+    // so the liquid's channels, the vapour and the coupler's counters all carry state.
+    const std::string path = write(boilingPan(40));
+    const fs::path a = mDir / "a", b = mDir / "b";
+    ASSERT_EQ(run("run " + path + " --out " + a.string() + " -q").code, 0);
+    ASSERT_EQ(run("run " + path + " --out " + b.string() + " -q --frames 1-2").code, 0);
+    const Result resumed = run("run " + path + " --out " + b.string() + " -q --resume "
+                               + (b / "checkpoint.0002.h5").string());
+    ASSERT_EQ(resumed.code, 0) << resumed.err;
+
+    const std::string fingerprint = vdbio::readScene(path).simulationFingerprint();
+    const auto states = vdbio::readCheckpointStates((a / "checkpoint.0002.h5").string(), fingerprint);
+    ASSERT_EQ(states.size(), 3u);
+    EXPECT_GT(states[0].particles.count(sph::ParticleKind::Liquid), 100u);
+    EXPECT_GT(states[1].particles.count(sph::ParticleKind::Gas), 100u);
+    EXPECT_GT(states[2].integer("boiled") + states[2].integer("evaporated"), 0);
+    EXPECT_EQ(ghostfx::testing::checkpointDifference(path, a / "checkpoint.0004.h5",
+                                                     b / "checkpoint.0004.h5"),
+              "");
+    for (const char* file : {"liquid.0004.vdb", "gas.0004.vdb", "liquid_points.0004.vdb"}) {
+        EXPECT_TRUE(gridBytes(a / file) == gridBytes(b / file)) << file;
+    }
+    EXPECT_TRUE(csvColumn(a / "stats.csv", "mass_gas") == csvColumn(b / "stats.csv", "mass_gas"));
+}
+
+// Signals ----------------------------------------------------------------------------------------
+
+/// SIGTERM and SIGUSR1 (a farm's pre-emption) stop the run as Ctrl-C does: the frame finished
+/// and written, a checkpoint of it, a resume command that works pasted as it is (it keeps the
+/// -D overrides and --out), exit code 128 + the signal.
+TEST_F(Robustness, SigtermAndSigusr1StopAfterTheFrameWithACheckpointAndAResumeCommand)
+{
+    for (const int signal : {SIGTERM, SIGUSR1}) {
+        const fs::path out = mDir / ("out" + std::to_string(signal));
+        const fs::path err = mDir / ("err" + std::to_string(signal) + ".txt");
+        const pid_t pid = startLongRun(out, 10, err);
+        ASSERT_TRUE(ghostfx::testing::waitForFile(out / "liquid.0002.vdb"));
+        ::kill(pid, signal);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << WTERMSIG(status);
+        EXPECT_EQ(WEXITSTATUS(status), 128 + signal);
+        const std::string text = slurp(err);
+        int stopped = 0;
+        const std::size_t at = text.find("ghostfx: stopped by SIG");
+        ASSERT_NE(at, std::string::npos) << text;
+        ASSERT_EQ(std::sscanf(text.c_str() + text.find(" after frame ", at), " after frame %d",
+                              &stopped),
+                  1)
+            << text;
+        EXPECT_GE(stopped, 2);
+        EXPECT_LT(stopped, 400);
+        char name[32];
+        std::snprintf(name, sizeof(name), "state.%04d.h5", stopped);
+        ASSERT_TRUE(fs::exists(out / name)) << text;
+        std::snprintf(name, sizeof(name), "liquid.%04d.vdb", stopped);
+        EXPECT_TRUE(fs::exists(out / name));
+
+        // The printed command, pasted as it is (with this build's program), continues in the
+        // same folder; the scene is cut to two more frames (frame_range is not a setting a
+        // checkpoint must match).
+        const std::size_t from = text.find("resume with: ghostfx ");
+        ASSERT_NE(from, std::string::npos) << text;
+        std::string command = text.substr(from + std::string("resume with: ghostfx ").size());
+        command = command.substr(0, command.find('\n'));
+        Json scene = Json::parse(slurp(mScene));
+        scene["settings"]["frame_range"] = {1, stopped + 2};
+        std::ofstream(mScene) << scene.dump(2);
+        const Result resumed = run(command + " -q");
+        ASSERT_EQ(resumed.code, 0) << command << "\n" << resumed.err;
+        std::snprintf(name, sizeof(name), "liquid.%04d.vdb", stopped + 2);
+        EXPECT_TRUE(fs::exists(out / name)) << command;
+    }
+}
+
+TEST_F(Robustness, ASecondSignalEndsTheRunAtOnce)
+{
+    // Frames of 400 steps (a few tenths of a second): the second SIGTERM comes 20 ms after the
+    // first, long before the frame ends, and the default action ends the process.
+    const fs::path out = mDir / "out";
+    const pid_t pid = startLongRun(out, 400, mDir / "err.txt");
+    ASSERT_TRUE(ghostfx::testing::waitForFile(out / "liquid.0001.vdb"));
+    ::kill(pid, SIGTERM);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "exit code " << WEXITSTATUS(status);
+    EXPECT_EQ(WTERMSIG(status), SIGTERM);
+    // Nothing half-written under a frame's own name (files are renamed into place whole).
+    for (const auto& e : fs::directory_iterator(out)) {
+        const std::string name = e.path().filename().string();
+        if (name[0] == '.' || e.path().extension() != ".vdb") continue;
+        EXPECT_FALSE(gridBytes(e.path()).empty()) << name;
+    }
+}
+
+} // namespace
