@@ -5,6 +5,8 @@
 #include "DistributedRun.h"
 #include "FrameWriter.h"
 #include "LiquidScene.h"
+#include "OutputChecks.h"
+#include "SceneWarnings.h"
 #include "Simulation.h"
 #include "StopSignals.h"
 
@@ -263,8 +265,7 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
         layer.grid = sph::gridOf(shape);
         layer.albedo = vdbio::SOLID_ALBEDO;
         // A solid that neither moves nor changes shape looks the same in every frame.
-        layer.fixed = solid.sequenceFile.empty() && solid.motion.keys.empty()
-                      && solid.velocity == openvdb::Vec3d(0.0);
+        layer.fixed = solid.isStatic();
         if (solid.motion.keys.empty()) {
             layer.translation = solid.velocity * snapshot.time;
         } else {
@@ -438,6 +439,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         sim = makeSimulation(scene);
     }
     checkSolidSequences(scene, sim->frame() + 1, last);
+    checkOutputs(scene, *sim);
     if (distributed) distributed->share(*sim, manifest ? &manifest->decomposition : nullptr);
     if (writes) vdbio::ensureWritableDirectory(folder);
     auto inFolder = [&](const std::string& pattern, int frame) {
@@ -483,23 +485,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         parallel::maxThreads(), " threads",
         distributed ? msg(" on each of ", distributed->ranks(), " processes") : std::string(),
         ", output in '", folder, "'"));
-    // A fixed step far beyond the stability limit blows up within a few steps, after a frame
-    // or more of output: say so before the first step, with both numbers.
-    if (const double fixed = sim->fixedTimeStep(); fixed > 0) {
-        const double limit = sim->stabilityLimit();
-        if (fixed > limit && writes) {
-            const int substeps = int(std::lround(1.0 / (fixed * scene.frameRate)));
-            std::fprintf(stderr, "%s\n",
-                         msg("ghostfx: warning: scene '", scene.file, "': the fixed step ", fixed,
-                             " s (frame_rate ", scene.frameRate, ", substeps ", substeps, ") is ",
-                             std::round(10 * fixed / limit) / 10, "x the stability limit ", limit,
-                             " s (Courant number 1: sound speed and forces); "
-                             "expect a blow-up: use substeps >= ",
-                             int(std::ceil(substeps * fixed / limit)),
-                             ", or substeps 0 for CFL steps")
-                             .c_str());
-        }
-    }
+    if (writes) warnFixedStepBeyondTheLimit(scene, *sim);
     // What each emitter pours, so a wrong velocity or shape shows before the run.
     const auto rates = sim->emitterRates();
     for (std::size_t e = 0; e < rates.size() && e < scene.emitters.size(); ++e) {
@@ -509,22 +495,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
                              std::round(rates[e].massRate * 100) / 100, " kg/s from ", em.start,
                              " s", std::isfinite(em.end) ? msg(" to ", em.end, " s") : ""));
     }
-    // A solid thinner than the kernel support holds too few ghost solids (or boundary
-    // particles): liquid beside it is under-dense, and a stiff liquid sticks to it (issue 18).
-    if (const double depth = sim->boundaryLayerDepth(); depth > 0) {
-        for (const vdbio::SceneSolid& solid : scene.solids) {
-            const double thin = solid.shape.fractionThinnerThan(sph::Real(depth));
-            if (thin < 0.01 || !writes) continue;
-            std::fprintf(stderr, "%s\n",
-                         msg("ghostfx: warning: scene '", scene.file, "': solid '", solid.name,
-                             "' is thinner than the kernel support ", depth, " m over ",
-                             std::lround(100 * thin),
-                             " % of its surface: liquid there lacks boundary particles (too "
-                             "low a density; a stiff liquid sticks to it); make it at least ",
-                             depth, " m thick")
-                             .c_str());
-        }
-    }
+    if (writes) warnThinSolids(scene, sim->boundaryLayerDepth());
     const bool checkpoints = !out.checkpointFile.empty();
 
     // Statistics.

@@ -107,18 +107,7 @@ std::vector<std::pair<std::string, Json>> assignments(const vdbio::JsonObject& o
 
 StudySpec readStudy(const std::string& path)
 {
-    std::ifstream in(path);
-    if (!in) throw IoError(msg("study '", path, "': cannot open the file"));
-    Json doc;
-    try {
-        doc = Json::parse(in, nullptr, true, /*ignore_comments=*/true);
-    } catch (const Json::parse_error& e) {
-        const std::string what = e.what();
-        const std::size_t colon = what.find(": ");
-        throw SceneError(msg("study '", path, "': not valid JSON (",
-                             colon == std::string::npos ? what : what.substr(colon + 2), ")"));
-    }
-    auto shared = std::make_shared<const Json>(std::move(doc));
+    auto shared = std::make_shared<const Json>(vdbio::readJsonFile(path, "study"));
     const vdbio::JsonObject root(shared, shared.get(), "", path, "study");
 
     StudySpec s;

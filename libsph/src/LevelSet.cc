@@ -488,10 +488,19 @@ openvdb::FloatGrid::Ptr makeSphereLevelSet(const Vec3& center, Real radius, Real
         float(voxelSize), float(halfWidthVoxels));
 }
 
-double LevelSet::fractionThinnerThan(Real depth) const
+double LevelSet::fractionThinnerThan(Real depth) const { return fractionThinnerThan(depth, {}); }
+
+double LevelSet::fractionThinnerThan(Real depth, const std::vector<const LevelSet*>& others) const
 {
     const openvdb::FloatGrid& grid = *gridOf(*this);
     const double half = 0.5 * double(voxelSize());
+    // phi of the others' union at x (their bounds first: beyond them phi is the background).
+    auto insideOthers = [&](const Vec3& x, double margin) {
+        for (const LevelSet* o : others) {
+            if (o->bounds().contains(x) && double(o->phi(x)) < margin) return true;
+        }
+        return false;
+    };
     std::size_t surface = 0, thin = 0;
     for (auto it = grid.cbeginValueOn(); it; ++it) {
         if (std::abs(double(*it)) > half) continue;
@@ -499,9 +508,12 @@ double LevelSet::fractionThinnerThan(Real depth) const
         const Vec3 x(Real(w.x()), Real(w.y()), Real(w.z()));
         const Vec3 n = normal(x);
         if (n.lengthSqr() == Real(0)) continue;
+        // Buried in a neighbour, or against one within a voxel: no liquid gets there.
+        if (insideOthers(x, 2 * half)) continue;
         ++surface;
         // Half a voxel of slack: a wall exactly `depth` thick is not thin.
-        thin += double(phi(x - depth * n)) > half;
+        const Vec3 below = x - depth * n;
+        thin += double(phi(below)) > half && !insideOthers(below, half);
     }
     return surface == 0 ? 0.0 : double(thin) / double(surface);
 }

@@ -717,3 +717,29 @@ TEST(LevelSet, ThinWallsAreFoundWhereAKernelRadiusDoesNotFit)
                   .fractionThinnerThan(Real(0.03)),
               0.0);
 }
+
+TEST(LevelSet, ThinFractionOfAPartOfAUnionCountsItsNeighbours)
+{
+    // A 1 cm plate lying on a 10 cm floor, depth 3 cm: alone, its top and bottom faces (most
+    // of its surface) are thin; beside the floor, its underside is buried and the point 3 cm
+    // under its top lies in the floor, so only its 1 cm high edges could be thin, and they
+    // are deep along the plate. A plate held 5 cm above the floor stays thin.
+    const Real voxel = Real(0.0025);
+    const LevelSet floor = makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.3f, -0.1f, -0.3f), Vec3(0.3f, 0.0f, 0.3f), voxel), "floor");
+    const LevelSet lying = makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.1f, 0.0f, -0.1f), Vec3(0.1f, 0.01f, 0.1f), voxel), "lying");
+    const LevelSet held = makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.1f, 0.05f, -0.1f), Vec3(0.1f, 0.06f, 0.1f), voxel), "held");
+    const double alone = lying.fractionThinnerThan(Real(0.03));
+    const double onFloor = lying.fractionThinnerThan(Real(0.03), {&floor});
+    const double above = held.fractionThinnerThan(Real(0.03), {&floor});
+    std::printf("[measured] thin fraction of a 1 cm plate: alone %.3f, on the floor %.3f, 5 cm "
+                "above it %.3f\n",
+                alone, onFloor, above);
+    EXPECT_GT(alone, 0.9);
+    EXPECT_EQ(onFloor, 0.0);
+    EXPECT_GT(above, 0.9);
+    // The floor itself, 10 cm deep, is not thin beside the plate either.
+    EXPECT_EQ(floor.fractionThinnerThan(Real(0.03), {&lying}), 0.0);
+}

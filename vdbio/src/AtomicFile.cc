@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -18,6 +19,31 @@ namespace vdbio {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+/// Below this many free bytes a failed write is taken to have met a full device (libraries
+/// such as HDF5 and OpenVDB do not always leave errno at ENOSPC).
+constexpr std::uintmax_t FULL_DEVICE_BYTES = 1 << 20;
+
+/// ": the device holding 'folder' is full (...)" when a write into `folder` that failed with
+/// `savedErrno` and the message `what` met a full device or quota, else "".
+std::string fullDeviceNote(const fs::path& folder, int savedErrno, const std::string& what)
+{
+    std::error_code ec;
+    const fs::space_info space = fs::space(folder.empty() ? fs::path(".") : folder, ec);
+    const bool full = savedErrno == ENOSPC || savedErrno == EDQUOT
+                      || (!ec && space.free < FULL_DEVICE_BYTES);
+    if (!full) return "";
+    const std::string reason = std::strerror(savedErrno == EDQUOT ? EDQUOT : ENOSPC);
+    std::string detail = what.find(reason) == std::string::npos ? reason : std::string();
+    if (!ec) detail += msg(detail.empty() ? "" : ", ", space.free, " bytes free");
+    return msg(": the device holding '", folder.empty() ? "." : folder.string(), "' is full",
+               detail.empty() ? std::string() : " (" + detail + ")",
+               "; nothing of this file was kept");
+}
+
+} // namespace
+
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write)
 {
     // Unique per process and call, in the target's folder so the rename never crosses devices.
@@ -26,8 +52,16 @@ void writeAtomically(const std::string& path, const std::function<void(const std
     const fs::path tmp = target.parent_path()
                          / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid())
                             + "_" + std::to_string(counter++));
+    errno = 0;
     try {
         write(tmp.string());
+    } catch (const std::exception& e) {
+        // Asked while the temporary still holds what was written.
+        const std::string full = fullDeviceNote(target.parent_path(), errno, e.what());
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        if (full.empty()) throw;
+        throw IoError(msg(e.what(), full));
     } catch (...) {
         std::error_code ec;
         fs::remove(tmp, ec);

@@ -7,6 +7,8 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 
 namespace ghostfx {
@@ -372,6 +374,86 @@ void applyOverride(Json& document, const std::string& assignment)
         if (i < path.size() && path[i] == '.') ++i;
     }
     *node = value;
+}
+
+namespace {
+
+/// Follows a parse (nlohmann's parser callback) to name where it is in the document, as the
+/// readers' messages do ("settings.spacing", "solids[1].name"), and refuses a key given twice
+/// in one object: nlohmann keeps the last value silently.
+class DuplicateKeyCheck
+{
+public:
+    DuplicateKeyCheck(std::string kind, std::string path)
+        : mKind(std::move(kind))
+        , mFile(std::move(path))
+    {}
+
+    bool operator()(int /*depth*/, Json::parse_event_t event, Json& parsed)
+    {
+        using Event = Json::parse_event_t;
+        if (event == Event::object_start || event == Event::array_start
+            || event == Event::value) {
+            if (!mStack.empty() && mStack.back().array) ++mStack.back().elements;
+        }
+        if (event == Event::object_start || event == Event::array_start) {
+            mStack.push_back(Level{event == Event::array_start, 0, {}, {}});
+        } else if (event == Event::object_end || event == Event::array_end) {
+            mStack.pop_back();
+        } else if (event == Event::key) {
+            Level& level = mStack.back();
+            level.key = parsed.get<std::string>();
+            if (!level.keys.insert(level.key).second) {
+                throw SceneError(msg(mKind, " '", mFile, "': ", where(),
+                                     ": key given twice in one object (which one is meant?)"));
+            }
+        }
+        return true;
+    }
+
+private:
+    struct Level
+    {
+        bool array;
+        std::size_t elements; ///< of an array: values begun so far
+        std::set<std::string> keys;
+        std::string key; ///< of an object: the key being read
+    };
+
+    std::string where() const
+    {
+        std::string path;
+        for (const Level& level : mStack) {
+            if (level.array) path += msg("[", level.elements - 1, "]");
+            else path += (path.empty() ? "" : ".") + level.key;
+        }
+        return path;
+    }
+
+    std::string mKind, mFile;
+    std::vector<Level> mStack;
+};
+
+} // namespace
+
+Json readJsonFile(const std::string& path, const std::string& kind)
+{
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+        throw IoError(msg(kind, " '", path, "': is a folder; expected a ", kind, " file (.json)"));
+    }
+    std::ifstream in(path);
+    if (!in) throw IoError(msg(kind, " '", path, "': cannot open the file"));
+    try {
+        return Json::parse(in, DuplicateKeyCheck(kind, path), true, /*ignore_comments=*/true);
+    } catch (const Json::parse_error& e) {
+        // nlohmann's message carries the line and column.
+        const std::string what = e.what();
+        const std::size_t colon = what.find(": ");
+        throw SceneError(msg(kind, " '", path, "': not valid JSON (",
+                             colon == std::string::npos ? what : what.substr(colon + 2), ")"));
+    }
 }
 
 } // namespace vdbio

@@ -2,6 +2,8 @@
 /// @brief  Assimp mesh reading, vertex welding, edge checks and tools::meshToLevelSet.
 #include <ghostfx/vdbio/MeshToSdf.h>
 
+#include "FrameGridsDetail.h"
+
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
@@ -228,16 +230,7 @@ openvdb::FloatGrid::Ptr convertMeshFile(const std::string& meshPath, const std::
     openvdb::FloatGrid::Ptr grid = meshToLevelSet(meshPath, options, stats);
     openvdb::MetaMap fileMeta;
     fileMeta.insertMeta("creator", openvdb::StringMetadata("ghostfx mesh2sdf"));
-    writeAtomically(vdbPath, [&](const std::string& tmp) {
-        try {
-            openvdb::io::File file(tmp);
-            file.write({grid}, fileMeta);
-            file.close();
-        } catch (const openvdb::Exception&) {
-            // OpenVDB's message names the temporary file: name the target instead.
-            throw IoError(msg("'", vdbPath, "': cannot write the file"));
-        }
-    });
+    detail::writeVdbFile(vdbPath, "level set", openvdb::GridCPtrVec{grid}, fileMeta);
     return grid;
 }
 

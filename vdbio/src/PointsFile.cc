@@ -114,11 +114,10 @@ double autoPointsVoxelSize(const std::vector<sph::Vec3>& positions)
                                           PointsOptions::AUTO_POINTS_PER_VOXEL));
 }
 
-openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
-                                      const PointsOptions& options, const std::string& where)
+void checkPointsOutput(const sph::ParticleSet& particles, const PointsOptions& options,
+                       const std::string& where)
 {
     options.validate();
-    // Resolve every channel before any work, so a typo costs nothing.
     for (const std::string& name : options.channels) {
         bool builtin = false;
         for (const char* b : BUILTIN_CHANNELS) builtin = builtin || name == b;
@@ -132,6 +131,13 @@ openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
         throw ValueError(msg(where, ": channel '", name,
                              "' not found: available: ", detail::joinNames(available)));
     }
+}
+
+openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
+                                      const PointsOptions& options, const std::string& where)
+{
+    // Resolve every channel before any work, so a typo costs nothing.
+    checkPointsOutput(particles, options, where);
 
     const std::vector<sph::Index> selection = detail::selectKinds(particles, options.kinds);
 

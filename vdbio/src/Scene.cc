@@ -343,8 +343,23 @@ std::vector<std::string> readGridNames(const JsonObject& s,
     return grids;
 }
 
+/// The file name `s.key` (a frame pattern) must end in one of `extensions`, the formats that
+/// output is written in; `what` names them ("OpenVDB (.vdb)").
+std::string outputFile(const JsonObject& s, const char* key, const std::string& fallback,
+                       const std::vector<std::string>& extensions, const char* what)
+{
+    const std::string file = s.get<std::string>(key, fallback);
+    const std::string ext = extensionOf(file);
+    if (std::find(extensions.begin(), extensions.end(), ext) != extensions.end()) return file;
+    std::string names;
+    for (const std::string& e : extensions) names += (names.empty() ? "" : " or ") + e;
+    s.failValue(key, msg("this output is written as ", what, ": expected a name ending in ",
+                         names, ext.empty() ? "" : msg(", not ", ext)));
+}
+
 void readOutputs(const JsonObject& o, SceneOutputs& out)
 {
+    const std::vector<std::string> vdb{".vdb"}, h5{".h5", ".hdf5"};
     out.directory = o.get<std::string>("directory", out.directory);
     // Each section: an object, or false / null to switch that output off.
     auto section = [&](const char* key, auto&& read, auto&& off) {
@@ -362,7 +377,7 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     section(
         "points",
         [&](const JsonObject& s) {
-        out.pointsFile = s.get<std::string>("file", out.pointsFile);
+        out.pointsFile = outputFile(s, "file", out.pointsFile, vdb, "OpenVDB points");
         out.pointChannels = s.get<std::vector<std::string>>("channels", out.pointChannels);
         out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
         },
@@ -370,7 +385,7 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     section(
         "volume",
         [&](const JsonObject& s) {
-        out.volumeFile = s.get<std::string>("file", out.volumeFile);
+        out.volumeFile = outputFile(s, "file", out.volumeFile, vdb, "OpenVDB grids");
         out.volumeGrids =
             readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
         const std::string method =
@@ -384,14 +399,14 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     section(
         "gas_points",
         [&](const JsonObject& s) {
-        out.gasPointsFile = s.get<std::string>("file", out.gasPointsFile);
+        out.gasPointsFile = outputFile(s, "file", out.gasPointsFile, vdb, "OpenVDB points");
         out.gasPointChannels = s.get<std::vector<std::string>>("channels", out.gasPointChannels);
         },
         [&] { out.gasPointsFile.clear(); });
     section(
         "gas_volume",
         [&](const JsonObject& s) {
-        out.gasVolumeFile = s.get<std::string>("file", out.gasVolumeFile);
+        out.gasVolumeFile = outputFile(s, "file", out.gasVolumeFile, vdb, "OpenVDB grids");
         out.gasVolumeGrids =
             readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature"});
         out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
@@ -401,7 +416,8 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     section(
         "preview",
         [&](const JsonObject& s) {
-        out.previewFile = s.get<std::string>("file", "preview.$F4.exr");
+        out.previewFile =
+            outputFile(s, "file", "preview.$F4.exr", {".exr", ".png"}, "an EXR or PNG image");
         out.previewGrid = s.get<std::string>("grid", out.previewGrid);
         out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
         out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
@@ -437,13 +453,15 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     section(
         "checkpoint",
         [&](const JsonObject& s) {
-        out.checkpointFile = s.get<std::string>("file", out.checkpointFile);
+        out.checkpointFile = outputFile(s, "file", out.checkpointFile, h5, "HDF5");
         out.checkpointEvery = int(s.inRange("every", out.checkpointEvery, 0, 1e6));
         },
         [&] { out.checkpointFile.clear(); });
     section(
         "stats",
-        [&](const JsonObject& s) { out.statsFile = s.get<std::string>("file", out.statsFile); },
+        [&](const JsonObject& s) {
+        out.statsFile = outputFile(s, "file", out.statsFile, h5, "HDF5 (and CSV beside it)");
+        },
         [&] { out.statsFile.clear(); });
     o.finish();
 }
@@ -535,17 +553,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     if (ext == ".vdb") {
         doc = documentFromRoles(path);
     } else {
-        std::ifstream in(path);
-        if (!in) throw IoError(msg("scene '", path, "': cannot open the file"));
-        try {
-            doc = Json::parse(in, nullptr, true, /*ignore_comments=*/true);
-        } catch (const Json::parse_error& e) {
-            // nlohmann's message carries the line and column.
-            std::string what = e.what();
-            const std::size_t colon = what.find(": ");
-            throw SceneError(msg("scene '", path, "': not valid JSON (",
-                                 colon == std::string::npos ? what : what.substr(colon + 2), ")"));
-        }
+        doc = readJsonFile(path, "scene");
     }
     for (const std::string& o : overrides) {
         try {

@@ -8,11 +8,15 @@
 #include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/FrameFiles.h>
 
+#include <openvdb/io/Archive.h>
 #include <openvdb/io/File.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <set>
 
 namespace ghostfx {
@@ -110,14 +114,40 @@ void setCommonGridMetadata(openvdb::GridBase& grid)
     grid.setSaveFloatAsHalf(false);
 }
 
+namespace {
+
+/// OpenVDB's file format (what io::File::write writes: a seekable stream with grid offsets)
+/// into a stream whose errors are checked. io::File::write does not look at its stream after
+/// writing, so a full disk left an empty or cut file that was then renamed into place.
+class CheckedVdbWriter : public openvdb::io::Archive
+{
+public:
+    /// Throws IoError naming `target` (the file `file` will become).
+    void write(const std::string& file, const std::string& target, const char* what,
+               const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& fileMetadata) const
+    {
+        std::ofstream out(file, std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
+        if (!out) {
+            throw IoError(msg(what, " '", target, "': cannot create it (", std::strerror(errno),
+                              ")"));
+        }
+        Archive::write(out, grids, /*seekable=*/true, fileMetadata);
+        out.close();
+        if (out.fail()) {
+            throw IoError(msg(what, " '", target, "': cannot write it (",
+                              errno != 0 ? std::strerror(errno) : "the stream failed", ")"));
+        }
+    }
+};
+
+} // namespace
+
 void writeVdbFile(const std::string& path, const char* what, const openvdb::GridCPtrVec& grids,
                   const openvdb::MetaMap& fileMetadata)
 {
     writeAtomically(path, [&](const std::string& tmp) {
         try {
-            openvdb::io::File file(tmp);
-            file.write(grids, fileMetadata);
-            file.close();
+            CheckedVdbWriter().write(tmp, path, what, grids, fileMetadata);
         } catch (const openvdb::Exception& e) {
             throw IoError(msg(what, " '", path, "': cannot write (", e.what(), ")"));
         } catch (const std::ios_base::failure& e) {
@@ -235,16 +265,22 @@ void VolumeOptions::validate() const
 // makeVolumeGrids
 // ---------------------------------------------------------------------------------------------
 
-openvdb::GridPtrVec makeVolumeGrids(const sph::ParticleSet& particles, const VolumeOptions& options)
+void checkVolumeOutput(const sph::ParticleSet& particles, const VolumeOptions& options,
+                       const std::string& where)
 {
     options.validate();
     for (const std::string& name : options.scalarChannels) {
         if (name == "pressure" || particles.hasScalarChannel(name)) continue;
         std::vector<std::string> available{"pressure"};
         for (const std::string& n : particles.scalarChannelNames()) available.push_back(n);
-        throw ValueError(msg("volume output: scalar channel '", name,
+        throw ValueError(msg(where, ": scalar channel '", name,
                              "' not found: available: ", detail::joinNames(available)));
     }
+}
+
+openvdb::GridPtrVec makeVolumeGrids(const sph::ParticleSet& particles, const VolumeOptions& options)
+{
+    checkVolumeOutput(particles, options);
 
     const std::vector<sph::Index> selection = detail::selectKinds(particles, options.kinds);
     openvdb::GridPtrVec grids;

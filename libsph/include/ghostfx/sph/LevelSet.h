@@ -75,6 +75,12 @@ public:
     /// thinner than `depth` (m): the point `depth` inward along the normal lies outside again.
     /// A boundary layer of particles one kernel radius deep does not fit there.
     double fractionThinnerThan(Real depth) const;
+    /// The same for this shape as a part of its union with `others` (the solids beside it): a
+    /// surface voxel inside one of `others`, or within a voxel of one, is buried (no liquid
+    /// reaches it) and not counted,
+    /// and a surface point is thin only where the point `depth` inward lies outside this shape
+    /// and all of `others` (a plate lying on a floor is as thick as both).
+    double fractionThinnerThan(Real depth, const std::vector<const LevelSet*>& others) const;
     /// Area (m^2) of the shadow the shape casts along `direction` (any length but zero): the
     /// cross-section through which a body translating along it sweeps. Rays along `direction`
     /// through the centres of a square grid of `resolution` (m) over the projected bounds are

@@ -87,6 +87,12 @@ openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
                                       const PointsOptions& options,
                                       const std::string& where = "points output");
 
+/// Refuse what makePointsGrid would refuse for `particles`, without building anything: a bad
+/// option, or a channel the set does not have (named in a ValueError prefixed by `where`). A
+/// run calls it before its first step, so no output is written before such an error.
+void checkPointsOutput(const sph::ParticleSet& particles, const PointsOptions& options,
+                       const std::string& where = "points output");
+
 /// The voxel size PointsOptions::voxelSize = 0 picks for these positions (OpenVDB's
 /// points::computeVoxelSize at AUTO_POINTS_PER_VOXEL; 0.1 m for fewer than two).
 double autoPointsVoxelSize(const std::vector<sph::Vec3>& positions);
@@ -231,6 +237,11 @@ struct VolumeOptions
         return densityVoxelSize > 0 ? densityVoxelSize : particleSpacing;
     }
 };
+
+/// Refuse what makeVolumeGrids would refuse for `particles`, without building anything: a bad
+/// option, or a scalar channel the set does not have (a ValueError prefixed by `where`).
+void checkVolumeOutput(const sph::ParticleSet& particles, const VolumeOptions& options,
+                       const std::string& where = "volume output");
 
 /// Build the grids asked for, in this order: "surface" (GRID_LEVEL_SET FloatGrid, background
 /// = half width in metres), "density" (GRID_FOG_VOLUME FloatGrid, rho / rho0, metadata

@@ -86,6 +86,12 @@ private:
     mutable std::set<std::string> mKnown;
 };
 
+/// Read the JSON file `path` (comments allowed) as a `kind` ("scene" or "study") is read. Refuses,
+/// with one line naming the file: a folder or a file that cannot be opened (IoError), text that
+/// is not JSON, with nlohmann's line and column, and a key given twice in one object, with its
+/// path ("scene 'a.json': settings.spacing: key given twice in one object") (SceneError).
+Json readJsonFile(const std::string& path, const std::string& kind = "scene");
+
 /// Apply a `-D path=value` override to `document`. `value` is parsed as JSON if it is valid
 /// JSON (numbers, arrays, true/false, quoted strings) and taken as a plain string otherwise.
 /// Missing objects on the path are created; indexing past an array's end is a SceneError.

@@ -103,6 +103,12 @@ struct SceneSolid : SceneShape
     KeyedMotion motion;     ///< keyed rigid motion (empty: constant velocity)
     /// Per-frame shapes (deforming solid): file pattern with $F and grid name; empty if static.
     std::string sequenceFile, sequenceGrid;
+
+    /// Neither moves nor changes shape.
+    bool isStatic() const
+    {
+        return sequenceFile.empty() && motion.keys.empty() && velocity == sph::Vec3d(0.0);
+    }
 };
 
 struct SceneLiquid : SceneShape
