@@ -117,6 +117,10 @@ public:
         return std::min(double(mLiquid->stableTimeStep()) / double(mLiquid->settings().cflNumber),
                         double(mGas->stableTimeStep()) / double(mGas->settings().cflNumber));
     }
+    double cflTimeStep() const override
+    {
+        return double(std::min(mLiquid->stableTimeStep(), mGas->stableTimeStep()));
+    }
     std::uint64_t stepCount() const override { return mLiquid->stepCount(); }
     void beforeFrame(int frame) override { updateSolidSequences(mScene, *mLiquid, frame); }
     void setStepObserver(std::function<void(double)> observer) override

@@ -94,6 +94,8 @@ public:
         return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
     }
 
+    double cflTimeStep() const override { return double(mSolver->stableTimeStep()); }
+
     void setStepObserver(std::function<void(double)> observer) override
     {
         mSolver->setStepObserver(

@@ -91,6 +91,7 @@ public:
     {
         return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
     }
+    double cflTimeStep() const override { return double(mSolver->stableTimeStep()); }
     double boundaryLayerDepth() const override
     {
         return double(mSolver->settings().supportRadius());

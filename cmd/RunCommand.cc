@@ -6,7 +6,7 @@
 #include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "OutputChecks.h"
-#include "SceneWarnings.h"
+#include "RunChecks.h"
 #include "Simulation.h"
 #include "StopSignals.h"
 
@@ -171,6 +171,17 @@ std::string resumeCommand(const RunOptions& o, const std::string& checkpoint, in
     for (const std::string& define : o.defines) command += " -D " + shellWord(define);
     if (!o.sampleCache.empty()) command += " --sample-cache " + shellWord(o.sampleCache);
     return command + " --resume " + shellWord(checkpoint);
+}
+
+/// Simulate one frame; a blow-up's message names the scene and the keys that set its step.
+void advanceFrame(const vdbio::Scene& scene, Simulation& sim)
+{
+    try {
+        sim.advanceFrame();
+    } catch (const NumericalError& e) {
+        throw NumericalError(
+            msg("scene '", scene.file, "': ", e.what(), " (in this scene: ", stepKeys(scene), ")"));
+    }
 }
 
 /// The media's particles, summed over the processes of a distributed run (collective).
@@ -440,6 +451,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
     }
     checkSolidSequences(scene, sim->frame() + 1, last);
     checkOutputs(scene, *sim);
+    checkStepsPerFrame(scene, *sim);
     if (distributed) distributed->share(*sim, manifest ? &manifest->decomposition : nullptr);
     if (writes) vdbio::ensureWritableDirectory(folder);
     auto inFolder = [&](const std::string& pattern, int frame) {
@@ -545,7 +557,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         const std::uint64_t stepsBefore = sim->stepCount();
         substep = 0;
         sim->beforeFrame(frame);
-        sim->advanceFrame();
+        advanceFrame(scene, *sim);
 
         const bool write = frame >= first;
         if (write && distributed) {

@@ -53,6 +53,9 @@ public:
     /// The largest stable step now (s): the solvers' limits at Courant number 1 (sound speed,
     /// forces, explicit diffusion), the CFL step divided by the scene's cfl.
     virtual double stabilityLimit() const = 0;
+    /// The step (s) CFL-adaptive steps would take now: the stability limit times the scene's
+    /// cfl (with DFSPH, bound by the flow speed and max_dt instead).
+    virtual double cflTimeStep() const = 0;
     /// How deep (m) the boundary particles inside a solid must reach: the kernel support of a
     /// liquid with ghost solids or boundary particles; 0 where solids are not sampled so.
     virtual double boundaryLayerDepth() const { return 0; }

@@ -246,13 +246,23 @@ TEST_F(SceneTest, MethodIsANameTheProgramChecks)
     s = baseScene();
     s["settings"]["method"] = 3;
     EXPECT_CONTAINS(errorOf(s), "settings.method");
-    // Not JSON at all: the parser's position is kept.
+    // Not JSON at all: the parser's line and column are kept, with the key it was in.
     std::ofstream(mDir / "broken.json") << "{ \"ghostfx_scene\": 1, ";
     try {
         vdbio::readScene((mDir / "broken.json").string());
         ADD_FAILURE();
     } catch (const SceneError& e) {
-        EXPECT_CONTAINS(e.what(), "broken.json': not valid JSON (");
+        EXPECT_CONTAINS(e.what(), "broken.json': not valid JSON at line 1, column 23: ");
+    }
+    std::ofstream(mDir / "nan.json") << "{ \"ghostfx_scene\": 1,\n \"settings\": { \"gravity\": "
+                                        "[0, NaN, 0] } }";
+    try {
+        vdbio::readScene((mDir / "nan.json").string());
+        ADD_FAILURE();
+    } catch (const SceneError& e) {
+        EXPECT_CONTAINS(e.what(), "nan.json': not valid JSON at line 2, column 31 (in "
+                                  "settings.gravity[1]): ");
+        EXPECT_CONTAINS(e.what(), "; NaN and Infinity are not JSON numbers");
     }
     try {
         vdbio::readScene((mDir / "missing.json").string());

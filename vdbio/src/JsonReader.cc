@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 
 namespace ghostfx {
 namespace vdbio {
@@ -24,21 +25,34 @@ std::string shortDump(const Json& value)
     return text;
 }
 
-const char* typeWanted(const double*) { return "a number"; }
+/// The magnitudes a scene number may have, 0 aside: every setting and coordinate becomes a Real,
+/// a float in the default build, where a larger one would be infinite and a smaller one 0 or
+/// a denormal.
+constexpr double LARGEST_NUMBER = double(std::numeric_limits<float>::max());
+constexpr double SMALLEST_NUMBER = double(std::numeric_limits<float>::min());
+
+const char* typeWanted(const double*) { return "a number, 0 or of magnitude 1.2e-38 to 3.4e38"; }
 const char* typeWanted(const int*) { return "an integer"; }
 const char* typeWanted(const std::int64_t*) { return "an integer"; }
 const char* typeWanted(const std::uint64_t*) { return "an integer >= 0"; }
 const char* typeWanted(const bool*) { return "true or false"; }
 const char* typeWanted(const std::string*) { return "a string"; }
-const char* typeWanted(const std::array<double, 3>*) { return "an array of 3 numbers"; }
-const char* typeWanted(const std::vector<double>*) { return "an array of numbers"; }
+const char* typeWanted(const std::array<double, 3>*)
+{
+    return "an array of 3 numbers (each 0 or of magnitude 1.2e-38 to 3.4e38)";
+}
+const char* typeWanted(const std::vector<double>*)
+{
+    return "an array of numbers (each 0 or of magnitude 1.2e-38 to 3.4e38)";
+}
 const char* typeWanted(const std::vector<std::string>*) { return "an array of strings"; }
 
 bool convert(const Json& v, double& out)
 {
     if (!v.is_number()) return false;
     out = v.get<double>();
-    return std::isfinite(out);
+    const double magnitude = std::abs(out);
+    return magnitude == 0 || (magnitude >= SMALLEST_NUMBER && magnitude <= LARGEST_NUMBER);
 }
 bool convert(const Json& v, std::int64_t& out)
 {
@@ -389,6 +403,20 @@ public:
         , mFile(std::move(path))
     {}
 
+    /// Where the parse is, as a key path ("" at the top). `failed`: the parse stopped in a
+    /// value not yet begun, so the innermost array's element is the next one.
+    std::string where(bool failed = false) const
+    {
+        std::string path;
+        for (std::size_t k = 0; k < mStack.size(); ++k) {
+            const Level& level = mStack[k];
+            const bool next = failed && k + 1 == mStack.size();
+            if (level.array) path += msg("[", next ? level.elements : level.elements - 1, "]");
+            else if (!level.key.empty()) path += (path.empty() ? "" : ".") + level.key;
+        }
+        return path;
+    }
+
     bool operator()(int /*depth*/, Json::parse_event_t event, Json& parsed)
     {
         using Event = Json::parse_event_t;
@@ -400,6 +428,9 @@ public:
             mStack.push_back(Level{event == Event::array_start, 0, {}, {}});
         } else if (event == Event::object_end || event == Event::array_end) {
             mStack.pop_back();
+            valueDone();
+        } else if (event == Event::value) {
+            valueDone();
         } else if (event == Event::key) {
             Level& level = mStack.back();
             level.key = parsed.get<std::string>();
@@ -412,6 +443,12 @@ public:
     }
 
 private:
+    /// A value of the innermost object is complete: the parse is between its keys.
+    void valueDone()
+    {
+        if (!mStack.empty() && !mStack.back().array) mStack.back().key.clear();
+    }
+
     struct Level
     {
         bool array;
@@ -419,16 +456,6 @@ private:
         std::set<std::string> keys;
         std::string key; ///< of an object: the key being read
     };
-
-    std::string where() const
-    {
-        std::string path;
-        for (const Level& level : mStack) {
-            if (level.array) path += msg("[", level.elements - 1, "]");
-            else path += (path.empty() ? "" : ".") + level.key;
-        }
-        return path;
-    }
 
     std::string mKind, mFile;
     std::vector<Level> mStack;
@@ -445,14 +472,30 @@ Json readJsonFile(const std::string& path, const std::string& kind)
     }
     std::ifstream in(path);
     if (!in) throw IoError(msg(kind, " '", path, "': cannot open the file"));
+    // The parser copies its callback: the check is shared so its place survives a parse error.
+    const auto check = std::make_shared<DuplicateKeyCheck>(kind, path);
     try {
-        return Json::parse(in, DuplicateKeyCheck(kind, path), true, /*ignore_comments=*/true);
+        return Json::parse(
+            in, [check](int depth, Json::parse_event_t event, Json& parsed) {
+                return (*check)(depth, event, parsed);
+            },
+            true, /*ignore_comments=*/true);
     } catch (const Json::parse_error& e) {
-        // nlohmann's message carries the line and column.
+        // nlohmann's message: "[json.exception.parse_error.101] parse error at line 3, column
+        // 25: syntax error while parsing value - invalid literal; last read: '...'".
         const std::string what = e.what();
-        const std::size_t colon = what.find(": ");
-        throw SceneError(msg(kind, " '", path, "': not valid JSON (",
-                             colon == std::string::npos ? what : what.substr(colon + 2), ")"));
+        const std::size_t at = what.find(" at line "), colon = what.find(": ", at);
+        const std::string place = at == std::string::npos || colon == std::string::npos
+                                      ? std::string()
+                                      : what.substr(at, colon - at);
+        const std::string detail = colon == std::string::npos ? what : what.substr(colon + 2);
+        const std::string key = check->where(/*failed=*/true);
+        const bool special = detail.find("last read: '") != std::string::npos
+                             && (detail.find("N'") != std::string::npos
+                                 || detail.find("I'") != std::string::npos);
+        throw SceneError(msg(kind, " '", path, "': not valid JSON", place,
+                             key.empty() ? std::string() : " (in " + key + ")", ": ", detail,
+                             special ? "; NaN and Infinity are not JSON numbers" : ""));
     }
 }
 

@@ -186,9 +186,9 @@ double physicalMemory()
 /// level set is built (which alone can take hours at a spacing far too fine for the shape).
 /// Particles: the volume, or the surface area times the band depth, over spacing^3; bytes per
 /// particle: 350, the most a run measured with its neighbour lists (bench/RESULTS.md).
-void checkParticleBudget(const JsonObject& g, double spacing, Sampled sampled, const char* kind)
+void checkParticleBudget(const JsonObject& g, double spacing, double voxel, Sampled sampled,
+                         const char* kind)
 {
-    if (sampled == Sampled::None) return;
     const JsonObject shape = g.object(kind);
     double volume = 0, area = 0;
     if (std::string(kind) == "sphere") {
@@ -210,9 +210,21 @@ void checkParticleBudget(const JsonObject& g, double spacing, Sampled sampled, c
                        + (c + 2 * w) * (a + 2 * w));
         }
     }
+    const double memory = physicalMemory();
+    if (sampled == Sampled::None) {
+        // Only the level set: a narrow band of 2 x 3 voxels over the surface, about 8 bytes a
+        // voxel with OpenVDB's tree.
+        const double bytes = 8 * 6 * area / (voxel * voxel);
+        if (memory > 0 && bytes > memory) {
+            g.fail(kind, msg("at voxel size ", voxel, " m this shape's level set needs about ",
+                             bytes / double(1ULL << 30), " GiB, more than this machine's ",
+                             memory / double(1ULL << 30), " GiB: expected a smaller shape"));
+        }
+        return;
+    }
     if (sampled == Sampled::Band) volume = std::min(volume, area * 2 * spacing);
     const double particles = volume / (spacing * spacing * spacing);
-    const double bytes = particles * BYTES_PER_PARTICLE, memory = physicalMemory();
+    const double bytes = particles * BYTES_PER_PARTICLE;
     if (memory > 0 && bytes > memory) {
         const double fits = spacing * std::cbrt(bytes / memory);
         g.fail(kind, msg("at spacing ", spacing, " m this shape needs about ", particles,
@@ -222,6 +234,21 @@ void checkParticleBudget(const JsonObject& g, double spacing, Sampled sampled, c
                          memory / double(1ULL << 30), " GiB: expected a spacing of at least ", fits,
                          " m"));
     }
+}
+
+/// A point of a built-in shape, `s.key`, within OpenVDB's index range at `voxel` (m): about a
+/// billion voxels from the origin on every axis (coordinates are 32-bit voxel indices).
+Vec3d point(const JsonObject& s, const char* key, double voxel)
+{
+    const Vec3d x = vec(s.require<std::array<double, 3>>(key));
+    const double reach = double(1 << 30) * voxel;
+    for (int a = 0; a < 3; ++a) {
+        if (!(std::abs(x[a]) < reach)) {
+            s.failValue(key, msg("expected coordinates within +-", reach,
+                                 " m (OpenVDB's index range at voxel size ", voxel, " m)"));
+        }
+    }
+    return x;
 }
 
 /// A shape: a grid in a file, or a built-in sphere, box or container (a closed tank: solid walls
@@ -262,11 +289,12 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
         g.failValue("voxel_size", msg("expected at least ", MIN_SPACING / 2,
                                       " m (OpenVDB's smallest usable voxel)"));
     }
-    checkParticleBudget(g, scene.spacing, sampled, sphere ? "sphere" : box ? "box" : "container");
+    checkParticleBudget(g, scene.spacing, voxel, sampled,
+                        sphere ? "sphere" : box ? "box" : "container");
     openvdb::FloatGrid::Ptr grid;
     if (sphere) {
         const JsonObject s = g.object("sphere");
-        const Vec3d c = vec(s.require<std::array<double, 3>>("center"));
+        const Vec3d c = point(s, "center", voxel);
         const double r = s.positive("radius", 0);
         s.finish();
         if (r < 2 * voxel)
@@ -275,8 +303,8 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
         description = msg("sphere r = ", r, " m");
     } else {
         const JsonObject b = g.object(box ? "box" : "container");
-        const Vec3d lo = vec(b.require<std::array<double, 3>>("min"));
-        const Vec3d hi = vec(b.require<std::array<double, 3>>("max"));
+        const Vec3d lo = point(b, "min", voxel);
+        const Vec3d hi = point(b, "max", voxel);
         for (int a = 0; a < 3; ++a) {
             if (!(hi[a] - lo[a] >= 2 * voxel)) {
                 b.failValue("max",
@@ -302,7 +330,11 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
         }
     }
     g.finish();
-    return sph::makeLevelSet(grid, g.path());
+    try {
+        return sph::makeLevelSet(grid, g.path());
+    } catch (const GridError& e) {
+        throw SceneError(msg("scene '", scene.file, "': ", e.what()));
+    }
 }
 
 /// Keys of a rigid motion: { "keys": [ { "time", "translate", "rotate" }, ... ] }.

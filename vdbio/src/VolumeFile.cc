@@ -268,7 +268,12 @@ void VolumeOptions::validate() const
 void checkVolumeOutput(const sph::ParticleSet& particles, const VolumeOptions& options,
                        const std::string& where)
 {
-    options.validate();
+    try {
+        options.validate();
+    } catch (const ValueError& e) {
+        if (where == "volume output") throw; // validate() says so itself
+        throw ValueError(msg(where, ": ", e.what()));
+    }
     for (const std::string& name : options.scalarChannels) {
         if (name == "pressure" || particles.hasScalarChannel(name)) continue;
         std::vector<std::string> available{"pressure"};

@@ -1,14 +1,41 @@
-/// @file   SceneWarnings.cc
-/// @brief  The warnings before the first step (SceneWarnings.h).
-#include "SceneWarnings.h"
+/// @file   RunChecks.cc
+/// @brief  The checks and warnings before the first step (RunChecks.h).
+#include "RunChecks.h"
 
 #include <ghostfx/sph/Exceptions.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 namespace ghostfx {
 namespace cmd {
+
+std::string stepKeys(const vdbio::Scene& scene)
+{
+    const bool gas = scene.method.rfind("gas", 0) == 0, boiling = !scene.heaters.empty();
+    std::string keys;
+    if (!gas) keys = "settings.substeps, settings.cfl, settings.stiffness";
+    if (gas || boiling) {
+        keys += std::string(keys.empty() ? "" : "; ")
+                + "settings.gas.substeps, settings.gas.cfl, settings.gas.kappa";
+    }
+    return keys;
+}
+
+void checkStepsPerFrame(const vdbio::Scene& scene, const Simulation& sim)
+{
+    if (sim.fixedTimeStep() > 0) return; // substeps are in range already
+    const double step = sim.cflTimeStep();
+    const double steps = 1.0 / (scene.frameRate * step);
+    if (!(steps > MAX_STEPS_PER_FRAME)) return;
+    throw SceneError(msg("scene '", scene.file, "': the CFL step at the start is ", step,
+                         " s, ", steps, " steps a frame at settings.frame_rate ",
+                         scene.frameRate, ", more than the ", MAX_STEPS_PER_FRAME,
+                         " settings.substeps allows: expected a softer liquid or gas or a larger "
+                         "step (",
+                         stepKeys(scene), ")"));
+}
 
 void warnFixedStepBeyondTheLimit(const vdbio::Scene& scene, const Simulation& sim)
 {
@@ -17,13 +44,18 @@ void warnFixedStepBeyondTheLimit(const vdbio::Scene& scene, const Simulation& si
     const double limit = sim.stabilityLimit();
     if (fixed <= limit) return;
     const int substeps = int(std::lround(1.0 / (fixed * scene.frameRate)));
+    const double needed = std::ceil(substeps * fixed / limit);
     std::fprintf(stderr, "%s\n",
                  msg("ghostfx: warning: scene '", scene.file, "': the fixed step ", fixed,
                      " s (frame_rate ", scene.frameRate, ", substeps ", substeps, ") is ",
                      std::round(10 * fixed / limit) / 10, "x the stability limit ", limit,
-                     " s (Courant number 1: sound speed and forces); expect a blow-up: use "
-                     "substeps >= ",
-                     int(std::ceil(substeps * fixed / limit)), ", or substeps 0 for CFL steps")
+                     " s (Courant number 1: sound speed and forces); expect a blow-up: ",
+                     needed <= MAX_STEPS_PER_FRAME
+                         ? msg("use substeps >= ", std::int64_t(needed),
+                               ", or substeps 0 for CFL steps")
+                         : msg("it would take ", needed, " substeps, more than the ",
+                               MAX_STEPS_PER_FRAME, " allowed; lower the stiffness (",
+                               stepKeys(scene), ")"))
                      .c_str());
 }
 
