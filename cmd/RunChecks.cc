@@ -37,12 +37,12 @@ void checkStepsPerFrame(const vdbio::Scene& scene, const Simulation& sim)
                          stepKeys(scene), ")"));
 }
 
-void warnFixedStepBeyondTheLimit(const vdbio::Scene& scene, const Simulation& sim)
+void warnFixedStepBeyondTheLimit(const vdbio::Scene& scene, const Simulation& sim, bool prints)
 {
     const double fixed = sim.fixedTimeStep();
     if (!(fixed > 0)) return;
     const double limit = sim.stabilityLimit();
-    if (fixed <= limit) return;
+    if (fixed <= limit || !prints) return;
     const int substeps = int(std::lround(1.0 / (fixed * scene.frameRate)));
     const double needed = std::ceil(substeps * fixed / limit);
     std::fprintf(stderr, "%s\n",

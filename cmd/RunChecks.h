@@ -26,8 +26,9 @@ std::string stepKeys(const vdbio::Scene& scene);
 void checkStepsPerFrame(const vdbio::Scene& scene, const Simulation& sim);
 
 /// A fixed step far beyond the stability limit blows up within a few steps, after a frame or
-/// more of output: say so with both numbers and the substeps that would hold.
-void warnFixedStepBeyondTheLimit(const vdbio::Scene& scene, const Simulation& sim);
+/// more of output: say so (where `prints`) with both numbers and the substeps that would hold.
+/// Collective over the processes of a distributed run (the limit is every process's).
+void warnFixedStepBeyondTheLimit(const vdbio::Scene& scene, const Simulation& sim, bool prints);
 
 /// A solid thinner than the kernel support `depth` (m) holds too few ghost solids (or boundary
 /// particles): liquid beside it is under-dense, and a stiff liquid sticks to it. Each static

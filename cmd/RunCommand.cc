@@ -497,7 +497,7 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
         parallel::maxThreads(), " threads",
         distributed ? msg(" on each of ", distributed->ranks(), " processes") : std::string(),
         ", output in '", folder, "'"));
-    if (writes) warnFixedStepBeyondTheLimit(scene, *sim);
+    warnFixedStepBeyondTheLimit(scene, *sim, writes);
     // What each emitter pours, so a wrong velocity or shape shows before the run.
     const auto rates = sim->emitterRates();
     for (std::size_t e = 0; e < rates.size() && e < scene.emitters.size(); ++e) {
