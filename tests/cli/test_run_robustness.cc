@@ -114,6 +114,30 @@ TEST_F(Robustness, LiquidDrainingOutOfTheKillBoxRunsToTheEndWithEmptyFrames)
     EXPECT_TRUE(fs::exists(out / "checkpoint.0010.h5"));
 }
 
+TEST_F(Robustness, ADrainedLiquidIsFilledAgainByAnEmitterThatOpensLater)
+{
+    // The block is gone by frame 5; a nozzle opens at 0.25 s (frame 7.5) and pours for 0.05 s.
+    Json scene = fallingBlock();
+    scene["settings"]["frame_range"] = {1, 12};
+    scene["emitters"] = Json::parse(R"([{ "name": "late",
+        "geometry": { "box": { "min": [0, 0.6, 0], "max": [0.08, 0.66, 0.08] } },
+        "velocity": [0, -0.5, 0], "start": 0.25, "end": 0.3 }])");
+    const fs::path out = mDir / "out";
+    const Result r = run("run " + write(scene) + " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_CONTAINS(r.err, "frame 5: no liquid particles are left");
+    const std::vector<double> frame = csvColumn(out / "stats.csv", "frame");
+    const std::vector<double> liquid = csvColumn(out / "stats.csv", "count_liquid");
+    const std::vector<double> air = csvColumn(out / "stats.csv", "count_ghost_air");
+    for (std::size_t k = 0; k < frame.size(); ++k) {
+        if (frame[k] == 7) EXPECT_EQ(liquid[k] + air[k], 0) << "step " << k;
+    }
+    // Poured liquid, with its air layer grown back, falls towards the box's floor.
+    EXPECT_GT(liquid.back(), 40);
+    EXPECT_GT(air.back(), liquid.back());
+    EXPECT_GT(pointCount(out / "liquid_points.0012.vdb"), 40u);
+}
+
 TEST_F(Robustness, LiquidAllOutsideTheKillBoxAtTheStartRunsToTheEnd)
 {
     Json scene = fallingBlock();
