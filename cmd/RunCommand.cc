@@ -6,6 +6,7 @@
 #include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "OutputChecks.h"
+#include "Progress.h"
 #include "RunChecks.h"
 #include "Simulation.h"
 #include "StopSignals.h"
@@ -44,20 +45,6 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double seconds(Clock::time_point a, Clock::time_point b)
-{
-    return std::chrono::duration<double>(b - a).count();
-}
-
-std::string duration(double s)
-{
-    char buffer[32];
-    if (s < 60) std::snprintf(buffer, sizeof(buffer), "%.0fs", s);
-    else if (s < 3600) std::snprintf(buffer, sizeof(buffer), "%dm%02ds", int(s) / 60, int(s) % 60);
-    else std::snprintf(buffer, sizeof(buffer), "%dh%02dm", int(s) / 3600, (int(s) % 3600) / 60);
-    return buffer;
-}
-
 /// Parse "--frames A-B" or "--frames B" (whole numbers in [1, MAX_FRAME], first <= last).
 void parseFrames(const std::string& text, int& first, int& last)
 {
@@ -89,62 +76,6 @@ void parseFrames(const std::string& text, int& first, int& last)
     first = int(a);
     last = int(b);
 }
-
-/// Progress on a terminal (one line redrawn) or as log lines.
-class Progress
-{
-public:
-    enum class Mode { None, Log, Bar };
-
-    Progress(Mode mode, int first, int last) : mMode(mode), mFirst(first), mLast(last) {}
-
-    void step(const Simulation& sim, int frame, int substep)
-    {
-        if (mMode != Mode::Bar) return;
-        const auto now = Clock::now();
-        if (seconds(mLastDraw, now) < 0.2) return;
-        mLastDraw = now;
-        const double elapsed = seconds(mStart, now);
-        const double rate = elapsed > 0 ? double(mSteps) / elapsed : 0;
-        const double done = double(frame - mFirst) + 0.0;
-        const double total = double(mLast - mFirst + 1);
-        const double eta = done > 0 ? elapsed * (total - done) / done : 0;
-        const int width = 24;
-        const int filled = int(width * done / total);
-        std::fprintf(stderr, "\r\033[Kframe %d/%d [%s%s] substep %d | %s | %.1f steps/s | ETA %s",
-                     frame, mLast, std::string(std::size_t(filled), '#').c_str(),
-                     std::string(std::size_t(width - filled), '.').c_str(), substep,
-                     sim.counts().c_str(), rate, done > 0 ? duration(eta).c_str() : "?");
-        std::fflush(stderr);
-    }
-
-    void countStep() { ++mSteps; }
-
-    /// `counts`: the particles, as Simulation::counts() (or DistributedRun::counts()) says.
-    void frame(const Simulation& sim, const std::string& counts, int frame, int steps,
-               double frameSeconds, bool written)
-    {
-        if (mMode == Mode::None) return;
-        if (mMode == Mode::Bar) std::fprintf(stderr, "\r\033[K");
-        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %d steps, %s, %.2f s%s\n", frame, mLast,
-                     sim.time(), steps, counts.c_str(), frameSeconds,
-                     written ? "" : " (not written: before the first frame)");
-        std::fflush(stderr);
-    }
-
-    void message(const std::string& text)
-    {
-        if (mMode == Mode::None) return;
-        if (mMode == Mode::Bar) std::fprintf(stderr, "\r\033[K");
-        std::fprintf(stderr, "%s\n", text.c_str());
-    }
-
-private:
-    Mode mMode;
-    int mFirst, mLast;
-    std::uint64_t mSteps = 0;
-    Clock::time_point mStart = Clock::now(), mLastDraw{};
-};
 
 /// `text` as one shell word: as it is when it holds only characters no shell treats specially,
 /// else in single quotes.
@@ -237,243 +168,123 @@ private:
     std::map<std::string, std::size_t> mLast;
 };
 
-} // namespace
 
-namespace {
-
-/// The world box of the media's active voxels.
-openvdb::BBoxd mediaBox(const std::vector<vdbio::PreviewLayer>& media)
+/// One `ghostfx run`, as a sequence of named steps: the scene, the simulation (fresh or from a
+/// checkpoint) and every check before any output; what the run says before its first step; the
+/// statistics; the frames, each written, checkpointed and reported; how it ends. `distributed`
+/// is null for a single process (else rank 0 writes, DistributedRun.h).
+class SceneRun
 {
-    openvdb::BBoxd box;
-    for (const vdbio::PreviewLayer& l : media) {
-        const openvdb::CoordBBox ibox = l.grid->evalActiveVoxelBoundingBox();
-        if (ibox.empty()) continue;
-        box.expand(l.grid->indexToWorld(ibox.min()));
-        box.expand(l.grid->indexToWorld(ibox.max()));
+public:
+    SceneRun(const RunOptions& o, DistributedRun* distributed)
+        : mOptions(o)
+        , mDistributed(distributed)
+        , mWrites(!distributed || distributed->root())
+        , mThreadLimit(o.threads)
+    {
+        if (!o.sampleCache.empty()) setProcessSampleCache(o.sampleCache);
     }
-    return box;
-}
 
-/// The scene's solids where they are at the snapshot's time (rigid motion from the scene's keys
-/// or velocity, a per-frame shape from its file), as preview layers. A solid around the media's
-/// centre (the centre is inside its box but outside the solid: a tank) is cut away so what it
-/// holds shows.
-std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
-                                             const FrameSnapshot& snapshot,
-                                             const openvdb::BBoxd& media)
-{
-    std::vector<vdbio::PreviewLayer> layers;
-    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
-        const vdbio::SceneSolid& solid = scene.solids[i];
-        sph::LevelSet shape = solid.shape;
-        if (!solid.sequenceFile.empty()) {
-            shape = vdbio::loadLevelSet(
-                vdbio::expandFramePattern(solid.sequenceFile, snapshot.frame), solid.sequenceGrid,
-                msg("scene '", scene.file, "': solids[", i, "].sequence"));
+    int run()
+    {
+        readScene();
+        makeSimulation();
+        checkBeforeOutput();
+        makeProgress();
+        if (mSim->frame() >= mLast) {
+            mProgress->message(msg("nothing to do: the checkpoint is at frame ", mSim->frame(),
+                                   ", the last frame is ", mLast));
+            return 0;
         }
-        vdbio::PreviewLayer layer;
-        layer.name = solid.name;
-        layer.grid = sph::gridOf(shape);
-        layer.albedo = vdbio::SOLID_ALBEDO;
-        // A solid that neither moves nor changes shape looks the same in every frame.
-        layer.fixed = solid.isStatic();
-        if (solid.motion.keys.empty()) {
-            layer.translation = solid.velocity * snapshot.time;
-        } else {
-            const vdbio::RigidKey key = solid.motion.at(snapshot.time);
-            layer.rotation = vdbio::KeyedMotion::rotation(key.rotateDegrees);
-            layer.translation = key.translate;
+        announce();
+        openStatistics();
+        return runFrames();
+    }
+
+private:
+    /// The scene, its frames and folder: every input error before any simulation.
+    void readScene()
+    {
+        mScene = vdbio::readScene(mOptions.scene, mOptions.defines);
+        mFirst = mScene.firstFrame;
+        mLast = mScene.lastFrame;
+        if (!mOptions.frames.empty()) parseFrames(mOptions.frames, mFirst, mLast);
+        mFolder = mOptions.out.empty() ? mScene.outputs.directory : mOptions.out;
+        mFingerprint = mScene.simulationFingerprint();
+    }
+
+    /// The solvers the scene needs, fresh or from a checkpoint.
+    void makeSimulation()
+    {
+        if (mOptions.resume.empty()) {
+            mSim = cmd::makeSimulation(mScene);
+            return;
         }
-        if (media.max().x() >= media.min().x()) {
-            const openvdb::Vec3d centre = media.getCenter();
-            const openvdb::Vec3d local = layer.rotation.transpose() * (centre - layer.translation);
-            // The level set keeps its active box (walking a large solid's tree every frame cost
-            // more than drawing it).
-            const sph::Aabb b = shape.bounds();
-            const openvdb::BBoxd box(openvdb::Vec3d(b.min), openvdb::Vec3d(b.max));
-            layer.cutaway = box.isInside(local) && shape.phi(sph::Vec3(local)) > 0;
+        std::vector<sph::SolverState> states = readResumeStates();
+        mSim = cmd::makeSimulation(mScene, &states);
+    }
+
+    /// A run over several processes resumes from its manifest: on as many processes, each from
+    /// its own file, with the saved regions (bit for bit); on another count (one process
+    /// included), every process reads every file and the domain is cut anew. A one-process
+    /// checkpoint resumed on several processes is cut the same way.
+    std::vector<sph::SolverState> readResumeStates()
+    {
+        if (!isDistributedManifest(mOptions.resume)) {
+            return vdbio::readCheckpointStates(mOptions.resume, mFingerprint);
         }
-        layers.push_back(layer);
-    }
-    return layers;
-}
-
-/// Write one medium's points and volume files for `frame`; returns its grids (for previews).
-/// `built`: the grids already built (a run over several processes), else built here.
-openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
-                                const std::string& pointsPath, const std::string& volumePath,
-                                const openvdb::MetaMap& fileMeta, const BuiltGrids* built)
-{
-    if (!pointsPath.empty()) {
-        if (built) {
-            vdbio::writePointsGridFile(pointsPath, built->points, fileMeta);
-        } else if (out.pointGhosts && m.withGhosts) {
-            vdbio::writePointsFile(pointsPath, m.withGhosts(), pointsOptions(m, out), fileMeta);
-        } else {
-            vdbio::writePointsFile(pointsPath, *m.particles, pointsOptions(m, out), fileMeta);
+        const int here = mDistributed ? mDistributed->ranks() : 1;
+        mManifest = readDistributedManifest(mOptions.resume);
+        if (mManifest->ranks == here) {
+            const int rank = mDistributed ? mDistributed->rank() : 0;
+            return {vdbio::readCheckpoint(mManifest->files[std::size_t(rank)], mFingerprint)};
         }
+        std::vector<sph::SolverState> parts;
+        for (const std::string& file : mManifest->files)
+            parts.push_back(vdbio::readCheckpoint(file, mFingerprint));
+        mResumeNote = msg("note: '", mOptions.resume, "' was written by ", mManifest->ranks,
+                          " processes and this run has ", here, ": its parts are merged",
+                          here > 1 ? " and the domain cut anew" : "",
+                          " (the run goes on, but not bit for bit as it would have on ",
+                          mManifest->ranks, ")");
+        mManifest.reset();
+        return {mergeProcessStates(std::move(parts))};
     }
-    if (volumePath.empty()) return {};
-    const openvdb::GridPtrVec grids =
-        built ? built->volumes : vdbio::makeVolumeGrids(*m.particles, volumeOptions(m, out));
-    vdbio::writeVolumeFile(volumePath, grids, fileMeta);
-    return grids;
-}
 
-} // namespace
-
-void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
-                       const std::string& folder, vdbio::PreviewCache* previewCache)
-{
-    const int frame = snapshot.frame;
-    const vdbio::SceneOutputs& out = scene.outputs;
-    auto inFolder = [&](const std::string& pattern) {
-        return pattern.empty()
-                   ? std::string()
-                   : (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
-    };
-    openvdb::MetaMap fileMeta;
-    fileMeta.insertMeta("ghostfx_scene", openvdb::StringMetadata(scene.file));
-    fileMeta.insertMeta("ghostfx_method", openvdb::StringMetadata(scene.method));
-    fileMeta.insertMeta("frame", openvdb::Int32Metadata(frame));
-    fileMeta.insertMeta("time", openvdb::DoubleMetadata(snapshot.time));
-    // The media's grids as preview layers: the liquid's surface (else its density), the gas's
-    // density, or the grid outputs.preview.grid names.
-    std::vector<vdbio::PreviewLayer> media;
-    bool namedGridFound = false;
-    for (const OutputMedium& m : snapshot.media) {
-        const bool liquid = m.liquid;
-        const std::size_t index = std::size_t(&m - snapshot.media.data());
-        const openvdb::GridPtrVec grids =
-            writeMedium(m, out, inFolder(liquid ? out.pointsFile : out.gasPointsFile),
-                        inFolder(liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
-                        index < snapshot.built.size() ? &snapshot.built[index] : nullptr);
-        if (out.previewFile.empty()) continue;
-        // outputs.preview.grid where the medium has it, else the medium's default.
-        std::vector<std::string> wanted = liquid ? std::vector<std::string>{"surface", "density"}
-                                                 : std::vector<std::string>{"density"};
-        if (!out.previewGrid.empty()) wanted.insert(wanted.begin(), out.previewGrid);
-        for (const std::string& name : wanted) {
-            auto g = std::find_if(grids.begin(), grids.end(),
-                                  [&](const auto& grid) { return grid->getName() == name; });
-            auto floatGrid =
-                g == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(*g);
-            if (!floatGrid) continue;
-            vdbio::PreviewLayer layer;
-            layer.name = m.name + " " + name;
-            layer.grid = floatGrid;
-            layer.kind = floatGrid->getGridClass() == openvdb::GRID_LEVEL_SET
-                             ? vdbio::PreviewLayer::Kind::Surface
-                             : vdbio::PreviewLayer::Kind::Fog;
-            layer.albedo = liquid ? vdbio::LIQUID_ALBEDO : vdbio::GAS_ALBEDO;
-            media.push_back(layer);
-            namedGridFound = namedGridFound || name == out.previewGrid;
-            break;
-        }
+    /// What would fail after the first frame fails now, before anything is written; then the
+    /// processes share the simulation and the output folder is made.
+    void checkBeforeOutput()
+    {
+        checkSolidSequences(mScene, mSim->frame() + 1, mLast);
+        checkOutputs(mScene, *mSim);
+        checkStepsPerFrame(mScene, *mSim);
+        if (mDistributed)
+            mDistributed->share(*mSim, mManifest ? &mManifest->decomposition : nullptr);
+        if (mWrites) vdbio::ensureWritableDirectory(mFolder);
     }
-    if (out.previewFile.empty()) return;
-    if (media.empty() || (!out.previewGrid.empty() && !namedGridFound)) {
-        throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '",
-                             out.previewGrid.empty() ? "(default)" : out.previewGrid,
-                             "': the volume output has no such grid"));
-    }
-    std::vector<vdbio::PreviewLayer> layers;
-    if (out.previewSolids) layers = solidLayers(scene, snapshot, mediaBox(media));
-    layers.insert(layers.end(), media.begin(), media.end());
-    vdbio::PreviewOptions pv;
-    pv.width = out.previewWidth;
-    pv.height = out.previewHeight;
-    pv.azimuth = out.previewAzimuth;
-    pv.elevation = out.previewElevation;
-    if (out.previewBackground) {
-        const auto& c = *out.previewBackground;
-        pv.background = {float(c[0]), float(c[1]), float(c[2]), 1.0f};
-    }
-    openvdb::BBoxd framed; // empty: the camera frames everything drawn
-    if (!out.previewFrame.empty()) {
-        framed = openvdb::BBoxd(openvdb::Vec3d(out.previewFrame.min),
-                                openvdb::Vec3d(out.previewFrame.max));
-    }
-    vdbio::renderScenePreview(layers, pv, framed, inFolder(out.previewFile), previewCache);
-}
 
-/// The run; `distributed` is null for a single process (else rank 0 writes, DistributedRun.h).
-int runSceneWith(const RunOptions& o, DistributedRun* distributed)
-{
-    const auto runStart = Clock::now();
-    parallel::ThreadLimit threadLimit(o.threads);
-    const bool writes = !distributed || distributed->root();
-    if (!o.sampleCache.empty()) setProcessSampleCache(o.sampleCache);
-
-    // Scene, settings and outputs: every input error is found before any simulation.
-    vdbio::Scene scene = vdbio::readScene(o.scene, o.defines);
-    int first = scene.firstFrame, last = scene.lastFrame;
-    if (!o.frames.empty()) parseFrames(o.frames, first, last);
-    const vdbio::SceneOutputs& out = scene.outputs;
-    const std::string folder = o.out.empty() ? out.directory : o.out;
-    const std::string fingerprint = scene.simulationFingerprint();
-
-    // The solvers the scene needs, fresh or from a checkpoint.
-    std::unique_ptr<Simulation> sim;
-    std::optional<DistributedManifest> manifest; // resuming on the count that wrote it
-    std::string resumeNote;
-    if (!o.resume.empty()) {
-        // A run over several processes resumes from its manifest: on as many processes, each
-        // from its own file, with the saved regions (bit for bit); on another count (one
-        // process included), every process reads every file and the domain is cut anew. A
-        // one-process checkpoint resumed on several processes is cut the same way.
-        std::vector<sph::SolverState> states;
-        const int here = distributed ? distributed->ranks() : 1;
-        if (isDistributedManifest(o.resume)) {
-            manifest = readDistributedManifest(o.resume);
-            if (manifest->ranks == here) {
-                states.push_back(vdbio::readCheckpoint(
-                    manifest->files[std::size_t(distributed ? distributed->rank() : 0)],
-                    fingerprint));
-            } else {
-                std::vector<sph::SolverState> parts;
-                for (const std::string& file : manifest->files)
-                    parts.push_back(vdbio::readCheckpoint(file, fingerprint));
-                states.push_back(mergeProcessStates(std::move(parts)));
-                resumeNote = msg("note: '", o.resume, "' was written by ", manifest->ranks,
-                                 " processes and this run has ", here, ": its parts are merged",
-                                 here > 1 ? " and the domain cut anew" : "",
-                                 " (the run goes on, but not bit for bit as it would have on ",
-                                 manifest->ranks, ")");
-                manifest.reset();
-            }
-        } else {
-            states = vdbio::readCheckpointStates(o.resume, fingerprint);
-        }
-        sim = makeSimulation(scene, &states);
-    } else {
-        sim = makeSimulation(scene);
+    void makeProgress()
+    {
+        const RunOptions& o = mOptions;
+        Progress::Mode mode = Progress::Mode::Log;
+        if (o.quiet || o.progress == "none" || !mWrites) mode = Progress::Mode::None;
+        else if (o.progress == "bar" || (o.progress == "auto" && ::isatty(STDERR_FILENO)))
+            mode = Progress::Mode::Bar;
+        mProgress = std::make_unique<Progress>(mode, std::max(mFirst, mSim->frame() + 1), mLast);
+        if (!mResumeNote.empty()) mProgress->message(mResumeNote);
+        reportSampleCache();
     }
-    checkSolidSequences(scene, sim->frame() + 1, last);
-    checkOutputs(scene, *sim);
-    checkStepsPerFrame(scene, *sim);
-    if (distributed) distributed->share(*sim, manifest ? &manifest->decomposition : nullptr);
-    if (writes) vdbio::ensureWritableDirectory(folder);
-    auto inFolder = [&](const std::string& pattern, int frame) {
-        return pattern.empty()
-                   ? std::string()
-                   : (fs::path(folder) / vdbio::expandFramePattern(pattern, frame)).string();
-    };
-    const int startFrame = sim->frame();
 
-    Progress::Mode mode = Progress::Mode::Log;
-    if (o.quiet || o.progress == "none" || !writes) mode = Progress::Mode::None;
-    else if (o.progress == "bar" || (o.progress == "auto" && ::isatty(STDERR_FILENO)))
-        mode = Progress::Mode::Bar;
-    Progress progress(mode, std::max(first, startFrame + 1), last);
-    if (!resumeNote.empty()) progress.message(resumeNote);
-    if (const vdbio::SampleCache* cache = processSampleCacheIfMade()) {
-        progress.message(msg("sample cache '", cache->folder(), "': ", cache->hits(),
-                             " shapes loaded, ", cache->stored(), " sampled and kept",
-                             cache->evicted() > 0
-                                 ? msg(", ", cache->evicted(), " least recently used removed")
-                                 : std::string()));
-        if (cache->failures() > 0 && writes) {
+    void reportSampleCache()
+    {
+        const vdbio::SampleCache* cache = processSampleCacheIfMade();
+        if (!cache) return;
+        mProgress->message(msg("sample cache '", cache->folder(), "': ", cache->hits(),
+                               " shapes loaded, ", cache->stored(), " sampled and kept",
+                               cache->evicted() > 0
+                                   ? msg(", ", cache->evicted(), " least recently used removed")
+                                   : std::string()));
+        if (cache->failures() > 0 && mWrites) {
             std::fprintf(stderr,
                          "ghostfx: warning: sample cache: %llu shapes could not be kept "
                          "(%s); the run goes on without them\n",
@@ -481,147 +292,189 @@ int runSceneWith(const RunOptions& o, DistributedRun* distributed)
                          cache->firstFailure().c_str());
         }
     }
-    if (startFrame >= last) {
-        progress.message(msg("nothing to do: the checkpoint is at frame ", startFrame,
-                             ", the last frame is ", last));
+
+    /// The run's first line, its warnings, and what each emitter pours (so a wrong velocity or
+    /// shape shows before the run).
+    void announce()
+    {
+        const vdbio::Scene& scene = mScene;
+        const std::size_t fields = scene.forceFields.size();
+        mProgress->message(msg(
+            "ghostfx run '", scene.file, "': ", scene.method,
+            scene.heaters.empty() ? "" : " + boiling",
+            fields == 0 ? "" : msg(" + ", fields, fields == 1 ? " attractor" : " attractors"),
+            ", spacing ", scene.spacing, " m, frames ", std::max(mFirst, mSim->frame() + 1), "-",
+            mLast, (mOptions.resume.empty() ? "" : " (resumed from '" + mOptions.resume + "')"),
+            ", ", parallel::maxThreads(), " threads",
+            mDistributed ? msg(" on each of ", mDistributed->ranks(), " processes") : "",
+            ", output in '", mFolder, "'"));
+        warnFixedStepBeyondTheLimit(scene, *mSim, mWrites);
+        const auto rates = mSim->emitterRates();
+        for (std::size_t e = 0; e < rates.size() && e < scene.emitters.size(); ++e) {
+            const vdbio::SceneEmitter& em = scene.emitters[e];
+            mProgress->message(msg("emitter '", em.name, "': ", em.velocity.length(),
+                                   " m/s through ", std::round(rates[e].crossSection * 1e6) / 100,
+                                   " cm^2 = ", std::round(rates[e].massRate * 100) / 100,
+                                   " kg/s from ", em.start, " s",
+                                   std::isfinite(em.end) ? msg(" to ", em.end, " s") : ""));
+        }
+        if (mWrites) warnThinSolids(scene, mSim->boundaryLayerDepth());
+        if (mDistributed && scene.outputs.pointGhosts && !scene.outputs.pointsFile.empty()) {
+            mProgress->message("note: outputs.points.ghosts: over several processes the points "
+                               "files hold the liquid only (the ghosts stay with their processes)");
+        }
+    }
+
+    /// Per-step statistics; over several processes rank 0 writes the rows combined from every
+    /// process's.
+    void openStatistics()
+    {
+        const vdbio::SceneOutputs& out = mScene.outputs;
+        if (!out.statsFile.empty() && mWrites) {
+            const std::string h5 = inFolder(out.statsFile, 0);
+            const std::string csv = (fs::path(h5).replace_extension(".csv")).string();
+            mStats = std::make_unique<vdbio::StatsWriter>(h5, csv);
+            if (!mOptions.resume.empty()) mStats->resumeFrom(std::int64_t(mSim->stepCount()));
+        }
+        const bool combine = !out.statsFile.empty() && mDistributed;
+        mSim->setStepObserver([this, combine](double dt) {
+            ++mSubstep;
+            mProgress->countStep();
+            mProgress->step(*mSim, mFrame, mSubstep);
+            if (combine) {
+                const vdbio::StatsRow row = mDistributed->combine(mSim->statsRow(mFrame, dt));
+                if (mStats) mStats->append(row);
+            } else if (mStats) {
+                mStats->append(mSim->statsRow(mFrame, dt));
+            }
+        });
+    }
+
+    /// Every frame to the last, or to the one after which a signal asked to stop.
+    int runFrames()
+    {
+        const StopSignals stopSignals;
+        EmptyMediaWatch emptyMedia(mScene, mWrites, mediumCounts(*mSim, mDistributed));
+        // Frame N's files are written while frame N + 1 simulates (FrameWriter.h).
+        FrameWriter writer(mScene, mFolder, !mOptions.serialOutput);
+        const std::uint64_t stepsAtStart = mSim->stepCount();
+        for (mFrame = mSim->frame() + 1; mFrame <= mLast; ++mFrame) {
+            const int stopSignal = runFrame(writer);
+            emptyMedia.check(mediumCounts(*mSim, mDistributed), mFrame);
+            if (stopSignal != 0) return StopSignals::exitCode(stopSignal);
+        }
+        writer.finish();
+        reportDone(mSim->stepCount() - stepsAtStart);
         return 0;
     }
-    progress.message(msg(
-        "ghostfx run '", scene.file, "': ", scene.method, scene.heaters.empty() ? "" : " + boiling",
-        scene.forceFields.empty()
-            ? ""
-            : msg(" + ", scene.forceFields.size(),
-                  scene.forceFields.size() == 1 ? " attractor" : " attractors"),
-        ", spacing ", scene.spacing, " m, frames ", std::max(first, startFrame + 1), "-", last,
-        (o.resume.empty() ? "" : " (resumed from '" + o.resume + "')"), ", ",
-        parallel::maxThreads(), " threads",
-        distributed ? msg(" on each of ", distributed->ranks(), " processes") : std::string(),
-        ", output in '", folder, "'"));
-    warnFixedStepBeyondTheLimit(scene, *sim, writes);
-    // What each emitter pours, so a wrong velocity or shape shows before the run.
-    const auto rates = sim->emitterRates();
-    for (std::size_t e = 0; e < rates.size() && e < scene.emitters.size(); ++e) {
-        const vdbio::SceneEmitter& em = scene.emitters[e];
-        progress.message(msg("emitter '", em.name, "': ", em.velocity.length(), " m/s through ",
-                             std::round(rates[e].crossSection * 1e6) / 100, " cm^2 = ",
-                             std::round(rates[e].massRate * 100) / 100, " kg/s from ", em.start,
-                             " s", std::isfinite(em.end) ? msg(" to ", em.end, " s") : ""));
-    }
-    if (writes) warnThinSolids(scene, sim->boundaryLayerDepth());
-    const bool checkpoints = !out.checkpointFile.empty();
 
-    // Statistics.
-    // Over several processes, rank 0 writes the rows combined from every process's.
-    std::unique_ptr<vdbio::StatsWriter> stats;
-    const bool combineStats = !out.statsFile.empty() && distributed;
-    if (distributed && out.pointGhosts && !out.pointsFile.empty()) {
-        progress.message("note: outputs.points.ghosts: over several processes the points files "
-                         "hold the liquid only (the ghosts stay with their processes)");
-    }
-    if (!out.statsFile.empty() && writes) {
-        const std::string h5 = inFolder(out.statsFile, 0);
-        const std::string csv = (fs::path(h5).replace_extension(".csv")).string();
-        stats = std::make_unique<vdbio::StatsWriter>(h5, csv);
-        if (!o.resume.empty()) stats->resumeFrom(std::int64_t(sim->stepCount()));
-    }
-
-    int frame = startFrame + 1, substep = 0;
-    sim->setStepObserver([&](double dt) {
-        ++substep;
-        progress.countStep();
-        progress.step(*sim, frame, substep);
-        if (combineStats) {
-            const vdbio::StatsRow row = distributed->combine(sim->statsRow(frame, dt));
-            if (stats) stats->append(row);
-        } else if (stats) {
-            stats->append(sim->statsRow(frame, dt));
-        }
-    });
-
-    StopSignals stopSignals;
-    EmptyMediaWatch emptyMedia(scene, writes, mediumCounts(*sim, distributed));
-    // Frame N's files are written while frame N + 1 simulates (FrameWriter.h).
-    FrameWriter writer(scene, folder, !o.serialOutput);
-    auto writeCheckpoint = [&](int f) {
-        if (!checkpoints) return std::string();
-        const std::string path = inFolder(out.checkpointFile, f);
-        // Over several processes: a file per process and a manifest to resume from.
-        if (distributed) return distributed->writeCheckpoint(path, *sim, fingerprint, f);
-        vdbio::writeCheckpoint(path, sim->saveStates(), fingerprint, f);
-        return path;
-    };
-
-    const std::uint64_t stepsAtStart = sim->stepCount();
-    for (; frame <= last; ++frame) {
+    /// Simulate, write and report frame mFrame; returns the stop signal seen by any process
+    /// (0: none), after writing the frame's checkpoint for it.
+    int runFrame(FrameWriter& writer)
+    {
         const auto frameStart = Clock::now();
-        const std::uint64_t stepsBefore = sim->stepCount();
-        substep = 0;
-        sim->beforeFrame(frame);
-        advanceFrame(scene, *sim);
-
-        const bool write = frame >= first;
-        if (write && distributed) {
-            FrameSnapshot snapshot = distributed->snapshot(out, *sim, frame);
-            if (writes) writer.submit(std::move(snapshot));
+        const std::uint64_t stepsBefore = mSim->stepCount();
+        mSubstep = 0;
+        mSim->beforeFrame(mFrame);
+        advanceFrame(mScene, *mSim);
+        const bool write = mFrame >= mFirst;
+        if (write && mDistributed) {
+            FrameSnapshot snapshot = mDistributed->snapshot(mScene.outputs, *mSim, mFrame);
+            if (mWrites) writer.submit(std::move(snapshot));
         } else if (write) {
-            writer.submit(snapshotFrame(out, *sim, frame));
+            writer.submit(snapshotFrame(mScene.outputs, *mSim, mFrame));
         }
-        if (stats) stats->flush();
+        if (mStats) mStats->flush();
         // Every process stops at the same frame, whichever saw the signal, and all report the
         // same one.
-        const int stopSignal = distributed
-                                   ? int(distributed->maxOf(double(StopSignals::received())))
+        const int stopSignal = mDistributed
+                                   ? int(mDistributed->maxOf(double(StopSignals::received())))
                                    : StopSignals::received();
+        const vdbio::SceneOutputs& out = mScene.outputs;
         std::string checkpoint;
-        if (stopSignal != 0 || frame == last
-            || (out.checkpointEvery > 0 && frame % out.checkpointEvery == 0)) {
+        if (stopSignal != 0 || mFrame == mLast
+            || (out.checkpointEvery > 0 && mFrame % out.checkpointEvery == 0)) {
             writer.finish(); // the frames on disk reach at least as far as the checkpoint
-            checkpoint = writeCheckpoint(frame);
+            checkpoint = writeCheckpoint();
         }
         // Over several processes the counts are every process's, summed (collective).
-        progress.frame(*sim, distributed ? distributed->counts(*sim) : sim->counts(), frame,
-                       int(sim->stepCount() - stepsBefore), seconds(frameStart, Clock::now()),
-                       write);
-        emptyMedia.check(mediumCounts(*sim, distributed), frame);
-        if (stopSignal != 0) {
-            if (writes) {
-                std::fprintf(stderr, "ghostfx: stopped by %s after frame %d%s\n",
-                             StopSignals::describe(stopSignal), frame,
-                             checkpoint.empty()
-                                 ? " (no checkpoint: nothing to resume from)"
-                                 : ("; resume with: "
-                                    + resumeCommand(o, checkpoint,
-                                                    distributed ? distributed->ranks() : 1))
-                                       .c_str());
-            }
-            return StopSignals::exitCode(stopSignal);
+        mProgress->frame(*mSim, mDistributed ? mDistributed->counts(*mSim) : mSim->counts(),
+                         mFrame, int(mSim->stepCount() - stepsBefore),
+                         secondsBetween(frameStart, Clock::now()), write);
+        if (stopSignal != 0) reportStop(stopSignal, checkpoint);
+        return stopSignal;
+    }
+
+    /// The checkpoint of mFrame, if the scene asks for checkpoints; returns the path to resume
+    /// from (over several processes, the manifest of a file per process).
+    std::string writeCheckpoint()
+    {
+        const vdbio::SceneOutputs& out = mScene.outputs;
+        if (out.checkpointFile.empty()) return std::string();
+        const std::string path = inFolder(out.checkpointFile, mFrame);
+        if (mDistributed) return mDistributed->writeCheckpoint(path, *mSim, mFingerprint, mFrame);
+        vdbio::writeCheckpoint(path, mSim->saveStates(), mFingerprint, mFrame);
+        return path;
+    }
+
+    void reportStop(int signal, const std::string& checkpoint) const
+    {
+        if (!mWrites) return;
+        const int ranks = mDistributed ? mDistributed->ranks() : 1;
+        std::fprintf(stderr, "ghostfx: stopped by %s after frame %d%s\n",
+                     StopSignals::describe(signal), mFrame,
+                     checkpoint.empty()
+                         ? " (no checkpoint: nothing to resume from)"
+                         : ("; resume with: " + resumeCommand(mOptions, checkpoint, ranks)).c_str());
+    }
+
+    void reportDone(std::uint64_t steps)
+    {
+        const double total = secondsBetween(mStart, Clock::now());
+        const std::string done = msg("done: ", steps, " steps in ", duration(total), " (",
+                                     total > 0 ? double(steps) / total : 0.0, " steps/s), ");
+        if (mDistributed) {
+            mProgress->message(done + mDistributed->counts(*mSim));
+            return;
         }
+        const std::size_t n = mSim->particleCount();
+        mProgress->message(msg(done, n, " particles, ",
+                               n ? double(mSim->memoryBytes()) / double(n) : 0.0,
+                               " bytes per particle"));
     }
-    writer.finish();
-    const double total = seconds(runStart, Clock::now());
-    const std::uint64_t steps = sim->stepCount() - stepsAtStart;
-    if (distributed) {
-        const std::string counts = distributed->counts(*sim);
-        progress.message(msg("done: ", steps, " steps in ", duration(total), " (",
-                             total > 0 ? double(steps) / total : 0.0, " steps/s), ", counts));
-        return 0;
+
+    std::string inFolder(const std::string& pattern, int frame) const
+    {
+        return pattern.empty()
+                   ? std::string()
+                   : (fs::path(mFolder) / vdbio::expandFramePattern(pattern, frame)).string();
     }
-    progress.message(
-        msg("done: ", steps, " steps in ", duration(total), " (",
-            total > 0 ? double(steps) / total : 0.0, " steps/s), ", sim->particleCount(),
-            " particles, ",
-            sim->particleCount() ? double(sim->memoryBytes()) / double(sim->particleCount()) : 0.0,
-            " bytes per particle"));
-    return 0;
-}
+
+    const RunOptions& mOptions;
+    DistributedRun* mDistributed;
+    const bool mWrites;
+    const Clock::time_point mStart = Clock::now();
+    parallel::ThreadLimit mThreadLimit;
+    vdbio::Scene mScene; ///< before mSim: the simulation keeps a reference to it
+    int mFirst = 1, mLast = 1;
+    std::string mFolder, mFingerprint;
+    std::optional<DistributedManifest> mManifest; ///< resuming on the count that wrote it
+    std::string mResumeNote;
+    std::unique_ptr<Simulation> mSim;
+    std::unique_ptr<Progress> mProgress;
+    std::unique_ptr<vdbio::StatsWriter> mStats;
+    int mFrame = 0, mSubstep = 0; ///< what the step observer reports
+};
+
+} // namespace
 
 int runScene(const RunOptions& o)
 {
     // Under mpirun: one simulation over the processes.
     const std::unique_ptr<DistributedRun> distributed = DistributedRun::startIfLaunched();
-    if (!distributed) return runSceneWith(o, nullptr);
+    if (!distributed) return SceneRun(o, nullptr).run();
     try {
-        return runSceneWith(o, distributed.get());
+        return SceneRun(o, distributed.get()).run();
     } catch (const std::exception& e) {
         // An error on one process would leave the others waiting for it: say it, stop all.
         std::fprintf(stderr, "ghostfx: error: process %d of %d: %s\n", distributed->rank(),

@@ -103,7 +103,9 @@ TEST_F(Robustness, LiquidDrainingOutOfTheKillBoxRunsToTheEndWithEmptyFrames)
     ASSERT_EQ(frame.size(), liquid.size());
     EXPECT_GT(liquid.front(), 100);
     for (std::size_t k = 0; k < frame.size(); ++k) {
-        if (frame[k] >= 6) EXPECT_EQ(liquid[k], 0) << "frame " << frame[k];
+        if (frame[k] >= 6) {
+            EXPECT_EQ(liquid[k], 0) << "frame " << frame[k];
+        }
     }
     // The empty frames are valid files with the grids of a full one, and no points.
     EXPECT_EQ(pointCount(out / "liquid_points.0010.vdb"), 0u);
@@ -130,7 +132,9 @@ TEST_F(Robustness, ADrainedLiquidIsFilledAgainByAnEmitterThatOpensLater)
     const std::vector<double> liquid = csvColumn(out / "stats.csv", "count_liquid");
     const std::vector<double> air = csvColumn(out / "stats.csv", "count_ghost_air");
     for (std::size_t k = 0; k < frame.size(); ++k) {
-        if (frame[k] == 7) EXPECT_EQ(liquid[k] + air[k], 0) << "step " << k;
+        if (frame[k] == 7) {
+            EXPECT_EQ(liquid[k] + air[k], 0) << "step " << k;
+        }
     }
     // Poured liquid, with its air layer grown back, falls towards the box's floor.
     EXPECT_GT(liquid.back(), 40);

@@ -1,0 +1,215 @@
+/// @file   FrameOutputs.cc
+/// @brief  A frame's files from its snapshot (FrameWriter.h, writeFrameOutputs): each medium's
+///         points and volume files, and the preview of the scene with its solids where they are.
+#include "FrameWriter.h"
+
+
+#include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
+#include <ghostfx/vdbio/AtomicFile.h>
+#include <ghostfx/vdbio/FrameFiles.h>
+#include <ghostfx/vdbio/Preview.h>
+#include <ghostfx/vdbio/Scene.h>
+#include <ghostfx/vdbio/ScenePreview.h>
+
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <optional>
+
+namespace ghostfx {
+namespace cmd {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// The world box of the media's active voxels.
+openvdb::BBoxd mediaBox(const std::vector<vdbio::PreviewLayer>& media)
+{
+    openvdb::BBoxd box;
+    for (const vdbio::PreviewLayer& l : media) {
+        const openvdb::CoordBBox ibox = l.grid->evalActiveVoxelBoundingBox();
+        if (ibox.empty()) continue;
+        box.expand(l.grid->indexToWorld(ibox.min()));
+        box.expand(l.grid->indexToWorld(ibox.max()));
+    }
+    return box;
+}
+
+/// The scene's solids where they are at the snapshot's time (rigid motion from the scene's keys
+/// or velocity, a per-frame shape from its file), as preview layers. A solid around the media's
+/// centre (the centre is inside its box but outside the solid: a tank) is cut away so what it
+/// holds shows.
+std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
+                                             const FrameSnapshot& snapshot,
+                                             const openvdb::BBoxd& media)
+{
+    std::vector<vdbio::PreviewLayer> layers;
+    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+        const vdbio::SceneSolid& solid = scene.solids[i];
+        sph::LevelSet shape = solid.shape;
+        if (!solid.sequenceFile.empty()) {
+            shape = vdbio::loadLevelSet(
+                vdbio::expandFramePattern(solid.sequenceFile, snapshot.frame), solid.sequenceGrid,
+                msg("scene '", scene.file, "': solids[", i, "].sequence"));
+        }
+        vdbio::PreviewLayer layer;
+        layer.name = solid.name;
+        layer.grid = sph::gridOf(shape);
+        layer.albedo = vdbio::SOLID_ALBEDO;
+        // A solid that neither moves nor changes shape looks the same in every frame.
+        layer.fixed = solid.isStatic();
+        if (solid.motion.keys.empty()) {
+            layer.translation = solid.velocity * snapshot.time;
+        } else {
+            const vdbio::RigidKey key = solid.motion.at(snapshot.time);
+            layer.rotation = vdbio::KeyedMotion::rotation(key.rotateDegrees);
+            layer.translation = key.translate;
+        }
+        if (media.max().x() >= media.min().x()) {
+            const openvdb::Vec3d centre = media.getCenter();
+            const openvdb::Vec3d local = layer.rotation.transpose() * (centre - layer.translation);
+            // The level set keeps its active box (walking a large solid's tree every frame cost
+            // more than drawing it).
+            const sph::Aabb b = shape.bounds();
+            const openvdb::BBoxd box(openvdb::Vec3d(b.min), openvdb::Vec3d(b.max));
+            layer.cutaway = box.isInside(local) && shape.phi(sph::Vec3(local)) > 0;
+        }
+        layers.push_back(layer);
+    }
+    return layers;
+}
+
+/// Write one medium's points and volume files for `frame`; returns its grids (for previews).
+/// `built`: the grids already built (a run over several processes), else built here.
+openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
+                                const std::string& pointsPath, const std::string& volumePath,
+                                const openvdb::MetaMap& fileMeta, const BuiltGrids* built)
+{
+    if (!pointsPath.empty()) {
+        if (built) {
+            vdbio::writePointsGridFile(pointsPath, built->points, fileMeta);
+        } else if (out.pointGhosts && m.withGhosts) {
+            vdbio::writePointsFile(pointsPath, m.withGhosts(), pointsOptions(m, out), fileMeta);
+        } else {
+            vdbio::writePointsFile(pointsPath, *m.particles, pointsOptions(m, out), fileMeta);
+        }
+    }
+    if (volumePath.empty()) return {};
+    const openvdb::GridPtrVec grids =
+        built ? built->volumes : vdbio::makeVolumeGrids(*m.particles, volumeOptions(m, out));
+    vdbio::writeVolumeFile(volumePath, grids, fileMeta);
+    return grids;
+}
+
+/// The file metadata every frame file carries: the scene, its method, the frame and its time.
+openvdb::MetaMap frameMetadata(const vdbio::Scene& scene, const FrameSnapshot& snapshot)
+{
+    openvdb::MetaMap meta;
+    meta.insertMeta("ghostfx_scene", openvdb::StringMetadata(scene.file));
+    meta.insertMeta("ghostfx_method", openvdb::StringMetadata(scene.method));
+    meta.insertMeta("frame", openvdb::Int32Metadata(snapshot.frame));
+    meta.insertMeta("time", openvdb::DoubleMetadata(snapshot.time));
+    return meta;
+}
+
+/// The preview layer of one medium's grids: outputs.preview.grid where the medium has it, else
+/// its default (the liquid's surface, else its density; the gas's density). Sets
+/// `namedGridFound` when the one drawn is outputs.preview.grid.
+std::optional<vdbio::PreviewLayer> mediumLayer(const OutputMedium& m,
+                                               const openvdb::GridPtrVec& grids,
+                                               const std::string& previewGrid,
+                                               bool& namedGridFound)
+{
+    std::vector<std::string> wanted = m.liquid ? std::vector<std::string>{"surface", "density"}
+                                               : std::vector<std::string>{"density"};
+    if (!previewGrid.empty()) wanted.insert(wanted.begin(), previewGrid);
+    for (const std::string& name : wanted) {
+        auto g = std::find_if(grids.begin(), grids.end(),
+                              [&](const auto& grid) { return grid->getName() == name; });
+        auto floatGrid = g == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(*g);
+        if (!floatGrid) continue;
+        vdbio::PreviewLayer layer;
+        layer.name = m.name + " " + name;
+        layer.grid = floatGrid;
+        layer.kind = floatGrid->getGridClass() == openvdb::GRID_LEVEL_SET
+                         ? vdbio::PreviewLayer::Kind::Surface
+                         : vdbio::PreviewLayer::Kind::Fog;
+        layer.albedo = m.liquid ? vdbio::LIQUID_ALBEDO : vdbio::GAS_ALBEDO;
+        namedGridFound = namedGridFound || name == previewGrid;
+        return layer;
+    }
+    return std::nullopt;
+}
+
+/// The camera and image of outputs.preview.
+vdbio::PreviewOptions previewOptions(const vdbio::SceneOutputs& out)
+{
+    vdbio::PreviewOptions pv;
+    pv.width = out.previewWidth;
+    pv.height = out.previewHeight;
+    pv.azimuth = out.previewAzimuth;
+    pv.elevation = out.previewElevation;
+    if (out.previewBackground) {
+        const auto& c = *out.previewBackground;
+        pv.background = {float(c[0]), float(c[1]), float(c[2]), 1.0f};
+    }
+    return pv;
+}
+
+/// Render the preview of a frame from its media's layers, the solids drawn where they are.
+void writePreview(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
+                  const std::vector<vdbio::PreviewLayer>& media, const std::string& path,
+                  vdbio::PreviewCache* previewCache)
+{
+    const vdbio::SceneOutputs& out = scene.outputs;
+    std::vector<vdbio::PreviewLayer> layers;
+    if (out.previewSolids) layers = solidLayers(scene, snapshot, mediaBox(media));
+    layers.insert(layers.end(), media.begin(), media.end());
+    openvdb::BBoxd framed; // empty: the camera frames everything drawn
+    if (!out.previewFrame.empty()) {
+        framed = openvdb::BBoxd(openvdb::Vec3d(out.previewFrame.min),
+                                openvdb::Vec3d(out.previewFrame.max));
+    }
+    vdbio::renderScenePreview(layers, previewOptions(out), framed, path, previewCache);
+}
+
+} // namespace
+
+void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
+                       const std::string& folder, vdbio::PreviewCache* previewCache)
+{
+    const vdbio::SceneOutputs& out = scene.outputs;
+    auto inFolder = [&](const std::string& pattern) {
+        return pattern.empty() ? std::string()
+                               : (fs::path(folder) / vdbio::expandFramePattern(pattern, snapshot.frame))
+                                     .string();
+    };
+    const openvdb::MetaMap fileMeta = frameMetadata(scene, snapshot);
+    std::vector<vdbio::PreviewLayer> media;
+    bool namedGridFound = false;
+    for (std::size_t index = 0; index < snapshot.media.size(); ++index) {
+        const OutputMedium& m = snapshot.media[index];
+        const openvdb::GridPtrVec grids =
+            writeMedium(m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
+                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
+                        index < snapshot.built.size() ? &snapshot.built[index] : nullptr);
+        if (out.previewFile.empty()) continue;
+        if (auto layer = mediumLayer(m, grids, out.previewGrid, namedGridFound))
+            media.push_back(*layer);
+    }
+    if (out.previewFile.empty()) return;
+    // checkOutputs() refused this before the first step; a medium's grids can still be missing
+    // (a frame written by a script).
+    if (media.empty() || (!out.previewGrid.empty() && !namedGridFound)) {
+        throw SceneError(msg("scene '", scene.file, "': outputs.preview.grid = '",
+                             out.previewGrid.empty() ? "(default)" : out.previewGrid,
+                             "': the volume output has no such grid"));
+    }
+    writePreview(scene, snapshot, media, inFolder(out.previewFile), previewCache);
+}
+
+} // namespace cmd
+} // namespace ghostfx
