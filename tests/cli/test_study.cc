@@ -154,8 +154,7 @@ TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
         // (ghost air pushes the liquid but is not pushed back; XSPH weights m_j / rho_j differ):
         // over 12 sample realisations (the sampler's seed salted, both volume relaxations;
         // bench/RESULTS.md, "Tests that hold over sample realisations") -0.040 to +0.109
-        // spacings from the integrator's error, as the sampling falls; allowed 0.15
-        // (0.06 until 2026-11-28).
+        // spacings from the integrator's error, as the sampling falls; allowed 0.15.
         const double T = 4.0 / 30.0, dt = T / num(row, "steps");
         const double expected = 9.81 * T * dt / 2 / 0.02;
         const double tolerance = row.at("settings.method") == "basic" ? 0.01 * expected : 0.15;
@@ -351,7 +350,7 @@ TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
     // above rho0 |g| by about the mean compression (about +9 % when first measured); over 12
     // sample realisations (the sampler's seed salted, both volume relaxations;
     // bench/RESULTS.md, "Tests that hold over sample realisations") +12.9 to +15.2 %;
-    // allowed 0 to 20 % (15 % until 2026-11-28).
+    // allowed 0 to 20 %.
     EXPECT_GT(num(rows[0], "hydrostatic_slope_error"), 0.0);
     EXPECT_LT(num(rows[0], "hydrostatic_slope_error"), 0.20);
     // Mean |rho / rho0 - 1| below the bottom's 10 %.

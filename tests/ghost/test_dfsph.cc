@@ -284,9 +284,8 @@ TEST(Dfsph, StillTankHoldsTheDensityLimitAndHydrostaticPressure)
     // realisations (seeds 9 and 1-5; bench/RESULTS.md, "DFSPH: ghost solids as mirror
     // images"): slope -0.07 to +0.35 %, worst layer 1.81-2.13 %, interior density error
     // 0.32-0.36 %, top layer 0.89-1.07 %, fastest interior particle 0.048-0.060 m/s. With
-    // the walls' own pressure term (the model until 2026-11-29) the slope was +0.6 to +1.4 %,
-    // the worst layer 2.2-3.8 % and the interior speed up to 0.26 m/s: that test's bounds
-    // were 2 %, 6 % and 0.3 m/s.
+    // the walls' own pressure term (WallPressure::Own) the slope is +0.6 to +1.4 %, the worst
+    // layer 2.2-3.8 % and the interior speed up to 0.26 m/s.
     expectStillTankHolds(measureStillTank(GhostSettings().supportFactor), 0.01, 0.15, 0.03);
 }
 
@@ -299,9 +298,9 @@ TEST(Dfsph, TankAcceleratingUpwardsHoldsItsHydrostaticPressure)
     // c sum_s M (v_i - v_s) . grad W_is. Measured over six sample realisations (seeds 9 and
     // 1-5): slope -0.87 to +0.54 %, worst layer 1.96-3.16 % of rho0 1.5 g D, interior density
     // error 0.49-0.56 %, fastest particle in the tank's frame 0.13-0.18 m/s inside and 0.15-0.26
-    // at the top. Extrapolated with g alone (the model until 2026-11-29): slope +1.97 to
-    // +4.39 %, worst layer 3.6-5.3 %. Until the same day v_s entered with the wrong sign, and
-    // the rising floor squeezed the liquid to 3-5 rho0 while the solves reported convergence.
+    // at the top. Extrapolated with g alone the slope would be +1.97 to +4.39 % and the worst
+    // layer 3.6-5.3 %; with v_s of the wrong sign the rising floor squeezes the liquid to 3-5
+    // rho0 while the solves report convergence, which this test catches.
     // Bounds: slope 1.5 % (the still tank's 1 % plus the measured spread; every seed of the
     // g-only extrapolation is outside it), worst layer 4 %, interior density error 1 % (a solve
     // stopping at its limit leaves up to density_error / density_relaxation = 1 %), top layer
@@ -752,10 +751,10 @@ TEST(Dfsph, SmallCflStepsStayBounded)
 // downwards under gravity for 0.1 s, at the default CFL 0.4 and at CFL 0.1. The new particles
 // carry density errors of tens of percent; with the relaxation's whole share at the small
 // steps and the warm start applied whole, the CFL 0.1 stream ran away (a particle at 18.6 m/s,
-// dt at dfsph.min_dt: the code before ran past 300 s here; bench/RESULTS.md, "DFSPH at small
-// steps"). Run at [SB12]'s 3 h support and at 2.5 h, where until 2026-11-29 the pressure's
-// acceleration in the step's force limit shrank the steps from 1 ms to 10 us and threw a
-// particle at 8.8 m/s (bench/RESULTS.md, "DFSPH: the pressure out of the step's force limit").
+// dt at dfsph.min_dt, past 300 s here; bench/RESULTS.md, "DFSPH at small steps"). Run at
+// [SB12]'s 3 h support and at 2.5 h, where the pressure's acceleration in the step's force
+// limit would shrink the steps from 1 ms to 10 us and throw a particle at 8.8 m/s
+// (bench/RESULTS.md, "DFSPH: the pressure out of the step's force limit").
 // Asserted: the CFL 0.1 run pours what the CFL 0.4 run pours within 5 % (a step-size
 // property; Emitter.TapUnderGravityPoursItsRateAtAnyStep checks the rate itself), and no
 // particle faster than 1.5 x the free-fall speed 1 m/s + g t. Measured since the fills are
@@ -875,8 +874,8 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
     // liquid's mirror images (DfsphSettings::WallPressure::Mirror) they pull with the
     // tension the slab needs, and it hangs: over six sample realisations (seeds 1-6) the top
     // layer moved -0.9 to +0.3 mm in 0.1 s (free fall 4.9 cm; the Tait step holds it within
-    // 0.4 mm). Pulling with the particle's own pressure term once (WallPressure::Own, the
-    // model until 2026-11-29) the ceiling holds the top layer with half the force the layer
+    // 0.4 mm). Pulling with the particle's own pressure term once (WallPressure::Own) the
+    // ceiling holds the top layer with half the force the layer
     // below pulls it down with: it slides 1.5-1.7 cm, the layers packing together under
     // tension (bench/RESULTS.md, "DFSPH: ghost solids as mirror images"; 1.16 cm in the
     // double build). Bounds: 3 mm mirrored, and more than half a spacing with the own term

@@ -225,9 +225,8 @@ TEST(Extremes, StiffCollapseAgreesWithTheReferenceStiffness)
         // (4.7-31 x) and its front lagged 16-28 %. Over 12 sample realisations (the sampler's
         // seed salted, both volume relaxations; bench/RESULTS.md, "Tests that hold over sample
         // realisations") k 2e5 measured front -9.5 to -16.4 % and column +14.8 to +38.4 % (one
-        // outlier; the rest to +22.7 %). Bounds: front 25 %, column 45 % (30 % until 2026-11-28;
-        // the double build measured -19.0 % / +21.0 %); speed 4 x sqrt(2 g H), the test that
-        // caught the old blow-ups.
+        // outlier; the rest to +22.7 %; the double build -19.0 % / +21.0 %). Bounds: front
+        // 25 %, column 45 %; speed 4 x sqrt(2 g H), which a blow-up passes.
         EXPECT_NEAR(o.front / ref.front, 1.0, 0.25) << "k " << c.k << " eps " << c.eps;
         EXPECT_NEAR(o.column / ref.column, 1.0, 0.45) << "k " << c.k << " eps " << c.eps;
         EXPECT_LT(o.maxSpeed, 4 * freeFall) << "k " << c.k << " eps " << c.eps;
@@ -238,9 +237,8 @@ TEST(Extremes, StiffCollapseAgreesWithTheReferenceStiffness)
             // Over 12 sample realisations: Algorithm 2's samples 2.72-3.29 % mean relax to
             // 0.51-1.09 % (0.16-0.37 of it), largest 3.96-9.42 %; packing's 1.79-2.14 % relax to
             // 0.57-1.03 % (0.27-0.49 of it), largest 7.06-12.55 %. Bounds: the sampled liquid
-            // has an error to relax (above 1 %; 2 % until 2026-11-28, which packing's better
-            // samples do not reach), relaxed below 1.5 % mean and 15 % largest (10 % until
-            // 2026-11-28), and at most 0.6 of the sampled mean (0.5).
+            // has an error to relax (above 1 %), relaxed below 1.5 % mean and 15 % largest, and
+            // at most 0.6 of the sampled mean.
             std::printf("[measured] initial density error k %g: sampled mean %.2f %% max %.2f "
                         "%%, relaxed mean %.2f %% max %.2f %%\n",
                         double(c.k), 100 * o.initial.meanSampled, 100 * o.initial.maxSampled,

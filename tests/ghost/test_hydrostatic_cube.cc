@@ -123,7 +123,7 @@ TEST(HydrostaticCube, GhostKeepsShapeVolumeAndUniformDensityWhereBasicShrinksInt
     // its start. Bounds: volume 2 %, gyration 6 %, densities 1.5 %, spacing ratio 8 %: over
     // 12 sample realisations (the sampler's seed salted, both volume relaxations;
     // bench/RESULTS.md, "Tests that hold over sample realisations") the ratio moved by -3.0
-    // to -6.1 % (bound 5 % until 2026-11-28); Basic SPH's outer spacing falls by half.
+    // to -6.1 %; Basic SPH's outer spacing falls by half.
     EXPECT_NEAR(ghost.end.volume / ghost.start.volume, 1.0, 0.02);
     EXPECT_NEAR(ghost.end.gyration / ghost.start.gyration, 1.0, 0.06);
     EXPECT_NEAR(ghost.end.outerDensity / ghost.end.innerDensity, 1.0, 0.015);

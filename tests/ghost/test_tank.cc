@@ -125,7 +125,7 @@ void expectHydrostaticTank(AirWeights weights)
     // is an extreme of the sampling's noise: over 24 sample realisations (the sampler's seed
     // salted, 6 each for both weights and both volume relaxations; bench/RESULTS.md, "Tests
     // that hold over sample realisations") it measured 0.057-0.112 m/s. Bound: half of
-    // sqrt(g h), 0.15 m/s (0.1 until 2026-11-28, which 3 of those 24 exceeded).
+    // sqrt(g h), 0.15 m/s.
     EXPECT_LT(maxSpeed, 0.15);
 }
 
@@ -138,7 +138,7 @@ TEST(HydrostaticTank, PressureGrowsAsRhoGDepthAndNoParticleEntersTheWalls)
     expectHydrostaticTank(GhostSettings().airWeights);
 }
 
-// settings.air_weights "matched" (the default until 2026-11-25) must keep the tank too.
+// settings.air_weights "matched" must keep the tank too.
 // Measured: slope -0.08 %, 0.061 m/s (float); +0.84 %, 0.083 m/s (double).
 TEST(HydrostaticTank, MatchedAirWeightsHoldTheTankToo)
 {

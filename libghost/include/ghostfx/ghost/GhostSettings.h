@@ -80,8 +80,8 @@ struct DfsphSettings
         /// that holds liquid under a ceiling.
         Mirror,
         /// The liquid particle's own pressure term, once (SPlisHSPlasH's DFSPH boundary
-        /// term): the model until 2026-11-29, kept for comparison; pressure 0.6-1.4 % too
-        /// steep in a still tank, and a slab under a ceiling slides a spacing or two.
+        /// term), to compare with that solver: pressure 0.6-1.4 % too steep in a still tank,
+        /// and a slab under a ceiling slides a spacing or two.
         Own
     };
     WallPressure wallPressure = WallPressure::Mirror;
@@ -164,7 +164,7 @@ enum class SolidSlip {
 /// (GhostAir.cc, step 6). Chosen by name in scenes (settings.air_weights).
 enum class AirWeights {
     /// min(1, n0 / sigma_a): an air particle weighs less where the air around it is packed
-    /// closer than the liquid ([SB12]'s weight 1 elsewhere). The default until 2026-11-25:
+    /// closer than the liquid ([SB12]'s weight 1 elsewhere), the weights nearest the paper's:
     /// the kept air's mass grows at every resampling and a zero-gravity cube spreads by 4-6 %
     /// in 2 s (bench/RESULTS.md, "Air that completes the liquid's density").
     Matched,
