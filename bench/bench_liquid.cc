@@ -15,10 +15,10 @@
 ///          and the mass scaling, timed on its own), resets the solver's PhaseTimings and runs
 ///          `--steps` measured steps, each timed with std::chrono around GhostSolver::step().
 ///          dt is fixed at 1 / (30 * 20) s ([SB12]: 20 steps per frame at 30 frames/s) unless
-///          `--cfl` is given. Basic SPH blows up at that dt in both scenes (bench/RESULTS.md);
-///          its per-step cost comes from `--method basic --cfl 0.4`. Plain main (no Google
-///          Benchmark): one scene run takes a minute, not a loop to repeat. Results and how they
-///          were taken: bench/RESULTS.md.
+///          `--cfl` is given. Basic SPH blows up at that dt in both scenes
+///          (bench/history/diary-2026-11.md); its per-step cost comes from
+///          `--method basic --cfl 0.4`. Plain main (no Google Benchmark): one scene run takes a
+///          minute, not a loop to repeat. Results and how they were taken: bench/RESULTS.md.
 ///
 ///          Run: build/bench/bench_liquid [--liquid 100000] [--steps 30] [--warmup 20]
 #include <ghostfx/ghost/GhostSolver.h>
@@ -222,11 +222,11 @@ struct RunResult
 };
 
 /// The halos that a domain decomposition of the solver's present state would exchange, for
-/// slabs and recursive bisection over 2 to 1,024 parts (the scaling model of bench/RESULTS.md,
-/// "One simulation over many ranks"). A part owns the liquid and air in its region (what it
-/// computes); its halo is the liquid and air of other parts within a support radius R of its
-/// region (copies it receives every step); its solid particles are those in or within R of
-/// its region (sampled locally, never exchanged).
+/// slabs and recursive bisection over 2 to 1,024 parts (the scaling model of
+/// bench/history/diary-2026-11.md, "One simulation over many ranks"). A part owns the liquid and
+/// air in its region (what it computes); its halo is the liquid and air of other parts within a
+/// support radius R of its region (copies it receives every step); its solid particles are those in
+/// or within R of its region (sampled locally, never exchanged).
 /// One line per step (--trace): what to look at when a run goes wrong at some step.
 void traceStep(const GhostSolver& solver, Real dt, double wall)
 {

@@ -64,7 +64,7 @@ constexpr double REST_DENSITY = 1000.0;     ///< m = REST_DENSITY h^3 (kg/m^3)
 constexpr double DENSITY_REL_TOL = 1e-4;
 
 /// PointIndexGrid configuration of the headline BM_PointIndexGrid_* benchmarks: the fastest
-/// of the BM_PointIndexGrid_*Variant runs (see bench/RESULTS.md).
+/// of the BM_PointIndexGrid_*Variant runs (see bench/history/diary-2026-11.md).
 constexpr int PIG_VOXELS_PER_RADIUS = 2; ///< voxel size = R / this
 constexpr PointIndexQuery PIG_QUERY = PointIndexQuery::BoxThenDistance;
 

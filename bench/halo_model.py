@@ -7,7 +7,8 @@ radius R of its region, owned by other parts) and the parallel efficiency that h
 The geometry is exact for a uniform block: a part's halo is the volume within R of its box,
 inside the block and outside the box (faces, quarter-cylinder edges and ball corners, clipped
 where the block ends), times the particle density. Its check against halos counted in a real
-simulation state is `bench_liquid --halo` (bench/RESULTS.md, "One simulation over many ranks").
+simulation state is `bench_liquid --halo` (bench/history/diary-2026-11.md,
+"One simulation over many ranks").
 
 Usage:
   python3 bench/halo_model.py check            # the dam-break block of bench_liquid (98k)

@@ -360,7 +360,7 @@ Real GasSolver::referenceMass() const
     // as the mass scaling of [SB12] Sec. 4.6 does for liquids.
     const Real R = mSettings.supportRadius();
     // Interior 8 R wide, a few thousand samples: the mass then varies by about 1 % with the
-    // seed (a block 4 R wide, a few hundred, varied by about 4 %; bench/RESULTS.md).
+    // seed (a block 4 R wide, a few hundred, varied by about 4 %; bench/history/diary-2026-11.md).
     const Real half = Real(5) * R;
     const LevelSet block =
         makeLevelSet(makeBoxLevelSet(Vec3(-half), Vec3(half), Real(0.5) * mSettings.spacing),

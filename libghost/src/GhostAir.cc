@@ -449,8 +449,8 @@ void GhostSolver::resampleAir(int phase, int count)
     //    asks for none), and each air particle of the region takes the least-squares weight
     //    for its liquid neighbours, sum_i W_ai A_i^2 f_i / sum_i W_ai A_i^2: the particles with
     //    much air decide, those whose neighbourhood is nearly complete (f_i a noisy ratio of
-    //    small numbers) hardly count. Measured (bench/RESULTS.md, "Air that completes the
-    //    liquid's density"): the zero-gravity cube -0.4 % in gyration over 2 s.
+    //    small numbers) hardly count. Measured (bench/history/diary-2026-11.md, "Air that completes
+    //    the liquid's density"): the zero-gravity cube -0.4 % in gyration over 2 s.
     if (mMass > Real(0) && mSettings.airWeights == AirWeights::Complete) {
         const auto& xs = mParticles.positions();
         NeighborGrid freshGrid(R);

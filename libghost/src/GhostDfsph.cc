@@ -27,7 +27,8 @@
 ///          3 h support: with about 110 neighbours the off-diagonal coupling outweighs the
 ///          diagonal (measured: the error grew 4.4 x per iteration on a sampled ball).
 ///
-///          How the ghosts take part (each choice measured: bench/RESULTS.md, "DFSPH"):
+///          How the ghosts take part (each choice measured: bench/history/diary-2026-11.md,
+///          "DFSPH"):
 ///           - ghost air gives a surface particle its full density (its mass is in rho_i) at
 ///             zero pressure (k = 0), and moves with the liquid: it adds nothing to the rate of
 ///             density change or to the forces. So no density clamping and no surface special
@@ -48,10 +49,10 @@
 ///             For a linear pressure field the sum over liquid and ghosts then gives grad k
 ///             times the full moment of the kernel: without the mirror, the solid term leaves
 ///             a force proportional to k_i itself, which at depth outweighs the pressure
-///             gradient. Measured (bench/RESULTS.md, "DFSPH: ghost solids as mirror images"):
-///             with WallPressure::Own (c = 1, no extrapolation, the previous model) a still
-///             tank's pressure rose 0.6 to 1.4 % too fast with depth and a slab under a ceiling
-///             slid 1.2-1.8 cm in 0.1 s (the top layer packed against the layer below under
+///             gradient. Measured (bench/history/diary-2026-11.md, "DFSPH: ghost solids as mirror
+///             images"): with WallPressure::Own (c = 1, no extrapolation, the previous model) a
+///             still tank's pressure rose 0.6 to 1.4 % too fast with depth and a slab under a
+///             ceiling slid 1.2-1.8 cm in 0.1 s (the top layer packed against the layer below under
 ///             tension); mirrored, -0.1 to +0.4 % and within 1 mm. The factor alone (c = 2
 ///             without the extrapolation) compressed the tank by 2.6 %; c = 2 in G but not in
 ///             D (D the exact rate of the density sum) is not symmetric, and the conjugate
@@ -311,7 +312,8 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // Largest |e| / rho0 of one particle. The mean alone does not see a few particles in a
     // hundred thousand: in SPlisHSPlasH's dam break at 100k, a handful beside the floor were
     // squeezed from 1.3 to 2.7 rho0 over ten steps in which the mean stayed under its limit
-    // and no iteration ran (bench/RESULTS.md, "DFSPH: a peak limit"; DfsphSettings::PEAK_FACTOR).
+    // and no iteration ran (bench/history/diary-2026-11.md, "DFSPH: a peak limit";
+    // DfsphSettings::PEAK_FACTOR).
     auto largestError = [&](const std::vector<Real>& r) {
         const double m = parallel::maximum(
             0, n, [&](std::size_t i) { return solved(i) ? double(std::abs(r[i])) : 0.0; });
@@ -376,7 +378,7 @@ int GhostSolver::solvePressure(Real dt, bool density, std::vector<Real>& total, 
     // last pressure fits, the solve iterates at least once whatever its limit says: the share
     // alone bounds the run-away but leaves local misfits (a global s is set by the bulk) that
     // at CFL 0.1 kept the column tank's fastest particles at 2 to 9 m/s against 1.3 to 2.3
-    // with the iteration. Measured: bench/RESULTS.md, "DFSPH at small steps".
+    // with the iteration. Measured: bench/history/diary-2026-11.md, "DFSPH at small steps".
     Real share = 1;
     bool residualKnown = false;
     if (warm) {

@@ -171,8 +171,8 @@ using sph::secondsSince;
 /// acceleration of e h / dt^2 that shortened the next step asked the next solve for a larger
 /// one, and the steps shrank geometrically to minTimeStep (a tap at 2.5 h support and CFL
 /// 0.1: 1 ms to 10 us in 3 ms of simulated time, a particle thrown at 8.8 m/s;
-/// bench/RESULTS.md, "DFSPH: the pressure out of the step's force limit"). Its displacement
-/// is bounded by the velocity CFL of the step after.
+/// bench/history/diary-2026-11.md, "DFSPH: the pressure out of the step's force limit"). Its
+/// displacement is bounded by the velocity CFL of the step after.
 inline Real dfsphTimeStep(const GhostSettings& s, Real fastest, Real cfl)
 {
     const DfsphSettings& d = s.dfsph;

@@ -46,7 +46,8 @@ Real GhostSettings::solidDragReferenceStep(Real vmax) const
     // Why a rate (issue 18): with epsilon per step, the wall drag per second grows as 1 / dt,
     // i.e. as sqrt(k) on acoustic steps, and a stiff liquid crept along the floor. The
     // liquid's own epsilon stays per step, as [SB12] defines it: it damps the acoustic noise,
-    // whose frequency grows with sqrt(k) as the steps do (bench/RESULTS.md, "Stiff liquid").
+    // whose frequency grows with sqrt(k) as the steps do (bench/history/diary-2026-11.md, "Stiff
+    // liquid").
     const Real referenceStiffness = Real(2000), referenceCfl = Real(0.4);
     const Real c = std::sqrt(Real(7) * referenceStiffness / restDensity);
     return referenceCfl * spacing / (c + vmax);

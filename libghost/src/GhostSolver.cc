@@ -491,7 +491,7 @@ void GhostSolver::emit()
         // liquid inside moves at the emitter's velocity (the emitter is kept full of liquid
         // moving so): left at its own, gravity and the pressure of the fills sped it up inside
         // the nozzle and a tap poured 30 % (DFSPH) to 120 % (Tait at CFL 0.2) over its rate,
-        // more the smaller the steps (bench/RESULTS.md, "The tap's rate by mass").
+        // more the smaller the steps (bench/history/diary-2026-11.md, "The tap's rate by mass").
         std::vector<Vec3> seeds, obstacles;
         auto& v = mParticles.velocities();
         for (std::size_t i = 0; i < mParticles.size(); ++i) {
@@ -561,8 +561,8 @@ void GhostSolver::limitToCredit(Emitter& em, std::size_t e, std::vector<Vec3>& f
 {
     // The fills find every gap of r in the nozzle, and gaps opened a few millimetres a step
     // fill more tightly than the sampler's relaxed bodies: a tap held at its velocity poured
-    // 10-17 % over rho0 v A with either pressure model (bench/RESULTS.md, "The tap's rate by
-    // mass"). The fills are capped by the mass the emitter owes; a random choice of them
+    // 10-17 % over rho0 v A with either pressure model (bench/history/diary-2026-11.md, "The tap's
+    // rate by mass"). The fills are capped by the mass the emitter owes; a random choice of them
     // (the same on every process: all sample the same fills) spreads the gaps left evenly,
     // and the next steps' fills find them again.
     if (em.crossSection <= 0 || mMass <= Real(0)) return;
@@ -586,7 +586,7 @@ void GhostSolver::limitToCredit(Emitter& em, std::size_t e, std::vector<Vec3>& f
     // Thinned fills leave the nozzle's top short of liquid, so the fills' radius follows the
     // packing that pays the rate: a little wider while the fills outrun the credit, back
     // towards r while they fall a layer behind (a 5 mm tap under gravity settles near 1.06 r,
-    // bench/RESULTS.md, "An emitter that pours its rate").
+    // bench/history/diary-2026-11.md, "An emitter that pours its rate").
     const double layer =
         double(mSettings.restDensity) * em.crossSection * double(mSettings.spacing);
     if (capped) em.fillScale = std::min(MAX_FILL_SCALE, em.fillScale * FILL_SCALE_STEP);

@@ -398,8 +398,8 @@ void GhostSolver::relaxInitialLiquid()
     // beyond R), and one that enters is missed where it weighs under 1 % of the gradient's
     // peak (r > R - 0.1 h: 0.3 % at R = 3 h, 0.75 % at 2 h). Keeping lists for four passes
     // (to the next resampling) missed pairs up to 5 % of the peak, and left the stiff
-    // collapse's relaxed error 15 % higher (bench/RESULTS.md); every other pass leaves it as
-    // it was.
+    // collapse's relaxed error 15 % higher (bench/history/diary-2026-11.md); every other pass
+    // leaves it as it was.
     std::vector<Vec3> shift;
     for (int pass = 0; pass <= passes; ++pass) {
         const bool resample = pass > 0 && (pass % 5 == 0 || pass == passes);
@@ -581,8 +581,8 @@ void GhostSolver::stepGhost(Real dt)
             for (const SolidBlock* block : {&mStatic, &mMoving}) {
                 // p / rho^2 of a ghost solid from its nearest liquid particle's values (lines
                 // 5-7), computed here: solid pairs are a few percent of all, and an array of
-                // it for every solid particle cost 4 bytes each (bench/RESULTS.md, "Memory:
-                // the lists' ends").
+                // it for every solid particle cost 4 bytes each (bench/history/diary-2026-11.md,
+                // "Memory: the lists' ends").
                 const ParticleSet& solids = block->block.particles();
                 const Real* pS = solids.pressures().data();
                 const Real* rhoS = solids.densities().data();

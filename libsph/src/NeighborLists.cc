@@ -377,8 +377,8 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
         }
         // Fit the chunk to its lists (they shrank since an earlier step, or it grew by a
         // sixteenth while being filled): capacity is what the process holds. Most chunks are
-        // re-allocated in most steps; that costs less than a step's noise (bench/RESULTS.md,
-        // "Memory: lists fitted").
+        // re-allocated in most steps; that costs less than a step's noise
+        // (bench/history/diary-2026-11.md, "Memory: lists fitted").
         if (out.capacity > used + used / 64 + 64 + List::READ_PAST) out.shrink(used);
         },
         1);

@@ -96,8 +96,8 @@ void ParticleSet::growFor(std::size_t count)
     // Room for `count` more, growing by a thirty-second rather than doubling: a solver appends
     // a few particles every step (emission, air), and doubling would leave up to half of every
     // channel unused (ParticleSet::memoryBytes counts capacity); an eighth left 12 % of the
-    // paper-size double dam break's liquid set unused (bench/RESULTS.md). A copy of the set
-    // every 3 % of growth costs little next to the steps in between.
+    // paper-size double dam break's liquid set unused (bench/history/diary-2026-11.md). A copy of
+    // the set every 3 % of growth costs little next to the steps in between.
     const std::size_t n = mPositions.size() + count;
     if (n <= mPositions.capacity()) return;
     const std::size_t grown = std::max(n, mPositions.size() + mPositions.size() / 32);

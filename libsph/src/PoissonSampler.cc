@@ -675,9 +675,10 @@ void PoissonDiskSampler::growInterior(SampleSet& samples, const LevelSet& shape,
     // colours run in order, and a tile grows again when samples were placed in it from a
     // neighbour, until no tile places any. Only the order in which samples grow differs from
     // one sequential pass, not how; but fronts of growth now meet inside every tile, which
-    // leaves the unrelaxed samples 1-2 % denser at tile faces than mid-tile (bench/RESULTS.md,
-    // "Sampler: Algorithm 1 and Bridson's growth in parallel tiles"; the relaxations even most
-    // of it). The samples depend on the seed and the tiles, never on the thread count.
+    // leaves the unrelaxed samples 1-2 % denser at tile faces than mid-tile
+    // (bench/history/diary-2026-11.md, "Sampler: Algorithm 1 and Bridson's growth in parallel
+    // tiles"; the relaxations even most of it). The samples depend on the seed and the tiles, never
+    // on the thread count.
     const Real r = mSettings.radius;
     const DepthLimit band(samples, shape, mSettings.bandDepth, r);
     const Aabb bounds = samplingBounds(shape, r);

@@ -26,8 +26,8 @@
 ///              for solids, within the band.
 ///          The surface is not compensated for its missing neighbours: the surface samples
 ///          (about 0.87 per h^2) stand in for them, and the profile of density against depth
-///          then matches Algorithm 2's (bench/RESULTS.md, "Sampler: SPH packing as the volume
-///          relaxation").
+///          then matches Algorithm 2's (bench/history/diary-2026-11.md, "Sampler: SPH packing as
+///          the volume relaxation").
 #include "ghostfx/sph/Kernels.h"
 #include "ghostfx/sph/NeighborGrid.h"
 #include "ghostfx/sph/NeighborLists.h"
@@ -50,7 +50,8 @@ namespace {
 /// is what evens the spacing, at a third of the pairs of the solver's 3h.
 constexpr Real SUPPORT_SPACINGS = Real(2);
 /// Step gain a of x -= a R^2 h^3 sum_j grad W (unitless). With it the bench sphere's interior
-/// density spread falls from 6.3 % to 1.8 % in 5 steps and 1.6 % in 8 (bench/RESULTS.md).
+/// density spread falls from 6.3 % to 1.8 % in 5 steps and 1.6 % in 8
+/// (bench/history/diary-2026-11.md).
 constexpr Real STEP_GAIN = Real(0.25);
 /// Largest move per step, in Poisson radii (a surface sample's projection may add as much
 /// again): a sample that may come within r of another's new position is within r + 4 r / 5

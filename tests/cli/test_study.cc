@@ -153,8 +153,8 @@ TEST_F(Study, SweepWritesTableAndParetoPlotWithMeasuredErrors)
         // metric must find. Basic SPH's forces are symmetric: to 1 %. Ghost SPH's are not quite
         // (ghost air pushes the liquid but is not pushed back; XSPH weights m_j / rho_j differ):
         // over 12 sample realisations (the sampler's seed salted, both volume relaxations;
-        // bench/RESULTS.md, "Tests that hold over sample realisations") -0.040 to +0.109
-        // spacings from the integrator's error, as the sampling falls; allowed 0.15.
+        // bench/history/diary-2026-11.md, "Tests that hold over sample realisations") -0.040 to
+        // +0.109 spacings from the integrator's error, as the sampling falls; allowed 0.15.
         const double T = 4.0 / 30.0, dt = T / num(row, "steps");
         const double expected = 9.81 * T * dt / 2 / 0.02;
         const double tolerance = row.at("settings.method") == "basic" ? 0.01 * expected : 0.15;
@@ -349,7 +349,7 @@ TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
     // bottom is 10 % denser than rho0 (rho0 g H / 7k = 0.14 -> (1.14)^(1/7)), so the slope is
     // above rho0 |g| by about the mean compression (about +9 % when first measured); over 12
     // sample realisations (the sampler's seed salted, both volume relaxations;
-    // bench/RESULTS.md, "Tests that hold over sample realisations") +12.9 to +15.2 %;
+    // bench/history/diary-2026-11.md, "Tests that hold over sample realisations") +12.9 to +15.2 %;
     // allowed 0 to 20 %.
     EXPECT_GT(num(rows[0], "hydrostatic_slope_error"), 0.0);
     EXPECT_LT(num(rows[0], "hydrostatic_slope_error"), 0.20);

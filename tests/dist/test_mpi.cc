@@ -515,10 +515,10 @@ TEST(DistributedGhost, MovingAndReshapedSolidsOnSeveralRanksFollowOneRank)
     // the rms and the centre of mass. Measured, 2 / 3 ranks: rms 0.10 / 0.11 h, worst 0.65 /
     // 0.55 h, centre of mass 0.01 h. The worst particle is often one squeezed through the
     // two-spacing gap under the moving paddle, where which way it goes is a coin toss: over
-    // 12 sample realisations at 2 ranks (the seed salted, both volume relaxations; bench/
-    // RESULTS.md, "Tests that hold over sample realisations") rms 0.04-0.12 h, worst 0.18-2.47 h
-    // (above 1 h only at the floor beside the paddle). Bound for the worst: 3 h (2 h until
-    // 2026-11-28).
+    // 12 sample realisations at 2 ranks (the seed salted, both volume relaxations; bench/history/
+    // diary-2026-11.md, "Tests that hold over sample realisations") rms 0.04-0.12 h, worst
+    // 0.18-2.47 h (above 1 h only at the floor beside the paddle). Bound for the worst: 3 h (2 h
+    // until 2026-11-28).
     EXPECT_LT(late.rms, 0.3 * h);
     EXPECT_LT(late.worst, 3 * h);
     EXPECT_LT(late.com, 0.1 * h);

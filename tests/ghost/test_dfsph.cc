@@ -281,7 +281,7 @@ TEST(Dfsph, StillTankHoldsTheDensityLimitAndHydrostaticPressure)
     //    the top layer (sqrt(g h) = 0.31 m/s is the speed a particle-sized disturbance
     //    reaches).
     // Measured with mirrored walls (DfsphSettings::WallPressure::Mirror) over six sample
-    // realisations (seeds 9 and 1-5; bench/RESULTS.md, "DFSPH: ghost solids as mirror
+    // realisations (seeds 9 and 1-5; bench/history/diary-2026-11.md, "DFSPH: ghost solids as mirror
     // images"): slope -0.07 to +0.35 %, worst layer 1.81-2.13 %, interior density error
     // 0.32-0.36 %, top layer 0.89-1.07 %, fastest interior particle 0.048-0.060 m/s. With
     // the walls' own pressure term (WallPressure::Own) the slope is +0.6 to +1.4 %, the worst
@@ -751,10 +751,10 @@ TEST(Dfsph, SmallCflStepsStayBounded)
 // downwards under gravity for 0.1 s, at the default CFL 0.4 and at CFL 0.1. The new particles
 // carry density errors of tens of percent; with the relaxation's whole share at the small
 // steps and the warm start applied whole, the CFL 0.1 stream ran away (a particle at 18.6 m/s,
-// dt at dfsph.min_dt, past 300 s here; bench/RESULTS.md, "DFSPH at small steps"). Run at
-// [SB12]'s 3 h support and at 2.5 h, where the pressure's acceleration in the step's force
+// dt at dfsph.min_dt, past 300 s here; bench/history/diary-2026-11.md, "DFSPH at small steps"). Run
+// at [SB12]'s 3 h support and at 2.5 h, where the pressure's acceleration in the step's force
 // limit would shrink the steps from 1 ms to 10 us and throw a particle at 8.8 m/s
-// (bench/RESULTS.md, "DFSPH: the pressure out of the step's force limit").
+// (bench/history/diary-2026-11.md, "DFSPH: the pressure out of the step's force limit").
 // Asserted: the CFL 0.1 run pours what the CFL 0.4 run pours within 5 % (a step-size
 // property; Emitter.TapUnderGravityPoursItsRateAtAnyStep checks the rate itself), and no
 // particle faster than 1.5 x the free-fall speed 1 m/s + g t. Measured since the fills are
@@ -801,8 +801,8 @@ TEST(Dfsph, AnEmitterAtSmallCflStepsPoursAsAtTheDefaultStep)
 // One particle of a still lattice block (zero gravity, 4,096 particles) starts 0.4 h from the
 // particle below it and moving into it at 5 m/s. Its error is several percent, yet the mean over
 // the block stays within the 0.1 % limit: a solve that stops on the mean alone lets it go
-// (SPlisHSPlasH's dam break at 100k blew up so, bench/RESULTS.md, "DFSPH: a peak limit").
-// Asserted: no particle's error above the peak limit, 30 x 0.1 % = 3 % (DfsphSettings::
+// (SPlisHSPlasH's dam break at 100k blew up so, bench/history/diary-2026-11.md, "DFSPH: a peak
+// limit"). Asserted: no particle's error above the peak limit, 30 x 0.1 % = 3 % (DfsphSettings::
 // PEAK_FACTOR). Measured: 2.93 % / 2.68 % (density / divergence); with the peak limit off the
 // first divergence solve ran no iteration and left 5.76 %.
 TEST(Dfsph, OneParticleDrivenIntoItsNeighbourIsStoppedThoughTheMeanIsMet)
@@ -877,8 +877,8 @@ TEST(Dfsph, LiquidHangsUnderACeiling)
     // 0.4 mm). Pulling with the particle's own pressure term once (WallPressure::Own) the
     // ceiling holds the top layer with half the force the layer
     // below pulls it down with: it slides 1.5-1.7 cm, the layers packing together under
-    // tension (bench/RESULTS.md, "DFSPH: ghost solids as mirror images"; 1.16 cm in the
-    // double build). Bounds: 3 mm mirrored, and more than half a spacing with the own term
+    // tension (bench/history/diary-2026-11.md, "DFSPH: ghost solids as mirror images"; 1.16 cm in
+    // the double build). Bounds: 3 mm mirrored, and more than half a spacing with the own term
     // (that the test tells the two apart).
     auto drop = [](DfsphSettings::WallPressure wall) {
         GhostSettings s = dfsphSettings();

@@ -223,10 +223,10 @@ TEST(Extremes, StiffCollapseAgreesWithTheReferenceStiffness)
         // CFL 0.2 -0.5 % / -0.5 %, epsilon 0.02 and 0.1 +8.7 % and -10.2 % / -6.1 % and
         // +4.6 %; largest speed 0.9-2.3 x free fall. Before this round k = 2e5 reached 9-62 m/s
         // (4.7-31 x) and its front lagged 16-28 %. Over 12 sample realisations (the sampler's
-        // seed salted, both volume relaxations; bench/RESULTS.md, "Tests that hold over sample
-        // realisations") k 2e5 measured front -9.5 to -16.4 % and column +14.8 to +38.4 % (one
-        // outlier; the rest to +22.7 %; the double build -19.0 % / +21.0 %). Bounds: front
-        // 25 %, column 45 %; speed 4 x sqrt(2 g H), which a blow-up passes.
+        // seed salted, both volume relaxations; bench/history/diary-2026-11.md, "Tests that hold
+        // over sample realisations") k 2e5 measured front -9.5 to -16.4 % and column +14.8 to
+        // +38.4 % (one outlier; the rest to +22.7 %; the double build -19.0 % / +21.0 %). Bounds:
+        // front 25 %, column 45 %; speed 4 x sqrt(2 g H), which a blow-up passes.
         EXPECT_NEAR(o.front / ref.front, 1.0, 0.25) << "k " << c.k << " eps " << c.eps;
         EXPECT_NEAR(o.column / ref.column, 1.0, 0.45) << "k " << c.k << " eps " << c.eps;
         EXPECT_LT(o.maxSpeed, 4 * freeFall) << "k " << c.k << " eps " << c.eps;

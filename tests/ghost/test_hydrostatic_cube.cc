@@ -122,8 +122,8 @@ TEST(HydrostaticCube, GhostKeepsShapeVolumeAndUniformDensityWhereBasicShrinksInt
     // apart, outer/inner nearest-neighbour spacing ratio 0.968 -> 0.936, outer spacing 0.90 of
     // its start. Bounds: volume 2 %, gyration 6 %, densities 1.5 %, spacing ratio 8 %: over
     // 12 sample realisations (the sampler's seed salted, both volume relaxations;
-    // bench/RESULTS.md, "Tests that hold over sample realisations") the ratio moved by -3.0
-    // to -6.1 %; Basic SPH's outer spacing falls by half.
+    // bench/history/diary-2026-11.md, "Tests that hold over sample realisations") the ratio moved
+    // by -3.0 to -6.1 %; Basic SPH's outer spacing falls by half.
     EXPECT_NEAR(ghost.end.volume / ghost.start.volume, 1.0, 0.02);
     EXPECT_NEAR(ghost.end.gyration / ghost.start.gyration, 1.0, 0.06);
     EXPECT_NEAR(ghost.end.outerDensity / ghost.end.innerDensity, 1.0, 0.015);
@@ -217,7 +217,7 @@ void expectCubeKeepsTogether(AirWeights weights)
 // ("complete", GhostAir.cc: the air weighs what the liquid next to it lacks) measured -0.39 %
 // and 0.056 m/s (float), +0.97 % and 0.070 m/s (double). The former default, "matched" (by
 // the air's own packing), let the kept air's mass grow and the cube spread: +5.8 % and a late
-// 3.7 m/s (seed 1, bench/RESULTS.md "Air that completes the liquid's density").
+// 3.7 m/s (seed 1, bench/history/diary-2026-11.md "Air that completes the liquid's density").
 TEST(ZeroGravityCube, DefaultGhostAirKeepsTheCubeTogetherForTwoSeconds)
 {
     ASSERT_EQ(GhostSettings().airWeights, AirWeights::Complete);

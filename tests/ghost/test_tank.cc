@@ -123,8 +123,8 @@ void expectHydrostaticTank(AirWeights weights)
     EXPECT_GE(worstInside, -0.01 * double(H));
     // At rest: residual speeds well below sqrt(g h) = 0.31 m/s. The fastest of 1,400 particles
     // is an extreme of the sampling's noise: over 24 sample realisations (the sampler's seed
-    // salted, 6 each for both weights and both volume relaxations; bench/RESULTS.md, "Tests
-    // that hold over sample realisations") it measured 0.057-0.112 m/s. Bound: half of
+    // salted, 6 each for both weights and both volume relaxations; bench/history/diary-2026-11.md,
+    // "Tests that hold over sample realisations") it measured 0.057-0.112 m/s. Bound: half of
     // sqrt(g h), 0.15 m/s.
     EXPECT_LT(maxSpeed, 0.15);
 }
@@ -206,9 +206,9 @@ void expectCalmLanding(const char* name, double bound,
 
 // A liquid block dropped 3 h onto the floor of a tank, with DFSPH: the small cousin of
 // SPlisHSPlasH's dam break at 100k, whose cube blew up after its 1 m/s landing until the solves
-// also bounded each particle's error (DfsphSettings::PEAK_FACTOR; bench/RESULTS.md, "DFSPH: a
-// peak limit"; Dfsph.OneParticleDrivenIntoItsNeighbourIsStoppedThoughTheMeanIsMet tests the
-// limit itself: at this size the mean alone already keeps every particle within it). Measured
+// also bounded each particle's error (DfsphSettings::PEAK_FACTOR; bench/history/diary-2026-11.md,
+// "DFSPH: a peak limit"; Dfsph.OneParticleDrivenIntoItsNeighbourIsStoppedThoughTheMeanIsMet tests
+// the limit itself: at this size the mean alone already keeps every particle within it). Measured
 // over the fall and the landing: the largest error of one particle any solve left (bound: the
 // peak limit, 3 %), the solves that stopped short (none), and the fastest liquid (the landing at
 // 0.77 m/s throws a few particles at about 3.3 m/s at this coarse size; bound 5 m/s: a splash,
@@ -237,8 +237,8 @@ TEST(HydrostaticTank, ALandingBlockLeavesNoParticleSqueezed)
 // "full" the fastest particle of this landing (0.77 m/s) reached 2.0-3.5 m/s at 3 h support and
 // 3.6-8.6 m/s at 2.5 h over six sample realisations (settings.seed 1-6; the thrown particles
 // sat at 1.3-1.5 rho0 among 30-66 air particles and 7-22 liquid ones); with "fill" 1.6-2.2 and
-// 2.2-2.7 m/s (bench/RESULTS.md, "DFSPH: ghost air that fills and never compresses"). Bound
-// 3.5 m/s at both supports: the realisations' largest with 30 % to spare, below what "full"
+// 2.2-2.7 m/s (bench/history/diary-2026-11.md, "DFSPH: ghost air that fills and never compresses").
+// Bound 3.5 m/s at both supports: the realisations' largest with 30 % to spare, below what "full"
 // reaches at 2.5 h for five of the six.
 TEST(HydrostaticTank, AirThatFillsKeepsTheLandingsSplashDownAtEitherSupport)
 {
@@ -252,8 +252,8 @@ TEST(HydrostaticTank, AirThatFillsKeepsTheLandingsSplashDownAtEitherSupport)
 // under the landing and up the walls between resamplings. With one phase a step ("step", the
 // default) the fastest particle of this landing (0.77 m/s) reached 2.0-3.5 m/s at 3 h support
 // and 3.6-8.6 m/s at 2.5 h over six sample realisations (settings.seed 1-6); with "time"
-// 1.47-2.01 and 2.21-2.57 m/s (bench/RESULTS.md, "DFSPH: the air resampled as often as
-// [SB12]'s steps"). Bound 3 m/s at both supports: the realisations' largest with 15 % to
+// 1.47-2.01 and 2.21-2.57 m/s (bench/history/diary-2026-11.md, "DFSPH: the air resampled as often
+// as [SB12]'s steps"). Bound 3 m/s at both supports: the realisations' largest with 15 % to
 // spare, below what "step" reaches at 2.5 h in all six.
 TEST(HydrostaticTank, AirResampledAsOftenAsSb12sStepsKeepsTheLandingsSplashDown)
 {

@@ -425,8 +425,8 @@ TEST(Sampler, TiledGrowthIsEvenAcrossTilesAndTheSameAtAnyThreadCount)
     //    least 3r from every face (samples deeper than one support radius; the tiles start at
     //    the level set's bounds less r). Fronts of growth enter a tile from several faces and
     //    meet inside it, which packs a little sparser, as one sequential pass does where its
-    //    fronts meet in the middle of a body (bench/RESULTS.md, "Sampler: Algorithm 1 and
-    //    Bridson's growth in parallel tiles"). Measured over seeds 1, 2, 3, 5: +1.0 to +2.0 %
+    //    fronts meet in the middle of a body (bench/history/diary-2026-11.md, "Sampler: Algorithm 1
+    //    and Bridson's growth in parallel tiles"). Measured over seeds 1, 2, 3, 5: +1.0 to +2.0 %
     //    (one sequential pass: -0.3 to +0.5 %, the noise). Bound: 3 %, which a tiling that grew
     //    samples twice near faces (+3.8 % on a larger box) would not meet.
     const CubicSplineKernel kernel = CubicSplineKernel::fromSpacing(SPACING);

@@ -48,7 +48,7 @@
 ///          Calibration (tests/vdbio/test_surface_accuracy.cc, "[measured]" lines): see
 ///          VolumeOptions::anisotropicIsoValue. Cost (bench/bench_surface.cc, 1e5 particles):
 ///          about 3.5x the sphere method's, two thirds of it the field on the leaves at and
-///          outside the surface, where no sum can stop early (bench/RESULTS.md).
+///          outside the surface, where no sum can stop early (bench/history/diary-2026-11.md).
 #include "FrameGridsDetail.h"
 
 #include <ghostfx/sph/Kernels.h>

@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 
 namespace {
 /// Memory per particle for the budget check (bytes): the most a run measured, neighbour lists
-/// included (bench/RESULTS.md, "memory").
+/// included (bench/history/diary-2026-11.md, "memory").
 constexpr double BYTES_PER_PARTICLE = 350;
 } // namespace
 using sph::Vec3d;
@@ -185,7 +185,8 @@ double physicalMemory()
 /// Refuse a built-in shape whose particles cannot fit in this machine's memory, before its
 /// level set is built (which alone can take hours at a spacing far too fine for the shape).
 /// Particles: the volume, or the surface area times the band depth, over spacing^3; bytes per
-/// particle: 350, the most a run measured with its neighbour lists (bench/RESULTS.md).
+/// particle: 350, the most a run measured with its neighbour lists
+/// (bench/history/diary-2026-11.md).
 void checkParticleBudget(const JsonObject& g, double spacing, double voxel, Sampled sampled,
                          const char* kind)
 {

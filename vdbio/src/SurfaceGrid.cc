@@ -43,7 +43,7 @@
 ///          tools::signedFloodFill fills the rest. Every kept voxel gets the value the full
 ///          union gives it (FrameFiles.SurfaceOfABodyWithABubble* checks the sides against a
 ///          brute-force nearest-particle distance), at a fraction of the work in a deep body of
-///          liquid (bench/RESULTS.md, "Frame output").
+///          liquid (bench/history/diary-2026-11.md, "Frame output").
 ///          The union and the filters use min / Jacobi updates, so the result does not depend on
 ///          the thread count. The recipe is that of Houdini's "VDB from Particles" followed by
 ///          "VDB Reshape SDF" (dilate, smooth, erode) and "VDB Smooth SDF".

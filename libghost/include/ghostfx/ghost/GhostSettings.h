@@ -53,23 +53,23 @@ struct DfsphSettings
     /// (Asai et al. 2012's relaxed density invariance; the velocity divergence is removed in
     /// full). 1 is [BK15]'s solve; at 0.2 the few-percent errors of emitted particles become
     /// velocity kicks (a tap poured 29 % more at CFL 0.4 than at 0.1, its fastest particle at
-    /// 4.1 m/s), and larger shares grow without bound (bench/RESULTS.md, "DFSPH"). 0.1 since
-    /// the mirrored walls: at 0.05 a still tank's settled density error stayed at 0.5-0.7 %
-    /// (a solve that stops at its limit leaves up to limit / beta; bench/RESULTS.md, "DFSPH:
-    /// ghost solids as mirror images").
+    /// 4.1 m/s), and larger shares grow without bound (bench/history/diary-2026-11.md, "DFSPH").
+    /// 0.1 since the mirrored walls: at 0.05 a still tank's settled density error stayed at
+    /// 0.5-0.7 % (a solve that stops at its limit leaves up to limit / beta;
+    /// bench/history/diary-2026-11.md, "DFSPH: ghost solids as mirror images").
     /// This share is per step of the length that CFL number RELAXATION_CFL (the default, 0.4)
     /// gives; a shorter step (a smaller CFL number, a frame's last step) takes a share in
     /// proportion, dt / that step (0.0125 at CFL 0.1), so that the velocity its correction asks
     /// for, about beta (rho - rho0) h / (rho0 dt), does not grow as the steps shrink: at CFL
-    /// 0.1 the whole share ran away (bench/RESULTS.md, "DFSPH at small steps"). Steps held at
-    /// dfsph.max_dt by a calm scene keep the whole share at any CFL number.
+    /// 0.1 the whole share ran away (bench/history/diary-2026-11.md, "DFSPH at small steps"). Steps
+    /// held at dfsph.max_dt by a calm scene keep the whole share at any CFL number.
     Real densityRelaxation = Real(0.1);
     static constexpr Real RELAXATION_CFL = Real(0.4);
     /// Besides its mean error, a solve must bring every particle's error within this many times
     /// its limit (3 % at the default 0.1 %): on the mean alone a few particles in 100k can be
     /// squeezed to 2.7 rho0 without one iteration (a 1 m/s landing then blew up). Measured on
-    /// the 98k dam break (bench/RESULTS.md, "DFSPH: a peak limit"): 10 and 20 also hold the
-    /// landing but cost 45 % and 17 % more per step; 30 costs nothing measurable.
+    /// the 98k dam break (bench/history/diary-2026-11.md, "DFSPH: a peak limit"): 10 and 20 also
+    /// hold the landing but cost 45 % and 17 % more per step; 30 costs nothing measurable.
     static constexpr double PEAK_FACTOR = 30;
     /// How a ghost solid's pressure enters the solves (GhostDfsph.cc, file comment). Chosen by
     /// name in scenes (settings.dfsph.wall_pressure).
@@ -100,9 +100,9 @@ struct DfsphSettings
         /// below (only the divergence solve holds it), and under load it compacts: its
         /// liquid-only density rose from 0.82-0.84 to 0.86-0.91 rho0 in a still tank and to
         /// 0.99 in one accelerating at g / 2, whose pressure offset grew from 1.8 to 3.9 % of
-        /// rho0 g D (bench/RESULTS.md, "DFSPH: ghost air that fills and never compresses",
-        /// and "DFSPH: the air resampled as often as [SB12]'s steps"). The Tait step does not
-        /// take it: there the air's excess balances the surface's pull, and without it a
+        /// rho0 g D (bench/history/diary-2026-11.md, "DFSPH: ghost air that fills and never
+        /// compresses", and "DFSPH: the air resampled as often as [SB12]'s steps"). The Tait step
+        /// does not take it: there the air's excess balances the surface's pull, and without it a
         /// zero-gravity cube shrinks 4 % in 2 s.
         Fill
     };
@@ -119,7 +119,8 @@ struct DfsphSettings
         /// support: 3.6-8.6 against 2.2-2.6). Not the default: about 7 % of a dam-break step
         /// and 10 % of the column tank's run, and the tank accelerating at g / 2 (test_dfsph.cc)
         /// has a pressure slope of -1.7 to +0.5 % over six sample realisations against -0.9 to
-        /// +0.5 % (bench/RESULTS.md, "DFSPH: the air resampled as often as [SB12]'s steps").
+        /// +0.5 % (bench/history/diary-2026-11.md, "DFSPH: the air resampled as often as [SB12]'s
+        /// steps").
         Time
     };
     AirResampling airResampling = AirResampling::Step;
@@ -137,14 +138,14 @@ struct DfsphSettings
     /// pressure phase is 28 % cheaper (193 -> 33 divergence iterations over 216 -> 212 steps).
     /// The cost is a noisier still tank: interior density error 0.32 -> 0.46 %, worst layer
     /// 3.5 -> 5.1 % of rho0 g D, fastest interior particle 0.15 -> 0.19 m/s in float, 0.17 ->
-    /// 0.32 in double (bench/RESULTS.md, "DFSPH: the divergence solve from zero"). A
+    /// 0.32 in double (bench/history/diary-2026-11.md, "DFSPH: the divergence solve from zero"). A
     /// look-development trade, not the default.
     bool divergenceWarmStart = true;
     /// Keep each liquid pair's m_j grad W_ij for the step (12 bytes a pair in float, about
     /// 1 kB a liquid particle at [SB12]'s 3 h support), so the solves' passes read them instead
     /// of gathering positions and evaluating the kernel again: the dam break's pressure phase
-    /// takes a third less time (bench/RESULTS.md, "DFSPH: the pairs' kernel gradients kept for
-    /// the step"). Off: the same solve, recomputed each pass, for scenes memory bounds.
+    /// takes a third less time (bench/history/diary-2026-11.md, "DFSPH: the pairs' kernel gradients
+    /// kept for the step"). Off: the same solve, recomputed each pass, for scenes memory bounds.
     bool keepGradients = true;
     /// The most memory (bytes) one process's kept gradients may take in a step: 4 GiB, about
     /// 360M pairs, 4M liquid particles at [SB12]'s 3 h support. A step whose pairs would need
@@ -166,7 +167,7 @@ enum class AirWeights {
     /// min(1, n0 / sigma_a): an air particle weighs less where the air around it is packed
     /// closer than the liquid ([SB12]'s weight 1 elsewhere), the weights nearest the paper's:
     /// the kept air's mass grows at every resampling and a zero-gravity cube spreads by 4-6 %
-    /// in 2 s (bench/RESULTS.md, "Air that completes the liquid's density").
+    /// in 2 s (bench/history/diary-2026-11.md, "Air that completes the liquid's density").
     Matched,
     /// What the liquid next to the air lacks: the weight that brings the neighbouring liquid
     /// particles' density sums to rest density (least squares over them, within [0, 1]).
@@ -242,8 +243,9 @@ struct GhostSettings
     /// Volume relaxation of sampled liquid bodies, emitters and solids
     /// (PoissonSettings::volumeRelaxation): SPH packing (default since 2026-11-28), about a
     /// third of the sampling time of [SB12]'s Algorithm 2 with half its interior density noise,
-    /// or Algorithm 2 itself (Relaxation::Sb12, the paper's pipeline; bench/RESULTS.md,
-    /// "Sampler: SPH packing" and "Tests that hold over sample realisations").
+    /// or Algorithm 2 itself (Relaxation::Sb12, the paper's pipeline;
+    /// bench/history/diary-2026-11.md, "Sampler: SPH packing" and "Tests that hold over sample
+    /// realisations").
     sph::PoissonSettings::Relaxation samplingRelaxation = sph::PoissonSettings::Relaxation::Packing;
 
     /// Kernel support radius (m).

@@ -305,8 +305,8 @@ private:
     /// this step, as packed (distance, index) keys (GhostInternal.h, nearestKey) that the
     /// density pass lowers. Kept in pages of 2^PAGE_BITS particles, allocated only for the
     /// pages that the step's lists reach: most of a tank's ghosts are out of every liquid
-    /// particle's reach (bench/RESULTS.md, "Bytes per particle over the double dam break's
-    /// run").
+    /// particle's reach (bench/history/diary-2026-11.md, "Bytes per particle over the double dam
+    /// break's run").
     class NearestKeys
     {
     public:
@@ -480,7 +480,8 @@ private:
     /// DFSPH, this step: m_j grad W_ij of each liquid particle i's fluid neighbours j, in its
     /// list's order from mPairStart[i] on, one array a component. The solves' passes read
     /// them instead of gathering positions and evaluating the kernel again (the factor pass
-    /// fills them; bench/RESULTS.md, "DFSPH: the pairs' kernel gradients kept for the step").
+    /// fills them; bench/history/diary-2026-11.md, "DFSPH: the pairs' kernel gradients kept for the
+    /// step").
     std::vector<std::size_t> mPairStart;
     std::vector<Real> mPairGradient[3];
     /// Whether this step's solves read mPairGradient (DfsphSettings::keepGradients and

@@ -249,7 +249,8 @@ inline void NeighborGrid::visitCell(const Cell& c, const Vec3& x, Real radius2, 
     // Two passes per batch of slots: a branch-free filter that appends every slot within the
     // radius to `hit`, then the callbacks, in slot order with the same xij and rij as a plain
     // loop. Inside a cell the particle order is arbitrary in a running simulation, so a branch
-    // on `r2 < radius2` is mispredicted very often (bench/RESULTS.md, "Neighbour search").
+    // on `r2 < radius2` is mispredicted very often (bench/history/diary-2026-11.md, "Neighbour
+    // search").
     constexpr std::uint32_t BATCH = 64;
     std::uint32_t hit[BATCH];
     Real hitR2[BATCH];

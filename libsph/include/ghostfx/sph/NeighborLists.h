@@ -30,8 +30,8 @@
 ///          in a few windows: about 1.3 bytes per neighbour, where 16-bit offsets took 2 and
 ///          32-bit indices 4. A list whose windows span more than 65,536, or that runs would
 ///          make larger (unsorted targets), is kept as 32-bit indices (raw()). The entries are
-///          written and read by loops the compiler vectorises; bench/RESULTS.md ("Neighbour
-///          lists in windows of 256") has the memory and the cost.
+///          written and read by loops the compiler vectorises; bench/history/diary-2026-11.md
+///          ("Neighbour lists in windows of 256") has the memory and the cost.
 #pragma once
 
 #include "ghostfx/sph/NeighborGrid.h"
@@ -266,7 +266,8 @@ private:
     /// its lists at the end of the build), and the ends of its queries' lists. A chunk whose
     /// lists are all empty holds no ends: lists into a solid are empty for most liquid
     /// particles, and one vector of ends for every query (doubled by its growth) held 11.6 of
-    /// the paper-size double dam break's 296 MB (bench/RESULTS.md, "Memory: the lists' ends").
+    /// the paper-size double dam break's 296 MB (bench/history/diary-2026-11.md, "Memory: the
+    /// lists' ends").
     struct Chunk
     {
         std::unique_ptr<std::uint8_t[]> bytes;

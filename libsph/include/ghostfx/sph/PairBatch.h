@@ -3,17 +3,19 @@
 ///         SPH pair sum runs on SIMD lanes.
 /// @details A neighbour loop written pair by pair gathers x_j, computes r with a square root and
 ///          the kernel with a division, one pair at a time, and the three accumulators of a
-///          vector sum form dependency chains: about 25 cycles per pair (bench/RESULTS.md,
-///          "Liquid step"). Here the gathers fill small arrays first (xij components, r), the
-///          arithmetic then runs over the arrays in loops the compiler vectorises, and sums
-///          are taken over `LANES` interleaved partial sums. The order of every addition is
-///          fixed by the list, so results are the same at any thread count.
+///          vector sum form dependency chains: about 25 cycles per pair
+///          (bench/history/diary-2026-11.md, "Liquid step"). Here the gathers fill small arrays
+///          first (xij components, r), the arithmetic then runs over the arrays in loops the
+///          compiler vectorises, and sums are taken over `LANES` interleaved partial sums. The
+///          order of every addition is fixed by the list, so results are the same at any thread
+///          count.
 ///
 ///          In a float build with AVX2 the sums run in one register a component, with the
 ///          neighbours' values gathered into it: GCC vectorised the lane loops with shuffles
 ///          and spilled the lanes to the stack, and the solve passes spent most of their time
 ///          there. Each lane adds the same terms in the same order as the scalar loops, so
-///          both give the same bits (bench/RESULTS.md, "Pair sums in AVX2 registers").
+///          both give the same bits (bench/history/diary-2026-11.md, "Pair sums in AVX2
+///          registers").
 ///
 ///          Use (forEachBatch walks a list batch by batch):
 ///          @code
@@ -251,7 +253,7 @@ struct PairBatch
     /// The components of values[idx[l]], l < count (<= LANES), in three registers (0 in the
     /// lanes from count on): each Vec3 read with an 8-byte and a 4-byte load, then the eight
     /// transposed. Measured cheaper than three vgatherdps a group on this project's machine
-    /// (bench/RESULTS.md, "Pair sums in AVX2 registers").
+    /// (bench/history/diary-2026-11.md, "Pair sums in AVX2 registers").
     static void loadLanes(const Vec3* values, const Index* idx, int count, __m256& vx, __m256& vy,
                           __m256& vz)
     {

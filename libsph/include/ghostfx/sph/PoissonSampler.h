@@ -16,9 +16,9 @@
 ///     locations", reached by moving every sample at once down the gradient of its SPH number
 ///     density, never closer than r to another sample; eight such steps leave about half the
 ///     interior density noise of Algorithm 2's 30 sweeps in about an eighth of their time
-///     (the 107k bench sphere's whole pipeline: 4.9 s -> 1.6 s on 2 threads; bench/RESULTS.md,
-///     "Sampler: SPH packing as the volume relaxation"). Algorithm 2 stays the surface
-///     relaxation and the default volume relaxation.
+///     (the 107k bench sphere's whole pipeline: 4.9 s -> 1.6 s on 2 threads;
+///     bench/history/diary-2026-11.md, "Sampler: SPH packing as the volume relaxation").
+///     Algorithm 2 stays the surface relaxation and the default volume relaxation.
 ///   - Seeded sampling (air layers, emission, [SB12] Sec. 4.5.2 with t = 8): grow samples from
 ///     existing particles inside a region given by a predicate, keeping r from other particles.
 ///   With r = 0.92 h ([SB12] Sec. 4.6) the SPH density of the result is close to the rest
@@ -78,7 +78,7 @@ struct PoissonSettings
     /// relaxed once ([SB12] Algorithms 1 and 2 run only between the surface and that depth):
     /// about twice as fast for large bodies, but the whole interior inherits the one tile's
     /// packing density, which differs from the layer near the surface by up to about 2 %
-    /// (bench/RESULTS.md); off by default. See sampleVolume.
+    /// (bench/history/diary-2026-11.md); off by default. See sampleVolume.
     bool tiledInterior = false;
     /// Refuse (SamplingError) to create more samples than this: a guard against a spacing far
     /// too small for the shape.
@@ -116,7 +116,7 @@ public:
     /// between the surface and that depth, with the tile points held still. The result keeps
     /// the Poisson radius everywhere (the tile is periodic, the layer grows around it) and the
     /// relaxed density spread, at a cost that grows with the surface, not the volume
-    /// (bench/RESULTS.md, "Poisson-disk sampling rate").
+    /// (bench/history/diary-2026-11.md, "Poisson-disk sampling rate").
     /// Throws SamplingError if the level set has no zero crossing.
     SampleSet sampleVolume(const LevelSet& shape) const;
 

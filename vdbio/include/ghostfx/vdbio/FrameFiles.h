@@ -216,7 +216,7 @@ struct VolumeOptions
     /// iso-value puts the surface outside the outer particles (measured: the crossing stays at
     /// the outer layer as the iso-value goes to 0). With 3 the calibrated iso-value is 0.2,
     /// where phi is still steep; with 2.5 it is 0.08, in the spline's tail, where a jittered
-    /// face came out 1.3x rougher. The cost grows as k_s^3 (bench/RESULTS.md).
+    /// face came out 1.3x rougher. The cost grows as k_s^3 (bench/history/diary-2026-11.md).
     double anisotropicScale = 3.0;
     /// k_n: kernel radius / h_k of a particle with too few neighbours (paper: 0.5).
     double anisotropicIsolatedScale = 0.5;
