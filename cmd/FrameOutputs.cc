@@ -64,8 +64,8 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
         if (solid.motion.keys.empty()) {
             layer.translation = solid.velocity * snapshot.time;
         } else {
-            const vdbio::RigidKey key = solid.motion.at(snapshot.time);
-            layer.rotation = vdbio::KeyedMotion::rotation(key.rotateDegrees);
+            const sph::RigidKey key = solid.motion.at(snapshot.time);
+            layer.rotation = sph::KeyedMotion::rotation(key.rotateDegrees);
             layer.translation = key.translate;
         }
         if (media.max().x() >= media.min().x()) {

@@ -99,7 +99,7 @@ std::unique_ptr<gas::GasSolver> makeGasSolver(const vdbio::Scene& scene,
     if (restored) solver->restoreState(*restored);
     for (const vdbio::SceneSolid& solid : scene.solids) {
         if (solid.motion.keys.empty()) solver->addSolid(solid.shape, Vec3(solid.velocity));
-        else solver->addMovingSolid(solid.shape, keyedMotion(solid.motion));
+        else solver->addMovingSolid(solid.shape, solid.motion.motion());
     }
     for (const vdbio::SceneGasSource& src : scene.gasSources) {
         gas::GasSource s;
@@ -108,7 +108,7 @@ std::unique_ptr<gas::GasSolver> makeGasSolver(const vdbio::Scene& scene,
         s.rate = Real(src.rate);
         s.start = src.start;
         s.end = src.end;
-        if (!src.motion.keys.empty()) s.motion = keyedMotion(src.motion);
+        if (!src.motion.keys.empty()) s.motion = src.motion.motion();
         solver->addSource(src.shape, s);
     }
     return solver;

@@ -113,33 +113,10 @@ ghost::RigidMotion motionOf(const vdbio::SceneSolid& solid)
     if (solid.motion.keys.empty()) {
         return sph::constantVelocity(Vec3(solid.velocity));
     }
-    return keyedMotion(solid.motion);
+    return solid.motion.motion();
 }
 
 } // namespace
-
-sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed)
-{
-    return [keyed](double t) {
-        const vdbio::RigidKey k = keyed.at(t);
-        const openvdb::math::Mat3d r = vdbio::KeyedMotion::rotation(k.rotateDegrees);
-        sph::RigidTransform xf;
-        for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) xf.rotation(i, j) = Real(r(i, j));
-        }
-        xf.translation = Vec3(k.translate);
-        // The rates from the keys themselves, not a difference of placements.
-        const vdbio::RigidKey rate = keyed.rate(t);
-        const openvdb::math::Mat3d dr =
-            vdbio::KeyedMotion::rotationRate(k.rotateDegrees, rate.rotateDegrees);
-        for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) xf.rotationRate(i, j) = Real(dr(i, j));
-        }
-        xf.translationRate = Vec3(rate.translate);
-        xf.hasRates = true;
-        return xf;
-    };
-}
 
 namespace {
 

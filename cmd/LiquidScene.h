@@ -43,9 +43,6 @@ std::string defaultSampleCacheFolder();
 /// Whether a folder given for the sample cache means none: "off" or empty.
 bool isSampleCacheOff(const std::string& folder);
 
-/// The solver-side motion of keys read from a scene (rotation R = Rz Ry Rx, then translation).
-sph::RigidMotion keyedMotion(const vdbio::KeyedMotion& keyed);
-
 /// Before simulating towards `frame` (the state at t = frame / fps), give every solid with a
 /// per-frame file sequence that frame's shape.
 void updateSolidSequences(const vdbio::Scene& scene, ghost::GhostSolver& solver, int frame);

@@ -214,7 +214,7 @@ public:
             for (const auto& s : solids) {
                 mMotions.push_back(s.motion.keys.empty()
                                        ? sph::constantVelocity(sph::Vec3(s.velocity))
-                                       : cmd::keyedMotion(s.motion));
+                                       : s.motion.motion());
             }
         }
         const double t0 = mSim->time();

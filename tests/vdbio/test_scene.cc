@@ -374,47 +374,6 @@ TEST_F(SceneTest, SpacingTooFineForOpenVdbOrForMemoryIsRefusedBeforeSampling)
     EXPECT_NO_THROW(vdbio::readScene(write(s)));
 }
 
-TEST(KeyedMotion, InterpolatesAndHolds)
-{
-    vdbio::KeyedMotion m;
-    m.keys = {{0.0, sph::Vec3d(0), sph::Vec3d(0)},
-              {1.0, sph::Vec3d(2, 0, 0), sph::Vec3d(0, 90, 0)}};
-    EXPECT_EQ(m.at(-1).translate, sph::Vec3d(0));
-    EXPECT_EQ(m.at(0.5).translate, sph::Vec3d(1, 0, 0));
-    EXPECT_DOUBLE_EQ(m.at(0.5).rotateDegrees[1], 45.0);
-    EXPECT_EQ(m.at(3).translate, sph::Vec3d(2, 0, 0));
-    // 90 degrees about y takes +x to -z (right-handed), to round-off.
-    const openvdb::math::Mat3d r = vdbio::KeyedMotion::rotation(sph::Vec3d(0, 90, 0));
-    const openvdb::Vec3d x = r * openvdb::Vec3d(1, 0, 0);
-    EXPECT_NEAR(x[0], 0, 1e-12);
-    EXPECT_NEAR(x[2], -1, 1e-12);
-}
-
-TEST(KeyedMotion, RatesAreTheDerivativesOfTheKeys)
-{
-    vdbio::KeyedMotion m;
-    m.keys = {{0.0, sph::Vec3d(0), sph::Vec3d(0)},
-              {2.0, sph::Vec3d(4, 0, -2), sph::Vec3d(30, 90, -60)}};
-    const vdbio::RigidKey rate = m.rate(0.7);
-    EXPECT_EQ(rate.translate, sph::Vec3d(2, 0, -1));
-    EXPECT_EQ(rate.rotateDegrees, sph::Vec3d(15, 45, -30));
-    EXPECT_EQ(m.rate(-1).translate, sph::Vec3d(0));      // held before the first key
-    EXPECT_EQ(m.rate(2.5).rotateDegrees, sph::Vec3d(0)); // and after the last
-    // dR/dt against a central difference of the rotation in double precision (step 1e-6 s:
-    // truncation error ~1e-12 relative; the analytic form must agree to 1e-8).
-    const double t = 0.7, dt = 1e-6;
-    const openvdb::math::Mat3d analytic =
-        vdbio::KeyedMotion::rotationRate(m.at(t).rotateDegrees, rate.rotateDegrees);
-    const openvdb::math::Mat3d numeric =
-        (vdbio::KeyedMotion::rotation(m.at(t + dt).rotateDegrees)
-         - vdbio::KeyedMotion::rotation(m.at(t - dt).rotateDegrees))
-        * (0.5 / dt);
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j)
-            EXPECT_NEAR(analytic(i, j), numeric(i, j), 1e-8) << i << "," << j;
-    }
-}
-
 TEST_F(SceneTest, GasSourceMayBeAFogVolume)
 {
     // A fog sphere of radius 0.1 m (density 1 inside, ramping to 0 across the old band).

@@ -30,80 +30,6 @@ constexpr double BYTES_PER_PARTICLE = 350;
 } // namespace
 using sph::Vec3d;
 
-// Keyed motion ---------------------------------------------------------------------------------
-
-RigidKey KeyedMotion::at(double time) const
-{
-    if (keys.empty()) return RigidKey{};
-    if (time <= keys.front().time) return keys.front();
-    if (time >= keys.back().time) return keys.back();
-    const auto upper = std::upper_bound(keys.begin(), keys.end(), time,
-                                        [](double t, const RigidKey& k) { return t < k.time; });
-    const RigidKey& b = *upper;
-    const RigidKey& a = *(upper - 1);
-    const double s = (time - a.time) / (b.time - a.time);
-    RigidKey k;
-    k.time = time;
-    k.translate = a.translate + (b.translate - a.translate) * s;
-    k.rotateDegrees = a.rotateDegrees + (b.rotateDegrees - a.rotateDegrees) * s;
-    return k;
-}
-
-RigidKey KeyedMotion::rate(double time) const
-{
-    RigidKey r;
-    r.time = time;
-    if (keys.size() < 2 || time < keys.front().time || time >= keys.back().time) return r;
-    const auto upper = std::upper_bound(keys.begin(), keys.end(), time,
-                                        [](double t, const RigidKey& k) { return t < k.time; });
-    const RigidKey& b = *upper;
-    const RigidKey& a = *(upper - 1);
-    const double span = b.time - a.time;
-    r.translate = (b.translate - a.translate) / span;
-    r.rotateDegrees = (b.rotateDegrees - a.rotateDegrees) / span;
-    return r;
-}
-
-namespace {
-
-/// The three factors of R = Rz Ry Rx for angles in degrees, and each one's derivative with
-/// respect to its own angle (radians).
-struct AxisRotations
-{
-    openvdb::math::Mat3d rx, ry, rz, drx, dry, drz;
-
-    explicit AxisRotations(const Vec3d& degrees)
-    {
-        const double d2r = M_PI / 180.0;
-        const double cx = std::cos(degrees[0] * d2r), sx = std::sin(degrees[0] * d2r);
-        const double cy = std::cos(degrees[1] * d2r), sy = std::sin(degrees[1] * d2r);
-        const double cz = std::cos(degrees[2] * d2r), sz = std::sin(degrees[2] * d2r);
-        const double one = 1, zero = 0;
-        rx = openvdb::math::Mat3d(one, zero, zero, zero, cx, -sx, zero, sx, cx);
-        ry = openvdb::math::Mat3d(cy, zero, sy, zero, one, zero, -sy, zero, cy);
-        rz = openvdb::math::Mat3d(cz, -sz, zero, sz, cz, zero, zero, zero, one);
-        drx = openvdb::math::Mat3d(zero, zero, zero, zero, -sx, -cx, zero, cx, -sx);
-        dry = openvdb::math::Mat3d(-sy, zero, cy, zero, zero, zero, -cy, zero, -sy);
-        drz = openvdb::math::Mat3d(-sz, -cz, zero, cz, -sz, zero, zero, zero, zero);
-    }
-};
-
-} // namespace
-
-openvdb::math::Mat3d KeyedMotion::rotationRate(const Vec3d& degrees, const Vec3d& degreesPerSecond)
-{
-    // dR/dt = Rz' Ry Rx wz + Rz Ry' Rx wy + Rz Ry Rx' wx.
-    const AxisRotations a(degrees);
-    const Vec3d w = degreesPerSecond * (M_PI / 180.0);
-    return a.drz * a.ry * a.rx * w[2] + a.rz * a.dry * a.rx * w[1] + a.rz * a.ry * a.drx * w[0];
-}
-
-openvdb::math::Mat3d KeyedMotion::rotation(const Vec3d& degrees)
-{
-    const AxisRotations a(degrees);
-    return a.rz * a.ry * a.rx;
-}
-
 // Level sets -----------------------------------------------------------------------------------
 
 namespace {
@@ -339,11 +265,11 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
 }
 
 /// Keys of a rigid motion: { "keys": [ { "time", "translate", "rotate" }, ... ] }.
-KeyedMotion readMotion(const JsonObject& motion)
+sph::KeyedMotion readMotion(const JsonObject& motion)
 {
-    KeyedMotion m;
+    sph::KeyedMotion m;
     for (const JsonObject& k : motion.objects("keys")) {
-        RigidKey key;
+        sph::RigidKey key;
         key.time = k.require<double>("time");
         key.translate = vec(k.get<std::array<double, 3>>("translate", {0, 0, 0}));
         key.rotateDegrees = vec(k.get<std::array<double, 3>>("rotate", {0, 0, 0}));

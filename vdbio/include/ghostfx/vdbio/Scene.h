@@ -21,6 +21,7 @@
 ///          The full format is in docs/scene-format.md.
 #pragma once
 
+#include <ghostfx/sph/KeyedMotion.h>
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/Types.h>
 #include <ghostfx/vdbio/JsonReader.h>
@@ -43,34 +44,6 @@ constexpr int SCENE_FORMAT_VERSION = 1;
 
 /// Metadata key of a grid's role in a role-tagged .vdb scene ("solid", "liquid", "emitter", "source").
 constexpr const char* ROLE_METADATA = "ghostfx_role";
-
-/// One key of a rigid motion: at `time` (s) the solid's local frame is rotated by
-/// `rotateDegrees` (about x, then y, then z) and moved by `translate` (m).
-struct RigidKey
-{
-    double time = 0;
-    sph::Vec3d translate{0};
-    sph::Vec3d rotateDegrees{0};
-};
-
-/// Piecewise-linear rigid motion through keys: translation and the three angles are
-/// interpolated linearly (exact for a rotation about one axis); held constant before the first
-/// and after the last key.
-struct KeyedMotion
-{
-    std::vector<RigidKey> keys;
-
-    /// The interpolated key at time t (s).
-    RigidKey at(double time) const;
-    /// Its time derivative: translate in m/s, rotateDegrees in degrees/s (zero outside the keys;
-    /// at a key, the rate of the segment that starts there).
-    RigidKey rate(double time) const;
-    /// Rotation for column vectors, world = R * local + translate: R = Rz * Ry * Rx.
-    static openvdb::math::Mat3d rotation(const sph::Vec3d& degrees);
-    /// dR/dt of rotation(degrees) while the angles change at degreesPerSecond.
-    static openvdb::math::Mat3d rotationRate(const sph::Vec3d& degrees,
-                                             const sph::Vec3d& degreesPerSecond);
-};
 
 /// The largest frame number a scene or `--frames` may name: frame files carry the number in
 /// their names and frames count in an int; ten million frames is days of film at any rate.
@@ -100,7 +73,7 @@ struct SceneSolid : SceneShape
     using SceneShape::SceneShape;
 
     sph::Vec3d velocity{0}; ///< constant velocity (m/s), if no keys
-    KeyedMotion motion;     ///< keyed rigid motion (empty: constant velocity)
+    sph::KeyedMotion motion;     ///< keyed rigid motion (empty: constant velocity)
     /// Per-frame shapes (deforming solid): file pattern with $F and grid name; empty if static.
     std::string sequenceFile, sequenceGrid;
 
@@ -136,7 +109,7 @@ struct SceneGasSource : SceneShape
     double temperature = 373.15;
     double rate = 0; ///< particles per second; 0: keep the volume full
     double start = 0, end = std::numeric_limits<double>::infinity();
-    KeyedMotion motion; ///< a moving source (the paper's steam train); empty: static
+    sph::KeyedMotion motion; ///< a moving source (the paper's steam train); empty: static
 };
 
 /// A heater for the liquid-gas phase transition: liquid near it is heated towards `temperature`.
