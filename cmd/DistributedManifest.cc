@@ -2,12 +2,14 @@
 /// @brief  The manifest of a checkpoint written by several processes (DistributedRun.h).
 #include "DistributedRun.h"
 
+#include <ghostfx/vdbio/AtomicFile.h>
+
 #include <ghostfx/sph/Exceptions.h>
 
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 
 namespace ghostfx {
 namespace cmd {
@@ -43,14 +45,14 @@ std::string rankCheckpointPath(const std::string& h5Path, int rank)
 
 DistributedManifest readDistributedManifest(const std::string& path)
 {
-    std::ifstream in(path);
-    if (!in) throw IoError(msg("checkpoint manifest '", path, "': cannot open the file"));
+    const std::optional<std::string> text = vdbio::readTextFile(path);
+    if (!text) throw IoError(msg("checkpoint manifest '", path, "': cannot open the file"));
     auto fail = [&](const std::string& why) {
         return SceneError(msg("checkpoint manifest '", path, "': ", why));
     };
     nlohmann::json doc;
     try {
-        in >> doc;
+        doc = nlohmann::json::parse(*text);
     } catch (const nlohmann::json::exception& e) {
         throw fail(msg("not valid JSON (", e.what(), ")"));
     }

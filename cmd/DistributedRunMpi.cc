@@ -15,7 +15,6 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 namespace ghostfx {
 namespace cmd {
@@ -61,11 +60,7 @@ public:
                 doc["files"].push_back(
                     std::filesystem::path(rankCheckpointPath(h5Path, r)).filename().string());
             doc["decomposition"] = mExchange->decomposition().save();
-            vdbio::writeAtomically(manifest, [&](const std::string& tmp) {
-                std::ofstream out(tmp);
-                out << doc.dump(1) << "\n";
-                if (!out) throw IoError(msg("checkpoint manifest '", manifest, "': write failed"));
-            });
+            vdbio::writeTextFile(manifest, doc.dump(1) + "\n", "checkpoint manifest");
         }
         mExchange->maxOf(0.0); // the manifest exists before anyone goes on
         return manifest;

@@ -33,7 +33,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -440,11 +440,7 @@ void writeRow(const StudySpec& spec, std::size_t k, Json result, const std::stri
 {
     result["case"] = k;
     result["label"] = spec.cases[k].label;
-    vdbio::writeAtomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp);
-        out << result.dump(1);
-        if (!out) throw IoError(msg("study row '", path, "': write failed"));
-    });
+    vdbio::writeTextFile(path, result.dump(1), "study row");
 }
 
 /// Case k's outcome from its row file; status "missing" when there is none (the job has not
@@ -452,8 +448,8 @@ void writeRow(const StudySpec& spec, std::size_t k, Json result, const std::stri
 CaseOutcome readRow(const StudySpec& spec, std::size_t k, const std::string& path)
 {
     CaseOutcome o;
-    std::ifstream in(path);
-    if (!in) {
+    const std::optional<std::string> text = vdbio::readTextFile(path);
+    if (!text) {
         o.status = "missing";
         o.note = msg("no row file ", fs::path(path).filename().string(),
                      ": the case has not run, or its job ended before writing it");
@@ -461,7 +457,7 @@ CaseOutcome readRow(const StudySpec& spec, std::size_t k, const std::string& pat
     }
     Json result;
     try {
-        in >> result;
+        result = Json::parse(*text);
     } catch (const Json::exception& e) {
         throw SceneError(msg("study row '", path, "': not valid JSON (", e.what(), ")"));
     }
@@ -504,17 +500,6 @@ std::string selfExecutable()
                           std::strerror(errno), ")"));
     }
     return "/proc/self/exe";
-}
-
-/// The last non-empty line of a log file (the child's error message).
-std::string lastLine(const std::string& path)
-{
-    std::ifstream in(path);
-    std::string line, last;
-    while (std::getline(in, line)) {
-        if (!line.empty()) last = line;
-    }
-    return last;
 }
 
 /// Run case `index` as a child process (`ghostfx study FILE --case K --out FOLDER`) and read
@@ -576,7 +561,7 @@ CaseOutcome runChild(const StudySpec& spec, std::size_t index, const std::string
         result["error"] =
             timedOut ? msg("stopped after max_seconds_per_run = ", spec.maxSecondsPerRun, " s")
             : WIFSIGNALED(status) ? msg("killed by signal ", WTERMSIG(status))
-                                  : lastLine(log);
+                                  : vdbio::lastLineOf(log);
         result["cost"]["peak_rss_mb"] = double(usage.ru_maxrss) / 1024.0; // Linux: kilobytes
         writeRow(spec, index, result, row);
     }
@@ -664,11 +649,7 @@ void writeTable(const StudySpec& spec, const std::vector<CaseOutcome>& outcomes,
         }
         text += "," + csvField(o.note) + "\n";
     }
-    vdbio::writeAtomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp);
-        out << text;
-        if (!out) throw IoError(msg("study table '", path, "': write failed"));
-    });
+    vdbio::writeTextFile(path, text, "study table");
 }
 
 /// The same table in Markdown, with the columns a reader compares (cost, then every metric),
@@ -724,11 +705,7 @@ void writeMarkdown(const StudySpec& spec, const std::vector<CaseOutcome>& outcom
             text += " " + cell(numberOr(outcomes[k], col)) + " |";
         text += "\n";
     }
-    vdbio::writeAtomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp);
-        out << text;
-        if (!out) throw IoError(msg("study table '", path, "': write failed"));
-    });
+    vdbio::writeTextFile(path, text, "study table");
 }
 
 /// Observed order of convergence between successive values of the convergence key (halving the
@@ -775,11 +752,7 @@ std::string convergenceReport(const StudySpec& spec, const std::vector<CaseOutco
                           number(e2), ", observed order ", number(order), "\n");
         }
     }
-    vdbio::writeAtomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp);
-        out << csv;
-        if (!out) throw IoError(msg("convergence table '", path, "': write failed"));
-    });
+    vdbio::writeTextFile(path, csv, "convergence table");
     return report;
 }
 
@@ -819,9 +792,10 @@ std::vector<PlotPoint> plotPoints(const StudySpec& spec, const std::vector<CaseO
 /// Read a study table back (for --replot): numbers by column, status and note, row by row.
 std::vector<CaseOutcome> readTable(const StudySpec& spec, const std::string& path)
 {
-    std::ifstream in(path);
-    if (!in)
+    const std::optional<std::string> text = vdbio::readTextFile(path);
+    if (!text)
         throw IoError(msg("study table '", path, "': cannot open the file (run the study first)"));
+    std::istringstream in(*text);
     auto split = [](const std::string& line) {
         std::vector<std::string> fields(1);
         bool quoted = false;
@@ -1038,11 +1012,7 @@ int emitSlurm(const StudyOptions& o, const StudySpec& spec)
     const std::string self = selfPath(), name = "ghostfx-" + fs::path(spec.file).stem().string();
     const int cpus = std::max(1, o.threads);
     auto write = [](const std::string& path, const std::string& text) {
-        vdbio::writeAtomically(path, [&](const std::string& tmp) {
-            std::ofstream out(tmp);
-            out << text;
-            if (!out) throw IoError(msg("job script '", path, "': write failed"));
-        });
+        vdbio::writeTextFile(path, text, "job script");
         fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
     };
 

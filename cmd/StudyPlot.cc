@@ -11,7 +11,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <limits>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -86,17 +86,15 @@ void writePlotPoints(const std::string& path, const std::string& xName, const st
 {
     std::vector<char> onFront(points.size(), 0);
     for (std::size_t i : paretoFront(points)) onFront[i] = 1;
-    vdbio::writeAtomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp);
-        out.precision(17);
-        out << "series,label," << csvField(xName) << "," << csvField(yName) << ",pareto\n";
-        for (std::size_t i = 0; i < points.size(); ++i) {
-            const PlotPoint& p = points[i];
-            out << csvField(p.series) << "," << csvField(p.label) << "," << p.x << "," << p.y << ","
-                << int(onFront[i]) << "\n";
-        }
-        if (!out) throw IoError(msg("plot points '", path, "': write failed"));
-    });
+    std::ostringstream out;
+    out.precision(17);
+    out << "series,label," << csvField(xName) << "," << csvField(yName) << ",pareto\n";
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const PlotPoint& p = points[i];
+        out << csvField(p.series) << "," << csvField(p.label) << "," << p.x << "," << p.y << ","
+            << int(onFront[i]) << "\n";
+    }
+    vdbio::writeTextFile(path, out.str(), "plot points");
 }
 
 std::string plotScript()
@@ -149,11 +147,7 @@ std::string drawPlot(const std::string& points, const std::string& image, const 
     while (::waitpid(pid, &status, 0) < 0) {
         if (errno != EINTR) return msg("waiting for the plotting script: ", std::strerror(errno));
     }
-    std::ifstream in(log);
-    std::string line, last;
-    while (std::getline(in, line)) {
-        if (!line.empty()) last = line;
-    }
+    const std::string last = vdbio::lastLineOf(log);
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
         std::error_code ec;
         fs::remove(log, ec);

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <unistd.h>
 
 namespace ghostfx {
@@ -74,6 +75,36 @@ void writeAtomically(const std::string& path, const std::function<void(const std
         fs::remove(tmp, ec);
         throw IoError(msg("'", path, "': cannot replace the file (", reason, ")"));
     }
+}
+
+void writeTextFile(const std::string& path, const std::string& text, const std::string& what)
+{
+    writeAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        out.close();
+        if (!out) {
+            throw IoError(msg(what, " '", path, "': write failed (",
+                              errno != 0 ? std::strerror(errno) : "the stream failed", ")"));
+        }
+    });
+}
+
+std::optional<std::string> readTextFile(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return std::nullopt;
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string lastLineOf(const std::string& path)
+{
+    std::ifstream in(path);
+    std::string line, last;
+    while (std::getline(in, line)) {
+        if (!line.empty()) last = line;
+    }
+    return last;
 }
 
 void ensureWritableDirectory(const std::string& dir)

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace ghostfx {
@@ -15,6 +16,16 @@ namespace vdbio {
 /// whole file there and returns; the temporary is then renamed to `path`. If `write` throws,
 /// the temporary is removed, `path` is untouched and the exception propagates.
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write);
+
+/// Write `text` to `path` atomically. `what` names the file in errors: IoError "<what>
+/// '<path>': write failed (...)".
+void writeTextFile(const std::string& path, const std::string& text, const std::string& what);
+
+/// The whole text of `path`, or nothing when it cannot be opened (a missing file).
+std::optional<std::string> readTextFile(const std::string& path);
+
+/// The last non-empty line of the text file `path` ("" for none, or a file that cannot be read).
+std::string lastLineOf(const std::string& path);
 
 /// Create `dir` (and its parents) if needed and check a file can be created in it; throws
 /// IoError "output folder '<dir>': <reason>" otherwise.
