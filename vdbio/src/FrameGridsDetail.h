@@ -7,6 +7,7 @@
 ///          options, selects particles and calls these.
 #pragma once
 
+#include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/vdbio/FrameFiles.h>
 
@@ -25,6 +26,19 @@ std::vector<sph::Index> selectKinds(const sph::ParticleSet& particles,
 
 /// Comma-separated list of names, for error messages.
 std::string joinNames(const std::vector<std::string>& names);
+
+/// options.validate(), its message prefixed by `where` unless `where` is the output's own name
+/// (`ownName`, which validate() already starts with).
+template <typename Options>
+void validateFor(const Options& options, const std::string& where, const char* ownName)
+{
+    try {
+        options.validate();
+    } catch (const ValueError& e) {
+        if (where == ownName) throw;
+        throw ValueError(msg(where, ": ", e.what()));
+    }
+}
 
 /// Liquid surface level set "surface" of the selected particles (options already validated).
 openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,

@@ -117,12 +117,7 @@ double autoPointsVoxelSize(const std::vector<sph::Vec3>& positions)
 void checkPointsOutput(const sph::ParticleSet& particles, const PointsOptions& options,
                        const std::string& where)
 {
-    try {
-        options.validate();
-    } catch (const ValueError& e) {
-        if (where == "points output") throw; // validate() says so itself
-        throw ValueError(msg(where, ": ", e.what()));
-    }
+    detail::validateFor(options, where, "points output");
     for (const std::string& name : options.channels) {
         bool builtin = false;
         for (const char* b : BUILTIN_CHANNELS) builtin = builtin || name == b;

@@ -268,12 +268,7 @@ void VolumeOptions::validate() const
 void checkVolumeOutput(const sph::ParticleSet& particles, const VolumeOptions& options,
                        const std::string& where)
 {
-    try {
-        options.validate();
-    } catch (const ValueError& e) {
-        if (where == "volume output") throw; // validate() says so itself
-        throw ValueError(msg(where, ": ", e.what()));
-    }
+    detail::validateFor(options, where, "volume output");
     for (const std::string& name : options.scalarChannels) {
         if (name == "pressure" || particles.hasScalarChannel(name)) continue;
         std::vector<std::string> available{"pressure"};
