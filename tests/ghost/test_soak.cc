@@ -90,5 +90,7 @@ TEST(Soak, AnEmitterFeedingAPlateThroughTheKillBoxStaysBoundedAndFlat)
     EXPECT_LE(double(second.all), 1.15 * double(first.all));
     // Flat: the solver's stores and the whole process peak within 5 % of the first span's.
     EXPECT_LE(second.solver, 1.05 * first.solver);
-    if (RESIDENT_MEMORY_MEANS_SOMETHING) EXPECT_LE(second.resident, 1.05 * first.resident);
+    if (RESIDENT_MEMORY_MEANS_SOMETHING) {
+        EXPECT_LE(second.resident, 1.05 * first.resident);
+    }
 }
