@@ -800,21 +800,15 @@ void GhostSolver::restoreState(const SolverState& state)
         throw ValueError("restoreState: call it on a freshly constructed solver, before adding "
                          "solids, emitters or liquid and before the first step");
     }
-    // States from before the pressure setting are Tait states.
-    const auto dfsph = state.integers.find("pressure_dfsph");
-    const PressureModel saved = dfsph != state.integers.end() && dfsph->second != 0
-                                    ? PressureModel::Dfsph
-                                    : PressureModel::Tait;
+    const PressureModel saved =
+        state.integer("pressure_dfsph", 0, 1) != 0 ? PressureModel::Dfsph : PressureModel::Tait;
     if (saved != mSettings.pressure) {
         throw ValueError(msg("restoreState: the state was saved with settings.pressure = '",
                              pressureName(saved), "', this run has '",
                              pressureName(mSettings.pressure),
                              "'; resume with the pressure model the run started with"));
     }
-    // States from before the air_weights setting, and from before "complete" became the
-    // default (2026-11-25), say nothing: they were saved with matched weights.
-    const auto complete = state.integers.find("air_weights_complete");
-    const bool savedComplete = complete != state.integers.end() && complete->second != 0;
+    const bool savedComplete = state.integer("air_weights_complete", 0, 1) != 0;
     if (savedComplete != (mSettings.airWeights == AirWeights::Complete)) {
         const char* saved = savedComplete ? "complete" : "matched";
         throw ValueError(msg("restoreState: the state was saved with settings.air_weights = '",
@@ -826,6 +820,13 @@ void GhostSolver::restoreState(const SolverState& state)
     const double mass = state.real("particle_mass");
     const double lennardJones = state.real("lennard_jones");
     const std::int64_t solids = state.count("solids"), emitters = state.count("emitters");
+    const std::uint64_t airPhase = std::uint64_t(state.count("air_phase"));
+    const double airPhaseCredit = state.real("air_phase_credit");
+    std::vector<std::pair<double, double>> emitterFills; // credit (kg) and fill scale
+    for (std::int64_t e = 0; e < emitters; ++e) {
+        emitterFills.emplace_back(state.real("emitter_credit_" + std::to_string(e)),
+                                  state.real("emitter_fill_scale_" + std::to_string(e)));
+    }
 
     // Every solid particle must name a solid the caller will add again.
     const ParticleSet& p = state.particles;
@@ -868,20 +869,9 @@ void GhostSolver::restoreState(const SolverState& state)
         mParticles.addScalarChannel(DIVERGENCE_KAPPA);
     }
     mRun = run;
-    // States from before DFSPH's steps spanned several air phases took one a step.
-    const auto airPhase = state.integers.find("air_phase");
-    const auto airCredit = state.reals.find("air_phase_credit");
-    mAirPhase = airPhase != state.integers.end() ? std::uint64_t(airPhase->second)
-                                                 : std::max<std::uint64_t>(1, run.step);
-    mAirPhaseCredit = airCredit != state.reals.end() ? airCredit->second : 0.0;
-    // States from before the emitters' mass credit start with none owed, filling at r.
-    mRestoredEmitterFills.assign(std::size_t(emitters), {0.0, 1.0});
-    for (std::size_t e = 0; e < mRestoredEmitterFills.size(); ++e) {
-        const auto credit = state.reals.find("emitter_credit_" + std::to_string(e));
-        const auto scale = state.reals.find("emitter_fill_scale_" + std::to_string(e));
-        if (credit != state.reals.end()) mRestoredEmitterFills[e].first = credit->second;
-        if (scale != state.reals.end()) mRestoredEmitterFills[e].second = scale->second;
-    }
+    mAirPhase = airPhase;
+    mAirPhaseCredit = airPhaseCredit;
+    mRestoredEmitterFills = emitterFills;
     mMass = Real(mass);
     mLennardJones = Real(lennardJones);
     mRestoredSolids = std::size_t(solids);

@@ -208,12 +208,26 @@ TEST(Checkpoint, RefusesOtherSchemaAndPrecision)
     EXPECT_EQ(readRefusal<IoError>("schema", path, SETTINGS),
               "checkpoint '" + path + "': schema version 3, this ghostfx reads 1 to 2");
 
-    // Schema 1 is schema 2 with one state and no state count: read as that.
-    writeCheckpoint(path, awkwardState(), SETTINGS, 1);
+    // Schema 1 is schema 2 with one state and no state count: read as that, a liquid state
+    // given the keys its solver added since at the values such states were saved with.
+    SolverState old = awkwardState();
+    old.integers["emitters"] = 2;
+    old.integers.erase("air_phase");
+    writeCheckpoint(path, old, SETTINGS, 1);
     vdbio::detail::patchCheckpointAttribute(path, "schema_version", std::int64_t(1));
     vdbio::detail::patchCheckpointAttribute(path, "state_count", std::int64_t(7));
     EXPECT_EQ(readCheckpointHeader(path).stateCount, 1);
-    EXPECT_EQ(firstDifference(awkwardState(), readCheckpoint(path, SETTINGS)), "");
+    const SolverState migrated = readCheckpoint(path, SETTINGS);
+    SolverState expected = old;
+    expected.integers["pressure_dfsph"] = 0;
+    expected.integers["air_weights_complete"] = 0;
+    expected.integers["air_phase"] = std::max<std::int64_t>(1, old.integers.at("step"));
+    expected.reals["air_phase_credit"] = 0;
+    for (const char* e : {"0", "1"}) {
+        expected.reals[std::string("emitter_credit_") + e] = 0;
+        expected.reals[std::string("emitter_fill_scale_") + e] = 1;
+    }
+    EXPECT_EQ(firstDifference(expected, migrated), "");
 
     // Written by a build of the other precision (float vs double).
     writeCheckpoint(path, awkwardState(), SETTINGS, 1);

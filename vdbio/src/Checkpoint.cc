@@ -495,6 +495,26 @@ ParticleSet readParticles(const Reader& r, const H5::Group& group, const std::st
     return p;
 }
 
+/// A schema-1 state of the liquid solver ("ghost" or "basic") with the keys its solver added
+/// since, at the values those states were saved with: Tait pressure, matched air weights, one
+/// air resampling phase a step, emitters owing nothing and filling at the Poisson radius.
+void migrateSchema1(SolverState& state)
+{
+    if (state.solver != "ghost" && state.solver != "basic") return;
+    auto integer = [&](const char* key, std::int64_t value) { state.integers.emplace(key, value); };
+    auto real = [&](const std::string& key, double value) { state.reals.emplace(key, value); };
+    integer("pressure_dfsph", 0);
+    integer("air_weights_complete", 0);
+    const auto step = state.integers.find("step");
+    integer("air_phase", std::max<std::int64_t>(1, step == state.integers.end() ? 0 : step->second));
+    real("air_phase_credit", 0.0);
+    const auto emitters = state.integers.find("emitters");
+    for (std::int64_t e = 0; emitters != state.integers.end() && e < emitters->second; ++e) {
+        real("emitter_credit_" + std::to_string(e), 0.0);
+        real("emitter_fill_scale_" + std::to_string(e), 1.0);
+    }
+}
+
 /// One solver state from `group` (the root, or "/state_k": `prefix`).
 SolverState readStateGroup(const Reader& r, const H5::Group& group, const std::string& prefix)
 {
@@ -563,6 +583,7 @@ std::vector<SolverState> readCheckpointStates(const std::string& path,
         }
         std::vector<SolverState> states;
         states.push_back(readStateGroup(r, r.file, ""));
+        if (header.schemaVersion == 1) migrateSchema1(states.front());
         for (int k = 1; k < header.stateCount; ++k) {
             const std::string name = stateGroupName(std::size_t(k));
             if (!r.file.nameExists(name)) r.fail(msg("missing group '/", name, "'"));

@@ -220,9 +220,12 @@ public:
     ///  - reals: "time" (s), "particle_mass" (kg), "lennard_jones" (m^2/s^2), "max_acceleration"
     ///    (m/s^2, used by the CFL limit), "mean_neighbors" (diagnostic), "emitter_credit_E"
     ///    (kg each emitter E still owes), "emitter_fill_scale_E" (its fills' radius, in Poisson
-    ///    radii);
+    ///    radii), "air_phase_credit" (air resampling phases owed, a fraction);
     ///  - integers: "step", "frame", "initialized" (0/1), "emitted", "killed", "solids" and
-    ///    "emitters" (how many the caller must add again after restoreState).
+    ///    "emitters" (how many the caller must add again after restoreState), "air_phase" (the
+    ///    next resampling phase), "pressure_dfsph" and "air_weights_complete" (0/1: the
+    ///    settings the state is valid for).
+    /// vdbio migrates checkpoints of older schemas to these keys (Checkpoint.h).
     /// Per-step scratch (neighbour grid, nearest-liquid table) is rebuilt by every step and
     /// timings are not simulation state, so neither is saved.
     sph::SolverState saveState() const;

@@ -25,7 +25,10 @@
 ///              particles get);
 ///            - `reals` and `integers`: groups whose attributes are the state's scalar maps
 ///              (double and int64).
-///          Schema 1 is schema 2 with one state and no `state_count`: it is read as that.
+///          Schema 1 is schema 2 with one state and no `state_count`: it is read as that, and a
+///          liquid solver's state gets the keys that solver added since at the values its
+///          schema-1 states were saved with (migrateSchema1 in Checkpoint.cc), so the solver
+///          reads one set of keys.
 #pragma once
 
 #include <ghostfx/sph/SolverState.h>
