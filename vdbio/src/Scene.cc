@@ -316,112 +316,100 @@ std::string outputFile(const JsonObject& s, const char* key, const std::string& 
                          names, ext.empty() ? "" : msg(", not ", ext)));
 }
 
+/// One section of `outputs`: an object that `read` reads, false or null to switch the output
+/// off (its `file` cleared), true for its defaults.
+template <typename Read>
+void readSection(const JsonObject& o, const char* key, std::string& file, Read&& read)
+{
+    const Json* v = o.raw(key);
+    if (!v) return;
+    if (v->is_null() || (v->is_boolean() && !v->get<bool>())) {
+        file.clear();
+        return;
+    }
+    if (v->is_boolean()) return; // true: defaults
+    const JsonObject s = o.object(key);
+    read(s);
+    s.finish();
+}
+
+/// outputs.preview's camera, image and background.
+void readPreview(const JsonObject& s, SceneOutputs& out)
+{
+    out.previewFile =
+        outputFile(s, "file", "preview.$F4.exr", {".exr", ".png"}, "an EXR or PNG image");
+    out.previewGrid = s.get<std::string>("grid", out.previewGrid);
+    out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
+    out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
+    out.previewSolids = s.get<bool>("solids", out.previewSolids);
+    out.previewAzimuth = s.inRange("azimuth", out.previewAzimuth, -360, 360);
+    out.previewElevation = s.inRange("elevation", out.previewElevation, -90, 90);
+    if (const Json* bg = s.raw("background")) {
+        if (bg->is_string() && bg->get<std::string>() == "transparent") {
+            out.previewBackground.reset();
+        } else {
+            const auto c = s.get<std::array<double, 3>>("background", {0, 0, 0});
+            for (double v : c) {
+                if (!(v >= 0 && v <= 1))
+                    s.failValue("background",
+                                "expected [r, g, b] in 0 to 1 (linear), or \"transparent\"");
+            }
+            out.previewBackground = c;
+        }
+    }
+    if (auto box = s.optionalObject("frame")) {
+        const Vec3d lo = vec(box->require<std::array<double, 3>>("min"));
+        const Vec3d hi = vec(box->require<std::array<double, 3>>("max"));
+        box->finish();
+        if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2]))
+            s.failValue("frame", "expected max > min on every axis");
+        out.previewFrame = sph::Aabb{sph::Vec3(lo), sph::Vec3(hi)};
+    }
+}
+
+/// outputs.volume: its file, grids, surface method and voxel sizes.
+void readVolume(const JsonObject& s, SceneOutputs& out)
+{
+    out.volumeFile = outputFile(s, "file", out.volumeFile, {".vdb"}, "OpenVDB grids");
+    out.volumeGrids = readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
+    const std::string method = s.choice(
+        "surface_method", sph::nameOf(SURFACE_METHOD_NAMES, out.surfaceMethod), surfaceMethodNames());
+    out.surfaceMethod = sph::valueOf(SURFACE_METHOD_NAMES, method, "surface method");
+    out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
+    out.densityVoxelSize = s.nonNegative("density_voxel_size", out.densityVoxelSize);
+}
+
 void readOutputs(const JsonObject& o, SceneOutputs& out)
 {
     const std::vector<std::string> vdb{".vdb"}, h5{".h5", ".hdf5"};
     out.directory = o.get<std::string>("directory", out.directory);
-    // Each section: an object, or false / null to switch that output off.
-    auto section = [&](const char* key, auto&& read, auto&& off) {
-        const Json* v = o.raw(key);
-        if (!v) return;
-        if (v->is_null() || (v->is_boolean() && !v->get<bool>())) {
-            off();
-            return;
-        }
-        if (v->is_boolean()) return; // true: defaults
-        const JsonObject s = o.object(key);
-        read(s);
-        s.finish();
-    };
-    section(
-        "points",
-        [&](const JsonObject& s) {
+    readSection(o, "points", out.pointsFile, [&](const JsonObject& s) {
         out.pointsFile = outputFile(s, "file", out.pointsFile, vdb, "OpenVDB points");
         out.pointChannels = s.get<std::vector<std::string>>("channels", out.pointChannels);
         out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
-        },
-        [&] { out.pointsFile.clear(); });
-    section(
-        "volume",
-        [&](const JsonObject& s) {
-        out.volumeFile = outputFile(s, "file", out.volumeFile, vdb, "OpenVDB grids");
-        out.volumeGrids =
-            readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
-        const std::string method =
-            s.choice("surface_method", sph::nameOf(SURFACE_METHOD_NAMES, out.surfaceMethod),
-                     surfaceMethodNames());
-        out.surfaceMethod = sph::valueOf(SURFACE_METHOD_NAMES, method, "surface method");
-        out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
-        out.densityVoxelSize = s.nonNegative("density_voxel_size", out.densityVoxelSize);
-        },
-        [&] { out.volumeFile.clear(); });
-    section(
-        "gas_points",
-        [&](const JsonObject& s) {
+    });
+    readSection(o, "volume", out.volumeFile, [&](const JsonObject& s) { readVolume(s, out); });
+    readSection(o, "gas_points", out.gasPointsFile, [&](const JsonObject& s) {
         out.gasPointsFile = outputFile(s, "file", out.gasPointsFile, vdb, "OpenVDB points");
         out.gasPointChannels = s.get<std::vector<std::string>>("channels", out.gasPointChannels);
-        },
-        [&] { out.gasPointsFile.clear(); });
-    section(
-        "gas_volume",
-        [&](const JsonObject& s) {
+    });
+    readSection(o, "gas_volume", out.gasVolumeFile, [&](const JsonObject& s) {
         out.gasVolumeFile = outputFile(s, "file", out.gasVolumeFile, vdb, "OpenVDB grids");
-        out.gasVolumeGrids =
-            readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature"});
+        out.gasVolumeGrids = readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature"});
         out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
-        },
-        [&] { out.gasVolumeFile.clear(); });
+    });
     out.previewFile.clear();
-    section(
-        "preview",
-        [&](const JsonObject& s) {
-        out.previewFile =
-            outputFile(s, "file", "preview.$F4.exr", {".exr", ".png"}, "an EXR or PNG image");
-        out.previewGrid = s.get<std::string>("grid", out.previewGrid);
-        out.previewWidth = int(s.inRange("width", out.previewWidth, 16, 8192));
-        out.previewHeight = int(s.inRange("height", out.previewHeight, 16, 8192));
-        out.previewSolids = s.get<bool>("solids", out.previewSolids);
-        out.previewAzimuth = s.inRange("azimuth", out.previewAzimuth, -360, 360);
-        out.previewElevation = s.inRange("elevation", out.previewElevation, -90, 90);
-        if (const Json* bg = s.raw("background")) {
-            if (bg->is_string() && bg->get<std::string>() == "transparent") {
-                out.previewBackground.reset();
-            } else {
-                const auto c = s.get<std::array<double, 3>>("background", {0, 0, 0});
-                for (double v : c) {
-                    if (!(v >= 0 && v <= 1))
-                        s.failValue("background",
-                                    "expected [r, g, b] in 0 to 1 (linear), or \"transparent\"");
-                }
-                out.previewBackground = c;
-            }
-        }
-        if (auto box = s.optionalObject("frame")) {
-            const Vec3d lo = vec(box->require<std::array<double, 3>>("min"));
-            const Vec3d hi = vec(box->require<std::array<double, 3>>("max"));
-            box->finish();
-            if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2]))
-                s.failValue("frame", "expected max > min on every axis");
-            out.previewFrame = sph::Aabb{sph::Vec3(lo), sph::Vec3(hi)};
-        }
-        },
-        [&] { out.previewFile.clear(); });
+    readSection(o, "preview", out.previewFile, [&](const JsonObject& s) { readPreview(s, out); });
     if (!out.previewFile.empty() && out.volumeFile.empty() && out.gasVolumeFile.empty()) {
         o.fail("preview", "a preview renders a grid of the volume output, which is off");
     }
-    section(
-        "checkpoint",
-        [&](const JsonObject& s) {
+    readSection(o, "checkpoint", out.checkpointFile, [&](const JsonObject& s) {
         out.checkpointFile = outputFile(s, "file", out.checkpointFile, h5, "HDF5");
         out.checkpointEvery = int(s.inRange("every", out.checkpointEvery, 0, 1e6));
-        },
-        [&] { out.checkpointFile.clear(); });
-    section(
-        "stats",
-        [&](const JsonObject& s) {
+    });
+    readSection(o, "stats", out.statsFile, [&](const JsonObject& s) {
         out.statsFile = outputFile(s, "file", out.statsFile, h5, "HDF5 (and CSV beside it)");
-        },
-        [&] { out.statsFile.clear(); });
+    });
     o.finish();
 }
 
@@ -478,7 +466,7 @@ Json documentFromRoles(const std::string& path)
 /// A shaped scene entry (solid, liquid, emitter, gas source, heater): its name (default: its
 /// path) and its geometry, sampled as `sampled` says.
 template <typename Entry>
-Entry readShaped(const JsonObject& o, Scene& scene, Sampled sampled, bool allowFog = false)
+Entry readShaped(const JsonObject& o, const Scene& scene, Sampled sampled, bool allowFog = false)
 {
     const std::string name = o.get<std::string>("name", o.path());
     std::string geometry;
@@ -505,15 +493,13 @@ std::string Scene::simulationFingerprint() const
     return copy.dump();
 }
 
-Scene readScene(const std::string& path, const std::vector<std::string>& overrides)
+namespace {
+
+/// The scene's document: a .json file, or the role-tagged grids of a .vdb; then the -D
+/// overrides.
+Json sceneDocument(const std::string& path, const std::vector<std::string>& overrides)
 {
-    Json doc;
-    const std::string ext = extensionOf(path);
-    if (ext == ".vdb") {
-        doc = documentFromRoles(path);
-    } else {
-        doc = readJsonFile(path, "scene");
-    }
+    Json doc = extensionOf(path) == ".vdb" ? documentFromRoles(path) : readJsonFile(path, "scene");
     for (const std::string& o : overrides) {
         try {
             applyOverride(doc, o);
@@ -521,21 +507,17 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
             throw SceneError(msg("scene '", path, "': ", e.what()));
         }
     }
+    return doc;
+}
 
-    Scene scene;
-    scene.file = path;
-    scene.folder = fs::path(path).parent_path().string();
-    auto shared = std::make_shared<const Json>(std::move(doc));
-    scene.document = shared;
-    const JsonObject root(shared, shared.get(), "", path);
-
+/// The settings every solver shares; the solver-specific rest is read by the caller.
+void readSharedSettings(const JsonObject& root, Scene& scene)
+{
     scene.version = root.require<int>("ghostfx_scene");
     if (scene.version != SCENE_FORMAT_VERSION) {
         root.failValue("ghostfx_scene",
                        msg("this ghostfx reads scene format ", SCENE_FORMAT_VERSION));
     }
-
-    // Shared settings; the solver-specific rest is read by the caller.
     scene.settings = root.object("settings");
     const JsonObject& s = scene.settings;
     scene.method = s.get<std::string>("method", "ghost");
@@ -555,39 +537,83 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     }
     scene.firstFrame = int(range[0]);
     scene.lastFrame = int(range[1]);
+}
 
-    if (auto domain = root.optionalObject("domain")) {
-        if (auto kill = domain->optionalObject("kill_box")) {
-            const Vec3d lo = vec(kill->require<std::array<double, 3>>("min"));
-            const Vec3d hi = vec(kill->require<std::array<double, 3>>("max"));
-            kill->finish();
-            if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2])) {
-                domain->failValue("kill_box", "expected max > min on every axis");
-            }
-            scene.killBox = sph::Aabb{sph::Vec3(lo), sph::Vec3(hi)};
+void readDomain(const JsonObject& root, Scene& scene)
+{
+    auto domain = root.optionalObject("domain");
+    if (!domain) return;
+    if (auto kill = domain->optionalObject("kill_box")) {
+        const Vec3d lo = vec(kill->require<std::array<double, 3>>("min"));
+        const Vec3d hi = vec(kill->require<std::array<double, 3>>("max"));
+        kill->finish();
+        if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2])) {
+            domain->failValue("kill_box", "expected max > min on every axis");
         }
-        domain->finish();
+        scene.killBox = sph::Aabb{sph::Vec3(lo), sph::Vec3(hi)};
     }
+    domain->finish();
+}
 
-    for (const JsonObject& o : root.objects("solids")) {
-        SceneSolid solid = readShaped<SceneSolid>(o, scene, Sampled::Band);
-        solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
-        if (auto motion = o.optionalObject("motion")) {
-            solid.motion = readMotion(*motion);
-            if (solid.velocity != Vec3d(0))
-                o.fail("velocity", "give either 'velocity' or 'motion', not both");
-        }
-        if (auto seq = o.optionalObject("sequence")) {
-            solid.sequenceFile = resolve(scene.folder, seq->require<std::string>("file"));
-            solid.sequenceGrid = seq->require<std::string>("grid");
-            seq->finish();
-            if (!hasFrameToken(solid.sequenceFile)) {
-                seq->failValue("file", "expected a frame pattern with $F (e.g. paddle.$F4.vdb)");
-            }
-        }
-        o.finish();
-        scene.solids.push_back(std::move(solid));
+SceneSolid readSolid(const JsonObject& o, const Scene& scene)
+{
+    SceneSolid solid = readShaped<SceneSolid>(o, scene, Sampled::Band);
+    solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
+    if (auto motion = o.optionalObject("motion")) {
+        solid.motion = readMotion(*motion);
+        if (solid.velocity != Vec3d(0))
+            o.fail("velocity", "give either 'velocity' or 'motion', not both");
     }
+    if (auto seq = o.optionalObject("sequence")) {
+        solid.sequenceFile = resolve(scene.folder, seq->require<std::string>("file"));
+        solid.sequenceGrid = seq->require<std::string>("grid");
+        seq->finish();
+        if (!hasFrameToken(solid.sequenceFile)) {
+            seq->failValue("file", "expected a frame pattern with $F (e.g. paddle.$F4.vdb)");
+        }
+    }
+    o.finish();
+    return solid;
+}
+
+SceneGasSource readGasSource(const JsonObject& o, const Scene& scene)
+{
+    SceneGasSource source = readShaped<SceneGasSource>(o, scene, Sampled::Volume, /*allowFog=*/true);
+    source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
+    source.temperature = o.positive("temperature", source.temperature);
+    source.rate = o.nonNegative("rate", 0);
+    readInterval(o, source.start, source.end);
+    if (auto motion = o.optionalObject("motion")) source.motion = readMotion(*motion);
+    o.finish();
+    return source;
+}
+
+SceneForceField readForceField(const JsonObject& o)
+{
+    SceneForceField field;
+    field.name = o.get<std::string>("name", o.path());
+    if (!o.has("attractor")) {
+        o.finish(); // a misspelt kind is reported as an unknown key with the closest one
+        o.fail("attractor", "missing; expected a field kind: 'attractor' { \"position\": [x, y, z], "
+                            "\"strength\": S, \"radius\": R }");
+    }
+    const JsonObject a = o.object("attractor");
+    SceneAttractor& at = field.attractor;
+    at.position = vec(a.require<std::array<double, 3>>("position"));
+    const double strength = a.require<double>("strength");
+    if (!std::isfinite(strength))
+        a.failValue("strength", "expected a finite number (m/s^2; < 0 repels)");
+    at.strength = strength;
+    at.radius = a.positive("radius", at.radius);
+    at.falloff = a.choice("falloff", at.falloff, {"inverse_square", "constant"});
+    a.finish();
+    o.finish();
+    return field;
+}
+
+/// Liquid bodies and emitters: a shape and a few values each.
+void readLiquidEntries(const JsonObject& root, Scene& scene)
+{
     for (const JsonObject& o : root.objects("liquids")) {
         SceneLiquid liquid = readShaped<SceneLiquid>(o, scene, Sampled::Volume);
         liquid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
@@ -601,45 +627,36 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
         o.finish();
         scene.emitters.push_back(std::move(emitter));
     }
-    for (const JsonObject& o : root.objects("gas_sources")) {
-        SceneGasSource source =
-            readShaped<SceneGasSource>(o, scene, Sampled::Volume, /*allowFog=*/true);
-        source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
-        source.temperature = o.positive("temperature", source.temperature);
-        source.rate = o.nonNegative("rate", 0);
-        readInterval(o, source.start, source.end);
-        if (auto motion = o.optionalObject("motion")) source.motion = readMotion(*motion);
-        o.finish();
-        scene.gasSources.push_back(std::move(source));
-    }
-    for (const JsonObject& o : root.objects("heaters")) {
-        SceneHeater heater = readShaped<SceneHeater>(o, scene, Sampled::None);
-        heater.temperature = o.positive("temperature", heater.temperature);
-        o.finish();
-        scene.heaters.push_back(std::move(heater));
-    }
-    for (const JsonObject& o : root.objects("force_fields")) {
-        SceneForceField field;
-        field.name = o.get<std::string>("name", o.path());
-        if (!o.has("attractor")) {
-            o.finish(); // a misspelt kind is reported as an unknown key with the closest one
-            o.fail("attractor",
-                   "missing; expected a field kind: 'attractor' { \"position\": [x, y, z], "
-                   "\"strength\": S, \"radius\": R }");
-        }
-        const JsonObject a = o.object("attractor");
-        SceneAttractor& at = field.attractor;
-        at.position = vec(a.require<std::array<double, 3>>("position"));
-        const double strength = a.require<double>("strength");
-        if (!std::isfinite(strength))
-            a.failValue("strength", "expected a finite number (m/s^2; < 0 repels)");
-        at.strength = strength;
-        at.radius = a.positive("radius", at.radius);
-        at.falloff = a.choice("falloff", at.falloff, {"inverse_square", "constant"});
-        a.finish();
-        o.finish();
-        scene.forceFields.push_back(std::move(field));
-    }
+}
+
+SceneHeater readHeater(const JsonObject& o, const Scene& scene)
+{
+    SceneHeater heater = readShaped<SceneHeater>(o, scene, Sampled::None);
+    heater.temperature = o.positive("temperature", heater.temperature);
+    o.finish();
+    return heater;
+}
+
+} // namespace
+
+Scene readScene(const std::string& path, const std::vector<std::string>& overrides)
+{
+    Scene scene;
+    scene.file = path;
+    scene.folder = fs::path(path).parent_path().string();
+    auto shared = std::make_shared<const Json>(sceneDocument(path, overrides));
+    scene.document = shared;
+    const JsonObject root(shared, shared.get(), "", path);
+
+    readSharedSettings(root, scene);
+    readDomain(root, scene);
+    for (const JsonObject& o : root.objects("solids")) scene.solids.push_back(readSolid(o, scene));
+    readLiquidEntries(root, scene);
+    for (const JsonObject& o : root.objects("gas_sources"))
+        scene.gasSources.push_back(readGasSource(o, scene));
+    for (const JsonObject& o : root.objects("heaters")) scene.heaters.push_back(readHeater(o, scene));
+    for (const JsonObject& o : root.objects("force_fields"))
+        scene.forceFields.push_back(readForceField(o));
     if (auto phase = root.optionalObject("phase_transition")) {
         if (scene.heaters.empty())
             root.fail("phase_transition",
