@@ -794,7 +794,9 @@ void GhostSolver::step(Real dt, bool reportPressure)
 
 bool GhostSolver::liquidIsGone() const
 {
-    const double here = double(mParticles.count(ParticleKind::Liquid));
+    const auto& kinds = mParticles.kinds();
+    const double here =
+        std::find(kinds.begin(), kinds.end(), ParticleKind::Liquid) != kinds.end() ? 1.0 : 0.0;
     // Over several processes all of them decide together (each takes part in every exchange).
     return (mExchange ? mExchange->maxOf(here) : here) == 0.0;
 }

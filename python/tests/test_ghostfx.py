@@ -100,21 +100,32 @@ def test_sample_a_level_set_from_a_vdb(tmp_path):
         ghostfx.sample(str(vdb), "nope", spacing)
 
 
-def test_resume_from_a_checkpoint_matches_an_uninterrupted_run_bit_for_bit(tmp_path):
-    scene = ghostfx.load_scene(DAM, {"settings.frame_range": [1, 3]})
+def resumed_and_straight(scene, stop, checkpoint):
+    """The scene run to its last frame straight, and the same run checkpointed after frame
+    `stop` (to `checkpoint`) and resumed from it."""
     straight = ghostfx.Simulation(scene)
     straight.run()
     first = ghostfx.Simulation(scene)
-    first.run(frames=1)
-    checkpoint = str(tmp_path / "dam.0001.h5")
+    first.run(frames=stop)
     first.save_checkpoint(checkpoint)
     resumed = ghostfx.Simulation.resume(scene, checkpoint)
-    assert resumed.frame == 1
+    assert resumed.frame == stop
     resumed.run()
-    assert resumed.frame == straight.frame == 3
-    for kind in ("liquid", "air"):
-        assert np.array_equal(resumed.positions(kind), straight.positions(kind))
-        assert np.array_equal(resumed.velocities(kind), straight.velocities(kind))
+    assert resumed.frame == straight.frame == scene.frame_range[1]
+    return resumed, straight
+
+
+def assert_same_particles(a, b, kinds):
+    for kind in kinds:
+        assert np.array_equal(a.positions(kind), b.positions(kind)), kind
+        assert np.array_equal(a.velocities(kind), b.velocities(kind)), kind
+
+
+def test_resume_from_a_checkpoint_matches_an_uninterrupted_run_bit_for_bit(tmp_path):
+    scene = ghostfx.load_scene(DAM, {"settings.frame_range": [1, 3]})
+    checkpoint = str(tmp_path / "dam.0001.h5")
+    resumed, straight = resumed_and_straight(scene, 1, checkpoint)
+    assert_same_particles(resumed, straight, ("liquid", "air"))
     # A checkpoint of other settings is refused, naming the key and both values.
     stiffer = ghostfx.load_scene(DAM, {"settings.frame_range": [1, 3], "settings.stiffness": 3000})
     with pytest.raises(ValueError, match="stiffness"):
@@ -203,19 +214,9 @@ def test_a_boiling_scene_checkpoints_and_resumes_bit_for_bit(tmp_path):
     # resumed pan equals the uninterrupted one particle for particle.
     scene = ghostfx.load_scene(os.path.join(SOURCE, "examples", "boiling_pan", "scene.json"),
                                {"settings.spacing": 0.03, "settings.frame_range": [1, 4]})
-    straight = ghostfx.Simulation(scene)
-    straight.run()
-    first = ghostfx.Simulation(scene)
-    first.run(frames=2)
-    checkpoint = str(tmp_path / "pan.0002.h5")
-    first.save_checkpoint(checkpoint)
-    resumed = ghostfx.Simulation.resume(scene, checkpoint)
-    resumed.run()
-    assert resumed.frame == straight.frame == 4
+    resumed, straight = resumed_and_straight(scene, 2, str(tmp_path / "pan.0002.h5"))
     assert len(straight.positions("gas")) > 0
-    for kind in ("liquid", "gas"):
-        assert np.array_equal(resumed.positions(kind), straight.positions(kind))
-        assert np.array_equal(resumed.velocities(kind), straight.velocities(kind))
+    assert_same_particles(resumed, straight, ("liquid", "gas"))
     assert np.array_equal(resumed.channel("liquid", "temperature"),
                           straight.channel("liquid", "temperature"))
 
