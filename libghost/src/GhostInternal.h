@@ -51,7 +51,7 @@ using sph::Index;
 using sph::Real;
 
 /// Names of the solver's particle channels (stored in checkpoints: do not rename).
-constexpr const char* VSTAR = "vstar";             ///< v* = v + dt a, Algorithm 3 line 14
+constexpr const char* VSTAR = LiquidStep::VELOCITY_STAR; ///< v* = v + dt a, Algorithm 3 line 14
 constexpr const char* SOLID_NORMAL = "normal";     ///< solid particle: outward normal, world frame
 constexpr const char* SOLID_INDEX = "solid_index"; ///< solid particle: which solid (index)
 constexpr const char* SOLID_VELOCITY = "solid_v";  ///< moving solid particle: velocity (m/s)
@@ -131,6 +131,16 @@ inline Real taitPressure(Real rho, Real rho0, Real k)
     const Real q = rho / rho0;
     const Real q2 = q * q;
     return k * (q2 * q2 * q2 * q - Real(1));
+}
+
+/// Every particle's pressure from its density by taitPressure.
+inline void setTaitPressure(sph::ParticleSet& set, const GhostSettings& settings)
+{
+    const auto& rho = set.densities();
+    auto& p = set.pressures();
+    const Real rho0 = settings.restDensity, k = settings.stiffness;
+    parallel::forEach(
+        0, set.size(), [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, k); }, 2048);
 }
 
 /// Nearest-liquid key of a solid particle: the distance in the high 32 bits (as float bits,

@@ -23,12 +23,13 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-GhostSolver::GhostSolver(const GhostSettings& settings)
+GhostSolver::GhostSolver(const GhostSettings& settings, std::unique_ptr<PressureSolver> pressure)
     : mSettings(settings)
     , mKernel((settings.validate(), settings.supportRadius()))
     , mGrid(settings.supportRadius())
     , mStatic(settings.supportRadius())
     , mMoving(settings.supportRadius())
+    , mPressure(pressure ? std::move(pressure) : makePressureSolver(settings))
 {
     // Model only what the scene needs: v* is used by every step of both methods, the ghost air
     // channels only by Ghost SPH (Basic SPH has no air). Solid channels live on the solid
@@ -38,13 +39,17 @@ GhostSolver::GhostSolver(const GhostSettings& settings)
         mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
-    if (mSettings.pressure == PressureModel::Dfsph) {
-        mParticles.addScalarChannel(DENSITY_KAPPA);
-        mParticles.addScalarChannel(DIVERGENCE_KAPPA);
-    }
+    for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
 }
 
 GhostSolver::~GhostSolver() = default;
+
+const PressureSolveStats& GhostSolver::pressureSolveStats() const
+{
+    static const PressureSolveStats none;
+    const PressureSolveStats* stats = mPressure->solveStats();
+    return stats ? *stats : none;
+}
 
 void GhostSolver::setParticleMass(Real mass)
 {
@@ -745,12 +750,7 @@ GhostSolver::MemoryUse GhostSolver::memoryUse() const
     use.lists = mFluidLists.memoryBytes();
     use.solidParticles = mPendingSolids.memoryBytes();
     use.stepArrays =
-        mQueryMask.capacity()
-        + (mScratch.capacity() + mAlpha.capacity() + mLiquidMass.capacity()) * sizeof(Real)
-        + (mSolidGradient.capacity() + mWallHydrostatic.capacity() + mMovingWallGravity.capacity())
-              * sizeof(Vec3)
-        + mPairStart.capacity() * sizeof(std::size_t);
-    for (const auto& c : mPairGradient) use.stepArrays += c.capacity() * sizeof(Real);
+        mQueryMask.capacity() + mScratch.capacity() * sizeof(Real) + mPressure->memoryBytes();
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
         use.solidParticles += b->block.particles().memoryBytes();
         use.solidGrids += b->block.grid().memoryBytes();
@@ -864,10 +864,7 @@ void GhostSolver::restoreState(const SolverState& state)
         mParticles.addScalarChannel(AIR_WEIGHT, Real(1));
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
-    if (mSettings.pressure == PressureModel::Dfsph) {
-        mParticles.addScalarChannel(DENSITY_KAPPA);
-        mParticles.addScalarChannel(DIVERGENCE_KAPPA);
-    }
+    for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
     mRun = run;
     mAirPhase = airPhase;
     mAirPhaseCredit = airPhaseCredit;
@@ -909,18 +906,7 @@ Real GhostSolver::stableTimeStep() const
     // Every process takes the same step: the fastest liquid of them all (between steps a
     // process holds no halo copies).
     if (mExchange) vmax = Real(mExchange->maxOf(double(vmax)));
-    const Real h = mSettings.spacing;
-    if (mSettings.pressure == PressureModel::Dfsph) {
-        // The implicit pressure has no sound speed to resolve: dt <= cfl h / |v|max
-        // ([BK15] Sec. 4.4), gravity's force limit, and [minTimeStep, maxTimeStep].
-        return detail::dfsphTimeStep(mSettings, vmax, mSettings.cflNumber);
-    }
-    Real dt = mSettings.cflNumber * h / (mSettings.soundSpeed() + vmax);
-    // Force limit (Monaghan 1992): dt <= cfl sqrt(h / |a|max), with the largest acceleration
-    // of the last step (gravity before the first), which covers stiff Lennard-Jones walls.
-    const Real a = std::max(mRun.maxAcceleration, mSettings.gravity.length());
-    if (a > Real(0)) dt = std::min(dt, mSettings.cflNumber * std::sqrt(h / a));
-    return dt;
+    return mPressure->stableTimeStep(mSettings, vmax, mRun.maxAcceleration);
 }
 
 void GhostSolver::advanceFrame()

@@ -11,6 +11,7 @@
 ///          particles no liquid reaches are never visited.
 #include "ghostfx/ghost/GhostSolver.h"
 
+#include "DfsphPressure.h"
 #include "GhostInternal.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -141,7 +142,7 @@ std::size_t GhostSolver::NearestKeys::memoryBytes() const
     return mPage.capacity() * sizeof(std::uint32_t) + mKeys.capacity() * sizeof(std::uint64_t);
 }
 
-void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
+void GhostSolver::computeDensity(const DensityPass& densityPass)
 {
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
@@ -149,20 +150,20 @@ void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
     const auto& kind = mParticles.kinds();
     auto& rho = mParticles.densities();
     const Real rho0 = mSettings.restDensity;
-    const bool ghost = mSettings.method == Method::Ghost;
-    // DFSPH's air fills a liquid particle's density up to rho0 and no further (AirDensity).
-    const bool fill = ghost && mSettings.pressure == PressureModel::Dfsph
-                      && mSettings.dfsph.airDensity == DfsphSettings::AirDensity::Fill;
+    const bool ghost = densityPass.solids;
+    // The model's air fills a liquid particle's density up to rho0 and no further.
+    const bool fill = ghost && mPressure->airFillsToRestDensity();
     SolidBlock* blocks[2] = {&mStatic, &mMoving};
 
-    // DFSPH's factors (GhostDfsph.cc, step 1) read the same pairs at the same positions: they
-    // are found in this pass, so the pairs are gathered and their distances taken once.
-    if (dfsphFactors) prepareDfsphFactors();
-    const DfsphSettings& opt = mSettings.dfsph;
-    const bool keep = dfsphFactors && mGradientsKept;
-    const bool mirror = opt.wallPressure == DfsphSettings::WallPressure::Mirror;
-    const int minNeighbours = minimumNeighbours(mSettings.supportFactor);
-    const Real wall = wallShare(opt);
+    // DFSPH's factors (DfsphPressure.cc, step 1) read the same pairs at the same positions:
+    // they are found in this pass, so the pairs are gathered and their distances taken once.
+    DfsphFactors* const f = densityPass.factors;
+    const bool dfsphFactors = f != nullptr;
+    const bool keep = dfsphFactors && f->gradientsKept;
+    const bool mirror = dfsphFactors && f->mirror;
+    const int minNeighbours = dfsphFactors ? f->minNeighbours : 0;
+    const Real wall = dfsphFactors ? f->wall : Real(1);
+    std::vector<Vec3>* const gradMass = dfsphFactors ? f->gradMass : nullptr;
     const Vec3 g = mSettings.gravity;
     const Real M = mMass;
 
@@ -187,9 +188,9 @@ void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
                 // Where this particle's m_j grad W_ij go (DfsphSettings::keepGradients).
                 Real *gx = nullptr, *gy = nullptr, *gz = nullptr;
                 if (factors && keep) {
-                    gx = mPairGradient[0].data() + mPairStart[i];
-                    gy = mPairGradient[1].data() + mPairStart[i];
-                    gz = mPairGradient[2].data() + mPairStart[i];
+                    gx = f->pairGradient[0].data() + f->pairStart[i];
+                    gy = f->pairGradient[1].data() + f->pairStart[i];
+                    gz = f->pairGradient[2].data() + f->pairStart[i];
                 }
                 auto keepGradients = [&](PairBatch& b) {
                     for (int k = 0; k < b.n; ++k) {
@@ -218,7 +219,7 @@ void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
                     if (factors && keep) {
                         batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
                             for (int k = 0; k < b.n; ++k)
-                                b.f[k] = mLiquidMass[b.j[k]] * kernel.gradFactor(b.r[k]);
+                                b.f[k] = f->liquidMass[b.j[k]] * kernel.gradFactor(b.r[k]);
                             keepGradients(b);
                         });
                     }
@@ -235,11 +236,11 @@ void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
                 batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
                     if constexpr (factors) {
                         for (int k = 0; k < b.n; ++k) b.g[k] = kernel.gradFactor(b.r[k]);
-                        for (int k = 0; k < b.n; ++k) b.f[k] = mLiquidMass[b.j[k]] * b.g[k];
+                        for (int k = 0; k < b.n; ++k) b.f[k] = f->liquidMass[b.j[k]] * b.g[k];
                         if (keep) keepGradients(b);
                         liquid += b.sumScaledOffsets(b.f);
                         for (int k = 0; k < b.n; ++k) {
-                            liquidNeighbours += mLiquidMass[b.j[k]] > Real(0);
+                            liquidNeighbours += f->liquidMass[b.j[k]] > Real(0);
                             b.f[k] = sqr(b.f[k] * b.r[k]);
                         }
                         squares += b.sum(b.f);
@@ -276,7 +277,7 @@ void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
                                 // dz) = x_i - x_s.
                                 if (moving) {
                                     for (int c = 0; c < b.n; ++c) {
-                                        const Vec3& e = mMovingWallGravity[b.j[c]];
+                                        const Vec3& e = f->movingWallGravity[b.j[c]];
                                         b.f[c] *=
                                             -(e[0] * b.dx[c] + e[1] * b.dy[c] + e[2] * b.dz[c])
                                             / rho0;
@@ -308,17 +309,17 @@ void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
                 rho[i] = sum;
                 neighbours[i] = std::uint32_t(count);
                 if constexpr (factors) {
-                    if (mirror) mWallHydrostatic[i] = hydrostatic;
+                    if (mirror) f->wallHydrostatic[i] = hydrostatic;
                     if (gradMass) (*gradMass)[i] = all + solid;
                     solid *= wall; // the wall's share c
                     const int solidNeighbours = int(count - fluid.size());
                     // The particle's own pressure term moves it by its liquid and solid
                     // gradient sums and each liquid neighbour by its own term.
                     const Real a = (liquid + solid).lengthSqr() + squares;
-                    mAlpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= minNeighbours
+                    f->alpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= minNeighbours
                                     ? Real(1) / a
                                     : Real(0);
-                    mSolidGradient[i] = solid;
+                    f->solidGradient[i] = solid;
                 }
             }
             if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
@@ -340,15 +341,11 @@ void GhostSolver::computeDensity(bool dfsphFactors, std::vector<Vec3>* gradMass)
     mRun.meanNeighbors = pairs / std::max(1.0, liquidCount);
     mPairCount = std::size_t(pairs);
 
-    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0). The DFSPH
-    // step finds its pressure by its solves (and reports it on a frame's last step only).
-    const bool stateEquation = mSettings.pressure == PressureModel::Tait;
+    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0), for a model
+    // that has one; an implicit model finds its pressure by its solves.
+    LiquidStep view(*this);
+    const bool stateEquation = mPressure->pressureFromDensity(view);
     auto& p = mParticles.pressures();
-    if (stateEquation) {
-        parallel::forEach(
-            0, n, [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, mSettings.stiffness); },
-            2048);
-    }
     if (mExchange) {
         const auto t = std::chrono::steady_clock::now();
         if (stateEquation) mExchange->refresh(mParticles, {"density", "pressure"});
@@ -482,28 +479,18 @@ void GhostSolver::extrapolateSolidVelocity()
     }
 }
 
-void GhostSolver::searchAndDensity(Real dt, bool dfsphFactors, std::vector<Vec3>* gradMass)
+void GhostSolver::searchAndDensity(const DensityPass& pass)
 {
     // Line 1: resample the air every airResampleSteps steps (the first step always has air),
-    // then move every fading air particle's weight one step towards its target; a DFSPH step
-    // does as much of both as [SB12]'s steps it spans (GhostSettings::airResampleSpan), its
+    // then move every fading air particle's weight one step towards its target; a step that
+    // spans more than [SB12]'s step does as much of both as it spans (pass.airSpan), its
     // fraction of a phase carried to the next step.
     // Fading runs first: it removes the air that has faded out, before the sort. New air is
     // sampled after the search (reusing it) with weight 0, so it has no part in this step's sums.
+    // Basic SPH has no air to fade or resample.
     prepareSolidBlocks();
-    Real span = 1;
-    if (mSettings.pressure == PressureModel::Dfsph
-        && mSettings.dfsph.airResampling == DfsphSettings::AirResampling::Time) {
-        const auto& v = mParticles.velocities();
-        const auto& kind = mParticles.kinds();
-        const Real* halo = haloFlags();
-        const double vmax = parallel::maximum(0, mParticles.size(), [&](std::size_t i) {
-            const bool owned = !halo || halo[i] == Real(0);
-            return kind[i] == ParticleKind::Liquid && owned ? double(v[i].length()) : 0.0;
-        });
-        span = mSettings.airResampleSpan(dt, Real(mExchange ? mExchange->maxOf(vmax) : vmax));
-    }
-    fadeAir(span);
+    const bool air = mSettings.method == Method::Ghost;
+    if (air) fadeAir(pass.airSpan);
     if (mExchange) {
         const auto t = std::chrono::steady_clock::now();
         mExchange->exchange(mParticles, mSettings.supportRadius());
@@ -514,10 +501,10 @@ void GhostSolver::searchAndDensity(Real dt, bool dfsphFactors, std::vector<Vec3>
     searchNeighbors();
     const double search = secondsSince(t0);
     mTimings.sortAndSearch += search;
-    if (mRun.step > 0) { // (the first step has fresh air)
+    if (air && mRun.step > 0) { // (the first step has fresh air)
         // With a span of 1 a step (the Tait step, DFSPH's default) step s resamples phase s.
         const auto N = std::uint64_t(mSettings.airResampleSteps);
-        mAirPhaseCredit += double(span);
+        mAirPhaseCredit += double(pass.airSpan);
         const double phases = std::floor(mAirPhaseCredit);
         mAirPhaseCredit -= phases;
         if (phases > 0) {
@@ -526,93 +513,18 @@ void GhostSolver::searchAndDensity(Real dt, bool dfsphFactors, std::vector<Vec3>
         }
     }
     t0 = std::chrono::steady_clock::now();
-    if (dfsphFactors) computeMovingWallGravity(dt);
-    computeDensity(dfsphFactors, gradMass);
+    if (pass.beforeDensity) pass.beforeDensity();
+    computeDensity(pass);
     mTimings.neighborsAndDensity += search + secondsSince(t0);
 }
 
-void GhostSolver::stepGhost(Real dt)
+void GhostSolver::pressureToSolids()
 {
-    searchAndDensity(dt);
-
-    const std::size_t n = mParticles.size();
-    const auto& x = mParticles.positions();
-    const auto& m = mParticles.masses();
-    const auto& rho = mParticles.densities();
-    const auto& p = mParticles.pressures();
-    const auto& kind = mParticles.kinds();
-    auto& v = mParticles.velocities();
-    auto& vstar = mParticles.vectorChannel(VSTAR);
-    const Vec3 g = mSettings.gravity;
-    const Real M = mMass;
-
-    // Lines 11-14: liquid acceleration from gravity and Monaghan's symmetric pressure gradient
-    // over every neighbour, v* = v + dt a.
-    const auto t0 = std::chrono::steady_clock::now();
-    resizeStepArray(mScratch, n);
-    parallel::forEach(
-        0, n, [&](std::size_t i) { mScratch[i] = p[i] / sqr(rho[i]); }, 2048);
-    std::vector<Real> accel(n, Real(0));
-    // Particle shifting needs grad C = sum_j (m_j / rho0) grad W_ij over the same pairs.
-    const bool shifting = mSettings.shifting() > Real(0);
-    std::vector<Vec3> gradMass(shifting ? n : 0, Vec3(0));
-    const Real* halo = haloFlags();
-    forRangeWithBatch(
-        n, mKernel,
-        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
-        for (std::size_t i = lo; i < hi; ++i) {
-            if (kind[i] != ParticleKind::Liquid || (halo && halo[i] != Real(0))) {
-                vstar[i] = v[i]; // a halo copy's comes from its owner (refresh)
-                continue;
-            }
-            const Vec3 xi = x[i];
-            const Real pi = mScratch[i];
-            // The particle itself is in its list: r = 0 gives grad W = 0.
-            Vec3 a = g;
-            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * (pi + mScratch[b.j[k]]);
-                for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
-                a += b.sumScaledOffsets(b.f);
-                if (shifting) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * kernel.gradFactor(b.r[k]);
-                    gradMass[i] += b.sumScaledOffsets(b.f);
-                }
-            });
-            for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                // p / rho^2 of a ghost solid from its nearest liquid particle's values (lines
-                // 5-7), computed here: solid pairs are a few percent of all, and an array of
-                // it for every solid particle cost 4 bytes each (bench/history/diary-2026-11.md,
-                // "Memory: the lists' ends").
-                const ParticleSet& solids = block->block.particles();
-                const Real* pS = solids.pressures().data();
-                const Real* rhoS = solids.densities().data();
-                batch.forEachBatch(xi, solids.positions().data(), block->lists[i],
-                                   [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k)
-                        b.f[k] = M * (pi + pS[b.j[k]] / sqr(rhoS[b.j[k]]));
-                    for (int k = 0; k < b.n; ++k) b.f[k] *= -kernel.gradFactor(b.r[k]);
-                    a += b.sumScaledOffsets(b.f);
-                    if (shifting) {
-                        for (int k = 0; k < b.n; ++k) b.f[k] = M * kernel.gradFactor(b.r[k]);
-                        gradMass[i] += b.sumScaledOffsets(b.f);
-                    }
-                });
-            }
-            vstar[i] = v[i] + dt * a;
-            accel[i] = a.length();
-        }
-        },
-        512);
-    // A process whose slab has no particles left still takes part in the exchange below.
-    mRun.maxAcceleration = n ? *std::max_element(accel.begin(), accel.end()) : Real(0);
-    mTimings.pressureForce += secondsSince(t0);
-    if (mExchange) {
-        const auto t = std::chrono::steady_clock::now();
-        mRun.maxAcceleration = Real(mExchange->maxOf(double(mRun.maxAcceleration)));
-        mExchange->refresh(mParticles, {VSTAR});
-        mTimings.exchange += secondsSince(t);
+    const Real* p = mParticles.pressures().data();
+    for (SolidBlock* b : {&mStatic, &mMoving}) {
+        Real* pSolid = b->block.particles().pressures().data();
+        forEachReachedSolid(*b, [&](Index s, Index j) { pSolid[s] = p[j]; });
     }
-    finishGhostStep(dt, gradMass);
 }
 
 void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
@@ -774,9 +686,8 @@ void GhostSolver::step(Real dt, bool reportPressure)
         stepWithoutLiquid(dt, start, true);
         return;
     }
-    if (mSettings.method == Method::Basic) stepBasic(dt);
-    else if (mSettings.pressure == PressureModel::Dfsph) stepDfsph(dt);
-    else stepGhost(dt);
+    LiquidStep parts(*this);
+    mPressure->step(parts, dt);
 
     const double t1 = mRun.time + double(dt);
     accrueEmission(mRun.time, t1);

@@ -36,6 +36,8 @@
 #pragma once
 
 #include <ghostfx/ghost/GhostSettings.h>
+#include <ghostfx/ghost/LiquidStep.h>
+#include <ghostfx/ghost/PressureSolver.h>
 #include <ghostfx/sph/BoundaryBlock.h>
 #include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/LevelSet.h>
@@ -83,31 +85,6 @@ struct PhaseTimings
     std::uint64_t steps = 0;
 };
 
-/// Work of the implicit pressure solves (settings.pressure = dfsph), accumulated since the last
-/// resetTimings(), with the last step's figures.
-struct PressureSolveStats
-{
-    std::uint64_t steps = 0;                ///< steps solved
-    std::uint64_t densityIterations = 0;    ///< constant-density iterations, all steps
-    std::uint64_t divergenceIterations = 0; ///< divergence iterations, all steps
-    std::uint64_t unconverged = 0;          ///< solves that stopped short of either limit
-                                            ///< (DfsphSettings::maxIterations)
-    /// Steps that recomputed their kernel gradients because keeping them would have taken
-    /// more than DfsphSettings::keptGradientLimit, and the bytes the last step's would have
-    /// taken (DfsphSettings::keepGradients on; 0 when off).
-    std::uint64_t recomputedSteps = 0;
-    double lastGradientBytes = 0;
-    int lastDensityIterations = 0, lastDivergenceIterations = 0;
-    double lastDensityError = 0; ///< mean |rho* / rho0 - 1| the last density solve reached
-    double lastDivergenceError =
-        0; ///< mean |D rho / Dt| dt / rho0 the last divergence solve reached
-    /// The largest error of one particle a density (divergence) solve left, over the steps:
-    /// a solve stops when its mean error is within the limit and no particle's exceeds
-    /// DfsphSettings::PEAK_FACTOR times the limit.
-    double largestDensityError = 0, largestDivergenceError = 0;
-    double lastLargestDensityError = 0, lastLargestDivergenceError = 0; ///< the last step's
-};
-
 class GhostSolver
 {
 public:
@@ -116,11 +93,16 @@ public:
     /// complete step, so the state stays consistent).
     using StepObserver = std::function<void(const GhostSolver&, Real dt)>;
 
-    explicit GhostSolver(const GhostSettings& settings);
+    /// A solver with the pressure model `pressure`, or (null) the one the settings name
+    /// (makePressureSolver).
+    explicit GhostSolver(const GhostSettings& settings,
+                         std::unique_ptr<PressureSolver> pressure = nullptr);
     ~GhostSolver();
 
     const GhostSettings& settings() const { return mSettings; }
     const sph::CubicSplineKernel& kernel() const { return mKernel; }
+    /// The pressure model that runs each step (PressureSolver.h).
+    const PressureSolver& pressureSolver() const { return *mPressure; }
 
     /// Add a static solid, or one moving rigidly with constant `velocity` (m/s). Its ghost
     /// (or boundary) particles are sampled at once, one kernel radius deep; after
@@ -173,7 +155,8 @@ public:
     /// With settings.pressure = dfsph the pressure channel is set by the frame's last step
     /// only (a step observer sees the last frame's pressure before it).
     void advanceFrame();
-    /// One step of Algorithm 3 (Ghost) or of Basic SPH, of length dt (s).
+    /// One step of length dt (s): the pressure model's (Algorithm 3 for Ghost SPH, or Basic
+    /// SPH's), then collisions, the kill box and the blow-up check.
     void step(Real dt) { step(dt, true); }
     /// The same; with reportPressure false a DFSPH step leaves the pressure channel as it was
     /// (only output reads it, and its pass costs about 3 % of the step): for drivers
@@ -285,10 +268,11 @@ public:
     void resetTimings()
     {
         mTimings = PhaseTimings();
-        mSolveStats = PressureSolveStats();
+        mPressure->resetStats();
     }
-    /// The implicit pressure solves' iterations and errors (settings.pressure = dfsph).
-    const PressureSolveStats& pressureSolveStats() const { return mSolveStats; }
+    /// The implicit pressure solves' iterations and errors (settings.pressure = dfsph; zeros
+    /// for a model without solves).
+    const PressureSolveStats& pressureSolveStats() const;
     /// Mean number of neighbours per liquid particle in the last density pass (self included).
     double meanNeighbors() const { return mRun.meanNeighbors; }
     /// Liquid-neighbour pairs in the last neighbour search, solid neighbours included.
@@ -302,6 +286,7 @@ public:
     std::uint64_t restoredFromSolidsCount() const { return mRestoredFromSolids; }
 
 private:
+    friend class LiquidStep;
     struct Solid;
     struct Emitter;
     /// The nearest liquid particle of each particle of a solid block that some liquid reaches
@@ -391,46 +376,20 @@ private:
     /// (span: GhostSettings::airResampleSpan).
     void fadeAir(Real span);
     void searchNeighbors();
-    /// Eq. 1's density of every liquid particle (ghost solids: their nearest liquid's), and
-    /// with dfsphFactors DFSPH's factors in the same pass (prepareDfsphFactors, GhostDfsph.cc)
-    /// and, with gradMass, the sum of m_j grad W_ij over every neighbour (particle shifting).
-    void computeDensity(bool dfsphFactors = false, std::vector<Vec3>* gradMass = nullptr);
+    /// Eq. 1's density of every liquid particle (ghost solids: their nearest liquid's), with
+    /// what `pass` asks for in the same pass over the pairs (DFSPH's factors), then the
+    /// pressure model's equation of state, if it has one.
+    void computeDensity(const DensityPass& pass = DensityPass());
     /// Move the liquid towards rest density before the first step (GhostSettings::
     /// initialRelaxation), recording the density error before and after.
     void relaxInitialLiquid();
     void extrapolateSolidVelocity();
-    /// Algorithm 3 lines 1-7 for a step of dt: air fading, the search, air resampling and
-    /// the density (with DFSPH's factors: computeDensity).
-    void searchAndDensity(Real dt, bool dfsphFactors = false,
-                          std::vector<Vec3>* gradMass = nullptr);
-    void stepGhost(Real dt);
-    /// Algorithm 3 lines 15-28 after the pressure: ghost solid velocity, XSPH, air velocity,
-    /// positions and (with gradMass) particle shifting. Reads VSTAR.
+    /// Algorithm 3 lines 1-7 (LiquidStep::searchAndDensity).
+    void searchAndDensity(const DensityPass& pass);
+    /// Algorithm 3 lines 15-28 after the pressure (LiquidStep::finish). Reads VSTAR.
     void finishGhostStep(Real dt, const std::vector<Vec3>& gradMass);
-    /// The Ghost method with the DFSPH pressure solves (GhostDfsph.cc).
-    void stepDfsph(Real dt);
-    /// DFSPH with mirrored walls: the known hydrostatic part of the ghost solids' pressure force
-    /// (mWallHydrostatic, from the factor pass) on v* (GhostDfsph.cc).
-    void applyWallHydrostatics(Real dt);
-    /// DFSPH with mirrored walls: mMovingWallGravity for the step from now to now + dt.
-    void computeMovingWallGravity(Real dt);
-    /// The arrays of DFSPH's factor pass, sized for this step: the factor 1 / (|sum_j m_j grad
-    /// W_ij|^2 + sum_liquid j |m_j grad W_ij|^2) (liquid and solid neighbours) of each liquid
-    /// particle in mAlpha, its solid sum, the kept pair gradients and the walls' hydrostatic
-    /// part. computeDensity(true) fills them.
-    void prepareDfsphFactors();
-    /// One DFSPH solve on the VSTAR velocities (preconditioned conjugate gradients): the
-    /// density solve (density = true) drives rho + dt D rho / Dt to rho0, the divergence solve
-    /// D rho / Dt to 0. `total` is the
-    /// per-particle channel of accumulated pressure terms (warm start in, result out).
-    /// Returns the iterations; sets `error` to the mean error reached and `largest` to the
-    /// largest error of one particle it left.
-    int solvePressure(Real dt, bool density, std::vector<Real>& total, double& error,
-                      double& largest);
-    /// The pressure channel after a DFSPH step: the Shepard average of the solves' terms, for
-    /// the liquid and (nearest liquid) the ghost solids.
-    void reportDfsphPressure();
-    void stepBasic(Real dt);
+    /// Each solid particle liquid reaches takes its nearest liquid particle's pressure.
+    void pressureToSolids();
     void moveSolids(double time);
     void projectOutOfSolids(Real dt);
     void checkBlowUp() const;
@@ -467,29 +426,9 @@ private:
     std::uint64_t mAirPhase = 1;
     double mAirPhaseCredit = 0;
     PhaseTimings mTimings;
-    PressureSolveStats mSolveStats;
-    /// DFSPH: whether this step sets the pressure channel (step()'s reportPressure).
+    /// Whether this step sets the pressure channel (step()'s reportPressure).
     bool mReportPressure = true;
-    /// DFSPH: each liquid particle's inverse diagonal (0: spray, not solved), and each
-    /// particle's mass if liquid, else 0.
-    std::vector<Real> mAlpha, mLiquidMass;
-    std::vector<Vec3> mSolidGradient; ///< DFSPH: sum_solid M grad W_is of each liquid particle
-    /// DFSPH with mirrored walls: sum_solid M (k_s - k_i) grad W_is, the walls' known
-    /// hydrostatic push on each liquid particle (GhostDfsph.cc)
-    std::vector<Vec3> mWallHydrostatic;
-    /// DFSPH with mirrored walls, this step: g - a_s of each moving solid particle, a_s its
-    /// acceleration over the step (the gravity its mirrored pressure is extrapolated with).
-    std::vector<Vec3> mMovingWallGravity;
-    /// DFSPH, this step: m_j grad W_ij of each liquid particle i's fluid neighbours j, in its
-    /// list's order from mPairStart[i] on, one array a component. The solves' passes read
-    /// them instead of gathering positions and evaluating the kernel again (the factor pass
-    /// fills them; bench/history/diary-2026-11.md, "DFSPH: the pairs' kernel gradients kept for the
-    /// step").
-    std::vector<std::size_t> mPairStart;
-    std::vector<Real> mPairGradient[3];
-    /// Whether this step's solves read mPairGradient (DfsphSettings::keepGradients and
-    /// keptGradientLimit) or recompute the gradients.
-    bool mGradientsKept = false;
+    std::unique_ptr<PressureSolver> mPressure;
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;

@@ -1,11 +1,11 @@
-/// @file   BasicSph.cc
+/// @file   BasicPressure.cc
 /// @brief  The "Basic SPH" baseline of [SB12] Sec. 3, the method Ghost SPH is compared with:
 ///         density summed over liquid only, Tait pressure, Becker and Teschner 2007 artificial
 ///         viscosity (alpha = 0.0005), Lennard-Jones repulsion from solid particles (Monaghan
 ///         1994) and XSPH on the position update (Monaghan 1989, epsilon = 0.5).
-/// @details Uses the step's neighbour lists like Ghost SPH (GhostStep.cc): the boundary
+/// @details Uses the step's neighbour lists like Ghost SPH (LiquidStep): the boundary
 ///          particles act only through the Lennard-Jones force, from the solid blocks' lists.
-#include "ghostfx/ghost/GhostSolver.h"
+#include "BasicPressure.h"
 
 #include "GhostInternal.h"
 
@@ -19,35 +19,37 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-void GhostSolver::stepBasic(Real dt)
+bool BasicPressure::pressureFromDensity(LiquidStep& step)
 {
-    prepareSolidBlocks();
-    auto t0 = std::chrono::steady_clock::now();
-    searchNeighbors();
-    mTimings.sortAndSearch += secondsSince(t0);
-    computeDensity();
-    mTimings.neighborsAndDensity += secondsSince(t0);
+    setTaitPressure(step.particles(), step.settings());
+    return true;
+}
 
-    t0 = std::chrono::steady_clock::now();
-    const std::size_t n = mParticles.size();
-    const auto& x = mParticles.positions();
-    const auto& m = mParticles.masses();
-    const auto& rho = mParticles.densities();
-    const auto& p = mParticles.pressures();
-    const auto& kind = mParticles.kinds();
-    auto& v = mParticles.velocities();
-    auto& vnew = mParticles.vectorChannel(VSTAR);
-    const Vec3 g = mSettings.gravity;
-    const Real c = mSettings.soundSpeed();
+void BasicPressure::accelerate(LiquidStep& step, Real dt)
+{
+    ParticleSet& set = step.particles();
+    const std::size_t n = set.size();
+    const auto& x = set.positions();
+    const auto& m = set.masses();
+    const auto& rho = set.densities();
+    const auto& p = set.pressures();
+    const auto& kind = set.kinds();
+    const auto& v = set.velocities();
+    auto& vnew = set.vectorChannel(VSTAR);
+    const GhostSettings& settings = step.settings();
+    const NeighborLists& lists = step.lists();
+    const CubicSplineKernel& kernel = step.kernel();
+    const Vec3 g = settings.gravity;
+    const Real c = settings.soundSpeed();
     // Becker and Teschner 2007, Eq. 11: Pi_ij = -nu min(v_ij . x_ij, 0) / (|x_ij|^2 + 0.01 s^2),
     // nu = 2 alpha s c / (rho_i + rho_j), with s the smoothing length (half the support).
-    const Real s = Real(0.5) * mSettings.supportRadius();
-    const Real alpha = mSettings.basicViscosityAlpha;
+    const Real s = Real(0.5) * settings.supportRadius();
+    const Real alpha = settings.basicViscosityAlpha;
     // Monaghan 1994, Eq. 4.3: f = D ((r0 / r)^12 - (r0 / r)^4) x_ij / r^2 for r < r0. Liquid
     // starts half a spacing from solid surfaces (GhostSolver::addLiquid), where the boundary's
     // surface particles sit, so r0 = h / 2: repulsion begins only closer than that.
-    const Real r0 = Real(0.5) * mSettings.spacing;
-    const Real D = mLennardJones;
+    const Real r0 = Real(0.5) * settings.spacing;
+    const Real D = step.lennardJones();
 
     std::vector<Real> accel(n, Real(0));
     parallel::forEach(
@@ -59,7 +61,7 @@ void GhostSolver::stepBasic(Real dt)
         }
         const Real pi = p[i] / sqr(rho[i]);
         Vec3 a = g;
-        mFluidLists[i].forEach([&](Index j) {
+        lists[i].forEach([&](Index j) {
             if (j == i) return;
             const Vec3 xij = x[i] - x[j];
             const Real r = xij.length();
@@ -69,11 +71,11 @@ void GhostSolver::stepBasic(Real dt)
                 const Real nu = Real(2) * alpha * s * c / (rho[i] + rho[j]);
                 term += -nu * vx / (r * r + Real(0.01) * s * s);
             }
-            a -= m[j] * term * mKernel.gradW(xij, r);
+            a -= m[j] * term * kernel.gradW(xij, r);
         });
-        for (const SolidBlock* b : {&mStatic, &mMoving}) {
-            const Vec3* y = b->block.particles().positions().data();
-            b->lists[i].forEach([&](Index k) {
+        for (const LiquidStep::Block b : {LiquidStep::STATIC, LiquidStep::MOVING}) {
+            const Vec3* y = step.solids(b).positions().data();
+            step.solidLists(b)[i].forEach([&](Index k) {
                 const Vec3 xik = x[i] - y[k];
                 const Real r = xik.length();
                 if (!(r < r0) || !(r > Real(0))) return;
@@ -86,13 +88,24 @@ void GhostSolver::stepBasic(Real dt)
         accel[i] = a.length();
         },
         512);
-    mRun.maxAcceleration = n ? *std::max_element(accel.begin(), accel.end()) : Real(0);
-    mTimings.pressureForce += secondsSince(t0);
+    step.setMaxAcceleration(n ? *std::max_element(accel.begin(), accel.end()) : Real(0));
+}
 
+void BasicPressure::move(LiquidStep& step, Real dt)
+{
     // XSPH on positions: x += dt (v + eps sum_j 2 m_j / (rho_i + rho_j) (v_j - v_i) W_ij).
-    t0 = std::chrono::steady_clock::now();
-    const Real eps = mSettings.basicXsphEpsilon;
-    auto& xw = mParticles.positions();
+    ParticleSet& set = step.particles();
+    const std::size_t n = set.size();
+    const auto& x = set.positions();
+    const auto& m = set.masses();
+    const auto& rho = set.densities();
+    const auto& kind = set.kinds();
+    auto& v = set.velocities();
+    const auto& vnew = set.vectorChannel(VSTAR);
+    const NeighborLists& lists = step.lists();
+    const CubicSplineKernel& kernel = step.kernel();
+    const Real eps = step.settings().basicXsphEpsilon;
+    auto& xw = set.positions();
     std::vector<Vec3> xnew(n);
     parallel::forEach(
         0, n,
@@ -100,10 +113,10 @@ void GhostSolver::stepBasic(Real dt)
         xnew[i] = x[i];
         if (kind[i] != ParticleKind::Liquid) return;
         Vec3 dv(0);
-        mFluidLists[i].forEach([&](Index j) {
+        lists[i].forEach([&](Index j) {
             if (j == i || kind[j] != ParticleKind::Liquid) return;
             const Real r = (x[i] - x[j]).length();
-            dv += (Real(2) * m[j] / (rho[i] + rho[j]) * mKernel.W(r)) * (vnew[j] - vnew[i]);
+            dv += (Real(2) * m[j] / (rho[i] + rho[j]) * kernel.W(r)) * (vnew[j] - vnew[i]);
         });
         xnew[i] = x[i] + dt * (vnew[i] + eps * dv);
         },
@@ -115,7 +128,20 @@ void GhostSolver::stepBasic(Real dt)
         if (kind[i] == ParticleKind::Liquid) v[i] = vnew[i];
         },
         4096);
-    mTimings.xsphAndBoundary += secondsSince(t0);
+}
+
+void BasicPressure::step(LiquidStep& step, Real dt)
+{
+    // The density over liquid only: the boundary particles act through Lennard-Jones forces.
+    DensityPass pass;
+    pass.solids = false;
+    step.searchAndDensity(pass);
+    auto t0 = std::chrono::steady_clock::now();
+    accelerate(step, dt);
+    step.timings().pressureForce += secondsSince(t0);
+    t0 = std::chrono::steady_clock::now();
+    move(step, dt);
+    step.timings().xsphAndBoundary += secondsSince(t0);
 }
 
 } // namespace ghost
