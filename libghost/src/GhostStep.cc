@@ -30,23 +30,6 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-namespace {
-
-/// *target = min(*target, key); true for the one caller that replaced NO_LIQUID.
-inline bool atomicMin(std::uint64_t* target, std::uint64_t key)
-{
-    std::uint64_t old = __atomic_load_n(target, __ATOMIC_RELAXED);
-    while (key < old) {
-        if (__atomic_compare_exchange_n(target, &old, key, true, __ATOMIC_RELAXED,
-                                        __ATOMIC_RELAXED)) {
-            return old == NO_LIQUID;
-        }
-    }
-    return false;
-}
-
-} // namespace
-
 void GhostSolver::prepareSolidBlocks()
 {
     // Forget the last step's extrapolation (only where it was made), then re-sort the blocks
@@ -140,229 +123,6 @@ void GhostSolver::NearestKeys::clear()
 std::size_t GhostSolver::NearestKeys::memoryBytes() const
 {
     return mPage.capacity() * sizeof(std::uint32_t) + mKeys.capacity() * sizeof(std::uint64_t);
-}
-
-void GhostSolver::computeDensity(const DensityPass& densityPass)
-{
-    const std::size_t n = mParticles.size();
-    const auto& x = mParticles.positions();
-    const auto& m = mParticles.masses();
-    const auto& kind = mParticles.kinds();
-    auto& rho = mParticles.densities();
-    const Real rho0 = mSettings.restDensity;
-    const bool ghost = densityPass.solids;
-    // The model's air fills a liquid particle's density up to rho0 and no further.
-    const bool fill = ghost && mPressure->airFillsToRestDensity();
-    SolidBlock* blocks[2] = {&mStatic, &mMoving};
-
-    // DFSPH's factors (DfsphPressure.cc, step 1) read the same pairs at the same positions:
-    // they are found in this pass, so the pairs are gathered and their distances taken once.
-    DfsphFactors* const f = densityPass.factors;
-    const bool dfsphFactors = f != nullptr;
-    const bool keep = dfsphFactors && f->gradientsKept;
-    const bool mirror = dfsphFactors && f->mirror;
-    const int minNeighbours = dfsphFactors ? f->minNeighbours : 0;
-    const Real wall = dfsphFactors ? f->wall : Real(1);
-    std::vector<Vec3>* const gradMass = dfsphFactors ? f->gradMass : nullptr;
-    const Vec3 g = mSettings.gravity;
-    const Real M = mMass;
-
-    // Eq. 1 for liquid particles: Ghost SPH sums over every kind, Basic SPH over liquid only
-    // (it has no air, and its boundary particles act through Lennard-Jones forces instead).
-    // Ghost SPH also finds each solid particle's nearest liquid particle (lines 5-7).
-    std::vector<std::uint32_t> neighbours(n, 0);
-    std::mutex touchedMutex;
-    const Real* halo = haloFlags();
-    // Instantiated once with and once without the factors (as solvePressure's passes).
-    auto pass = [&](auto withFactors) {
-        constexpr bool factors = decltype(withFactors)::value;
-        forRangeWithBatch(
-            n, mKernel,
-            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
-            std::vector<Index> firstTouch[2];
-            for (std::size_t i = lo; i < hi; ++i) {
-                if (kind[i] != ParticleKind::Liquid) {
-                    rho[i] = rho0;
-                    continue;
-                }
-                // Where this particle's m_j grad W_ij go (DfsphSettings::keepGradients).
-                Real *gx = nullptr, *gy = nullptr, *gz = nullptr;
-                if (factors && keep) {
-                    gx = f->pairGradient[0].data() + f->pairStart[i];
-                    gy = f->pairGradient[1].data() + f->pairStart[i];
-                    gz = f->pairGradient[2].data() + f->pairStart[i];
-                }
-                auto keepGradients = [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) {
-                        gx[k] = b.f[k] * b.dx[k];
-                        gy[k] = b.f[k] * b.dy[k];
-                        gz[k] = b.f[k] * b.dz[k];
-                    }
-                    gx += b.n;
-                    gy += b.n;
-                    gz += b.n;
-                };
-                if (halo && halo[i] != Real(0)) {
-                    // A halo copy: its density comes from its owner (refresh below); it only
-                    // offers itself as the nearest liquid particle of the solid particles it
-                    // sees. With DFSPH it is solved by its owner (alpha 0 here), but the
-                    // gradient pass gives it G k from its kept pairs.
-                    for (int k = 0; k < 2; ++k) {
-                        SolidBlock& block = *blocks[k];
-                        const Vec3* xs = block.block.particles().positions().data();
-                        for (Index j : block.lists[i]) {
-                            const Real r = (x[i] - xs[j]).length();
-                            if (atomicMin(&block.nearest[j], nearestKey(r, Index(i))))
-                                firstTouch[k].push_back(j);
-                        }
-                    }
-                    if (factors && keep) {
-                        batch.forEachBatch(x[i], x.data(), mFluidLists[i], [&](PairBatch& b) {
-                            for (int k = 0; k < b.n; ++k)
-                                b.f[k] = f->liquidMass[b.j[k]] * kernel.gradFactor(b.r[k]);
-                            keepGradients(b);
-                        });
-                    }
-                    continue;
-                }
-                const Vec3 xi = x[i];
-                const NeighborLists::List fluid = mFluidLists[i];
-                Real sum = 0, air = 0;
-                // The factor's sums: sum_liquid j m_j grad W_ij, over every neighbour (particle
-                // shifting), sum_liquid j |m_j grad W_ij|^2 and the liquid neighbours.
-                Vec3 liquid(0), all(0);
-                Real squares = 0;
-                int liquidNeighbours = 0;
-                batch.forEachBatch(xi, x.data(), fluid, [&](PairBatch& b) {
-                    if constexpr (factors) {
-                        for (int k = 0; k < b.n; ++k) b.g[k] = kernel.gradFactor(b.r[k]);
-                        for (int k = 0; k < b.n; ++k) b.f[k] = f->liquidMass[b.j[k]] * b.g[k];
-                        if (keep) keepGradients(b);
-                        liquid += b.sumScaledOffsets(b.f);
-                        for (int k = 0; k < b.n; ++k) {
-                            liquidNeighbours += f->liquidMass[b.j[k]] > Real(0);
-                            b.f[k] = sqr(b.f[k] * b.r[k]);
-                        }
-                        squares += b.sum(b.f);
-                        if (gradMass) {
-                            for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * b.g[k];
-                            all += b.sumScaledOffsets(b.f);
-                        }
-                    }
-                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]];
-                    for (int k = 0; k < b.n; ++k) b.f[k] *= kernel.W(b.r[k]);
-                    sum += b.sum(b.f);
-                    if (!fill) return;
-                    for (int k = 0; k < b.n; ++k)
-                        b.g[k] = kind[b.j[k]] == ParticleKind::GhostAir ? b.f[k] : Real(0);
-                    air += b.sum(b.g);
-                });
-                std::size_t count = fluid.size();
-                // The factor's solid sum_s M grad W_is and, for mirrored walls, the ghosts'
-                // known hydrostatic part (GhostDfsph.cc's file comment).
-                Vec3 solid(0), hydrostatic(0);
-                for (int k = 0; ghost && k < 2; ++k) {
-                    SolidBlock& block = *blocks[k];
-                    const bool moving = k == 1;
-                    const NeighborLists::List list = block.lists[i];
-                    Real w = 0;
-                    batch.forEachBatch(xi, block.block.particles().positions().data(), list,
-                                       [&](PairBatch& b) {
-                        if constexpr (factors) {
-                            for (int c = 0; c < b.n; ++c) b.f[c] = M * kernel.gradFactor(b.r[c]);
-                            solid += b.sumScaledOffsets(b.f);
-                            if (mirror) {
-                                // sum_s M (k_s - k_i) grad W_is with k_s - k_i = (g - a_s) .
-                                // (x_s - x_i) / rho0 (a_s = 0 for a static solid); (dx, dy,
-                                // dz) = x_i - x_s.
-                                if (moving) {
-                                    for (int c = 0; c < b.n; ++c) {
-                                        const Vec3& e = f->movingWallGravity[b.j[c]];
-                                        b.f[c] *=
-                                            -(e[0] * b.dx[c] + e[1] * b.dy[c] + e[2] * b.dz[c])
-                                            / rho0;
-                                    }
-                                } else {
-                                    for (int c = 0; c < b.n; ++c)
-                                        b.f[c] *=
-                                            -(g[0] * b.dx[c] + g[1] * b.dy[c] + g[2] * b.dz[c])
-                                            / rho0;
-                                }
-                                hydrostatic += b.sumScaledOffsets(b.f);
-                            }
-                        }
-                        for (int c = 0; c < b.n; ++c) b.f[c] = kernel.W(b.r[c]);
-                        w += b.sum(b.f);
-                        for (int c = 0; c < b.n; ++c) {
-                            if (atomicMin(&block.nearest[b.j[c]], nearestKey(b.r[c], Index(i)))) {
-                                firstTouch[k].push_back(b.j[c]);
-                            }
-                        }
-                    });
-                    sum += mMass * w;
-                    count += list.size();
-                }
-                if (fill) {
-                    const Real own = sum - air; // liquid and solids
-                    sum = own + std::min(air, std::max(Real(0), rho0 - own));
-                }
-                rho[i] = sum;
-                neighbours[i] = std::uint32_t(count);
-                if constexpr (factors) {
-                    if (mirror) f->wallHydrostatic[i] = hydrostatic;
-                    if (gradMass) (*gradMass)[i] = all + solid;
-                    solid *= wall; // the wall's share c
-                    const int solidNeighbours = int(count - fluid.size());
-                    // The particle's own pressure term moves it by its liquid and solid
-                    // gradient sums and each liquid neighbour by its own term.
-                    const Real a = (liquid + solid).lengthSqr() + squares;
-                    f->alpha[i] = a > Real(0) && liquidNeighbours + solidNeighbours >= minNeighbours
-                                    ? Real(1) / a
-                                    : Real(0);
-                    f->solidGradient[i] = solid;
-                }
-            }
-            if (!firstTouch[0].empty() || !firstTouch[1].empty()) {
-                std::lock_guard<std::mutex> lock(touchedMutex);
-                for (int k = 0; k < 2; ++k) {
-                    blocks[k]->touched.insert(blocks[k]->touched.end(), firstTouch[k].begin(),
-                                              firstTouch[k].end());
-                }
-            }
-            },
-            512);
-    };
-    if (dfsphFactors) pass(std::true_type());
-    else pass(std::false_type());
-    const double liquidCount = parallel::sum(0, n, [&](std::size_t i) {
-        return kind[i] == ParticleKind::Liquid && !(halo && halo[i] != Real(0)) ? 1.0 : 0.0;
-    });
-    const double pairs = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); });
-    mRun.meanNeighbors = pairs / std::max(1.0, liquidCount);
-    mPairCount = std::size_t(pairs);
-
-    // Lines 8-10: pressure from the equation of state (ghost air: rho0, so p = 0), for a model
-    // that has one; an implicit model finds its pressure by its solves.
-    LiquidStep view(*this);
-    const bool stateEquation = mPressure->pressureFromDensity(view);
-    auto& p = mParticles.pressures();
-    if (mExchange) {
-        const auto t = std::chrono::steady_clock::now();
-        if (stateEquation) mExchange->refresh(mParticles, {"density", "pressure"});
-        else mExchange->refresh(mParticles, {"density"});
-        mTimings.exchange += secondsSince(t);
-    }
-
-    // Lines 5-7: a ghost solid takes the density (and so the pressure) of its nearest liquid
-    // particle.
-    for (SolidBlock* b : blocks) {
-        Real* rhoSolid = b->block.particles().densities().data();
-        Real* pSolid = b->block.particles().pressures().data();
-        forEachReachedSolid(*b, [&](Index s, Index j) {
-            rhoSolid[s] = rho[j];
-            if (stateEquation) pSolid[s] = p[j];
-        });
-    }
 }
 
 void GhostSolver::relaxInitialLiquid()
@@ -530,6 +290,28 @@ void GhostSolver::pressureToSolids()
 void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
 {
     const auto t0 = std::chrono::steady_clock::now();
+    resizeStepArray(mScratch, mParticles.size());
+    extrapolateSolidVelocity();
+    applyXsph(dt);
+    // Halo liquid's new velocities, for the air near the cut that takes one of them.
+    if (mExchange) {
+        const auto t = std::chrono::steady_clock::now();
+        mExchange->refresh(mParticles, {"velocity"});
+        mTimings.exchange += secondsSince(t);
+    }
+
+    airFollowsLiquid();
+    // Lines 26-28: positions of liquid and air.
+    auto& x = mParticles.positions();
+    const auto& v = mParticles.velocities();
+    parallel::forEach(
+        0, mParticles.size(), [&](std::size_t i) { x[i] += dt * v[i]; }, 4096);
+    if (!gradMass.empty()) shiftParticles(dt, gradMass);
+    mTimings.xsphAndBoundary += secondsSince(t0);
+}
+
+void GhostSolver::applyXsph(Real dt)
+{
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
     const auto& m = mParticles.masses();
@@ -538,10 +320,6 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
     auto& v = mParticles.velocities();
     const auto& vstar = mParticles.vectorChannel(VSTAR);
     const Real M = mMass;
-    const bool shifting = !gradMass.empty();
-    resizeStepArray(mScratch, n);
-    extrapolateSolidVelocity();
-
     // Lines 19-21: XSPH artificial viscosity on the velocity (Eq. 2), liquid and solid
     // neighbours only: air would bias the outermost particles ([SB12] Sec. 4.3). The weight
     // eps m_j / rho_j of each neighbour is computed once (zero for air).
@@ -589,14 +367,16 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
         }
         },
         512);
+}
 
-    // Halo liquid's new velocities, for the air near the cut that takes one of them.
-    if (mExchange) {
-        const auto t = std::chrono::steady_clock::now();
-        mExchange->refresh(mParticles, {"velocity"});
-        mTimings.exchange += secondsSince(t);
-    }
-
+void GhostSolver::airFollowsLiquid()
+{
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& kind = mParticles.kinds();
+    auto& v = mParticles.velocities();
+    const Real* halo = haloFlags();
+    auto owned = [halo](std::size_t i) { return !halo || halo[i] == Real(0); };
     // Lines 22-25: air takes the new velocity of its nearest liquid particle (searched up to two
     // kernel radii: air advects between resamplings and may drift a little).
     // The nearest liquid entry of the air particle's list (within R), else a search to 2R.
@@ -621,38 +401,42 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
         if (j != INVALID_INDEX) v[i] = v[j];
         },
         256);
+}
 
-    // Lines 26-28: positions of liquid and air.
+void GhostSolver::shiftParticles(Real dt, const std::vector<Vec3>& gradMass)
+{
+    const std::size_t n = mParticles.size();
+    const auto& rho = mParticles.densities();
+    const auto& kind = mParticles.kinds();
+    const auto& v = mParticles.velocities();
     auto& xw = mParticles.positions();
+    const auto& x = xw;
+    const Real* halo = haloFlags();
+    auto owned = [halo](std::size_t i) { return !halo || halo[i] == Real(0); };
+    // Particle shifting (GhostSettings::shiftingCoefficient): down the concentration
+    // gradient, by a diffusion coefficient A h |v| dt that grows with the distance moved,
+    // so a liquid at rest is not shifted. grad C = grad(sum m W) / rho0.
+    const Real h = mSettings.spacing;
+    const Real scale = mSettings.shifting() * h * dt / mSettings.restDensity;
+    const Real cap = Real(0.1) * h;
+    const Real completeDensity = Real(0.9) * mSettings.restDensity;
     parallel::forEach(
-        0, n, [&](std::size_t i) { xw[i] += dt * v[i]; }, 4096);
-    if (shifting) {
-        // Particle shifting (GhostSettings::shiftingCoefficient): down the concentration
-        // gradient, by a diffusion coefficient A h |v| dt that grows with the distance moved,
-        // so a liquid at rest is not shifted. grad C = grad(sum m W) / rho0.
-        const Real h = mSettings.spacing;
-        const Real scale = mSettings.shifting() * h * dt / mSettings.restDensity;
-        const Real cap = Real(0.1) * h;
-        const Real completeDensity = Real(0.9) * mSettings.restDensity;
-        parallel::forEach(
-            0, n,
-            [&](std::size_t i) {
-            // A particle whose neighbourhood is far from complete (a fresh emitter layer, a
-            // drop outside the air layer) has no even spacing to move towards: not shifted.
-            // Liquid inside an emitter keeps the emitter's packing: the volume rate is set by
-            // how the emitter fills its shape.
-            if (kind[i] != ParticleKind::Liquid || rho[i] < completeDensity || !owned(i)) return;
-            for (const auto& em : mEmitters) {
-                if (em->shape.bounds().contains(x[i]) && em->shape.phi(x[i]) < Real(0)) return;
-            }
-            Vec3 d = -(scale * v[i].length()) * gradMass[i];
-            const Real length = d.length();
-            if (length > cap) d *= cap / length;
-            xw[i] += d;
-            },
-            4096);
-    }
-    mTimings.xsphAndBoundary += secondsSince(t0);
+        0, n,
+        [&](std::size_t i) {
+        // A particle whose neighbourhood is far from complete (a fresh emitter layer, a
+        // drop outside the air layer) has no even spacing to move towards: not shifted.
+        // Liquid inside an emitter keeps the emitter's packing: the volume rate is set by
+        // how the emitter fills its shape.
+        if (kind[i] != ParticleKind::Liquid || rho[i] < completeDensity || !owned(i)) return;
+        for (const auto& em : mEmitters) {
+            if (em->shape.bounds().contains(x[i]) && em->shape.phi(x[i]) < Real(0)) return;
+        }
+        Vec3 d = -(scale * v[i].length()) * gradMass[i];
+        const Real length = d.length();
+        if (length > cap) d *= cap / length;
+        xw[i] += d;
+        },
+        4096);
 }
 
 // The step ----------------------------------------------------------------------------------------

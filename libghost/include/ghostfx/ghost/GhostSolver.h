@@ -287,6 +287,7 @@ public:
 
 private:
     friend class LiquidStep;
+    friend class DensitySummation;
     struct Solid;
     struct Emitter;
     /// The nearest liquid particle of each particle of a solid block that some liquid reaches
@@ -388,6 +389,13 @@ private:
     void searchAndDensity(const DensityPass& pass);
     /// Algorithm 3 lines 15-28 after the pressure (LiquidStep::finish). Reads VSTAR.
     void finishGhostStep(Real dt, const std::vector<Vec3>& gradMass);
+    /// Lines 19-21: XSPH (Eq. 2) from v* into the liquid's velocities, with the walls' drag.
+    void applyXsph(Real dt);
+    /// Lines 22-25: each air particle takes its nearest liquid particle's new velocity.
+    void airFollowsLiquid();
+    /// Particle shifting down the concentration gradient (GhostSettings::shiftingCoefficient),
+    /// `gradMass` each particle's sum_j m_j grad W_ij.
+    void shiftParticles(Real dt, const std::vector<Vec3>& gradMass);
     /// Each solid particle liquid reaches takes its nearest liquid particle's pressure.
     void pressureToSolids();
     void moveSolids(double time);
