@@ -475,83 +475,97 @@ void GhostSolver::accrueEmission(double t0, double t1)
 void GhostSolver::emit()
 {
     for (std::size_t e = 0; e < mEmitters.size(); ++e) {
-        Emitter& em = *mEmitters[e];
-        if (mRun.time < em.start || mRun.time >= em.end) continue;
-        const Real R = mSettings.supportRadius();
-        const Aabb box = em.shape.bounds();
-        const Aabb near = box.padded(R);
-
-        // Air inside the emitter gives way to the liquid at once.
-        std::vector<std::uint8_t> remove(mParticles.size(), 0);
-        bool anyAir = false;
-        for (std::size_t i = 0; i < mParticles.size(); ++i) {
-            if (mParticles.kinds()[i] == ParticleKind::GhostAir
-                && em.shape.phi(mParticles.positions()[i]) < Real(0)) {
-                remove[i] = anyAir = true;
-            }
-        }
-        if (anyAir) mParticles.removeIf(remove);
-
-        // Seeds: liquid already in the emitter; obstacles: every other particle nearby. The
-        // liquid inside moves at the emitter's velocity (the emitter is kept full of liquid
-        // moving so): left at its own, gravity and the pressure of the fills sped it up inside
-        // the nozzle and a tap poured 30 % (DFSPH) to 120 % (Tait at CFL 0.2) over its rate,
-        // more the smaller the steps (bench/history/diary-2026-11.md, "The tap's rate by mass").
-        std::vector<Vec3> seeds, obstacles;
-        auto& v = mParticles.velocities();
-        for (std::size_t i = 0; i < mParticles.size(); ++i) {
-            const Vec3& x = mParticles.positions()[i];
-            if (!near.contains(x)) continue;
-            if (mParticles.kinds()[i] == ParticleKind::Liquid && em.shape.phi(x) < Real(0)) {
-                seeds.push_back(x);
-                v[i] = em.velocity;
-            } else {
-                obstacles.push_back(x);
-            }
-        }
-        // Over several processes, every one sees the emitter's surroundings whole (so all
-        // sample the same new liquid) and keeps the new particles in its own region.
-        if (mExchange) {
-            seeds = mExchange->allPositions(seeds);
-            obstacles = mExchange->allPositions(obstacles);
-        }
-        appendSolidPositionsInBox(near, obstacles);
-        std::vector<Vec3> fresh;
-        if (seeds.empty()) {
-            // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
-            const PoissonSettings ps =
-                bodySampling(mSettings.seed + 31337ULL * (e + 1) + mRun.step);
-            for (const Vec3& x : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
-                bool clear = !blockedBySolid(x);
-                for (const Vec3& o : obstacles) {
-                    if (!clear) break;
-                    clear = (o - x).lengthSqr() >= sqr(ps.radius);
-                }
-                if (clear) fresh.push_back(x);
-            }
-        } else {
-            PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-            ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
-            ps.radius *= Real(em.fillScale);
-            ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
-            auto accept = [&](const Vec3& x) {
-                return em.shape.phi(x) < Real(0) && !blockedBySolid(x);
-            };
-            fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
-        }
-        if (seeds.empty()) em.credit = 0;
-        else limitToCredit(em, e, fresh);
-        if (mExchange) {
-            fresh.erase(std::remove_if(fresh.begin(), fresh.end(),
-                                       [&](const Vec3& x) { return !mExchange->owns(x); }),
-                        fresh.end());
-        }
-        if (fresh.empty()) continue;
-        const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);
-        std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(),
-                  em.velocity);
-        mRun.emitted += fresh.size();
+        const Emitter& em = *mEmitters[e];
+        if (mRun.time >= em.start && mRun.time < em.end) emitFrom(e);
     }
+}
+
+void GhostSolver::emitFrom(std::size_t e)
+{
+    Emitter& em = *mEmitters[e];
+    const Real R = mSettings.supportRadius();
+    const Aabb box = em.shape.bounds();
+    const Aabb near = box.padded(R);
+
+    // Air inside the emitter gives way to the liquid at once.
+    std::vector<std::uint8_t> remove(mParticles.size(), 0);
+    bool anyAir = false;
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        if (mParticles.kinds()[i] == ParticleKind::GhostAir
+            && em.shape.phi(mParticles.positions()[i]) < Real(0)) {
+            remove[i] = anyAir = true;
+        }
+    }
+    if (anyAir) mParticles.removeIf(remove);
+
+    // Seeds: liquid already in the emitter; obstacles: every other particle nearby. The
+    // liquid inside moves at the emitter's velocity (the emitter is kept full of liquid
+    // moving so): left at its own, gravity and the pressure of the fills sped it up inside
+    // the nozzle and a tap poured 30 % (DFSPH) to 120 % (Tait at CFL 0.2) over its rate,
+    // more the smaller the steps (bench/history/diary-2026-11.md, "The tap's rate by mass").
+    std::vector<Vec3> seeds, obstacles;
+    auto& v = mParticles.velocities();
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        const Vec3& x = mParticles.positions()[i];
+        if (!near.contains(x)) continue;
+        if (mParticles.kinds()[i] == ParticleKind::Liquid && em.shape.phi(x) < Real(0)) {
+            seeds.push_back(x);
+            v[i] = em.velocity;
+        } else {
+            obstacles.push_back(x);
+        }
+    }
+    // Over several processes, every one sees the emitter's surroundings whole (so all
+    // sample the same new liquid) and keeps the new particles in its own region.
+    if (mExchange) {
+        seeds = mExchange->allPositions(seeds);
+        obstacles = mExchange->allPositions(obstacles);
+    }
+    appendSolidPositionsInBox(near, obstacles);
+    std::vector<Vec3> fresh = emitterFill(e, seeds, obstacles, box);
+    if (seeds.empty()) em.credit = 0;
+    else limitToCredit(em, e, fresh);
+    if (mExchange) {
+        fresh.erase(std::remove_if(fresh.begin(), fresh.end(),
+                                   [&](const Vec3& x) { return !mExchange->owns(x); }),
+                    fresh.end());
+    }
+    if (fresh.empty()) return;
+    const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);
+    std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(),
+              em.velocity);
+    mRun.emitted += fresh.size();
+}
+
+std::vector<Vec3> GhostSolver::emitterFill(std::size_t e, const std::vector<Vec3>& seeds,
+                                           const std::vector<Vec3>& obstacles,
+                                           const Aabb& box) const
+{
+    const Emitter& em = *mEmitters[e];
+    std::vector<Vec3> fresh;
+    if (seeds.empty()) {
+        // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
+        const PoissonSettings ps =
+            bodySampling(mSettings.seed + 31337ULL * (e + 1) + mRun.step);
+        for (const Vec3& x : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
+            bool clear = !blockedBySolid(x);
+            for (const Vec3& o : obstacles) {
+                if (!clear) break;
+                clear = (o - x).lengthSqr() >= sqr(ps.radius);
+            }
+            if (clear) fresh.push_back(x);
+        }
+    } else {
+        PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
+        ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
+        ps.radius *= Real(em.fillScale);
+        ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
+        auto accept = [&](const Vec3& x) {
+            return em.shape.phi(x) < Real(0) && !blockedBySolid(x);
+        };
+        fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
+    }
+    return fresh;
 }
 
 namespace {
@@ -645,69 +659,72 @@ bool GhostSolver::initialize()
         resampleAir(-1);
     }
 
-    if (mMass == Real(0)) {
-        // [SB12] Sec. 4.6: scale the mass so the liquid's mean density is rho0, measured with a
-        // ghost air layer in place so every liquid particle has a complete neighbourhood. Basic
-        // SPH gets the same mass (its air layer is sampled for the measurement only), so the
-        // two methods start from the same state and differ only in how they treat the surface.
-        const GhostSolver* measured = this;
-        std::unique_ptr<GhostSolver> probe;
-        if (mSettings.method == Method::Basic) {
-            GhostSettings probeSettings = mSettings;
-            probeSettings.method = Method::Ghost;
-            probe = std::make_unique<GhostSolver>(probeSettings);
-            // The probe shares the solids and takes this solver's boundary particles as its
-            // ghost solids: sampling them again would cost as much as the first time.
-            for (const auto& solid : mSolids)
-                probe->mSolids.push_back(std::make_unique<Solid>(*solid));
-            for (const SolidBlock* b : {&mStatic, &mMoving}) {
-                SolidBlock& to = b == &mStatic ? probe->mStatic : probe->mMoving;
-                to.block.particles() = restingParticles(*b);
-                auto& kinds = to.block.particles().kinds();
-                std::fill(kinds.begin(), kinds.end(), ParticleKind::GhostSolid);
-                to.block.touch();
-            }
-            std::vector<Vec3> liquidOnly;
-            for (std::size_t i = 0; i < mParticles.size(); ++i) {
-                if (mParticles.kinds()[i] == ParticleKind::Liquid)
-                    liquidOnly.push_back(mParticles.positions()[i]);
-            }
-            probe->addLiquidParticles(liquidOnly);
-            probe->prepareSolidBlocks();
-            probe->searchNeighbors();
-            probe->resampleAir(-1);
-            measured = probe.get();
-        }
-        const ParticleSet all = measured->allParticles();
-        std::vector<std::uint8_t> liquid(all.size());
-        for (std::size_t i = 0; i < liquid.size(); ++i)
-            liquid[i] = all.kinds()[i] == ParticleKind::Liquid;
-        setParticleMass(
-            massForRestDensity(all.positions(), mKernel, mSettings.restDensity, liquid));
-    } else {
-        setParticleMass(mMass);
-    }
+    if (mMass == Real(0)) scaleMass();
+    else setParticleMass(mMass);
     if (mSettings.method == Method::Ghost && !mRestored) relaxInitialLiquid();
-
-    if (mSettings.method == Method::Basic) {
-        mLennardJones = mSettings.lennardJonesStrength;
-        if (mLennardJones == Real(0)) {
-            // Monaghan 1994: D of the order of the largest squared speed, 5 g H.
-            const Real g = mSettings.gravity.length();
-            Real lo = std::numeric_limits<Real>::max(), hi = -lo;
-            const Vec3 up = g > Real(0) ? -mSettings.gravity / g : Vec3(0, 1, 0);
-            for (std::size_t i = 0; i < mParticles.size(); ++i) {
-                if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
-                const Real h = mParticles.positions()[i].dot(up);
-                lo = std::min(lo, h);
-                hi = std::max(hi, h);
-            }
-            mLennardJones = g > Real(0) ? Real(5) * g * std::max(hi - lo, mSettings.spacing)
-                                        : sqr(Real(0.1) * mSettings.soundSpeed());
-        }
-    }
+    if (mSettings.method == Method::Basic) mLennardJones = basicLennardJones();
     mRun.initialized = true;
     return true;
+}
+
+void GhostSolver::scaleMass()
+{
+    // [SB12] Sec. 4.6: scale the mass so the liquid's mean density is rho0, measured with a
+    // ghost air layer in place so every liquid particle has a complete neighbourhood. Basic
+    // SPH gets the same mass (its air layer is sampled for the measurement only, massProbe),
+    // so the two methods start from the same state and differ only in how they treat the
+    // surface.
+    std::unique_ptr<GhostSolver> probe;
+    if (mSettings.method == Method::Basic) probe = massProbe();
+    const ParticleSet all = (probe ? *probe : *this).allParticles();
+    std::vector<std::uint8_t> liquid(all.size());
+    for (std::size_t i = 0; i < liquid.size(); ++i)
+        liquid[i] = all.kinds()[i] == ParticleKind::Liquid;
+    setParticleMass(massForRestDensity(all.positions(), mKernel, mSettings.restDensity, liquid));
+}
+
+std::unique_ptr<GhostSolver> GhostSolver::massProbe() const
+{
+    GhostSettings probeSettings = mSettings;
+    probeSettings.method = Method::Ghost;
+    auto probe = std::make_unique<GhostSolver>(probeSettings);
+    // The probe shares the solids and takes this solver's boundary particles as its ghost
+    // solids: sampling them again would cost as much as the first time.
+    for (const auto& solid : mSolids) probe->mSolids.push_back(std::make_unique<Solid>(*solid));
+    for (const SolidBlock* b : {&mStatic, &mMoving}) {
+        SolidBlock& to = b == &mStatic ? probe->mStatic : probe->mMoving;
+        to.block.particles() = restingParticles(*b);
+        auto& kinds = to.block.particles().kinds();
+        std::fill(kinds.begin(), kinds.end(), ParticleKind::GhostSolid);
+        to.block.touch();
+    }
+    std::vector<Vec3> liquidOnly;
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        if (mParticles.kinds()[i] == ParticleKind::Liquid)
+            liquidOnly.push_back(mParticles.positions()[i]);
+    }
+    probe->addLiquidParticles(liquidOnly);
+    probe->prepareSolidBlocks();
+    probe->searchNeighbors();
+    probe->resampleAir(-1);
+    return probe;
+}
+
+Real GhostSolver::basicLennardJones() const
+{
+    if (mSettings.lennardJonesStrength != Real(0)) return mSettings.lennardJonesStrength;
+    // Monaghan 1994: D of the order of the largest squared speed, 5 g H.
+    const Real g = mSettings.gravity.length();
+    Real lo = std::numeric_limits<Real>::max(), hi = -lo;
+    const Vec3 up = g > Real(0) ? -mSettings.gravity / g : Vec3(0, 1, 0);
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
+        const Real h = mParticles.positions()[i].dot(up);
+        lo = std::min(lo, h);
+        hi = std::max(hi, h);
+    }
+    return g > Real(0) ? Real(5) * g * std::max(hi - lo, mSettings.spacing)
+                       : sqr(Real(0.1) * mSettings.soundSpeed());
 }
 
 // Counts and views ------------------------------------------------------------------------------
@@ -786,7 +803,7 @@ SolverState GhostSolver::saveState() const
     return state;
 }
 
-void GhostSolver::restoreState(const SolverState& state)
+void GhostSolver::checkStateFits(const SolverState& state) const
 {
     const std::string method = methodName(mSettings.method);
     if (state.solver != method) {
@@ -815,19 +832,11 @@ void GhostSolver::restoreState(const SolverState& state)
                              saved, "', this run has '", savedComplete ? "matched" : "complete",
                              "'; resume with -D settings.air_weights=", saved));
     }
-    // Read every key first, so a state missing one leaves the solver untouched.
-    const sph::RunCounters run = sph::RunCounters::load(state);
-    const double mass = state.real("particle_mass");
-    const double lennardJones = state.real("lennard_jones");
-    const std::int64_t solids = state.count("solids"), emitters = state.count("emitters");
-    const std::uint64_t airPhase = std::uint64_t(state.count("air_phase"));
-    const double airPhaseCredit = state.real("air_phase_credit");
-    std::vector<std::pair<double, double>> emitterFills; // credit (kg) and fill scale
-    for (std::int64_t e = 0; e < emitters; ++e) {
-        emitterFills.emplace_back(state.real("emitter_credit_" + std::to_string(e)),
-                                  state.real("emitter_fill_scale_" + std::to_string(e)));
-    }
+}
 
+std::vector<std::uint8_t> GhostSolver::solidParticlesOf(const SolverState& state,
+                                                        std::int64_t solids)
+{
     // Every solid particle must name a solid the caller will add again.
     const ParticleSet& p = state.particles;
     const std::vector<Real>* index =
@@ -842,6 +851,27 @@ void GhostSolver::restoreState(const SolverState& state)
         }
         solid[i] = 1;
     }
+    return solid;
+}
+
+void GhostSolver::restoreState(const SolverState& state)
+{
+    checkStateFits(state);
+    // Read every key first, so a state missing one leaves the solver untouched.
+    const sph::RunCounters run = sph::RunCounters::load(state);
+    const double mass = state.real("particle_mass");
+    const double lennardJones = state.real("lennard_jones");
+    const std::int64_t solids = state.count("solids"), emitters = state.count("emitters");
+    const std::uint64_t airPhase = std::uint64_t(state.count("air_phase"));
+    const double airPhaseCredit = state.real("air_phase_credit");
+    std::vector<std::pair<double, double>> emitterFills; // credit (kg) and fill scale
+    for (std::int64_t e = 0; e < emitters; ++e) {
+        emitterFills.emplace_back(state.real("emitter_credit_" + std::to_string(e)),
+                                  state.real("emitter_fill_scale_" + std::to_string(e)));
+    }
+
+    const ParticleSet& p = state.particles;
+    const std::vector<std::uint8_t> solid = solidParticlesOf(state, solids);
     if (mSettings.method == Method::Basic && p.count(ParticleKind::GhostAir) > 0) {
         throw ValueError("restoreState: a 'basic' state holds ghost air particles");
     }

@@ -125,30 +125,34 @@ std::size_t GhostSolver::NearestKeys::memoryBytes() const
     return mPage.capacity() * sizeof(std::uint32_t) + mKeys.capacity() * sizeof(std::uint64_t);
 }
 
+namespace {
+
+/// Mean and largest |rho / rho0 - 1| of the liquid in `set`.
+void liquidDensityError(const ParticleSet& set, Real rho0, double& mean, double& worst)
+{
+    const auto& rho = set.densities();
+    double sum = 0, count = 0;
+    worst = 0;
+    for (std::size_t i = 0; i < set.size(); ++i) {
+        if (set.kinds()[i] != ParticleKind::Liquid) continue;
+        const double e = std::abs(double(rho[i] / rho0) - 1);
+        sum += e;
+        worst = std::max(worst, e);
+        ++count;
+    }
+    mean = count > 0 ? sum / count : 0;
+}
+
+} // namespace
+
 void GhostSolver::relaxInitialLiquid()
 {
     // Each pass: the neighbours with every ghost in place, then each liquid particle moves down
-    // its density gradient by beta h^2 grad rho / rho0 (at most 0.05 h), a step of particle
-    // shifting with no flow; the air layer is resampled around the moved liquid every 5
-    // passes and at the end. beta = 0.5: 20 passes take the column of issue 18 at 10 mm from
-    // 3.2 % mean / 13.3 % largest error to 0.6 % / 4.1 % (60 passes: 0.6 % / 3.1 %).
+    // its density gradient (relaxationShift), a step of particle shifting with no flow; the air
+    // layer is resampled around the moved liquid every 5 passes and at the end.
     const int passes = mSettings.relaxationPasses();
     if (passes <= 0) return;
-    const Real h = mSettings.spacing, rho0 = mSettings.restDensity;
-    const Real beta = Real(0.5), cap = Real(0.05) * h, M = mMass;
-    auto densityError = [&](double& mean, double& worst) {
-        const auto& rho = mParticles.densities();
-        double sum = 0, count = 0;
-        worst = 0;
-        for (std::size_t i = 0; i < mParticles.size(); ++i) {
-            if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
-            const double e = std::abs(double(rho[i] / rho0) - 1);
-            sum += e;
-            worst = std::max(worst, e);
-            ++count;
-        }
-        mean = count > 0 ? sum / count : 0;
-    };
+    const Real rho0 = mSettings.restDensity;
     // Every other pass keeps the last pass's lists (Verlet lists without a skin). A pass moves
     // a particle by at most 0.05 h, so a pair's distance changes by at most 0.1 h while a list
     // is kept: a pair that leaves the support weighs nothing (the kernel's gradient is zero
@@ -171,46 +175,59 @@ void GhostSolver::relaxInitialLiquid()
         // The shift below reads the lists and masses only: the density is summed for the
         // errors reported before and after (and the end's sums are the first step's).
         if (pass == 0 || pass == passes) computeDensity();
-        if (pass == 0) densityError(mInitialError.meanSampled, mInitialError.maxSampled);
+        if (pass == 0) {
+            liquidDensityError(mParticles, rho0, mInitialError.meanSampled,
+                               mInitialError.maxSampled);
+        }
         if (pass == passes) {
-            densityError(mInitialError.meanRelaxed, mInitialError.maxRelaxed);
+            liquidDensityError(mParticles, rho0, mInitialError.meanRelaxed,
+                               mInitialError.maxRelaxed);
             break;
         }
-        const std::size_t n = mParticles.size();
-        const auto& x = mParticles.positions();
-        const auto& m = mParticles.masses();
-        const auto& kind = mParticles.kinds();
-        shift.assign(n, Vec3(0));
-        forRangeWithBatch(
-            n, mKernel,
-            [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
-            for (std::size_t i = lo; i < hi; ++i) {
-                if (kind[i] != ParticleKind::Liquid) continue;
-                const Vec3 xi = x[i];
-                Vec3 grad(0);
-                batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
-                    for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * kernel.gradFactor(b.r[k]);
-                    grad += b.sumScaledOffsets(b.f);
-                });
-                for (const SolidBlock* block : {&mStatic, &mMoving}) {
-                    batch.forEachBatch(xi, block->block.particles().positions().data(),
-                                       block->lists[i], [&](PairBatch& b) {
-                                           for (int k = 0; k < b.n; ++k)
-                                               b.f[k] = M * kernel.gradFactor(b.r[k]);
-                                           grad += b.sumScaledOffsets(b.f);
-                                       });
-                }
-                Vec3 d = -(beta * h * h / rho0) * grad;
-                const Real length = d.length();
-                if (length > cap) d *= cap / length;
-                shift[i] = d;
-            }
-            },
-            512);
+        relaxationShift(shift);
         auto& xw = mParticles.positions();
         parallel::forEach(
-            0, n, [&](std::size_t i) { xw[i] += shift[i]; }, 4096);
+            0, mParticles.size(), [&](std::size_t i) { xw[i] += shift[i]; }, 4096);
     }
+}
+
+void GhostSolver::relaxationShift(std::vector<Vec3>& shift) const
+{
+    // beta h^2 grad rho / rho0, at most 0.05 h. beta = 0.5: 20 passes take the column of issue
+    // 18 at 10 mm from 3.2 % mean / 13.3 % largest error to 0.6 % / 4.1 % (60 passes: 0.6 % /
+    // 3.1 %).
+    const Real h = mSettings.spacing, rho0 = mSettings.restDensity;
+    const Real beta = Real(0.5), cap = Real(0.05) * h, M = mMass;
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& kind = mParticles.kinds();
+    shift.assign(n, Vec3(0));
+    forRangeWithBatch(
+        n, mKernel,
+        [&](std::size_t lo, std::size_t hi, const CubicSplineKernel& kernel, PairBatch& batch) {
+        for (std::size_t i = lo; i < hi; ++i) {
+            if (kind[i] != ParticleKind::Liquid) continue;
+            const Vec3 xi = x[i];
+            Vec3 grad(0);
+            batch.forEachBatch(xi, x.data(), mFluidLists[i], [&](PairBatch& b) {
+                for (int k = 0; k < b.n; ++k) b.f[k] = m[b.j[k]] * kernel.gradFactor(b.r[k]);
+                grad += b.sumScaledOffsets(b.f);
+            });
+            for (const SolidBlock* block : {&mStatic, &mMoving}) {
+                batch.forEachBatch(xi, block->block.particles().positions().data(),
+                                   block->lists[i], [&](PairBatch& b) {
+                    for (int k = 0; k < b.n; ++k) b.f[k] = M * kernel.gradFactor(b.r[k]);
+                    grad += b.sumScaledOffsets(b.f);
+                });
+            }
+            Vec3 d = -(beta * h * h / rho0) * grad;
+            const Real length = d.length();
+            if (length > cap) d *= cap / length;
+            shift[i] = d;
+        }
+        },
+        512);
 }
 
 void GhostSolver::extrapolateSolidVelocity()

@@ -337,7 +337,19 @@ private:
     /// Emit, sample the first air layer and scale the mass, once; false while there is no
     /// liquid yet and an emitter starts later.
     bool initialize();
+    /// [SB12] Sec. 4.6's mass scaling (setParticleMass).
+    void scaleMass();
+    /// For Basic SPH's mass scaling: a Ghost SPH solver over the same liquid and solids, with
+    /// its air layer sampled.
+    std::unique_ptr<GhostSolver> massProbe() const;
+    /// Basic SPH's Lennard-Jones strength: the setting's, or Monaghan 1994's 5 g H.
+    Real basicLennardJones() const;
     void checkRestoredInputs() const;
+    /// restoreState's checks that `state` was saved by a solver like this one, which is fresh.
+    void checkStateFits(const sph::SolverState& state) const;
+    /// 1 for each solid particle of `state`, checking that it names one of its `solids`.
+    static std::vector<std::uint8_t> solidParticlesOf(const sph::SolverState& state,
+                                                      std::int64_t solids);
     void addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving);
     /// Sampler settings for a liquid body, an emitter or a solid's band ([SB12] Sec. 4.5):
     /// the spacing's Poisson radius, the settings' relaxation and tiling, and `seed`.
@@ -353,7 +365,13 @@ private:
     void prepareSolidBlocks();
     void sampleSolid(std::size_t solidIndex);
     void claimRestoredSolid(std::size_t solidIndex);
+    /// Algorithm 3 line 1: new liquid from every emitter open now ([SB12] Sec. 4.5.2).
     void emit();
+    void emitFrom(std::size_t emitter);
+    /// The emitter's new particles: grown from the liquid in it (`seeds`) at least r from
+    /// `obstacles`, or with no seed its shape sampled whole.
+    std::vector<Vec3> emitterFill(std::size_t emitter, const std::vector<Vec3>& seeds,
+                                  const std::vector<Vec3>& obstacles, const sph::Aabb& box) const;
     /// Add to every emitter's credit the mass it emits over [t0, t1) (s).
     void accrueEmission(double t0, double t1);
     /// Keep no more of `fresh` (emitter `e`'s new particles) than its credit pays for.
@@ -384,6 +402,8 @@ private:
     /// Move the liquid towards rest density before the first step (GhostSettings::
     /// initialRelaxation), recording the density error before and after.
     void relaxInitialLiquid();
+    /// One relaxation pass's move of each liquid particle down its density gradient.
+    void relaxationShift(std::vector<Vec3>& shift) const;
     void extrapolateSolidVelocity();
     /// Algorithm 3 lines 1-7 (LiquidStep::searchAndDensity).
     void searchAndDensity(const DensityPass& pass);
