@@ -100,11 +100,11 @@ void forRangeWithBatch(std::size_t n, const sph::CubicSplineKernel& kernel, Body
         grain);
 }
 
-// DFSPH (GhostDfsph.cc; its factors are found in the density's pass, GhostStep.cc) ---------
+// DFSPH (DfsphPressure.cc; its factors are found in the density pass, DensityPass.cc) -----
 
 /// Liquid and solid neighbours (self included) below which a liquid particle is spray, about a
 /// fifth of a full neighbourhood at [SB12]'s 3 h support; another support scales it with the
-/// neighbourhood's volume (see minimumNeighbours; GhostDfsph.cc). Measured: with 10 (liquid
+/// neighbourhood's volume (see minimumNeighbours; DfsphPressure.cc). Measured: with 10 (liquid
 /// only) the tomato's stream blew up at frame 8; with 20 liquid only, the still tank's corner
 /// particles went unsolved and were pushed into the walls; 20 with the solids holds both.
 constexpr int MIN_NEIGHBOURS = 20;
@@ -118,7 +118,7 @@ inline int minimumNeighbours(sph::Real supportFactor)
     return int(std::lround(MIN_NEIGHBOURS * ratio * ratio * ratio));
 }
 
-/// The wall's share c of GhostDfsph.cc's file comment: 2 for mirrored ghost solids, 1 for the
+/// The wall's share c of DfsphPressure.cc's file comment: 2 for mirrored ghost solids, 1 for the
 /// liquid particle's own pressure term.
 inline sph::Real wallShare(const DfsphSettings& opt)
 {

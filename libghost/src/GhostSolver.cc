@@ -1,7 +1,8 @@
 /// @file   GhostSolver.cc
 /// @brief  [SB12] set-up: solids and their particle blocks, liquid bodies, emitters, the kill
 ///         box, the mass scaling, time stepping, and saving and restoring a run. The step is in
-///         GhostStep.cc, the air layer in GhostAir.cc, Basic SPH in BasicSph.cc.
+///         GhostStep.cc and DensityPass.cc, the air layer in GhostAir.cc, the pressure models
+///         in TaitPressure.cc, DfsphPressure.cc and BasicPressure.cc.
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "GhostInternal.h"

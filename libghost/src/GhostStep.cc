@@ -1,14 +1,14 @@
 /// @file   GhostStep.cc
-/// @brief  [SB12] Algorithm 3, one step: one neighbour search, then density (Eq. 1) with the
-///         ghost solids' density (lines 5-7), pressure (lines 8-10), pressure force (lines
-///         11-14), ghost solid velocity (Eq. 3, lines 15-18), XSPH (Eq. 2, lines 19-21), air
-///         velocity (lines 22-25) and positions (lines 26-28); then collisions and the blow-up
-///         check.
+/// @brief  [SB12] Algorithm 3, one step, as the solver's parts the pressure model calls
+///         (LiquidStep): one neighbour search and the density (lines 1-7, with DensityPass.cc),
+///         then, after the model's pressure and forces (lines 8-14), ghost solid velocity (Eq.
+///         3, lines 15-18), XSPH (Eq. 2, lines 19-21), air velocity (lines 22-25) and positions
+///         (lines 26-28); then what follows every step: collisions, the kill box and the
+///         blow-up check.
 /// @details Every pass reads the neighbour lists of the step (searchNeighbors): liquid to liquid
 ///          and air, and liquid to the particles of each solid block. The nearest liquid particle
 ///          of a solid particle, which lines 5-7 and 15-18 need, is found in the density pass
-///          from the same lists, as the minimum of a packed (distance, index) key: the solid
-///          particles no liquid reaches are never visited.
+///          from the same lists.
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "DfsphPressure.h"

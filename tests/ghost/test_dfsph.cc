@@ -274,7 +274,7 @@ TEST(Dfsph, StillTankHoldsTheDensityLimitAndHydrostaticPressure)
     //    spacing above the top layer's mean height), between the top layer and R above the
     //    floor, is rho0 g within 1 % (the bound), and each 1 cm layer's mean p within
     //    3 % of rho0 g D of rho0 g d. The pressure is the solver's Shepard average of the
-    //    pressure terms (GhostDfsph.cc: single particles' terms scatter by tens of percent in
+    //    pressure terms (DfsphPressure.cc: single particles' terms scatter by tens of percent in
     //    patterns the SPH gradient cannot see). Within R of the floor the Shepard average
     //    reaches no liquid below and p is not rho0 g d; left out;
     //  - no liquid inside the walls; residual speeds below 0.15 m/s interior and 0.25 m/s in
@@ -320,7 +320,7 @@ TEST(Dfsph, TankAcceleratingUpwardsHoldsItsHydrostaticPressure)
 TEST(Dfsph, StillTankAtTwoSpacingsSupportHoldsTheDensityLimit)
 {
     // The same tank with kernel_support 2 (SPlisHSPlasH's support, 4 particle radii): a full
-    // neighbourhood is (2/3)^3 of [SB12]'s, so the spray threshold (GhostDfsph.cc,
+    // neighbourhood is (2/3)^3 of [SB12]'s, so the spray threshold (DfsphPressure.cc,
     // MIN_NEIGHBOURS) scales with it; fixed at the 3 h count, the top layer went unsolved
     // (its mean density error 6.8 %, the limit below 2 %). Measured over six sample
     // realisations (seeds 9 and 1-5) with mirrored walls: interior 0.36-0.45 %, top layer
@@ -703,7 +703,7 @@ TEST(Dfsph, ErrorLimitsAndTimeStepCapsAtTheirExtremesStayBounded)
 // start alone: applied whole, the last step's pressure was applied again and again with no
 // iteration to renew it, and the liquid ran away (measured: 22 m/s and dt at dfsph.min_dt,
 // 1e-5 s, within 0.06 s). The density solve now applies the line-searched share of it
-// (GhostDfsph.cc). Asserted as for the extremes above: speed below 3 x the column's free-fall
+// (DfsphPressure.cc). Asserted as for the extremes above: speed below 3 x the column's free-fall
 // speed, no liquid in the walls, and the steps those of CFL 0.1 at about that speed (dt above
 // a tenth of 0.1 h / 1.7 m/s). Measured: 1.14 m/s, smallest dt 2.7e-4 s, 90 steps.
 TEST(Dfsph, SmallCflStepsStayBounded)
