@@ -204,17 +204,29 @@ int run(const Options& o)
     return 0;
 }
 
-/// The command line into `o`.
-void addOptions(CLI::App& app, Options& o)
+/// The pan, its water and the heater.
+void addPanOptions(CLI::App& app, Options& o)
 {
     app.add_option("--spacing", o.spacing, "liquid spacing h (m)");
     app.add_option("--half-width", o.halfWidth, "pan inside half width a (m)");
     app.add_option("--depth", o.depth, "water depth (m)");
     app.add_option("--heater", o.heater, "plate temperature (K)");
+}
+
+/// The warm-up and the measured steps of both methods.
+void addStepOptions(CLI::App& app, Options& o)
+{
     app.add_option("--vapour", o.vapourTarget, "vapour particles before the measurement");
     app.add_option("--max-warmup", o.maxWarmup, "most warm-up steps");
     app.add_option("--steps", o.steps, "measured fast steps");
     app.add_option("--baseline-steps", o.baselineSteps, "measured baseline steps");
+}
+
+/// The command line into `o`: the pan, the steps, then the baseline's air box.
+void addOptions(CLI::App& app, Options& o)
+{
+    addPanOptions(app, o);
+    addStepOptions(app, o);
     app.add_option("--domain", o.domain, "baseline air box width and depth (m)");
     app.add_option("--height", o.height, "baseline air box height above the pan bottom (m)");
 }

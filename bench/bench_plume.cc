@@ -39,6 +39,16 @@ struct Options
     std::size_t gasTarget = 9000;
 };
 
+/// The command line into `o`.
+void addOptions(CLI::App& app, Options& o)
+{
+    app.add_option("--spacing", o.spacing, "gas spacing (m)");
+    app.add_option("--gas", o.gasTarget, "visible gas particles before the measurement");
+    app.add_option("--max-warmup", o.maxWarmup, "most simulated warm-up time (s)");
+    app.add_option("--steps", o.steps, "measured fast steps");
+    app.add_option("--ambient-steps", o.ambientSteps, "measured baseline steps (0: skip)");
+}
+
 /// The plume's solid and source added to a solver.
 void addScene(gas::GasSolver& solver, Real spacing)
 {
@@ -128,16 +138,6 @@ int run(const Options& o)
                 o.steps / fastWall, o.ambientSteps / ambientWall,
                 (ambientWall / o.ambientSteps) / (fastWall / o.steps));
     return 0;
-}
-
-/// The command line into `o`.
-void addOptions(CLI::App& app, Options& o)
-{
-    app.add_option("--spacing", o.spacing, "gas spacing (m)");
-    app.add_option("--gas", o.gasTarget, "visible gas particles before the measurement");
-    app.add_option("--max-warmup", o.maxWarmup, "most simulated warm-up time (s)");
-    app.add_option("--steps", o.steps, "measured fast steps");
-    app.add_option("--ambient-steps", o.ambientSteps, "measured baseline steps (0: skip)");
 }
 
 } // namespace
