@@ -36,15 +36,14 @@ enum class PointIndexQuery {
 
 const char* queryName(PointIndexQuery query);
 
-/// A tools::PointIndexGrid over a caller-owned position array.
+/// A tools::PointIndexGrid over a caller-owned position array. Not copyable: it owns its grid
+/// through a unique_ptr.
 class PointIndexDensity
 {
 public:
     /// @param voxelSize  voxel side of the index grid (m)
     explicit PointIndexDensity(double voxelSize);
     ~PointIndexDensity();
-    PointIndexDensity(const PointIndexDensity&) = delete;
-    PointIndexDensity& operator=(const PointIndexDensity&) = delete;
 
     /// tools::createPointIndexGrid over `count` positions (m). The array must outlive the
     /// queries: the grid stores indices into it, not copies.

@@ -11,63 +11,32 @@
 ///          `process_cpu_s`, the CPU time of all threads of the process (getrusage) during the
 ///          timed iteration: on a machine shared with other jobs, wall time alone says little.
 ///          Results and how they were taken: bench/RESULTS.md, "Frame output".
+#include "BenchCommon.h"
+#include "LiquidCube.h"
+
 #include <ghostfx/sph/ParticleSet.h>
-#include <ghostfx/sph/Random.h>
 #include <ghostfx/vdbio/FrameFiles.h>
 
 #include <benchmark/benchmark.h>
 
-#include <cmath>
 #include <filesystem>
-#include <map>
-#include <memory>
 #include <string>
-
-#include <sys/resource.h>
 
 namespace fs = std::filesystem;
 using namespace ghostfx;
+using bench::processCpuSeconds;
 
 namespace {
 
-constexpr double SPACING = 0.01;      // h (m)
-constexpr double REST_DENSITY = 1000; // rho0 (kg/m^3)
-
-/// Jittered lattice cube of exactly `count` liquid particles (cached per count).
+/// The cube with the swirl, so the vel grid has something to hold.
 const sph::ParticleSet& liquidCube(std::size_t count)
 {
-    static std::map<std::size_t, std::unique_ptr<sph::ParticleSet>> cache;
-    auto& slot = cache[count];
-    if (slot) return *slot;
-    slot = std::make_unique<sph::ParticleSet>();
-    sph::ParticleSet& p = *slot;
-    const int side = int(std::ceil(std::cbrt(double(count))));
-    sph::Rng rng(20240611);
-    const sph::Real h = sph::Real(SPACING);
-    const sph::Real m = sph::Real(REST_DENSITY * SPACING * SPACING * SPACING);
-    p.reserve(count);
-    for (int i = 0; i < side && p.size() < count; ++i) {
-        for (int j = 0; j < side && p.size() < count; ++j) {
-            for (int k = 0; k < side && p.size() < count; ++k) {
-                const sph::Vec3 x(h * (sph::Real(i) + rng.uniform(-0.1f, 0.1f)),
-                                  h * (sph::Real(j) + rng.uniform(-0.1f, 0.1f)),
-                                  h * (sph::Real(k) + rng.uniform(-0.1f, 0.1f)));
-                const sph::Vec3 v(-x[1], x[0], sph::Real(0.1));
-                p.add(x, v, m, sph::ParticleKind::Liquid);
-            }
-        }
-    }
-    for (auto& rho : p.densities()) rho = sph::Real(REST_DENSITY);
-    return p;
+    return bench::liquidCube(count, bench::CubeVelocity::Swirl);
 }
 
 vdbio::VolumeOptions volumeOptions(bool surface, bool density, bool velocity)
 {
-    vdbio::VolumeOptions o;
-    o.voxelSize = 0.5 * SPACING;
-    o.kernelSupport = 3 * SPACING;
-    o.restDensity = REST_DENSITY;
-    o.particleSpacing = SPACING;
+    vdbio::VolumeOptions o = bench::cubeVolumeOptions();
     o.surface = surface;
     o.density = density;
     o.velocity = velocity;
@@ -82,15 +51,6 @@ fs::path outputDir()
 }
 
 double megabytes(const fs::path& path) { return double(fs::file_size(path)) / 1e6; }
-
-/// User + system CPU time of every thread of this process so far (s).
-double processCpuSeconds()
-{
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec)
-           + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
 
 void writeVolume(benchmark::State& state, bool surface, bool density, bool velocity)
 {

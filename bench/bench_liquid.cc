@@ -99,6 +99,33 @@ struct Scene
     Aabb container;      ///< liquid outside this box counts as escaped
 };
 
+/// The walls of a box tank: the solid max(outer box, -cut box) (m). A cut box reaching above
+/// the outer one leaves the tank open at the top.
+struct Tank
+{
+    openvdb::Vec3d outerLo, outerHi, cutLo, cutHi;
+};
+
+/// A liquid block [blockLo, blockHi] (m) at rest in `tank`, spacing h (m), voxels h / 2; liquid
+/// outside the tank's outer box padded by 2 h counts as escaped.
+Scene blockInTank(std::string name, std::string description, double h, const Tank& tank,
+                  const char* tankName, const Vec3& blockLo, const Vec3& blockHi)
+{
+    const double voxel = 0.5 * h;
+    auto tankSdf = [=](const openvdb::Vec3d& x) {
+        return std::max(boxSignedDistance(x, tank.outerLo, tank.outerHi),
+                        -boxSignedDistance(x, tank.cutLo, tank.cutHi));
+    };
+    const Aabb outer{toVec3(tank.outerLo), toVec3(tank.outerHi)};
+    return Scene{std::move(name),
+                 std::move(description),
+                 Real(h),
+                 makeLevelSet(levelSetFromSdf(tankSdf, outer, Real(voxel)), tankName),
+                 makeLevelSet(makeBoxLevelSet(blockLo, blockHi, Real(voxel)), "water"),
+                 Vec3(0),
+                 outer.padded(Real(2 * h))};
+}
+
 /// Dam break: liquid block 0.4 x 0.8 x 0.4 m (scaled with h) in the corner of an open-top tank
 /// whose inside is 3 x 1.25 x 1 block (1.2 x 1.0 x 0.4 m), walls one kernel radius (3 h) thick:
 /// the ghost-solid band is one kernel radius deep ([SB12] Sec. 4.4), so thicker walls would add
@@ -111,32 +138,20 @@ Scene damBreak(double targetLiquid, double floorFactor)
 {
     const double blockX = 0.4, blockY = 0.8, blockZ = 0.4; // m
     const double h = std::cbrt(SAMPLES_PER_CUBIC_SPACING * blockX * blockY * blockZ / targetLiquid);
-    const double wall = 3 * h, voxel = 0.5 * h;
+    const double wall = 3 * h;
     const openvdb::Vec3d innerLo(0, 0, 0), innerHi(3 * blockX * floorFactor, 1.25 * blockY, blockZ);
     const openvdb::Vec3d outerLo = innerLo - openvdb::Vec3d(wall);
     const openvdb::Vec3d outerHi(innerHi.x() + wall, innerHi.y(), innerHi.z() + wall);
     // The inner box reaches above the top, so the tank is open there.
     const openvdb::Vec3d cutHi(innerHi.x(), innerHi.y() + 1, innerHi.z());
-    auto tankSdf = [=](const openvdb::Vec3d& x) {
-        return std::max(boxSignedDistance(x, outerLo, outerHi),
-                        -boxSignedDistance(x, innerLo, cutHi));
-    };
-    const Vec3 blockLo{0}, blockHi{Real(blockX), Real(blockY), Real(blockZ)};
     char text[256];
     std::snprintf(text, sizeof(text),
                   "block %.2f x %.2f x %.2f m in an open tank %.2f x %.2f x %.2f m (inside), "
                   "walls %.4f m, h = %.5f m",
                   blockX, blockY, blockZ, innerHi.x(), innerHi.y(), innerHi.z(), wall, h);
-    Scene s{
-        floorFactor == 1 ? "dam_break" : msg("dam_break_floor", floorFactor),
-        text,
-        Real(h),
-        makeLevelSet(levelSetFromSdf(tankSdf, Aabb{toVec3(outerLo), toVec3(outerHi)}, Real(voxel)),
-                     "tank"),
-        makeLevelSet(makeBoxLevelSet(blockLo, blockHi, Real(voxel)), "water"),
-        Vec3(0),
-        Aabb{toVec3(outerLo), toVec3(outerHi)}.padded(Real(2 * h))};
-    return s;
+    return blockInTank(floorFactor == 1 ? "dam_break" : msg("dam_break_floor", floorFactor), text,
+                       h, Tank{outerLo, outerHi, innerLo, cutHi}, "tank", Vec3(0),
+                       Vec3(Real(blockX), Real(blockY), Real(blockZ)));
 }
 
 /// SPlisHSPlasH's dam break (its `DamBreakModel` scene, as `shared/anchors/splishsplash.md`
@@ -147,30 +162,17 @@ Scene damBreak(double targetLiquid, double floorFactor)
 Scene splishDamBreak(double targetLiquid)
 {
     const double h = std::cbrt(SAMPLES_PER_CUBIC_SPACING * 1.0 / targetLiquid);
-    const double wall = 3 * h, voxel = 0.5 * h;
+    const double wall = 3 * h;
     const openvdb::Vec3d innerLo(0, 0, 0), innerHi(4, 3, 1.5);
-    const openvdb::Vec3d outerLo = innerLo - openvdb::Vec3d(wall);
-    const openvdb::Vec3d outerHi = innerHi + openvdb::Vec3d(wall);
-    auto boxSdf = [=](const openvdb::Vec3d& x) {
-        return std::max(boxSignedDistance(x, outerLo, outerHi),
-                        -boxSignedDistance(x, innerLo, innerHi));
-    };
     const Vec3 blockLo(Real(0.05), Real(0.05), Real(0.25));
-    const Vec3 blockHi = blockLo + Vec3(1);
     char text[256];
     std::snprintf(text, sizeof(text),
                   "SPlisHSPlasH's DamBreakModel: 1 m cube at (0.05, 0.05, 0.25) m in a closed box "
                   "4 x 3 x 1.5 m (inside), walls %.4f m, h = %.5f m",
                   wall, h);
-    return Scene{
-        "splish_dam_break",
-        text,
-        Real(h),
-        makeLevelSet(levelSetFromSdf(boxSdf, Aabb{toVec3(outerLo), toVec3(outerHi)}, Real(voxel)),
-                     "box"),
-        makeLevelSet(makeBoxLevelSet(blockLo, blockHi, Real(voxel)), "water"),
-        Vec3(0),
-        Aabb{toVec3(outerLo), toVec3(outerHi)}.padded(Real(2 * h))};
+    const Tank box{innerLo - openvdb::Vec3d(wall), innerHi + openvdb::Vec3d(wall), innerLo,
+                   innerHi};
+    return blockInTank("splish_dam_break", text, h, box, "box", blockLo, blockLo + Vec3(1));
 }
 
 /// Liquid sphere (radius from the target count) 2 h above a solid sphere of radius 0.2 m, its
@@ -562,34 +564,50 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     return results;
 }
 
-} // namespace
-
-int main(int argc, char** argv)
+/// A string option that takes one of `choices`, its default shown in the help.
+void addChoice(CLI::App& app, const std::string& flag, std::string& value, const std::string& help,
+               const std::vector<std::string>& choices)
 {
-    CLI::App app{"Liquid solver scene benchmark ([SB12] Sec. 5): Ghost SPH and Basic SPH"};
-    Options opt;
-    app.add_option("--liquid", opt.damLiquid, "dam break: target liquid particle count")
-        ->capture_default_str()
-        ->check(CLI::Range(100.0, 1e8));
-    app.add_option("--tank-floor", opt.tankFloor,
-                   "dam break: tank floor area as a multiple of the default (same liquid)")
-        ->capture_default_str()
-        ->check(CLI::Range(1.0, 100.0));
-    app.add_option("--sphere-liquid", opt.sphereLiquid,
-                   "sphere scene: target liquid particle count")
-        ->capture_default_str()
-        ->check(CLI::Range(100.0, 1e8));
+    app.add_option(flag, value, help)->capture_default_str()->check(CLI::IsMember(choices));
+}
+
+/// A number option in [lo, hi], its default shown in the help.
+template <typename T, typename Bound>
+void addBounded(CLI::App& app, const std::string& flag, T& value, const std::string& help, Bound lo,
+                Bound hi)
+{
+    app.add_option(flag, value, help)->capture_default_str()->check(CLI::Range(lo, hi));
+}
+
+/// The scene, size and step options.
+void addSceneOptions(CLI::App& app, Options& opt)
+{
+    addBounded(app, "--liquid", opt.damLiquid, "dam break: target liquid particle count", 100.0,
+               1e8);
+    addBounded(app, "--tank-floor", opt.tankFloor,
+               "dam break: tank floor area as a multiple of the default (same liquid)", 1.0, 100.0);
+    addBounded(app, "--sphere-liquid", opt.sphereLiquid,
+               "sphere scene: target liquid particle count", 100.0, 1e8);
     app.add_option("--sphere-spacing", opt.sphereSpacing, "sphere scene: particle spacing h (m)")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    app.add_option("--steps", opt.steps, "measured steps")
+    addBounded(app, "--steps", opt.steps, "measured steps", 1, 1000000);
+    addBounded(app, "--warmup", opt.warmup,
+               "steps before the measurement (the first includes initialisation)", 1, 1000000);
+    app.add_option("--threads", opt.threads, "TBB threads (0 = all)")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000000));
-    app.add_option("--warmup", opt.warmup,
-                   "steps before the measurement (the first includes "
-                   "initialisation)")
-        ->capture_default_str()
-        ->check(CLI::Range(1, 1000000));
+        ->check(CLI::NonNegativeNumber);
+    addChoice(app, "--scene", opt.scenes,
+              "dam, sphere, all (dam and sphere) or splish_dam (SPlisHSPlasH's dam-break "
+              "scene, --liquid particles)",
+              {"dam", "sphere", "all", "splish_dam"});
+    addChoice(app, "--method", opt.methods, "ghost, basic or both", {"ghost", "basic", "both"});
+    app.add_option("--seed", opt.seed, "random seed of all sampling")->capture_default_str();
+}
+
+/// The solver settings that replace GhostSettings' defaults.
+void addSettingOptions(CLI::App& app, Options& opt)
+{
     app.add_option("--cfl", opt.cfl,
                    "CFL-limited dt with this number (default: fixed dt = 1/600 s)")
         ->check(CLI::Range(1e-6, 2.0));
@@ -604,132 +622,152 @@ int main(int argc, char** argv)
                    "kernel support radius / h (default: [SB12] 3; SPlisHSPlasH uses 2)")
         ->check(CLI::Range(1.5, 6.0));
     app.add_option("--lj", opt.lennardJones,
-                   "Basic SPH Lennard-Jones strength D (m^2/s^2; "
-                   "default: 5 g H)")
+                   "Basic SPH Lennard-Jones strength D (m^2/s^2; default: 5 g H)")
         ->check(CLI::PositiveNumber);
-    app.add_option("--threads", opt.threads, "TBB threads (0 = all)")
-        ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
-    app.add_option("--scene", opt.scenes,
-                   "dam, sphere, all (dam and sphere) or splish_dam (SPlisHSPlasH's dam-break "
-                   "scene, --liquid particles)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"dam", "sphere", "all", "splish_dam"}));
-    app.add_option("--pressure", opt.pressure,
-                   "Ghost SPH pressure: tait ([SB12]) or dfsph (implicit, CFL steps on the flow "
-                   "speed)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"tait", "dfsph"}));
+}
+
+/// The pressure model and DFSPH's settings.
+void addPressureOptions(CLI::App& app, Options& opt)
+{
+    addChoice(app, "--pressure", opt.pressure,
+              "Ghost SPH pressure: tait ([SB12]) or dfsph (implicit, CFL steps on the flow "
+              "speed)",
+              {"tait", "dfsph"});
     app.add_option("--divergence-warm-start", opt.divergenceWarmStart,
                    "DFSPH: the divergence solve starts from its last pressure (settings.dfsph."
                    "divergence_warm_start)")
         ->capture_default_str();
-    app.add_option("--wall-pressure", opt.wallPressure,
-                   "DFSPH: ghost solids as the liquid's mirror images or with its own pressure "
-                   "term (settings.dfsph.wall_pressure)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"mirror", "own"}));
-    app.add_option("--air-density", opt.airDensity,
-                   "DFSPH: the ghost air's whole mass in the liquid's density, or only what fills "
-                   "it to rest density (settings.dfsph.air_density)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"full", "fill"}));
-    app.add_option("--air-resampling", opt.airResampling,
-                   "DFSPH: the ghost air resampled one phase a step, or as far per second as "
-                   "[SB12]'s steps take it (settings.dfsph.air_resampling)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"step", "time"}));
+    addChoice(app, "--wall-pressure", opt.wallPressure,
+              "DFSPH: ghost solids as the liquid's mirror images or with its own pressure "
+              "term (settings.dfsph.wall_pressure)",
+              {"mirror", "own"});
+    addChoice(app, "--air-density", opt.airDensity,
+              "DFSPH: the ghost air's whole mass in the liquid's density, or only what fills "
+              "it to rest density (settings.dfsph.air_density)",
+              {"full", "fill"});
+    addChoice(app, "--air-resampling", opt.airResampling,
+              "DFSPH: the ghost air resampled one phase a step, or as far per second as "
+              "[SB12]'s steps take it (settings.dfsph.air_resampling)",
+              {"step", "time"});
     app.add_option("--density-relaxation", opt.densityRelaxation,
                    "DFSPH: settings.dfsph.density_relaxation (default: DfsphSettings')")
         ->check(CLI::Range(1e-6, 1.0));
-    app.add_option("--method", opt.methods, "ghost, basic or both")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"ghost", "basic", "both"}));
-    app.add_option("--seed", opt.seed, "random seed of all sampling")->capture_default_str();
+}
+
+/// The diagnostics printed beside the measurement.
+void addDiagnosticOptions(CLI::App& app, Options& opt)
+{
     app.add_flag("--trace", opt.trace,
                  "print a line per measured step to stderr: time, dt, the fastest and densest "
                  "liquid particle, the pressure solve's iterations, the air count");
     app.add_flag("--halo", opt.halo,
                  "print the halos of slab and bisection decompositions into 2-1024 parts, "
                  "after the first step and at the end (the multi-rank scaling model)");
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return app.exit(e);
-    }
+}
 
+/// The command line and the run's threads, Real and time step.
+void printHeader(int argc, char** argv, const Options& opt)
+{
+    std::string command;
+    for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
+    std::printf("command: %s\n", command.c_str());
+    std::printf("threads: %d, Real = %s, dt = %s; DFSPH reports the pressure on the steps "
+                "that end a frame (%g fps), as a run does\n",
+                parallel::maxThreads(), sizeof(Real) == 4 ? "float" : "double",
+                opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str()
+                : opt.pressure == "dfsph"
+                    ? "CFL steps at the default number (DFSPH; Basic SPH: 1/600 s fixed)"
+                    : "1/600 s (fixed)",
+                double(GhostSettings().frameRate));
+}
+
+/// Every scene `--scene` names, each with every method `--method` names.
+std::vector<RunResult> runScenes(const Options& opt)
+{
+    std::vector<RunResult> all;
+    if (opt.scenes == "splish_dam") {
+        for (const RunResult& r : runScene(splishDamBreak(opt.damLiquid), opt)) all.push_back(r);
+    }
+    if (opt.scenes == "dam" || opt.scenes == "all") {
+        for (const RunResult& r : runScene(damBreak(opt.damLiquid, opt.tankFloor), opt))
+            all.push_back(r);
+    }
+    if (opt.scenes == "sphere" || opt.scenes == "all") {
+        const Scene scene = sphereDrop(opt.sphereLiquid, opt.sphereSpacing);
+        for (const RunResult& r : runScene(scene, opt)) all.push_back(r);
+    }
+    return all;
+}
+
+/// One row of the summary table for a run that completed its measured steps.
+void printSummaryRow(const RunResult& r)
+{
+    const PhaseTimings& t = r.phases;
+    const double n = double(t.steps);
+    auto cell = [&](double s) {
+        char text[64];
+        std::snprintf(text, sizeof(text), "%.1f (%.0f %%)", 1e3 * s / n, percent(s, t.total));
+        return std::string(text);
+    };
+    std::printf("| %s | %s | %zu | %zu | %zu | %.1f | %s | %s | %s | %s | %.1f | %.2f | "
+                "%.0f |\n",
+                r.scene.c_str(), methodName(r.method), r.liquid, r.air, r.solid, 1e3 * r.meanStep,
+                cell(t.neighborsAndDensity).c_str(), cell(t.pressureForce).c_str(),
+                cell(t.xsphAndBoundary).c_str(), cell(t.airResampling).c_str(), r.meanNeighbors,
+                1e9 * r.meanStep / (double(r.liquid) * r.meanNeighbors), r.meanStep / r.dt);
+}
+
+/// The summary table of all runs; false if one blew up.
+bool printSummary(const std::vector<RunResult>& all)
+{
+    std::printf("\n| scene | method | liquid | ghost air | ghost solid / boundary | ms/step | "
+                "nbr+density | pressure | XSPH+boundary | air resampling | mean nbrs | "
+                "ns/pair | wall s / sim s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    bool failed = false;
+    for (const RunResult& r : all) {
+        if (!r.ok) failed = true;
+        if (r.steps == 0) {
+            std::printf("| %s | %s | blew up in the warm-up: see above | | | | | | | | | | |\n",
+                        r.scene.c_str(), methodName(r.method));
+            continue;
+        }
+        if (!r.ok) {
+            std::printf("| %s | %s (blew up after %d measured steps) | %zu | %zu | %zu | %.1f "
+                        "| | | | | %.1f | %.2f | %.0f |\n",
+                        r.scene.c_str(), methodName(r.method), r.steps, r.liquid, r.air, r.solid,
+                        1e3 * r.meanStep, r.meanNeighbors,
+                        1e9 * r.meanStep / (double(r.liquid) * r.meanNeighbors), r.meanStep / r.dt);
+            continue;
+        }
+        printSummaryRow(r);
+    }
+    return !failed;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"Liquid solver scene benchmark ([SB12] Sec. 5): Ghost SPH and Basic SPH"};
+    Options opt;
+    addSceneOptions(app, opt);
+    addSettingOptions(app, opt);
+    addPressureOptions(app, opt);
+    addDiagnosticOptions(app, opt);
+    CLI11_PARSE(app, argc, argv);
+
+    // A blow-up is a NumericalError, which runScene records; what reaches here ends the run.
     try {
         openvdb::initialize();
         parallel::ThreadLimit limit(opt.threads);
-        std::string command;
-        for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
-        std::printf("command: %s\n", command.c_str());
-        std::printf("threads: %d, Real = %s, dt = %s; DFSPH reports the pressure on the steps "
-                    "that end a frame (%g fps), as a run does\n",
-                    parallel::maxThreads(), sizeof(Real) == 4 ? "float" : "double",
-                    opt.cfl > 0 ? ("CFL " + std::to_string(opt.cfl)).c_str()
-                    : opt.pressure == "dfsph"
-                        ? "CFL steps at the default number (DFSPH; Basic SPH: 1/600 s fixed)"
-                        : "1/600 s (fixed)",
-                    double(GhostSettings().frameRate));
-
-        std::vector<RunResult> all;
-        if (opt.scenes == "splish_dam") {
-            for (const RunResult& r : runScene(splishDamBreak(opt.damLiquid), opt))
-                all.push_back(r);
-        }
-        if (opt.scenes == "dam" || opt.scenes == "all") {
-            for (const RunResult& r : runScene(damBreak(opt.damLiquid, opt.tankFloor), opt))
-                all.push_back(r);
-        }
-        if (opt.scenes == "sphere" || opt.scenes == "all") {
-            const Scene scene = sphereDrop(opt.sphereLiquid, opt.sphereSpacing);
-            for (const RunResult& r : runScene(scene, opt)) all.push_back(r);
-        }
-
-        std::printf("\n| scene | method | liquid | ghost air | ghost solid / boundary | ms/step | "
-                    "nbr+density | pressure | XSPH+boundary | air resampling | mean nbrs | "
-                    "ns/pair | wall s / sim s |\n"
-                    "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-        bool failed = false;
-        for (const RunResult& r : all) {
-            if (!r.ok) failed = true;
-            if (r.steps == 0) {
-                std::printf("| %s | %s | blew up in the warm-up: see above | | | | | | | | | | |\n",
-                            r.scene.c_str(), methodName(r.method));
-                continue;
-            }
-            if (!r.ok) {
-                std::printf("| %s | %s (blew up after %d measured steps) | %zu | %zu | %zu | %.1f "
-                            "| | | | | %.1f | %.2f | %.0f |\n",
-                            r.scene.c_str(), methodName(r.method), r.steps, r.liquid, r.air,
-                            r.solid, 1e3 * r.meanStep, r.meanNeighbors,
-                            1e9 * r.meanStep / (double(r.liquid) * r.meanNeighbors),
-                            r.meanStep / r.dt);
-                continue;
-            }
-            const PhaseTimings& t = r.phases;
-            const double n = double(t.steps);
-            auto cell = [&](double s) {
-                char text[64];
-                std::snprintf(text, sizeof(text), "%.1f (%.0f %%)", 1e3 * s / n,
-                              percent(s, t.total));
-                return std::string(text);
-            };
-            std::printf("| %s | %s | %zu | %zu | %zu | %.1f | %s | %s | %s | %s | %.1f | %.2f | "
-                        "%.0f |\n",
-                        r.scene.c_str(), methodName(r.method), r.liquid, r.air, r.solid,
-                        1e3 * r.meanStep, cell(t.neighborsAndDensity).c_str(),
-                        cell(t.pressureForce).c_str(), cell(t.xsphAndBoundary).c_str(),
-                        cell(t.airResampling).c_str(), r.meanNeighbors,
-                        1e9 * r.meanStep / (double(r.liquid) * r.meanNeighbors), r.meanStep / r.dt);
-        }
-        return failed ? 1 : 0;
-    } catch (const ghostfx::Error& e) {
-        std::fprintf(stderr, "bench_liquid: error: %s\n", e.what());
-        return 1;
+        printHeader(argc, argv, opt);
+        return printSummary(runScenes(opt)) ? 0 : 1;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "bench_liquid: internal error: %s\n", e.what());
-        return 2;
+        // ghostfx::Error is what the library reports (status 1); anything else is a bug (2).
+        const bool reported = dynamic_cast<const ghostfx::Error*>(&e) != nullptr;
+        std::fprintf(stderr, "bench_liquid: %s%s\n",
+                     reported ? "error: " : "internal error: ", e.what());
+        return reported ? 1 : 2;
     }
 }

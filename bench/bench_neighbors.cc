@@ -42,15 +42,9 @@
 
 namespace {
 
+using namespace ghostfx::sph;
 using ghostfx::bench::PointIndexDensity;
 using ghostfx::bench::PointIndexQuery;
-using ghostfx::sph::CubicSplineKernel;
-using ghostfx::sph::Index;
-using ghostfx::sph::NeighborGrid;
-using ghostfx::sph::ParticleKind;
-using ghostfx::sph::ParticleSet;
-using ghostfx::sph::Real;
-using ghostfx::sph::Vec3;
 namespace parallel = ghostfx::parallel;
 
 constexpr double SPACING = 0.01;            ///< lattice spacing h (m)
@@ -263,6 +257,18 @@ void setCounters(benchmark::State& state, const Scenario& sc, std::size_t memory
     if (memoryBytes > 0) state.counters["mem_MB"] = double(memoryBytes) / 1e6;
 }
 
+/// Time `pass` (a density pass writing `rho`) once per iteration, its output kept from the
+/// optimiser.
+template <typename Pass>
+void timePasses(benchmark::State& state, const Real* rho, Pass&& pass)
+{
+    for (auto _ : state) {
+        pass();
+        benchmark::DoNotOptimize(rho);
+        benchmark::ClobberMemory();
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // ghostfx NeighborGrid
 // ---------------------------------------------------------------------------------------------
@@ -286,11 +292,8 @@ void BM_GhostfxGrid_Density(benchmark::State& state, Order order)
     NeighborGrid grid(sc.kernel.supportRadius());
     grid.build(sc.x);
     std::vector<Real> rho(sc.count);
-    for (auto _ : state) {
-        ghostfxDensity(grid, sc.kernel, sc.mass.data(), rho.data(), sc.count);
-        benchmark::DoNotOptimize(rho.data());
-        benchmark::ClobberMemory();
-    }
+    timePasses(state, rho.data(),
+               [&] { ghostfxDensity(grid, sc.kernel, sc.mass.data(), rho.data(), sc.count); });
     setCounters(state, sc);
 }
 
@@ -301,12 +304,10 @@ void BM_GhostfxGrid_DensitySorted(benchmark::State& state, Order order)
     NeighborGrid grid(sc.kernel.supportRadius());
     ParticleSet particles = sc.particles;
     grid.sortParticles(particles);
-    for (auto _ : state) {
+    timePasses(state, particles.densities().data(), [&] {
         ghostfxDensity(grid, sc.kernel, particles.masses().data(), particles.densities().data(),
                        sc.count);
-        benchmark::DoNotOptimize(particles.densities().data());
-        benchmark::ClobberMemory();
-    }
+    });
     setCounters(state, sc);
 }
 
@@ -316,12 +317,10 @@ void BM_GhostfxGrid_BuildDensity(benchmark::State& state, Order order)
     const Scenario& sc = scenario(std::size_t(state.range(0)), order);
     NeighborGrid grid(sc.kernel.supportRadius());
     std::vector<Real> rho(sc.count);
-    for (auto _ : state) {
+    timePasses(state, rho.data(), [&] {
         grid.build(sc.x);
         ghostfxDensity(grid, sc.kernel, sc.mass.data(), rho.data(), sc.count);
-        benchmark::DoNotOptimize(rho.data());
-        benchmark::ClobberMemory();
-    }
+    });
     setCounters(state, sc);
 }
 
@@ -356,11 +355,9 @@ void BM_GhostfxGrid_DensityVariant(benchmark::State& state)
     NeighborGrid grid(sc.kernel.supportRadius() / Real(cellsPerRadius));
     grid.build(sc.x);
     std::vector<Real> rho(sc.count);
-    for (auto _ : state) {
+    timePasses(state, rho.data(), [&] {
         ghostfxDensityInRadius(grid, sc.x.data(), sc.kernel, sc.mass.data(), rho.data(), sc.count);
-        benchmark::DoNotOptimize(rho.data());
-        benchmark::ClobberMemory();
-    }
+    });
     setCounters(state, sc, grid.memoryBytes());
     state.SetLabel(ghostfx::msg("cell R/", cellsPerRadius));
 }
@@ -399,11 +396,8 @@ void pigDensity(benchmark::State& state, Order order, int voxelsPerRadius, Point
     PointIndexDensity pig(pigVoxelSize(sc, voxelsPerRadius));
     pig.build(sc.x.data(), sc.count);
     std::vector<Real> rho(sc.count);
-    for (auto _ : state) {
-        pig.density(sc.kernel, sc.mass.data(), rho.data(), query);
-        benchmark::DoNotOptimize(rho.data());
-        benchmark::ClobberMemory();
-    }
+    timePasses(state, rho.data(),
+               [&] { pig.density(sc.kernel, sc.mass.data(), rho.data(), query); });
     setCounters(state, sc);
     state.SetLabel(pigLabel(voxelsPerRadius, query));
 }
@@ -423,12 +417,10 @@ void BM_PointIndexGrid_BuildDensity(benchmark::State& state, Order order)
     const Scenario& sc = scenario(std::size_t(state.range(0)), order);
     PointIndexDensity pig(pigVoxelSize(sc, PIG_VOXELS_PER_RADIUS));
     std::vector<Real> rho(sc.count);
-    for (auto _ : state) {
+    timePasses(state, rho.data(), [&] {
         pig.build(sc.x.data(), sc.count);
         pig.density(sc.kernel, sc.mass.data(), rho.data(), PIG_QUERY);
-        benchmark::DoNotOptimize(rho.data());
-        benchmark::ClobberMemory();
-    }
+    });
     setCounters(state, sc);
     state.SetLabel(pigLabel(PIG_VOXELS_PER_RADIUS, PIG_QUERY));
 }

@@ -76,28 +76,46 @@ Scene& scene()
     return s;
 }
 
+/// The grain of every pass: particles per task.
+constexpr std::size_t GRAIN = 512;
+
+/// A pair-by-pair pass: `perParticle(i)` for every particle, in parallel.
+template <typename PerParticle>
+void eachParticle(PerParticle&& perParticle)
+{
+    parallel::forEach(0, COUNT, perParticle, GRAIN);
+}
+
+/// A batched pass: `perBlock(b, lo, hi)` for each block [lo, hi) of particles, in parallel,
+/// with one PairBatch `b` per block.
+template <typename PerBlock>
+void eachBlock(PerBlock&& perBlock)
+{
+    parallel::forRange(
+        0, COUNT,
+        [&](std::size_t lo, std::size_t hi) {
+        PairBatch b;
+        perBlock(b, lo, hi);
+        },
+        GRAIN);
+}
+
 void densityScalar(const Scene& s, std::vector<Real>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forEach(
-        0, COUNT,
-        [&](std::size_t i) {
+    eachParticle([&](std::size_t i) {
         Real sum = 0;
         s.lists[i].forEach([&](Index j) { sum += m[j] * s.kernel.W((x[i] - x[j]).length()); });
         out[i] = sum;
-        },
-        512);
+    });
 }
 
 void densityBatch(const Scene& s, std::vector<Real>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forRange(
-        0, COUNT,
-        [&](std::size_t lo, std::size_t hi) {
-        PairBatch b;
+    eachBlock([&](PairBatch& b, std::size_t lo, std::size_t hi) {
         const CubicSplineKernel kernel = s.kernel;
         for (std::size_t i = lo; i < hi; ++i) {
             Real sum = 0;
@@ -108,17 +126,14 @@ void densityBatch(const Scene& s, std::vector<Real>& out)
             });
             out[i] = sum;
         }
-        },
-        512);
+    });
 }
 
 void pressureScalar(const Scene& s, std::vector<Vec3>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forEach(
-        0, COUNT,
-        [&](std::size_t i) {
+    eachParticle([&](std::size_t i) {
         Vec3 a(0);
         const Real pi = s.ratio[i];
         s.lists[i].forEach([&](Index j) {
@@ -127,18 +142,14 @@ void pressureScalar(const Scene& s, std::vector<Vec3>& out)
             a -= m[j] * (pi + s.ratio[j]) * s.kernel.gradW(xij, xij.length());
         });
         out[i] = a;
-        },
-        512);
+    });
 }
 
 void pressureBatch(const Scene& s, std::vector<Vec3>& out)
 {
     const auto& x = s.particles.positions();
     const auto& m = s.particles.masses();
-    parallel::forRange(
-        0, COUNT,
-        [&](std::size_t lo, std::size_t hi) {
-        PairBatch b;
+    eachBlock([&](PairBatch& b, std::size_t lo, std::size_t hi) {
         for (std::size_t i = lo; i < hi; ++i) {
             const Real pi = s.ratio[i];
             Vec3 a(0);
@@ -149,8 +160,14 @@ void pressureBatch(const Scene& s, std::vector<Vec3>& out)
             });
             out[i] = a;
         }
-        },
-        512);
+    });
+}
+
+/// Google Benchmark's counter of nanoseconds per pair, for `pairs` pairs an iteration.
+benchmark::Counter nsPerPair(std::size_t pairs)
+{
+    return benchmark::Counter(double(pairs) * 1e-9, benchmark::Counter::kIsIterationInvariantRate
+                                                        | benchmark::Counter::kInvert);
 }
 
 void BM_GridSort(benchmark::State& state)
@@ -170,39 +187,25 @@ void BM_ListsBuild(benchmark::State& state)
     for (auto _ : state)
         lists.build(s.grid, s.particles.positions().data(), COUNT, s.kernel.supportRadius());
     state.counters["pairs"] = double(lists.pairCount());
-    state.counters["ns/pair"] = benchmark::Counter(double(lists.pairCount()) * 1e-9,
-                                                   benchmark::Counter::kIsIterationInvariantRate
-                                                       | benchmark::Counter::kInvert);
+    state.counters["ns/pair"] = nsPerPair(lists.pairCount());
 }
 
-template <void (*Pass)(const Scene&, std::vector<Real>&)>
-void BM_Density(benchmark::State& state)
+/// One pass (a density or a pressure force, `T` per particle) over the scene's lists.
+template <typename T, void (*Pass)(const Scene&, std::vector<T>&)>
+void BM_Pass(benchmark::State& state)
 {
     Scene& s = scene();
-    std::vector<Real> out(COUNT);
+    std::vector<T> out(COUNT);
     for (auto _ : state) Pass(s, out);
-    state.counters["ns/pair"] = benchmark::Counter(double(s.lists.pairCount()) * 1e-9,
-                                                   benchmark::Counter::kIsIterationInvariantRate
-                                                       | benchmark::Counter::kInvert);
-}
-
-template <void (*Pass)(const Scene&, std::vector<Vec3>&)>
-void BM_Pressure(benchmark::State& state)
-{
-    Scene& s = scene();
-    std::vector<Vec3> out(COUNT);
-    for (auto _ : state) Pass(s, out);
-    state.counters["ns/pair"] = benchmark::Counter(double(s.lists.pairCount()) * 1e-9,
-                                                   benchmark::Counter::kIsIterationInvariantRate
-                                                       | benchmark::Counter::kInvert);
+    state.counters["ns/pair"] = nsPerPair(s.lists.pairCount());
 }
 
 BENCHMARK(BM_GridSort)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ListsBuild)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Density<densityScalar>)->Name("BM_Density/Scalar")->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Density<densityBatch>)->Name("BM_Density/Batch")->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Pressure<pressureScalar>)->Name("BM_Pressure/Scalar")->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Pressure<pressureBatch>)->Name("BM_Pressure/Batch")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Pass<Real, densityScalar>)->Name("BM_Density/Scalar")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Pass<Real, densityBatch>)->Name("BM_Density/Batch")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Pass<Vec3, pressureScalar>)->Name("BM_Pressure/Scalar")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Pass<Vec3, pressureBatch>)->Name("BM_Pressure/Batch")->Unit(benchmark::kMillisecond);
 
 /// Outside any timing: the batched passes give what the plain ones give.
 void checkAgreement()

@@ -13,6 +13,7 @@
 ///             `--ambient-steps` steps at the fast run's last dt are timed.
 ///
 ///          Run: build/bench/bench_plume [--spacing 0.0125] [--gas 9000] [--steps 200]
+#include "BenchMain.h"
 #include "GasCopy.h"
 
 #include <ghostfx/gas/GasSolver.h>
@@ -20,22 +21,32 @@
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
 
-#include <CLI/CLI.hpp>
 #include <openvdb/openvdb.h>
 
-#include <chrono>
 #include <cstdio>
-#include <exception>
 
 using namespace ghostfx;
 using namespace ghostfx::sph;
+using bench::now;
 
 namespace {
 
-double now()
+/// The command line: the plume's spacing, the warm-up and the measured steps.
+struct Options
 {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-        .count();
+    double spacing = 0.0125, maxWarmup = 3.0;
+    int steps = 200, ambientSteps = 20;
+    std::size_t gasTarget = 9000;
+};
+
+/// The command line into `o`.
+void addOptions(CLI::App& app, Options& o)
+{
+    app.add_option("--spacing", o.spacing, "gas spacing (m)");
+    app.add_option("--gas", o.gasTarget, "visible gas particles before the measurement");
+    app.add_option("--max-warmup", o.maxWarmup, "most simulated warm-up time (s)");
+    app.add_option("--steps", o.steps, "measured fast steps");
+    app.add_option("--ambient-steps", o.ambientSteps, "measured baseline steps (0: skip)");
 }
 
 /// The plume's solid and source added to a solver.
@@ -68,81 +79,72 @@ void report(const char* name, const gas::GasSolver& g, int steps, double wall, R
                 per * t.integration);
 }
 
+/// The fast plume's warm-up and measured steps, then the ambient baseline's; prints both.
+int run(const Options& o)
+{
+    openvdb::initialize();
+    std::printf("bench_plume: %d threads, gas spacing %.4f m\n", parallel::maxThreads(), o.spacing);
+    gas::GasSettings s;
+    s.spacing = Real(o.spacing);
+    s.seed = 1;
+    s.frameRate = Real(30);
+    s.domain = Aabb{Vec3(-0.6f, -0.05f, -0.6f), Vec3(0.6f, 1.6f, 0.6f)};
+
+    double t0 = now();
+    gas::GasSolver fast(s);
+    addScene(fast, s.spacing);
+    fast.step(fast.stableTimeStep()); // samples the floor and fills the burner
+    std::printf("set-up (first step): %.2f s, gas boundary %zu\n", now() - t0,
+                fast.particles().count(ParticleKind::Boundary));
+
+    t0 = now();
+    double warmTime = 0;
+    int warm = 0;
+    Real dt = 0;
+    while (fast.visibleGasCount() < o.gasTarget && warmTime < o.maxWarmup) {
+        dt = fast.stableTimeStep();
+        fast.step(dt);
+        warmTime += double(dt);
+        ++warm;
+    }
+    std::printf("warm-up: %d steps, %.3f s simulated in %.1f s wall, gas %zu\n", warm, warmTime,
+                now() - t0, fast.visibleGasCount());
+
+    fast.resetTimings();
+    t0 = now();
+    for (int k = 0; k < o.steps; ++k) {
+        dt = fast.stableTimeStep();
+        fast.step(dt);
+    }
+    const double fastWall = now() - t0;
+    report("fast", fast, o.steps, fastWall, dt);
+    if (o.ambientSteps <= 0) return 0;
+
+    gas::GasSettings bs = s;
+    bs.method = gas::Method::Ambient;
+    gas::GasSolver ambient(bs);
+    addScene(ambient, s.spacing);
+    bench::copyGas(fast, ambient);
+    t0 = now();
+    ambient.step(dt); // fills the box with air (not timed)
+    std::printf("ambient set-up step (air fill): %.1f s, air %zu\n", now() - t0,
+                ambient.ambientCount());
+    ambient.resetTimings();
+    t0 = now();
+    for (int k = 0; k < o.ambientSteps; ++k) ambient.step(dt);
+    const double ambientWall = now() - t0;
+    report("ambient", ambient, o.ambientSteps, ambientWall, dt);
+    std::printf("ratio: fast %.1f steps/s / ambient %.1f steps/s = %.1fx per step\n",
+                o.steps / fastWall, o.ambientSteps / ambientWall,
+                (ambientWall / o.ambientSteps) / (fastWall / o.steps));
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
 {
-    CLI::App app{"bench_plume: gas-only plume, fast gas vs the ambient-air baseline"};
-    double spacing = 0.0125, maxWarmup = 3.0;
-    int steps = 200, ambientSteps = 20;
-    std::size_t gasTarget = 9000;
-    app.add_option("--spacing", spacing, "gas spacing (m)");
-    app.add_option("--gas", gasTarget, "visible gas particles before the measurement");
-    app.add_option("--max-warmup", maxWarmup, "most simulated warm-up time (s)");
-    app.add_option("--steps", steps, "measured fast steps");
-    app.add_option("--ambient-steps", ambientSteps, "measured baseline steps (0: skip)");
-    CLI11_PARSE(app, argc, argv);
-    std::setvbuf(stdout, nullptr, _IOLBF, 0);
-    try {
-        openvdb::initialize();
-        std::printf("bench_plume: %d threads, gas spacing %.4f m\n", parallel::maxThreads(),
-                    spacing);
-        gas::GasSettings s;
-        s.spacing = Real(spacing);
-        s.seed = 1;
-        s.frameRate = Real(30);
-        s.domain = Aabb{Vec3(-0.6f, -0.05f, -0.6f), Vec3(0.6f, 1.6f, 0.6f)};
-
-        double t0 = now();
-        gas::GasSolver fast(s);
-        addScene(fast, s.spacing);
-        fast.step(fast.stableTimeStep()); // samples the floor and fills the burner
-        std::printf("set-up (first step): %.2f s, gas boundary %zu\n", now() - t0,
-                    fast.particles().count(ParticleKind::Boundary));
-
-        t0 = now();
-        double warmTime = 0;
-        int warm = 0;
-        Real dt = 0;
-        while (fast.visibleGasCount() < gasTarget && warmTime < maxWarmup) {
-            dt = fast.stableTimeStep();
-            fast.step(dt);
-            warmTime += double(dt);
-            ++warm;
-        }
-        std::printf("warm-up: %d steps, %.3f s simulated in %.1f s wall, gas %zu\n", warm, warmTime,
-                    now() - t0, fast.visibleGasCount());
-
-        fast.resetTimings();
-        t0 = now();
-        for (int k = 0; k < steps; ++k) {
-            dt = fast.stableTimeStep();
-            fast.step(dt);
-        }
-        const double fastWall = now() - t0;
-        report("fast", fast, steps, fastWall, dt);
-        if (ambientSteps <= 0) return 0;
-
-        gas::GasSettings bs = s;
-        bs.method = gas::Method::Ambient;
-        gas::GasSolver ambient(bs);
-        addScene(ambient, s.spacing);
-        bench::copyGas(fast, ambient);
-        t0 = now();
-        ambient.step(dt); // fills the box with air (not timed)
-        std::printf("ambient set-up step (air fill): %.1f s, air %zu\n", now() - t0,
-                    ambient.ambientCount());
-        ambient.resetTimings();
-        t0 = now();
-        for (int k = 0; k < ambientSteps; ++k) ambient.step(dt);
-        const double ambientWall = now() - t0;
-        report("ambient", ambient, ambientSteps, ambientWall, dt);
-        std::printf("ratio: fast %.1f steps/s / ambient %.1f steps/s = %.1fx per step\n",
-                    steps / fastWall, ambientSteps / ambientWall,
-                    (ambientWall / ambientSteps) / (fastWall / steps));
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "bench_plume: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+    return bench::benchMain(argc, argv, "bench_plume",
+                            "bench_plume: gas-only plume, fast gas vs the ambient-air baseline",
+                            addOptions, run);
 }

@@ -78,6 +78,32 @@ private:
     std::size_t mAt = 0;
 };
 
+/// The channels `names`, each as its name and its values at `rows` (`channel(name)` points to a
+/// channel's values), after their count.
+template <typename Channel>
+void packChannels(Writer& w, const std::vector<std::string>& names, const std::vector<Index>& rows,
+                  Channel&& channel)
+{
+    w.put(std::uint32_t(names.size()));
+    for (const std::string& name : names) {
+        w.put(name);
+        const auto& data = *channel(name);
+        for (Index i : rows) w.put(data[i]);
+    }
+}
+
+/// The channels packChannels wrote, each added by `add(name)` (which points to its values) and
+/// filled with `n` values of type T.
+template <typename T, typename Add>
+void unpackChannels(Reader& r, std::size_t n, Add&& add)
+{
+    const std::uint32_t count = r.get<std::uint32_t>();
+    for (std::uint32_t c = 0; c < count; ++c) {
+        auto& data = *add(r.getString());
+        for (std::size_t k = 0; k < n; ++k) data[k] = r.get<T>();
+    }
+}
+
 /// Rows of `set` with every channel, by name, so the receiver needs no agreement on layout.
 void packRows(const ParticleSet& set, const std::vector<Index>& rows, std::vector<char>& out)
 {
@@ -92,20 +118,10 @@ void packRows(const ParticleSet& set, const std::vector<Index>& rows, std::vecto
         w.put(std::uint8_t(set.kinds()[i]));
         w.put(set.ids()[i]);
     }
-    const std::vector<std::string> scalars = set.scalarChannelNames();
-    w.put(std::uint32_t(scalars.size()));
-    for (const std::string& name : scalars) {
-        w.put(name);
-        const auto& data = set.scalarChannel(name);
-        for (Index i : rows) w.put(data[i]);
-    }
-    const std::vector<std::string> vectors = set.vectorChannelNames();
-    w.put(std::uint32_t(vectors.size()));
-    for (const std::string& name : vectors) {
-        w.put(name);
-        const auto& data = set.vectorChannel(name);
-        for (Index i : rows) w.put(data[i]);
-    }
+    packChannels(w, set.scalarChannelNames(), rows,
+                 [&](const std::string& name) { return &set.scalarChannel(name); });
+    packChannels(w, set.vectorChannelNames(), rows,
+                 [&](const std::string& name) { return &set.vectorChannel(name); });
 }
 
 /// The rows of one message as a particle set (ids as sent).
@@ -135,16 +151,10 @@ ParticleSet unpackRows(const std::vector<char>& in)
     out.pressures() = p;
     out.kinds() = kind;
     out.ids() = id;
-    const std::uint32_t scalars = r.get<std::uint32_t>();
-    for (std::uint32_t c = 0; c < scalars; ++c) {
-        auto& data = out.addScalarChannel(r.getString());
-        for (std::size_t k = 0; k < n; ++k) data[k] = r.get<Real>();
-    }
-    const std::uint32_t vectors = r.get<std::uint32_t>();
-    for (std::uint32_t c = 0; c < vectors; ++c) {
-        auto& data = out.addVectorChannel(r.getString());
-        for (std::size_t k = 0; k < n; ++k) data[k] = r.get<Vec3>();
-    }
+    unpackChannels<Real>(r, n,
+                         [&](const std::string& name) { return &out.addScalarChannel(name); });
+    unpackChannels<Vec3>(r, n,
+                         [&](const std::string& name) { return &out.addVectorChannel(name); });
     if (!r.done()) throw Error("MPI exchange: message longer than its particles");
     // A set's counter stays above every id it holds, particles from other ranks included
     // (ParticleSet::append then lifts the receiver's counter on its own sequence).

@@ -1,7 +1,8 @@
 /// @file   CliHarness.h
 /// @brief  What the command-line tests share: running the real `ghostfx` executable in a test's
 ///         own folder (captured stderr, exit code), starting it in the background to signal it,
-///         and reading its outputs back (point counts, grids, checkpoints, statistics columns).
+///         reading its outputs back (point counts, grids, checkpoints, statistics columns),
+///         and a boiling-pan scene more than one suite runs.
 #pragma once
 
 #include <ghostfx/vdbio/Checkpoint.h>
@@ -22,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <signal.h>
 #include <spawn.h>
 #include <sstream>
 #include <string>
@@ -99,16 +101,46 @@ protected:
     std::filesystem::path mDir;
 };
 
-/// Wait (up to `limit`) until `file` exists; whether it does.
+/// Wait (up to `limit`, looking every `poll`) until `file` exists; whether it does.
 inline bool waitForFile(const std::filesystem::path& file,
-                        std::chrono::seconds limit = std::chrono::seconds(120))
+                        std::chrono::seconds limit = std::chrono::seconds(120),
+                        std::chrono::milliseconds poll = std::chrono::milliseconds(20))
 {
     const auto start = std::chrono::steady_clock::now();
     while (!std::filesystem::exists(file)) {
         if (std::chrono::steady_clock::now() - start > limit) return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        std::this_thread::sleep_for(poll);
     }
     return true;
+}
+
+/// Send `signal` to the process `pid` and wait for it to end; its wait status.
+inline int signalAndWait(pid_t pid, int signal)
+{
+    ::kill(pid, signal);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return status;
+}
+
+/// A pan of water on a 500 K plate that boils away in about three frames (spacing 2 cm, 10
+/// substeps a frame), run for frames 1 to `lastFrame`, the water's latent heat `latentHeat`
+/// (J/kg, scaled for a short test).
+inline vdbio::Json boilingPanScene(double latentHeat, int lastFrame)
+{
+    vdbio::Json scene = vdbio::Json::parse(R"({
+        "ghostfx_scene": 1,
+        "settings": { "method": "ghost", "spacing": 0.02, "substeps": 10 },
+        "solids": [ { "name": "pan", "geometry": { "container": { "min": [0, 0, 0], "max": [0.2, 0.3, 0.2], "wall": 0.04 } } } ],
+        "liquids": [ { "name": "water", "geometry": { "box": { "min": [0, 0, 0], "max": [0.2, 0.08, 0.2] } } } ],
+        "heaters": [ { "name": "plate", "geometry": { "box": { "min": [-0.04, -0.04, -0.04], "max": [0.24, 0.0, 0.24] } },
+                       "temperature": 500 } ],
+        "phase_transition": { "initial_temperature": 372, "heating_time": 0.02 },
+        "domain": { "kill_box": { "min": [-0.1, -0.1, -0.1], "max": [0.3, 1.0, 0.3] } }
+    })");
+    scene["settings"]["frame_range"] = {1, lastFrame};
+    scene["phase_transition"]["latent_heat"] = latentHeat;
+    return scene;
 }
 
 /// Points in the "particles" grid of a points file.

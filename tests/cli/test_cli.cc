@@ -30,16 +30,12 @@
 #include <iterator>
 #include <map>
 #include <optional>
-#include <spawn.h>
 #include <sstream>
 #include <sys/wait.h>
-#include <thread>
 
 namespace fs = std::filesystem;
 using namespace ghostfx;
 using vdbio::Json;
-
-extern char** environ;
 
 namespace {
 
@@ -47,7 +43,9 @@ using ghostfx::testing::CliTest;
 using ghostfx::testing::gridBytes;
 using ghostfx::testing::pointCount;
 using ghostfx::testing::Result;
+using ghostfx::testing::signalAndWait;
 using ghostfx::testing::slurp;
+using ghostfx::testing::waitForFile;
 
 /// "" when the checkpoints `a` and `b` of the scene `scene` hold the same state bit for bit,
 /// else what differs first.
@@ -62,6 +60,13 @@ class Cli : public CliTest
 {
 protected:
     void SetUp() override { mDir = ghostfx::testing::freshTestDir("cli"); }
+
+    /// Start `ghostfx run <scene> --out <out> --progress none` in the background, its stderr into
+    /// the test's folder; its pid (0 if it did not start).
+    pid_t spawnRun(const std::string& scene, const std::string& out) const
+    {
+        return spawn({"run", scene, "--out", out, "--progress", "none"}, mDir / "run_stderr.txt");
+    }
 
     static Json smallScene()
     {
@@ -334,21 +339,12 @@ TEST_F(Cli, CtrlCFinishesTheFrameWritesACheckpointAndExitsNonZero)
     scene["settings"]["frame_range"] = {1, 400};
     const std::string path = write(scene);
     const std::string out = (mDir / "out").string();
-    std::vector<std::string> args = {GHOSTFX_EXE, "run", path, "--out", out, "--progress", "none"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
+    const pid_t pid = spawnRun(path, out);
+    ASSERT_GT(pid, 0);
     // Wait for the first frame, then interrupt.
-    const auto start = std::chrono::steady_clock::now();
-    while (!fs::exists(fs::path(out) / "liquid.0001.vdb")
-           && std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    ::kill(pid, SIGINT);
-    int status = 0;
-    ::waitpid(pid, &status, 0);
+    waitForFile(fs::path(out) / "liquid.0001.vdb", std::chrono::seconds(120),
+                std::chrono::milliseconds(50));
+    const int status = signalAndWait(pid, SIGINT);
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), 130);
     // The checkpoint of the last finished frame is there and names that frame.
@@ -382,21 +378,10 @@ TEST_F(Cli, KilledRunLeavesOnlyCompleteFrames)
     scene["outputs"]["preview"] = {{"file", "preview.$F4.exr"}, {"width", 64}, {"height", 36}};
     const std::string path = write(scene);
     const fs::path out = mDir / "out";
-    std::vector<std::string> args = {GHOSTFX_EXE,  "run",        path,  "--out",
-                                     out.string(), "--progress", "none"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
-    const auto start = std::chrono::steady_clock::now();
-    while (!fs::exists(out / "liquid.0004.vdb")
-           && std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    ::kill(pid, SIGKILL);
-    int status = 0;
-    ::waitpid(pid, &status, 0);
+    const pid_t pid = spawnRun(path, out.string());
+    ASSERT_GT(pid, 0);
+    waitForFile(out / "liquid.0004.vdb", std::chrono::seconds(120), std::chrono::milliseconds(5));
+    const int status = signalAndWait(pid, SIGKILL);
     ASSERT_TRUE(WIFSIGNALED(status));
 
     std::map<std::string, std::vector<int>> frames; // pattern -> frame numbers on disk
@@ -634,16 +619,7 @@ TEST_F(Cli, AttractorRunsAndACheckpointWithoutItIsRefused)
 
 TEST_F(Cli, BoilingPanRunsLiquidAndVapour)
 {
-    const Json scene = Json::parse(R"({
-        "ghostfx_scene": 1,
-        "settings": { "method": "ghost", "spacing": 0.02, "substeps": 10, "frame_range": [1, 2] },
-        "solids": [ { "name": "pan", "geometry": { "container": { "min": [0, 0, 0], "max": [0.2, 0.3, 0.2], "wall": 0.04 } } } ],
-        "liquids": [ { "name": "water", "geometry": { "box": { "min": [0, 0, 0], "max": [0.2, 0.08, 0.2] } } } ],
-        "heaters": [ { "name": "plate", "geometry": { "box": { "min": [-0.04, -0.04, -0.04], "max": [0.24, 0.0, 0.24] } },
-                       "temperature": 500 } ],
-        "phase_transition": { "initial_temperature": 372, "latent_heat": 5, "heating_time": 0.02 },
-        "domain": { "kill_box": { "min": [-0.1, -0.1, -0.1], "max": [0.3, 1.0, 0.3] } }
-    })");
+    const Json scene = ghostfx::testing::boilingPanScene(5, 2);
     const fs::path out = mDir / "out";
     const Result r =
         run("run " + write(scene, "pan.json") + " --out " + out.string() + " --progress log");

@@ -39,21 +39,11 @@ protected:
         })");
     }
 
-    /// A pan of water on a 500 K plate that boils away in about three frames.
+    /// The harness's boiling pan for frames 1 to 4, with a checkpoint every 2 frames.
     static Json boilingPan(double latentHeat)
     {
-        Json scene = Json::parse(R"({
-            "ghostfx_scene": 1,
-            "settings": { "method": "ghost", "spacing": 0.02, "substeps": 10, "frame_range": [1, 4] },
-            "solids": [ { "name": "pan", "geometry": { "container": { "min": [0, 0, 0], "max": [0.2, 0.3, 0.2], "wall": 0.04 } } } ],
-            "liquids": [ { "name": "water", "geometry": { "box": { "min": [0, 0, 0], "max": [0.2, 0.08, 0.2] } } } ],
-            "heaters": [ { "name": "plate", "geometry": { "box": { "min": [-0.04, -0.04, -0.04], "max": [0.24, 0.0, 0.24] } },
-                           "temperature": 500 } ],
-            "phase_transition": { "initial_temperature": 372, "heating_time": 0.02 },
-            "domain": { "kill_box": { "min": [-0.1, -0.1, -0.1], "max": [0.3, 1.0, 0.3] } },
-            "outputs": { "checkpoint": { "every": 2 } }
-        })");
-        scene["phase_transition"]["latent_heat"] = latentHeat;
+        Json scene = ghostfx::testing::boilingPanScene(latentHeat, 4);
+        scene["outputs"]["checkpoint"]["every"] = 2;
         return scene;
     }
 

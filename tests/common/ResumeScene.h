@@ -44,6 +44,14 @@ struct ResumeScene
         solver.addEmitter(nozzle, sph::Vec3(0, sph::Real(-0.5), 0));
     }
 
+    /// Start a fresh `solver` (the inputs, then the liquid) and advance it `frames` frames.
+    void start(ghost::GhostSolver& solver, int frames) const
+    {
+        addInputs(solver);
+        solver.addLiquid(liquid);
+        for (int f = 0; f < frames; ++f) solver.advanceFrame();
+    }
+
 private:
     static sph::LevelSet box(const sph::Vec3& lo, const sph::Vec3& hi, const char* name)
     {

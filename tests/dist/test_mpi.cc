@@ -21,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <string>
 #include <vector>
 
 namespace {
@@ -283,6 +284,19 @@ Difference compareLiquid(const std::map<ParticleId, Vec3>& shared, const Particl
     return d;
 }
 
+/// What the dam-break comparisons print of the shared run against one rank alone: the
+/// differences after 2 steps and after `steps` steps (time `t`, s), at spacing `h` (m).
+std::string differencesText(const Difference& early, const Difference& late, int steps, double t,
+                            Real h)
+{
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "after 2 steps rms %.2e m, worst %.2e m; after %d steps (t = %.3f s) rms %.2e m "
+                  "(%.3f h), worst %.2e m, centre of mass %.2e m",
+                  early.rms, early.worst, steps, t, late.rms, late.rms / h, late.worst, late.com);
+    return text;
+}
+
 std::map<ParticleId, Vec3> liquidOf(const ParticleSet& p)
 {
     std::vector<std::uint8_t> keep(p.size());
@@ -364,12 +378,10 @@ TEST(DistributedGhost, DamBreakOnSeveralRanksFollowsOneRank)
         perturbed = compareLiquid(n, alone->particles());
     }
     if (worldRank() == 0) {
-        std::printf("[measured] %d ranks, %zu liquid: after 2 steps rms %.2e m, worst %.2e m; "
-                    "after %d steps (t = %.3f s) rms %.2e m (%.3f h), worst %.2e m, centre of "
-                    "mass %.2e m; serial nudged by 1e-8 m: rms %.2e m; %llu migrated, %llu halo "
-                    "copies received by rank 0\n",
-                    worldSize(), late.liquid, early.rms, early.worst, steps, shared->time(),
-                    late.rms, late.rms / h, late.worst, late.com, perturbed.rms,
+        std::printf("[measured] %d ranks, %zu liquid: %s; serial nudged by 1e-8 m: rms %.2e m; "
+                    "%llu migrated, %llu halo copies received by rank 0\n",
+                    worldSize(), late.liquid,
+                    differencesText(early, late, steps, shared->time(), h).c_str(), perturbed.rms,
                     static_cast<unsigned long long>(ex.migrated()),
                     static_cast<unsigned long long>(ex.haloReceived()));
     }
@@ -418,12 +430,10 @@ TEST(DistributedGhost, DfsphDamBreakOnSeveralRanksFollowsOneRank)
     const auto& a = shared->pressureSolveStats();
     const auto& b = alone->pressureSolveStats();
     if (worldRank() == 0) {
-        std::printf("[measured] dfsph, %d ranks, %zu liquid: after 2 steps rms %.2e m, worst "
-                    "%.2e m; after %d steps (t = %.3f s) rms %.2e m (%.3f h), worst %.2e m, "
-                    "centre of mass %.2e m; density iterations %llu / %llu (shared / alone), "
-                    "unconverged %llu / %llu\n",
-                    worldSize(), late.liquid, early.rms, early.worst, steps, shared->time(),
-                    late.rms, late.rms / h, late.worst, late.com,
+        std::printf("[measured] dfsph, %d ranks, %zu liquid: %s; density iterations %llu / %llu "
+                    "(shared / alone), unconverged %llu / %llu\n",
+                    worldSize(), late.liquid,
+                    differencesText(early, late, steps, shared->time(), h).c_str(),
                     static_cast<unsigned long long>(a.densityIterations),
                     static_cast<unsigned long long>(b.densityIterations),
                     static_cast<unsigned long long>(a.unconverged),

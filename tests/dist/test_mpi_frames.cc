@@ -15,6 +15,7 @@
 ///          volume fraction) through the distance transform, measured at most 4e-6 of a voxel;
 ///          the bound is 1e-5 of a voxel.
 #include "DistributedFrames.h"
+#include "common/LatticeBall.h"
 
 #include <ghostfx/sph/Random.h>
 
@@ -55,12 +56,7 @@ ParticleSet liquid(Real h)
         }
     }
     const Vec3 centre(Real(0.61), Real(0.2), Real(0.03));
-    for (int i = -5; i <= 5; ++i)
-        for (int j = -5; j <= 5; ++j)
-            for (int k = -5; k <= 5; ++k) {
-                const Vec3 p = centre + Vec3(Real(i), Real(j), Real(k)) * h;
-                if ((p - centre).length() < 4.5 * h) x.push_back(p);
-            }
+    ghostfx::testing::addLatticeBall(x, centre, h, 5, 4.5 * h);
     for (int s = 0; s < 12; ++s)
         x.emplace_back(Real(rng.uniform(0.05, 1.15)), Real(0.3 + 0.02 * s), Real(0.03));
     ParticleSet set;

@@ -10,6 +10,7 @@
 
 #include "common/LiquidMeasures.h"
 #include "common/ResumeScene.h"
+#include "common/SameParticles.h"
 #include "common/Shapes.h"
 #include "common/StateDiff.h"
 #include "common/Tap.h"
@@ -22,6 +23,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -396,11 +398,7 @@ TEST(Dfsph, MassIsConservedAndOneAndTwoThreadsAgreeBitForBit)
         return solver.particles();
     };
     const ParticleSet one = run(1), two = run(2);
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_TRUE(one.ids() == two.ids());
-    EXPECT_TRUE(one.positions() == two.positions());
-    EXPECT_TRUE(one.velocities() == two.velocities());
-    EXPECT_TRUE(one.pressures() == two.pressures());
+    ghostfx::testing::expectSameParticles(one, two, ghostfx::testing::AlsoCompare::Pressures);
 }
 
 // settings.dfsph.keep_gradients: the solves read each pair's m_j grad W_ij as the factor pass
@@ -567,14 +565,28 @@ TEST(Dfsph, AFrameReportsThePressureOnItsLastStepOnly)
     ASSERT_GE(steps.size(), 3u);
     EXPECT_EQ(std::count(changed.begin(), changed.end(), true), 1);
     EXPECT_TRUE(changed.back());
-    const ParticleSet& a = framed.particles();
-    const ParticleSet& b = stepped.particles();
-    ASSERT_EQ(a.size(), b.size());
-    EXPECT_TRUE(a.ids() == b.ids());
-    EXPECT_TRUE(a.positions() == b.positions());
-    EXPECT_TRUE(a.velocities() == b.velocities());
-    EXPECT_TRUE(a.pressures() == b.pressures());
+    ghostfx::testing::expectSameParticles(framed.particles(), stepped.particles(),
+                                          ghostfx::testing::AlsoCompare::Pressures);
 }
+
+namespace {
+
+/// Expect restoring `state` into a fresh solver with `settings` to be refused with a ValueError
+/// whose message names both values: `saved` (the state's) and `wanted` (the solver's).
+void expectRestoreRefused(const SolverState& state, const GhostSettings& settings,
+                          const std::string& saved, const std::string& wanted)
+{
+    GhostSolver solver(settings);
+    try {
+        solver.restoreState(state);
+        ADD_FAILURE() << "a state with " << saved << " restored into a solver with " << wanted;
+    } catch (const ValueError& e) {
+        EXPECT_THAT(e.what(), ::testing::HasSubstr(saved));
+        EXPECT_THAT(e.what(), ::testing::HasSubstr(wanted));
+    }
+}
+
+} // namespace
 
 TEST(Dfsph, ResumeIsBitIdenticalAndATaitStateIsRefused)
 {
@@ -587,14 +599,10 @@ TEST(Dfsph, ResumeIsBitIdenticalAndATaitStateIsRefused)
          {DfsphSettings::AirResampling::Step, DfsphSettings::AirResampling::Time}) {
         scene.settings.dfsph.airResampling = schedule;
         GhostSolver whole(scene.settings);
-        scene.addInputs(whole);
-        whole.addLiquid(scene.liquid);
-        for (int f = 0; f < frames; ++f) whole.advanceFrame();
+        scene.start(whole, frames);
 
         GhostSolver first(scene.settings);
-        scene.addInputs(first);
-        first.addLiquid(scene.liquid);
-        for (int f = 0; f < split; ++f) first.advanceFrame();
+        scene.start(first, split);
         saved = first.saveState();
         GhostSolver resumed(scene.settings);
         resumed.restoreState(saved);
@@ -614,26 +622,12 @@ TEST(Dfsph, ResumeIsBitIdenticalAndATaitStateIsRefused)
     // A state saved with the other pressure model names the key and both values.
     GhostSettings tait = scene.settings;
     tait.pressure = PressureModel::Tait;
-    GhostSolver other(tait);
-    try {
-        other.restoreState(saved);
-        ADD_FAILURE() << "a dfsph state restored into a tait solver";
-    } catch (const ValueError& e) {
-        EXPECT_THAT(e.what(), ::testing::HasSubstr("settings.pressure = 'dfsph'"));
-        EXPECT_THAT(e.what(), ::testing::HasSubstr("'tait'"));
-    }
+    expectRestoreRefused(saved, tait, "settings.pressure = 'dfsph'", "'tait'");
     // So is one saved with the other air weights (the default changed on 2026-11-25; states
     // from before say nothing and were saved with matched weights).
     GhostSettings matched = scene.settings;
     matched.airWeights = AirWeights::Matched;
-    GhostSolver otherAir(matched);
-    try {
-        otherAir.restoreState(saved);
-        ADD_FAILURE() << "a state with complete air weights restored into a matched solver";
-    } catch (const ValueError& e) {
-        EXPECT_THAT(e.what(), ::testing::HasSubstr("settings.air_weights = 'complete'"));
-        EXPECT_THAT(e.what(), ::testing::HasSubstr("'matched'"));
-    }
+    expectRestoreRefused(saved, matched, "settings.air_weights = 'complete'", "'matched'");
     SolverState old = saved;
     old.integers.erase("air_weights_complete");
     GhostSolver fromOld(scene.settings);

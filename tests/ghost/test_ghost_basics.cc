@@ -7,6 +7,7 @@
 #include <ghostfx/sph/Parallel.h>
 
 #include "common/LiquidMeasures.h"
+#include "common/SameParticles.h"
 
 #include <gtest/gtest.h>
 
@@ -99,10 +100,7 @@ TEST(GhostSolver, OneAndTwoThreadsGiveIdenticalParticles)
         return solver.particles();
     };
     const ParticleSet one = run(1), two = run(2);
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_TRUE(one.ids() == two.ids());
-    EXPECT_TRUE(one.positions() == two.positions());
-    EXPECT_TRUE(one.velocities() == two.velocities());
+    ghostfx::testing::expectSameParticles(one, two, ghostfx::testing::AlsoCompare::Nothing);
 }
 
 TEST(GhostSolver, BlowUpStopsWithAClearError)

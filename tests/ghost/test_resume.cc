@@ -47,14 +47,10 @@ TEST(Resume, GhostInMemoryContinuationIsBitIdentical)
     const Scene scene(Method::Ghost, 0);
     const int frames = 3, split = 1;
     GhostSolver whole(scene.settings);
-    scene.addInputs(whole);
-    whole.addLiquid(scene.liquid);
-    for (int f = 0; f < frames; ++f) whole.advanceFrame();
+    scene.start(whole, frames);
 
     GhostSolver first(scene.settings);
-    scene.addInputs(first);
-    first.addLiquid(scene.liquid);
-    for (int f = 0; f < split; ++f) first.advanceFrame();
+    scene.start(first, split);
     const SolverState saved = first.saveState();
 
     GhostSolver resumed(scene.settings);
@@ -270,10 +266,7 @@ TEST(SolidParticles, CarryTheStepWhereLiquidReachesAndRestValuesElsewhere)
     // stores rest values everywhere (the extrapolation is the step's scratch).
     const Scene scene(Method::Ghost, 0);
     GhostSolver solver(scene.settings);
-    scene.addInputs(solver);
-    solver.addLiquid(scene.liquid);
-    solver.advanceFrame();
-    solver.advanceFrame();
+    scene.start(solver, 2);
 
     const Real rho0 = scene.settings.restDensity, R = scene.settings.supportRadius();
     std::vector<Vec3> liquid;

@@ -319,15 +319,32 @@ std::vector<Vec3> queriesNearAndAround(const std::vector<Vec3>& xs, unsigned see
     return queries;
 }
 
+/// The nearest-neighbour tests' scene: 4 clusters of 500 points (5 cm spread) in a grid of
+/// 5 cm cells, and 400 queries near and around them (queriesNearAndAround).
+struct ClusterQueries
+{
+    /// `seed` places the clusters, `seed + 1` the queries.
+    explicit ClusterQueries(unsigned seed) : xs(clusteredPoints(4, 500, 0.05, seed)), grid(cellSize)
+    {
+        grid.build(xs);
+        queries = queriesNearAndAround(xs, seed + 1);
+    }
+
+    const Real cellSize = Real(0.05);
+    std::vector<Vec3> xs;
+    NeighborGrid grid;
+    std::vector<Vec3> queries;
+};
+
 } // namespace
 
 TEST(NeighborGrid, NearestMatchesBruteForce)
 {
-    const Real cellSize = Real(0.05);
-    const std::vector<Vec3> xs = clusteredPoints(4, 500, 0.05, 9);
-    NeighborGrid grid(cellSize);
-    grid.build(xs);
-    const std::vector<Vec3> queries = queriesNearAndAround(xs, 10);
+    const ClusterQueries scene(9);
+    const Real cellSize = scene.cellSize;
+    const std::vector<Vec3>& xs = scene.xs;
+    const NeighborGrid& grid = scene.grid;
+    const std::vector<Vec3>& queries = scene.queries;
     const auto any = [](Index) { return true; };
     std::size_t foundCount = 0, noneCount = 0;
     for (Real maxRadius :
@@ -362,15 +379,13 @@ TEST(NeighborGrid, AnyInRadiusAnswersAsNearestDoes)
     // anyInRadius(x, R, pred) must be exactly nearest(x, R, pred) != INVALID_INDEX (the air
     // resampling swapped one for the other and keeps the same samples), for a predicate that
     // rejects most particles and at radii below, at and above the cell size.
-    const Real cellSize = Real(0.05);
-    const std::vector<Vec3> xs = clusteredPoints(4, 500, 0.05, 11);
-    NeighborGrid grid(cellSize);
-    grid.build(xs);
-    const std::vector<Vec3> queries = queriesNearAndAround(xs, 12);
+    const ClusterQueries scene(11);
+    const Real cellSize = scene.cellSize;
+    const NeighborGrid& grid = scene.grid;
     const auto some = [](Index j) { return j % 7 == 3; };
     std::size_t yes = 0, no = 0;
     for (Real maxRadius : {Real(0.5) * cellSize, cellSize, Real(2.5) * cellSize}) {
-        for (const Vec3& x : queries) {
+        for (const Vec3& x : scene.queries) {
             const bool any = grid.anyInRadius(x, maxRadius, some);
             ASSERT_EQ(any, grid.nearest(x, maxRadius, some) != INVALID_INDEX)
                 << "query " << x << ", maxRadius " << maxRadius;

@@ -112,6 +112,17 @@ SampleSet crowdedCluster(Real r)
     return s;
 }
 
+/// The crowded-cluster tests' start: the test sphere's level set, the sampler settings at the
+/// test spacing, their Poisson radius r and crowdedCluster(r).
+struct CrowdedSphere
+{
+    Shape shape = sphereShape();
+    LevelSet ls = makeLevelSet(shape.grid, shape.name);
+    PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
+    Real r = settings.radius;
+    SampleSet samples = crowdedCluster(r);
+};
+
 /// The smallest distance between two of the points (m), by brute force.
 Real closestPair(const std::vector<Vec3>& x)
 {
@@ -296,13 +307,12 @@ TEST(Sampler, RelaxationOfACrowdedClusterKeepsEveryNeighbourInSight)
     // relaxation grid's cells (side 2r) have room for as the cluster spreads, so samples
     // move into cells that are full and are kept in their spill lists. A sample missed by
     // the search could move onto it, so the closest pair would come closer.
-    const Shape shape = sphereShape();
-    const LevelSet ls = makeLevelSet(shape.grid, shape.name);
-    PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
-    const Real r = settings.radius;
-    SampleSet s = crowdedCluster(r);
+    CrowdedSphere c;
+    const LevelSet& ls = c.ls;
+    const Real r = c.r;
+    SampleSet& s = c.samples;
     const Real closestBefore = closestPair(s.positions);
-    PoissonDiskSampler sampler(settings);
+    PoissonDiskSampler sampler(c.settings);
     SampleSet serial = s;
     sampler.relax(s, ls, 10, 0);
     {
@@ -757,11 +767,10 @@ TEST(Sampler, PackingSpreadsACrowdedClusterWithoutBringingAnyPairCloser)
     // closer than r. A packing step is kept only if it leaves the sample at least as far from
     // every other as its nearest was (or r), so the closest pair can only part; the density
     // gradient drives the cluster apart.
-    const Shape shape = sphereShape();
-    const LevelSet ls = makeLevelSet(shape.grid, shape.name);
-    PoissonSettings settings = PoissonSettings::forSpacing(SPACING);
-    const Real r = settings.radius;
-    SampleSet s = crowdedCluster(r);
+    CrowdedSphere c;
+    const LevelSet& ls = c.ls;
+    const Real r = c.r;
+    SampleSet& s = c.samples;
     auto gyration = [](const std::vector<Vec3>& x) {
         double sum = 0;
         for (const Vec3& p : x) sum += double(p.lengthSqr());
@@ -769,7 +778,7 @@ TEST(Sampler, PackingSpreadsACrowdedClusterWithoutBringingAnyPairCloser)
     };
     const Real closestBefore = closestPair(s.positions);
     const double spreadBefore = gyration(s.positions);
-    PoissonDiskSampler(settings).pack(s, ls, 20);
+    PoissonDiskSampler(c.settings).pack(s, ls, 20);
     const Real closestAfter = closestPair(s.positions);
     const double spreadAfter = gyration(s.positions);
     std::printf("[measured] packing a crowded cluster: closest pair %.3f r -> %.3f r, radius of "

@@ -328,17 +328,13 @@ void checkResume(const ResumeScene& scene, int frames, int split, const std::str
 {
     const auto t0 = std::chrono::steady_clock::now();
     GhostSolver whole(scene.settings);
-    scene.addInputs(whole);
-    whole.addLiquid(scene.liquid);
-    for (int f = 0; f < frames; ++f) whole.advanceFrame();
+    scene.start(whole, frames);
 
     const fs::path dir = freshDir("resume_" + tag);
     const std::string path = (dir / "checkpoint.h5").string();
     {
         GhostSolver first(scene.settings);
-        scene.addInputs(first);
-        first.addLiquid(scene.liquid);
-        for (int f = 0; f < split; ++f) first.advanceFrame();
+        scene.start(first, split);
         writeCheckpoint(path, first.saveState(), scene.settingsJson(), first.frame());
     } // the first solver is gone: nothing survives but the file
 

@@ -23,6 +23,8 @@
 
 #include "common/Expect.h"
 
+#include "SphereSurface.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -61,19 +63,10 @@ const Scene& scene()
 {
     static const Scene s = [] {
         Scene sc;
-        const SampleSet samples =
-            PoissonDiskSampler(PoissonSettings::forSpacing(Real(SPACING)))
-                .sampleVolume(
-                    makeLevelSet(makeSphereLevelSet(Vec3(0), Real(SPHERE_RADIUS), Real(VOXEL))));
-        // [SB12] Sec. 4.6 mass, measured on the particles with a full neighbourhood (deeper
-        // than R): in a sphere this small the surface layer holds most particles.
-        std::vector<std::uint8_t> interior(samples.size());
-        for (std::size_t i = 0; i < samples.size(); ++i) {
-            interior[i] = samples.positions[i].length() < Real(SPHERE_RADIUS - SUPPORT);
-        }
-        const Real mass = massForRestDensity(samples.positions, CubicSplineKernel(Real(SUPPORT)),
-                                             Real(REST_DENSITY), interior);
-        sc.particles.addBatch(samples.positions, mass, ParticleKind::Liquid);
+        const ghostfx::testing::LiquidSphere sphere = ghostfx::testing::poissonLiquidSphere(
+            SPACING, SPHERE_RADIUS, VOXEL, SUPPORT, REST_DENSITY);
+        const Real mass = sphere.mass;
+        sc.particles.addBatch(sphere.samples.positions, mass, ParticleKind::Liquid);
         // Ghost air: lattice points in the shell [R + h, R + 3 h], moving the other way.
         std::vector<Vec3> air;
         const int n = int(std::ceil((SPHERE_RADIUS + 3 * SPACING) / SPACING));
@@ -452,24 +445,12 @@ CrossingStats zeroCrossingAboutSphere(const openvdb::FloatGrid& surface, double 
 {
     CrossingStats st;
     double sum = 0, sum2 = 0;
-    const auto acc = surface.getConstAccessor();
-    const openvdb::Coord steps[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-    for (auto it = surface.cbeginValueOn(); it; ++it) {
-        const double a = *it;
-        if (a >= 0) continue;
-        for (const openvdb::Coord& step : steps) {
-            const double b = acc.getValue(it.getCoord() + step);
-            if (b < 0) continue;
-            const openvdb::Vec3d xa = surface.indexToWorld(it.getCoord());
-            const openvdb::Vec3d xb = surface.indexToWorld(it.getCoord() + step);
-            const double d = (xa + (a / (a - b)) * (xb - xa)).length() - radius;
-            sum += d;
-            sum2 += d * d;
-            st.lo = std::min(st.lo, d);
-            st.hi = std::max(st.hi, d);
-            ++st.count;
-        }
+    for (const double d : ghostfx::testing::radialCrossingErrors(surface, radius)) {
+        sum += d;
+        sum2 += d * d;
+        st.lo = std::min(st.lo, d);
+        st.hi = std::max(st.hi, d);
+        ++st.count;
     }
     if (st.count == 0) return st;
     st.mean = sum / double(st.count);
@@ -530,19 +511,30 @@ TEST(FrameFiles, SurfaceZeroCrossingLiesNearTheOutermostParticles)
     EXPECT_LT(ls.phi(Vec3(0)), Real(0));
 }
 
-TEST(FrameFiles, SurfaceOfAFlatFaceSitsHalfASpacingOutside)
+namespace {
+
+/// An n x n x n lattice of liquid particles at rest, spacing h from the origin, mass 1 kg.
+ParticleSet latticeCube(int n)
 {
-    // A 12^3 lattice block: on its flat faces the zero crossing should lie
-    // surfaceOffsetSpacings = 0.5 h outside the outer layer (VolumeOptions). Sampled on the line
-    // through the middle of the +x face, zero found by linear interpolation between voxels.
     ParticleSet block;
-    const int n = 12;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j)
             for (int k = 0; k < n; ++k) {
                 block.add(Vec3(Real(i * SPACING), Real(j * SPACING), Real(k * SPACING)), Vec3(0),
                           Real(1), ParticleKind::Liquid);
             }
+    return block;
+}
+
+} // namespace
+
+TEST(FrameFiles, SurfaceOfAFlatFaceSitsHalfASpacingOutside)
+{
+    // A 12^3 lattice block: on its flat faces the zero crossing should lie
+    // surfaceOffsetSpacings = 0.5 h outside the outer layer (VolumeOptions). Sampled on the line
+    // through the middle of the +x face, zero found by linear interpolation between voxels.
+    const int n = 12;
+    const ParticleSet block = latticeCube(n);
     vdbio::VolumeOptions o = volumeOptions();
     o.density = o.velocity = false;
     const auto surface =
@@ -572,14 +564,8 @@ TEST(FrameFiles, SprayKeepsADropletOfItsVolume)
     // found by linear interpolation between voxels, within a tenth of a voxel of that radius
     // (the band holds exact distances, so only the interpolation errs). With the droplet off,
     // nothing of the particle is inside.
-    ParticleSet p;
     const int n = 10;
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j)
-            for (int k = 0; k < n; ++k) {
-                p.add(Vec3(Real(i * SPACING), Real(j * SPACING), Real(k * SPACING)), Vec3(0),
-                      Real(1), ParticleKind::Liquid);
-            }
+    ParticleSet p = latticeCube(n);
     const int lone = int(std::lround((n - 1 + 6) * SPACING / VOXEL)); // voxel index along x
     const int mid = int(std::lround((n - 1) * SPACING / 2 / VOXEL));
     const Vec3 spray(Real(lone * VOXEL), Real(mid * VOXEL), Real(mid * VOXEL));

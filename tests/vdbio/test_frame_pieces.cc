@@ -10,6 +10,7 @@
 #include <ghostfx/vdbio/FrameFiles.h>
 
 #include "common/Expect.h"
+#include "common/LatticeBall.h"
 
 #include <gtest/gtest.h>
 
@@ -33,12 +34,7 @@ ParticleSet blockAndBall(Real h)
                                Real((j + 0.5 + rng.uniform(-0.1, 0.1)) * h),
                                Real((k + 0.5 + rng.uniform(-0.1, 0.1)) * h));
     const Vec3 centre(Real(0.15), Real(0.14), Real(0.05));
-    for (int i = -4; i <= 4; ++i)
-        for (int j = -4; j <= 4; ++j)
-            for (int k = -4; k <= 4; ++k) {
-                const Vec3 p = centre + Vec3(Real(i), Real(j), Real(k)) * h;
-                if ((p - centre).length() < 3.5 * h) x.push_back(p);
-            }
+    ghostfx::testing::addLatticeBall(x, centre, h, 4, 3.5 * h);
     ParticleSet set;
     set.addBatch(x, Real(1000) * h * h * h, ParticleKind::Liquid);
     for (std::size_t i = 0; i < set.size(); ++i)

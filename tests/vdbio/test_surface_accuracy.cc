@@ -25,6 +25,8 @@
 
 #include "common/Expect.h"
 
+#include "SphereSurface.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -118,28 +120,6 @@ void crossingsAlongZ(const openvdb::FloatGrid& phi, int i, int j, int k0, int k1
     }
 }
 
-/// Radial distance of every zero crossing on a voxel edge from a sphere of radius `radius`
-/// about the origin (m): as tests/vdbio/test_frame_files.cc, zeroCrossingAboutSphere.
-std::vector<double> radialErrors(const openvdb::FloatGrid& phi, double radius)
-{
-    std::vector<double> errors;
-    const auto acc = phi.getConstAccessor();
-    const openvdb::Coord steps[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-    for (auto it = phi.cbeginValueOn(); it; ++it) {
-        const double a = *it;
-        if (a >= 0) continue;
-        for (const openvdb::Coord& step : steps) {
-            const double b = acc.getValue(it.getCoord() + step);
-            if (b < 0) continue;
-            const openvdb::Vec3d xa = phi.indexToWorld(it.getCoord());
-            const openvdb::Vec3d xb = phi.indexToWorld(it.getCoord() + step);
-            errors.push_back((xa + (a / (a - b)) * (xb - xa)).length() - radius);
-        }
-    }
-    return errors;
-}
-
 /// Tank: the top face (z = (nz - 1) h) of a 24 x 24 x 8 block. Heights of the topmost zero
 /// crossing over the columns at least `margin` h inside the side faces, minus the top layer.
 Stats topFaceOffsets(const ParticleSet& block, SurfaceMethod method, int n, int nz, double margin)
@@ -206,16 +186,10 @@ TEST(SurfaceAccuracy, SphereRadiusIsKept)
 {
     // A Poisson-disk liquid sphere of radius 8 h ([SB12] Sec. 4.5): its surface samples lie on
     // the sphere, so the liquid's boundary is expected 0.5 h outside the outermost centres.
-    const SampleSet samples =
-        PoissonDiskSampler(PoissonSettings::forSpacing(Real(SPACING)))
-            .sampleVolume(
-                makeLevelSet(makeSphereLevelSet(Vec3(0), Real(SPHERE_RADIUS), Real(VOXEL))));
-    std::vector<std::uint8_t> interior(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-        interior[i] = samples.positions[i].length() < Real(SPHERE_RADIUS - 3 * SPACING);
-    }
-    const Real mass = massForRestDensity(samples.positions, CubicSplineKernel(Real(3 * SPACING)),
-                                         Real(REST_DENSITY), interior);
+    const ghostfx::testing::LiquidSphere liquid = ghostfx::testing::poissonLiquidSphere(
+        SPACING, SPHERE_RADIUS, VOXEL, 3 * SPACING, REST_DENSITY);
+    const SampleSet& samples = liquid.samples;
+    const Real mass = liquid.mass;
     ParticleSet sphere;
     sphere.addBatch(samples.positions, mass, ParticleKind::Liquid);
     double outermost = 0;
@@ -227,7 +201,7 @@ TEST(SurfaceAccuracy, SphereRadiusIsKept)
 
     for (SurfaceMethod method : {SurfaceMethod::Spheres, SurfaceMethod::Anisotropic}) {
         const auto phi = surfaceOf(sphere, method);
-        const Stats err = statsOf(radialErrors(*phi, expected));
+        const Stats err = statsOf(ghostfx::testing::radialCrossingErrors(*phi, expected));
         ASSERT_GT(err.count, 0u);
         std::printf("[measured] %s, sphere of %zu particles, expected radius %.3f h (outermost "
                     "+ 0.5 h; volume radius %.3f h): radius error mean %+.3f h, rms about the "
