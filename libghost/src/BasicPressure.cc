@@ -19,12 +19,6 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-bool BasicPressure::pressureFromDensity(LiquidStep& step)
-{
-    setTaitPressure(step.particles(), step.settings());
-    return true;
-}
-
 void BasicPressure::accelerate(LiquidStep& step, Real dt)
 {
     ParticleSet& set = step.particles();

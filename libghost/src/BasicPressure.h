@@ -2,20 +2,17 @@
 /// @brief  The "Basic SPH" baseline of [SB12] Sec. 3 as a pressure model (BasicPressure.cc).
 #pragma once
 
-#include "ghostfx/ghost/LiquidStep.h"
-#include "ghostfx/ghost/PressureSolver.h"
-
-#include <vector>
+#include "TaitPressure.h"
 
 namespace ghostfx {
 namespace ghost {
 
-class BasicPressure final : public PressureSolver
+/// Tait's equation of state with [SB12] Sec. 3's forces: Becker and Teschner's viscosity,
+/// Lennard-Jones walls and XSPH on the positions.
+class BasicPressure final : public TaitEquationOfState
 {
 public:
     std::string name() const override { return "basic"; }
-    /// Tait's equation, as TaitPressure.
-    bool pressureFromDensity(LiquidStep& step) override;
     void step(LiquidStep& step, Real dt) override;
 
 private:

@@ -177,6 +177,9 @@ private:
                                              DfsphSettings::RELAXATION_CFL);
         return std::min(Real(1), mDt / reference);
     }
+    template <typename T>
+    void takeOwners(std::vector<T>& values, std::vector<T>& channel, const char* name);
+    /// The halo copies' entries of `values` from their owners (DFSPH_SYNC carries them).
     void fromOwners(std::vector<Real>& values);
     template <bool KEPT> void gradientPass(const std::vector<Real>& k);
     /// u = G k (see the file comment), zero for air and spray.
@@ -247,16 +250,21 @@ private:
     std::vector<Vec3> change; ///< G k, accumulated with k
 };
 
-/// The halo copies' entries of `values` from their owners (DFSPH_SYNC carries them).
-void DfsphSolve::fromOwners(std::vector<Real>& values)
+/// The halo copies' entries of `values` from their owners, carried by `channel` (DFSPH_SYNC
+/// or DFSPH_SYNC_VECTOR).
+template <typename T>
+void DfsphSolve::takeOwners(std::vector<T>& values, std::vector<T>& channel, const char* name)
 {
-    if (!exchange) return;
-    auto& channel = mSet.scalarChannel(DFSPH_SYNC);
     std::copy(values.begin(), values.end(), channel.begin());
-    exchange->refresh(mSet, {DFSPH_SYNC});
+    exchange->refresh(mSet, {name});
     for (std::size_t i = 0; i < n; ++i) {
         if (halo[i] != Real(0)) values[i] = channel[i];
     }
+}
+
+void DfsphSolve::fromOwners(std::vector<Real>& values)
+{
+    if (exchange) takeOwners(values, mSet.scalarChannel(DFSPH_SYNC), DFSPH_SYNC);
 }
 
 template <bool KEPT> void DfsphSolve::gradientPass(const std::vector<Real>& k)
@@ -363,13 +371,7 @@ void DfsphSolve::gradientEverywhere(std::vector<Real>& values)
 {
     fromOwners(values);
     gradient(values);
-    if (!exchange) return;
-    auto& channel = mSet.vectorChannel(DFSPH_SYNC_VECTOR);
-    std::copy(u.begin(), u.end(), channel.begin());
-    exchange->refresh(mSet, {DFSPH_SYNC_VECTOR});
-    for (std::size_t i = 0; i < n; ++i) {
-        if (halo[i] != Real(0)) u[i] = channel[i];
-    }
+    if (exchange) takeOwners(u, mSet.vectorChannel(DFSPH_SYNC_VECTOR), DFSPH_SYNC_VECTOR);
 }
 
 /// r: the error the velocities w leave, beta (rho - rho0) + dt D rho / Dt for the density

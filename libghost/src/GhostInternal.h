@@ -133,16 +133,6 @@ inline Real taitPressure(Real rho, Real rho0, Real k)
     return k * (q2 * q2 * q2 * q - Real(1));
 }
 
-/// Every particle's pressure from its density by taitPressure.
-inline void setTaitPressure(sph::ParticleSet& set, const GhostSettings& settings)
-{
-    const auto& rho = set.densities();
-    auto& p = set.pressures();
-    const Real rho0 = settings.restDensity, k = settings.stiffness;
-    parallel::forEach(
-        0, set.size(), [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, k); }, 2048);
-}
-
 /// Nearest-liquid key of a solid particle: the distance in the high 32 bits (as float bits,
 /// which order like the values for r >= 0) and the liquid index in the low ones, so the
 /// smallest key is the nearest liquid particle and, at equal distance, the lowest index. Taking

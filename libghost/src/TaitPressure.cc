@@ -17,9 +17,14 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-bool TaitPressure::pressureFromDensity(LiquidStep& step)
+bool TaitEquationOfState::pressureFromDensity(LiquidStep& step)
 {
-    setTaitPressure(step.particles(), step.settings());
+    ParticleSet& set = step.particles();
+    const auto& rho = set.densities();
+    auto& p = set.pressures();
+    const Real rho0 = step.settings().restDensity, k = step.settings().stiffness;
+    parallel::forEach(
+        0, set.size(), [&](std::size_t i) { p[i] = taitPressure(rho[i], rho0, k); }, 2048);
     return true;
 }
 

@@ -11,12 +11,18 @@
 namespace ghostfx {
 namespace ghost {
 
-class TaitPressure final : public PressureSolver
+/// Tait's equation of state, p = k ((rho / rho0)^7 - 1) (ghost air: rho0, so p = 0), which
+/// the Tait step and Basic SPH's share.
+class TaitEquationOfState : public PressureSolver
+{
+public:
+    bool pressureFromDensity(LiquidStep& step) override;
+};
+
+class TaitPressure final : public TaitEquationOfState
 {
 public:
     std::string name() const override { return "tait"; }
-    /// p = k ((rho / rho0)^7 - 1) (ghost air: rho0, so p = 0).
-    bool pressureFromDensity(LiquidStep& step) override;
     void step(LiquidStep& step, Real dt) override;
     std::size_t memoryBytes() const override { return mTerm.capacity() * sizeof(Real); }
 
