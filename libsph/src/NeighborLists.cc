@@ -218,14 +218,13 @@ public:
         End ends[CHUNK];
         std::size_t used = 0; // bytes of the chunk
         for (std::size_t q = qFirst; q < qEnd; ++q) {
-            mHits = 0;
             if (!wanted(q) || !isFinite(mIn.queries[q])) {
                 ends[q - qFirst] = {std::uint32_t(used), 0};
                 continue;
             }
-            searchStencil(mIn.queries[q], radius2Of(q));
-            toParticleIndices();
-            const Index window = mHits > 0 ? store(out, used) : 0;
+            const std::size_t hits = searchStencil(mIn.queries[q], radius2Of(q));
+            toParticleIndices(hits);
+            const Index window = hits > 0 ? store(hits, out, used) : 0;
             if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
                 throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
             }
@@ -252,16 +251,17 @@ private:
 
     /// Search the cells around x that its ball of squared radius `radius2` reaches. Reachable
     /// cells whose slots follow each other (neighbours along z usually do: z is the lowest
-    /// Morton bit) are searched as one range.
-    void searchStencil(const Vec3& x, Real radius2)
+    /// Morton bit) are searched as one range. Returns the number of hits.
+    std::size_t searchStencil(const Vec3& x, Real radius2)
     {
         const NeighborGrid::Cell c = mIn.targets.cellOf(x);
         if (c != mStencil.centre) mStencil.lookUp(mIn.targets, c);
         Real axis2[3][3];
         reachPerAxis(x, c, axis2);
         const Real q[3] = {x[0], x[1], x[2]};
+        std::size_t hits = 0;
         NeighborGrid::SlotRange run;
-        for (int n = 0; n < mStencil.count; ++n) {
+        for (int n = 0, cells = mStencil.count; n < cells; ++n) {
             const std::uint8_t* o = mStencil.offset[n];
             if (axis2[0][o[0]] + axis2[1][o[1]] + axis2[2][o[2]] >= radius2) continue;
             const NeighborGrid::SlotRange range = mStencil.range[n];
@@ -269,10 +269,11 @@ private:
                 run.end = range.end;
                 continue;
             }
-            if (!run.empty()) searchRange(run, q, radius2);
+            if (!run.empty()) hits = searchRange(run, q, radius2, hits);
             run = range;
         }
-        if (!run.empty()) searchRange(run, q, radius2);
+        if (!run.empty()) hits = searchRange(run, q, radius2, hits);
+        return hits;
     }
 
     /// Squared distance from x (in cell c) to the slab of each neighbouring cell, per axis: 0
@@ -294,20 +295,20 @@ private:
         }
     }
 
-    /// Append the slots of `range` closer than sqrt(radius2) to q to the hits.
-    void searchRange(NeighborGrid::SlotRange range, const Real q[3], Real radius2)
+    /// Append the slots of `range` closer than sqrt(radius2) to q to the `hits` so far;
+    /// returns the new count.
+    std::size_t searchRange(NeighborGrid::SlotRange range, const Real q[3], Real radius2,
+                            std::size_t hits)
     {
-        const std::size_t room = mHits + (range.end - range.begin) + 8;
+        const std::size_t room = hits + (range.end - range.begin) + 8;
         if (mFound.size() < room) {
             mFound.resize(std::max(room, 2 * mFound.size()));
             mRunStart.resize(mFound.size() + 9);
         }
         Index* dst = mFound.data();
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-        if (mIn.avx2) {
-            mHits = searchRangeAvx2(mX, mY, mZ, range.begin, range.end, q, radius2, dst, mHits);
-            return;
-        }
+        if (mIn.avx2)
+            return searchRangeAvx2(mX, mY, mZ, range.begin, range.end, q, radius2, dst, hits);
 #endif
         const Real qx = q[0], qy = q[1], qz = q[2];
         for (std::uint32_t s0 = range.begin; s0 < range.end; s0 += BATCH) {
@@ -322,58 +323,60 @@ private:
                 const Real dx = qx - xs[k], dy = qy - ys[k], dz = qz - zs[k];
                 mR2[k] = dx * dx + dy * dy + dz * dz;
             }
-            mHits = appendHits(mR2, len, radius2, s0, dst, mHits);
+            hits = appendHits(mR2, len, radius2, s0, dst, hits);
         }
+        return hits;
     }
 
     /// Slots to particle indices (nothing to do for a grid over a sorted set).
-    void toParticleIndices()
+    void toParticleIndices(std::size_t hits)
     {
         if (mIn.targets.identityOrder()) return;
         Index* src = mFound.data();
-        for (std::size_t k = 0; k < mHits; ++k) src[k] = mIn.targets.particleAt(src[k]);
+        for (std::size_t k = 0; k < hits; ++k) src[k] = mIn.targets.particleAt(src[k]);
     }
 
-    /// Write the hits (at least one) to `out` from byte `used` on, advancing it: in runs of
+    /// Write the `hits` (at least one) to `out` from byte `used` on, advancing it: in runs of
     /// consecutive neighbours in one window of 256 indices where that is smaller and the
     /// windows fit 16 bits, else as 32-bit indices. Returns the list's first window, or RAW.
-    Index store(Chunk& out, std::size_t& used)
+    Index store(std::size_t hits, Chunk& out, std::size_t& used)
     {
         const Index* src = mFound.data();
         Index lo = RAW, hi = 0;
-        for (std::size_t k = 0; k < mHits; ++k) {
+        for (std::size_t k = 0; k < hits; ++k) {
             lo = std::min(lo, src[k]);
             hi = std::max(hi, src[k]);
         }
         const Index window = lo >> 8;
-        const std::size_t nRuns = findRuns();
-        const std::size_t bytes = List::COUNT + List::HEADER * nRuns + mHits;
-        if ((hi >> 8) - window <= 0xffff && nRuns <= 0xffff && bytes < sizeof(Index) * mHits) {
+        const std::size_t nRuns = findRuns(hits);
+        const std::size_t bytes = List::COUNT + List::HEADER * nRuns + hits;
+        if ((hi >> 8) - window <= 0xffff && nRuns <= 0xffff && bytes < sizeof(Index) * hits) {
             out.reserve(used + bytes + List::READ_PAST, used);
-            storeRuns(out.bytes.get() + used, nRuns, window);
+            storeRuns(out.bytes.get() + used, hits, nRuns, window);
             used += bytes;
             return window;
         }
         // Windows too far apart for 16 bits, or more runs than entries (targets not sorted).
-        out.reserve(used + sizeof(Index) * mHits + List::READ_PAST, used);
-        std::memcpy(out.bytes.get() + used, src, sizeof(Index) * mHits);
-        used += sizeof(Index) * mHits;
+        out.reserve(used + sizeof(Index) * hits + List::READ_PAST, used);
+        std::memcpy(out.bytes.get() + used, src, sizeof(Index) * hits);
+        used += sizeof(Index) * hits;
         return RAW;
     }
 
-    /// Where each run of the hits starts (where the window changes, branch-free), into
+    /// Where each run of the `hits` starts (where the window changes, branch-free), into
     /// mRunStart; returns the number of runs.
-    std::size_t findRuns()
+    std::size_t findRuns(std::size_t hits)
     {
         const Index* src = mFound.data();
+        std::uint32_t* runStart = mRunStart.data();
 #if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-        if (mIn.avx2) return findRunsAvx2(src, mHits, mRunStart.data());
+        if (mIn.avx2) return findRunsAvx2(src, hits, runStart);
 #endif
         std::size_t nRuns = 0;
         Index previous = RAW;
-        for (std::size_t k = 0; k < mHits; ++k) {
+        for (std::size_t k = 0; k < hits; ++k) {
             const Index w = src[k] >> 8;
-            mRunStart[nRuns] = std::uint32_t(k);
+            runStart[nRuns] = std::uint32_t(k);
             nRuns += std::size_t(w != previous);
             previous = w;
         }
@@ -382,22 +385,23 @@ private:
 
     /// Write the hits at `at` as a list in runs: the run count, a header per run (its window
     /// from `window`, its length less one), then a byte per neighbour.
-    void storeRuns(std::uint8_t* at, std::size_t nRuns, Index window)
+    void storeRuns(std::uint8_t* at, std::size_t hits, std::size_t nRuns, Index window)
     {
         const Index* src = mFound.data();
+        std::uint32_t* runStart = mRunStart.data();
         const std::uint16_t runs16 = std::uint16_t(nRuns);
         std::memcpy(at, &runs16, sizeof(runs16));
         std::uint8_t* header = at + List::COUNT;
-        mRunStart[nRuns] = std::uint32_t(mHits);
+        runStart[nRuns] = std::uint32_t(hits);
         for (std::size_t r = 0; r < nRuns; ++r, header += List::HEADER) {
-            const std::uint32_t k = mRunStart[r];
+            const std::uint32_t k = runStart[r];
             const std::uint16_t w = std::uint16_t((src[k] >> 8) - window);
             std::memcpy(header, &w, sizeof(w));
-            header[2] = std::uint8_t(mRunStart[r + 1] - k - 1); // at most 256 in a window
+            header[2] = std::uint8_t(runStart[r + 1] - k - 1); // at most 256 in a window
         }
         std::uint8_t* __restrict entry = header;
         const Index* __restrict from = src;
-        for (std::size_t k = 0; k < mHits; ++k) entry[k] = std::uint8_t(from[k]);
+        for (std::size_t k = 0; k < hits; ++k) entry[k] = std::uint8_t(from[k]);
     }
 
     /// Keep the chunk's `n` list ends (none when every list is empty) and fit its bytes to the
@@ -421,7 +425,6 @@ private:
     const Input& mIn;
     const Real *mX, *mY, *mZ; ///< the targets' sorted coordinates (m)
     Stencil mStencil;         ///< the cells around the last query's cell
-    std::size_t mHits = 0;    ///< the current query's hits in mFound
     /// The current query's hits as slots, then as particle indices.
     std::vector<Index> mFound = std::vector<Index>(1024);
     std::vector<std::uint32_t> mRunStart = std::vector<std::uint32_t>(1024 + 9); ///< its runs
