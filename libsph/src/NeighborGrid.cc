@@ -32,6 +32,23 @@ std::size_t NeighborGrid::memoryBytes() const
            + mIndex.capacity() * sizeof(Index) + mSlotOf.capacity() * sizeof(std::uint32_t);
 }
 
+namespace {
+
+/// Throw the error for position x of particle i, which the grid of `cellSize` (m) cannot hold.
+[[noreturn]] void throwBadPosition(const Vec3& x, std::size_t i, Real cellSize)
+{
+    if (!isFinite(x)) {
+        throw NumericalError(msg("neighbour grid: particle ", i, " has a non-finite position (",
+                                 x[0], ", ", x[1], ", ", x[2], ")"));
+    }
+    throw ValueError(msg("neighbour grid: particle ", i, " at (", x[0], ", ", x[1], ", ", x[2],
+                         ") m is beyond the grid range of +/-",
+                         Real(NeighborGrid::MAX_CELL_COORD) * cellSize, " m for cell size ",
+                         cellSize, " m"));
+}
+
+} // namespace
+
 void NeighborGrid::build(const Vec3* positions, std::size_t count)
 {
     if (count >= std::size_t(INVALID_INDEX)) {
@@ -46,9 +63,21 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     while (tableSize < 2 * count / mPerCellHint) tableSize *= 2;
     mTableMask = tableSize - 1;
 
-    // 1. Cell key and bucket of every particle; reject what the grid cannot represent.
     std::vector<std::uint32_t> bucket(count);
     std::vector<std::uint64_t> key(count);
+    keyPositions(positions, count, key, bucket);
+    const std::vector<std::uint32_t> bucketStart = scatterByBucket(bucket, tableSize);
+    const std::vector<std::uint32_t> bucketCells = sortBuckets(key, bucketStart);
+    buildLookup(tabulateCells(key, bucketStart, bucketCells));
+    gatherCoordinates(positions);
+}
+
+void NeighborGrid::keyPositions(const Vec3* positions, std::size_t count,
+                                std::vector<std::uint64_t>& key,
+                                std::vector<std::uint32_t>& bucket) const
+{
+    // The first position the grid cannot represent, by index, so the error does not depend
+    // on the thread count.
     std::atomic<std::size_t> badIndex{count};
     parallel::forEach(
         0, count,
@@ -66,20 +95,15 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         bucket[i] = bucketOf(c);
         },
         2048);
-    if (badIndex.load() < count) {
-        const std::size_t i = badIndex.load();
-        const Vec3& x = positions[i];
-        if (!isFinite(x)) {
-            throw NumericalError(msg("neighbour grid: particle ", i, " has a non-finite position (",
-                                     x[0], ", ", x[1], ", ", x[2], ")"));
-        }
-        throw ValueError(msg("neighbour grid: particle ", i, " at (", x[0], ", ", x[1], ", ", x[2],
-                             ") m is beyond the grid range of +/-",
-                             Real(MAX_CELL_COORD) * mCellSize, " m for cell size ", mCellSize,
-                             " m"));
-    }
+    const std::size_t bad = badIndex.load();
+    if (bad < count) throwBadPosition(positions[bad], bad, mCellSize);
+}
 
-    // 2. Histogram of bucket sizes.
+std::vector<std::uint32_t> NeighborGrid::scatterByBucket(const std::vector<std::uint32_t>& bucket,
+                                                         std::size_t tableSize)
+{
+    // Histogram of bucket sizes.
+    const std::size_t count = bucket.size();
     std::unique_ptr<std::atomic<std::uint32_t>[]> counts(new std::atomic<std::uint32_t>[tableSize]);
     parallel::forEach(
         0, tableSize, [&](std::size_t b) { counts[b].store(0, std::memory_order_relaxed); }, 8192);
@@ -87,7 +111,7 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         0, count, [&](std::size_t i) { counts[bucket[i]].fetch_add(1, std::memory_order_relaxed); },
         4096);
 
-    // 3. Exclusive scan into bucket starts; the counts become scatter cursors.
+    // Exclusive scan into bucket starts; the counts become scatter cursors.
     std::vector<std::uint32_t> bucketStart(tableSize + 1);
     std::uint32_t running = 0;
     for (std::size_t b = 0; b < tableSize; ++b) {
@@ -98,7 +122,7 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     }
     bucketStart[tableSize] = running;
 
-    // 4. Scatter particle indices to their bucket's slots.
+    // Scatter particle indices to their bucket's slots.
     mIndex.resize(count);
     parallel::forEach(
         0, count,
@@ -106,10 +130,15 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         mIndex[counts[bucket[i]].fetch_add(1, std::memory_order_relaxed)] = Index(i);
         },
         4096);
+    return bucketStart;
+}
 
-    // 5. The scatter order inside a bucket depends on thread timing: sort each bucket by cell,
-    //    then index, so the result is deterministic and every cell is one run of slots. Count
-    //    the cells of each bucket on the way.
+std::vector<std::uint32_t> NeighborGrid::sortBuckets(const std::vector<std::uint64_t>& key,
+                                                     const std::vector<std::uint32_t>& bucketStart)
+{
+    // The scatter order inside a bucket depends on thread timing: sorting each bucket by
+    // cell, then index, makes the result deterministic and every cell one run of slots.
+    const std::size_t tableSize = bucketStart.size() - 1;
     std::vector<std::uint32_t> bucketCells(tableSize + 1, 0);
     parallel::forEach(
         0, tableSize,
@@ -126,8 +155,15 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         bucketCells[b] = cells;
         },
         4096);
+    return bucketCells;
+}
 
-    // 6. Cell table: buckets to cells (exclusive scan), cells to slots and keys.
+std::vector<std::uint32_t> NeighborGrid::tabulateCells(
+    const std::vector<std::uint64_t>& key, const std::vector<std::uint32_t>& bucketStart,
+    const std::vector<std::uint32_t>& bucketCells)
+{
+    // Buckets to cells (exclusive scan), then cells to slots and keys.
+    const std::size_t tableSize = bucketStart.size() - 1;
     std::vector<std::uint32_t> bucketFirstCell(tableSize + 1);
     std::uint32_t cellCount = 0;
     for (std::size_t b = 0; b < tableSize; ++b) {
@@ -137,7 +173,7 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     bucketFirstCell[tableSize] = cellCount;
     mCellKey.resize(cellCount);
     mCellStart.resize(std::size_t(cellCount) + 1);
-    mCellStart[cellCount] = std::uint32_t(count);
+    mCellStart[cellCount] = std::uint32_t(mSize);
     parallel::forEach(
         0, tableSize,
         [&](std::size_t b) {
@@ -152,10 +188,16 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
         }
         },
         4096);
+    return bucketFirstCell;
+}
 
-    // 7. Lookup table: cells sit in bucket order, so 2^shift consecutive buckets hold one run
-    //    of cells. Merge as many as keep two lookup buckets per occupied cell: a liquid with
-    //    about 20 particles per cell keeps an eighth of the table the sort used.
+void NeighborGrid::buildLookup(const std::vector<std::uint32_t>& bucketFirstCell)
+{
+    // Cells sit in bucket order, so 2^shift consecutive buckets hold one run of cells. Merge
+    // as many as keep two lookup buckets per occupied cell: a liquid with about 20 particles
+    // per cell keeps an eighth of the table the sort used.
+    const std::size_t tableSize = bucketFirstCell.size() - 1;
+    const std::size_t cellCount = mCellKey.size();
     mLookupShift = 0;
     while (mLookupShift < MAX_LOOKUP_SHIFT
            && (tableSize >> (mLookupShift + 1)) >= 2 * std::size_t(cellCount)) {
@@ -165,9 +207,13 @@ void NeighborGrid::build(const Vec3* positions, std::size_t count)
     mBucketCell.resize(lookupSize + 1);
     for (std::size_t b = 0; b <= lookupSize; ++b)
         mBucketCell[b] = bucketFirstCell[b << mLookupShift];
+}
 
-    // 8. Gather coordinates in sorted order; inverse map for forEachNeighbor(i). The coordinate
-    //    arrays carry PADDING more entries, so vectorised distance loops may read past a range.
+void NeighborGrid::gatherCoordinates(const Vec3* positions)
+{
+    // The coordinate arrays carry PADDING more entries, so vectorised distance loops may read
+    // past a range; the inverse map serves forEachNeighbor(i).
+    const std::size_t count = mSize;
     mX.assign(count + PADDING, Real(0));
     mY.assign(count + PADDING, Real(0));
     mZ.assign(count + PADDING, Real(0));

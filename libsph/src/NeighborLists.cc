@@ -77,6 +77,20 @@ inline std::size_t appendHits(const Real* r2, std::size_t len, Real radius2, std
 /// The eight-lane table (AVX2).
 constexpr PackTable<8> PACK8;
 
+/// Append first + l to dst (from index `used`) for each lane l set in the eight-bit `mask`
+/// and below `left`, in increasing l, with one unconditional eight-wide store; returns the
+/// new count.
+__attribute__((target("avx2"))) inline std::size_t packLanes8(int mask, std::size_t left,
+                                                              std::uint32_t first,
+                                                              std::uint32_t* dst, std::size_t used)
+{
+    if (left < 8) mask &= (1 << left) - 1;
+    const __m256i lanes = _mm256_load_si256(reinterpret_cast<const __m256i*>(PACK8.lanes[mask]));
+    const __m256i index = _mm256_add_epi32(lanes, _mm256_set1_epi32(std::int32_t(first)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + used), index);
+    return used + PACK8.count[mask];
+}
+
 /// The same search as the portable path (the same products and sums in the same order, no
 /// fused multiply-add, so the same hits), eight candidates at a time. Compiled for AVX2 and
 /// called only where the processor has it. Reads up to seven slots past `end` (the grid pads
@@ -95,13 +109,8 @@ __attribute__((target("avx2"))) std::size_t searchRangeAvx2(const float* X, cons
         const __m256 dz = _mm256_sub_ps(cz, _mm256_loadu_ps(Z + s));
         const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
                                         _mm256_mul_ps(dz, dz));
-        int mask = _mm256_movemask_ps(_mm256_cmp_ps(r2, limit, _CMP_LT_OQ));
-        if (end - s < 8) mask &= (1 << (end - s)) - 1;
-        const __m256i lanes =
-            _mm256_load_si256(reinterpret_cast<const __m256i*>(PACK8.lanes[mask]));
-        const __m256i index = _mm256_add_epi32(lanes, _mm256_set1_epi32(std::int32_t(s)));
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + used), index);
-        used += PACK8.count[mask];
+        const int mask = _mm256_movemask_ps(_mm256_cmp_ps(r2, limit, _CMP_LT_OQ));
+        used = packLanes8(mask, end - s, s, dst, used);
     }
     return used;
 }
@@ -119,14 +128,9 @@ __attribute__((target("avx2"))) std::size_t findRunsAvx2(const Index* src, std::
             _mm256_srli_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + k)), 8);
         const __m256i before =
             _mm256_srli_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + k - 1)), 8);
-        int mask =
+        const int mask =
             ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(here, before))) & 0xff;
-        if (hits - k < 8) mask &= (1 << (hits - k)) - 1;
-        const __m256i lanes =
-            _mm256_load_si256(reinterpret_cast<const __m256i*>(PACK8.lanes[mask]));
-        const __m256i at = _mm256_add_epi32(lanes, _mm256_set1_epi32(std::int32_t(k)));
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(runStart + runs), at);
-        runs += PACK8.count[mask];
+        runs = packLanes8(mask, hits - k, std::uint32_t(k), runStart, runs);
     }
     return runs;
 }
@@ -170,7 +174,262 @@ struct Stencil
     }
 };
 
+/// The sum of count(list) over the lists of `lists`.
+template <typename Count>
+std::size_t sumOverLists(const NeighborLists& lists, Count&& count)
+{
+    std::size_t total = 0;
+    for (std::size_t q = 0; q < lists.size(); ++q) total += count(lists[q]);
+    return total;
+}
+
 } // namespace
+
+/// Fills the lists of one chunk of queries. Per query the reachable cells of the stencil are
+/// searched into a buffer of 32-bit hits (so the chunk needs room for the lists only, not for
+/// a search's candidates), which is then written to the chunk in its final form: runs, or
+/// 32-bit indices.
+class NeighborLists::ChunkBuilder
+{
+public:
+    /// What every chunk of one build reads.
+    struct Input
+    {
+        const NeighborGrid& targets;
+        const Vec3* queries;
+        std::size_t count;
+        Real radius;                ///< m
+        const std::uint8_t* select; ///< see buildSelected
+        int match;
+        const Real* queryRadius; ///< m, or null
+        bool avx2;               ///< whether to search with searchRangeAvx2
+    };
+
+    explicit ChunkBuilder(const Input& in)
+        : mIn(in)
+        , mX(in.targets.sortedX())
+        , mY(in.targets.sortedY())
+        , mZ(in.targets.sortedZ())
+    {}
+
+    /// Build the lists of queries [qFirst, qEnd) into `out` and fit it to them.
+    void fill(Chunk& out, std::size_t qFirst, std::size_t qEnd)
+    {
+        End ends[CHUNK];
+        std::size_t used = 0; // bytes of the chunk
+        for (std::size_t q = qFirst; q < qEnd; ++q) {
+            if (!wanted(q) || !isFinite(mIn.queries[q])) {
+                ends[q - qFirst] = {std::uint32_t(used), 0};
+                continue;
+            }
+            const std::size_t hits = searchStencil(mIn.queries[q], radius2Of(q));
+            toParticleIndices(hits);
+            const Index window = hits > 0 ? store(hits, out, used) : 0;
+            if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
+                throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
+            }
+            ends[q - qFirst] = {std::uint32_t(used), window};
+        }
+        finish(out, ends, qEnd - qFirst, used);
+    }
+
+private:
+    /// Whether query q gets a list (buildSelected's `select` and `match`).
+    bool wanted(std::size_t q) const
+    {
+        const std::uint8_t* select = mIn.select;
+        return !select || (mIn.match < 0 ? select[q] != 0 : int(select[q]) == mIn.match);
+    }
+
+    /// The squared search radius of query q (m^2): the build's, or its own when smaller.
+    Real radius2Of(std::size_t q) const
+    {
+        if (!mIn.queryRadius) return mIn.radius * mIn.radius;
+        const Real rq = std::min(mIn.queryRadius[q], mIn.radius);
+        return rq > Real(0) ? rq * rq : Real(0);
+    }
+
+    /// Search the cells around x that its ball of squared radius `radius2` reaches. Reachable
+    /// cells whose slots follow each other (neighbours along z usually do: z is the lowest
+    /// Morton bit) are searched as one range. Returns the number of hits.
+    std::size_t searchStencil(const Vec3& x, Real radius2)
+    {
+        const NeighborGrid::Cell c = mIn.targets.cellOf(x);
+        if (c != mStencil.centre) mStencil.lookUp(mIn.targets, c);
+        Real axis2[3][3];
+        reachPerAxis(x, c, axis2);
+        const Real q[3] = {x[0], x[1], x[2]};
+        std::size_t hits = 0;
+        NeighborGrid::SlotRange run;
+        for (int n = 0, cells = mStencil.count; n < cells; ++n) {
+            const std::uint8_t* o = mStencil.offset[n];
+            if (axis2[0][o[0]] + axis2[1][o[1]] + axis2[2][o[2]] >= radius2) continue;
+            const NeighborGrid::SlotRange range = mStencil.range[n];
+            if (!run.empty() && range.begin == run.end) {
+                run.end = range.end;
+                continue;
+            }
+            if (!run.empty()) hits = searchRange(run, q, radius2, hits);
+            run = range;
+        }
+        if (!run.empty()) hits = searchRange(run, q, radius2, hits);
+        return hits;
+    }
+
+    /// Squared distance from x (in cell c) to the slab of each neighbouring cell, per axis: 0
+    /// for its own cell, the distance to the lower / upper face for the others. A cell is
+    /// reachable when the sum over the axes is below R^2. The faces are moved out by a small
+    /// slack, so float rounding in the cell assignment never drops a neighbour.
+    void reachPerAxis(const Vec3& x, const NeighborGrid::Cell& c, Real axis2[3][3]) const
+    {
+        const Real cellSize = mIn.targets.cellSize();
+        const Real cell[3] = {Real(c.i), Real(c.j), Real(c.k)};
+        for (int a = 0; a < 3; ++a) {
+            const Real slack = Real(1e-3) * cellSize + Real(1e-5) * std::abs(x[a]);
+            const Real lo = x[a] - cell[a] * cellSize;
+            const Real below = std::max(Real(0), lo - slack);
+            const Real above = std::max(Real(0), cellSize - lo - slack);
+            axis2[a][0] = below * below;
+            axis2[a][1] = 0;
+            axis2[a][2] = above * above;
+        }
+    }
+
+    /// Append the slots of `range` closer than sqrt(radius2) to q to the `hits` so far;
+    /// returns the new count.
+    std::size_t searchRange(NeighborGrid::SlotRange range, const Real q[3], Real radius2,
+                            std::size_t hits)
+    {
+        const std::size_t room = hits + (range.end - range.begin) + 8;
+        if (mFound.size() < room) {
+            mFound.resize(std::max(room, 2 * mFound.size()));
+            mRunStart.resize(mFound.size() + 9);
+        }
+        Index* dst = mFound.data();
+#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
+        if (mIn.avx2)
+            return searchRangeAvx2(mX, mY, mZ, range.begin, range.end, q, radius2, dst, hits);
+#endif
+        const Real qx = q[0], qy = q[1], qz = q[2];
+        for (std::uint32_t s0 = range.begin; s0 < range.end; s0 += BATCH) {
+            const std::size_t len = std::min<std::size_t>(BATCH, range.end - s0);
+            const std::size_t padded = (len + 3) & ~std::size_t(3);
+            const Real* xs = mX + s0;
+            const Real* ys = mY + s0;
+            const Real* zs = mZ + s0;
+            // Distances first (vectorises; the grid pads its arrays, so reading up to three
+            // slots past the range is safe), then the hits.
+            for (std::size_t k = 0; k < padded; ++k) {
+                const Real dx = qx - xs[k], dy = qy - ys[k], dz = qz - zs[k];
+                mR2[k] = dx * dx + dy * dy + dz * dz;
+            }
+            hits = appendHits(mR2, len, radius2, s0, dst, hits);
+        }
+        return hits;
+    }
+
+    /// Slots to particle indices (nothing to do for a grid over a sorted set).
+    void toParticleIndices(std::size_t hits)
+    {
+        if (mIn.targets.identityOrder()) return;
+        Index* src = mFound.data();
+        for (std::size_t k = 0; k < hits; ++k) src[k] = mIn.targets.particleAt(src[k]);
+    }
+
+    /// Write the `hits` (at least one) to `out` from byte `used` on, advancing it: in runs of
+    /// consecutive neighbours in one window of 256 indices where that is smaller and the
+    /// windows fit 16 bits, else as 32-bit indices. Returns the list's first window, or RAW.
+    Index store(std::size_t hits, Chunk& out, std::size_t& used)
+    {
+        const Index* src = mFound.data();
+        Index lo = RAW, hi = 0;
+        for (std::size_t k = 0; k < hits; ++k) {
+            lo = std::min(lo, src[k]);
+            hi = std::max(hi, src[k]);
+        }
+        const Index window = lo >> 8;
+        const std::size_t nRuns = findRuns(hits);
+        const std::size_t bytes = List::COUNT + List::HEADER * nRuns + hits;
+        if ((hi >> 8) - window <= 0xffff && nRuns <= 0xffff && bytes < sizeof(Index) * hits) {
+            out.reserve(used + bytes + List::READ_PAST, used);
+            storeRuns(out.bytes.get() + used, hits, nRuns, window);
+            used += bytes;
+            return window;
+        }
+        // Windows too far apart for 16 bits, or more runs than entries (targets not sorted).
+        out.reserve(used + sizeof(Index) * hits + List::READ_PAST, used);
+        std::memcpy(out.bytes.get() + used, src, sizeof(Index) * hits);
+        used += sizeof(Index) * hits;
+        return RAW;
+    }
+
+    /// Where each run of the `hits` starts (where the window changes, branch-free), into
+    /// mRunStart; returns the number of runs.
+    std::size_t findRuns(std::size_t hits)
+    {
+        const Index* src = mFound.data();
+        std::uint32_t* runStart = mRunStart.data();
+#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
+        if (mIn.avx2) return findRunsAvx2(src, hits, runStart);
+#endif
+        std::size_t nRuns = 0;
+        Index previous = RAW;
+        for (std::size_t k = 0; k < hits; ++k) {
+            const Index w = src[k] >> 8;
+            runStart[nRuns] = std::uint32_t(k);
+            nRuns += std::size_t(w != previous);
+            previous = w;
+        }
+        return nRuns;
+    }
+
+    /// Write the hits at `at` as a list in runs: the run count, a header per run (its window
+    /// from `window`, its length less one), then a byte per neighbour.
+    void storeRuns(std::uint8_t* at, std::size_t hits, std::size_t nRuns, Index window)
+    {
+        const Index* src = mFound.data();
+        std::uint32_t* runStart = mRunStart.data();
+        const std::uint16_t runs16 = std::uint16_t(nRuns);
+        std::memcpy(at, &runs16, sizeof(runs16));
+        std::uint8_t* header = at + List::COUNT;
+        runStart[nRuns] = std::uint32_t(hits);
+        for (std::size_t r = 0; r < nRuns; ++r, header += List::HEADER) {
+            const std::uint32_t k = runStart[r];
+            const std::uint16_t w = std::uint16_t((src[k] >> 8) - window);
+            std::memcpy(header, &w, sizeof(w));
+            header[2] = std::uint8_t(runStart[r + 1] - k - 1); // at most 256 in a window
+        }
+        std::uint8_t* __restrict entry = header;
+        const Index* __restrict from = src;
+        for (std::size_t k = 0; k < hits; ++k) entry[k] = std::uint8_t(from[k]);
+    }
+
+    /// Keep the chunk's `n` list ends (none when every list is empty) and fit its bytes to the
+    /// `used` its lists take: they shrank since an earlier step, or it grew by a sixteenth
+    /// while being filled, and capacity is what the process holds. Most chunks are
+    /// re-allocated in most steps; that costs less than a step's noise
+    /// (bench/history/diary-2026-11.md, "Memory: lists fitted").
+    static void finish(Chunk& out, const End* ends, std::size_t n, std::size_t used)
+    {
+        if (used == 0) {
+            out.ends.reset();
+            out.bytes.reset();
+            out.capacity = 0;
+        } else {
+            if (!out.ends) out.ends.reset(new End[CHUNK]);
+            std::copy(ends, ends + n, out.ends.get());
+        }
+        if (out.capacity > used + used / 64 + 64 + List::READ_PAST) out.shrink(used);
+    }
+
+    const Input& mIn;
+    const Real *mX, *mY, *mZ; ///< the targets' sorted coordinates (m)
+    Stencil mStencil;         ///< the cells around the last query's cell
+    /// The current query's hits as slots, then as particle indices.
+    std::vector<Index> mFound = std::vector<Index>(1024);
+    std::vector<std::uint32_t> mRunStart = std::vector<std::uint32_t>(1024 + 9); ///< its runs
+    alignas(16) Real mR2[BATCH] = {}; ///< squared distances of one batch of candidates
+};
 
 void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
                           Real radius, const std::uint8_t* wanted, const Real* queryRadius)
@@ -202,184 +461,12 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
     }
     const std::size_t chunks = (count + CHUNK - 1) / CHUNK;
     mChunks.resize(chunks); // chunks beyond this build's queries give their memory back
-    const Real radiusSquared = radius * radius;
-    const Real cellSize = targets.cellSize();
-    const Real* X = targets.sortedX();
-    const Real* Y = targets.sortedY();
-    const Real* Z = targets.sortedZ();
-#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-    const bool avx2 = haveAvx2() && gWideSimd.load();
-#endif
-
+    const ChunkBuilder::Input in{targets, queries, count,       radius,
+                                 select,  match,   queryRadius, wideSimd()};
     parallel::forEach(
         0, chunks,
         [&](std::size_t chunk) {
-        Chunk& out = mChunks[chunk];
-        std::size_t used = 0; // bytes of the chunk
-        End ends[CHUNK];
-        const std::size_t qFirst = chunk * CHUNK;
-        std::size_t hits = 0;
-        // The current query's hits as 32-bit entries; the chunk then gets them in their
-        // final form, so it needs room for the lists only, not for a search's candidates.
-        std::vector<Index> found(1024);
-        std::vector<std::uint32_t> runStart(found.size() + 9); // the current list's runs
-        Stencil stencil;
-        alignas(16) Real r2[BATCH] = {};
-        const std::size_t qEnd = std::min(count, (chunk + 1) * CHUNK);
-        for (std::size_t q = qFirst; q < qEnd; ++q) {
-            hits = 0;
-            const bool wanted =
-                !select || (match < 0 ? select[q] != 0 : int(select[q]) == match);
-            if (!wanted || !isFinite(queries[q])) {
-                ends[q - qFirst] = {std::uint32_t(used), 0};
-                continue;
-            }
-            const Vec3& x = queries[q];
-            Real radius2 = radiusSquared;
-            if (queryRadius) {
-                const Real rq = std::min(queryRadius[q], radius);
-                radius2 = rq > Real(0) ? rq * rq : Real(0);
-            }
-            const NeighborGrid::Cell c = targets.cellOf(x);
-            if (c != stencil.centre) stencil.lookUp(targets, c);
-            // Squared distance from x to the slab of each neighbouring cell, per axis: 0 for its
-            // own cell, the distance to the lower / upper face for the others. A cell is
-            // reachable when the sum over the axes is below R^2. The faces are moved out by a
-            // small slack, so float rounding in the cell assignment never drops a neighbour.
-            Real axis2[3][3];
-            const Real cell[3] = {Real(c.i), Real(c.j), Real(c.k)};
-            for (int a = 0; a < 3; ++a) {
-                const Real slack = Real(1e-3) * cellSize + Real(1e-5) * std::abs(x[a]);
-                const Real lo = x[a] - cell[a] * cellSize;
-                const Real below = std::max(Real(0), lo - slack);
-                const Real above = std::max(Real(0), cellSize - lo - slack);
-                axis2[a][0] = below * below;
-                axis2[a][1] = 0;
-                axis2[a][2] = above * above;
-            }
-            const Real qx = x[0], qy = x[1], qz = x[2];
-            // Reachable cells whose slots follow each other (neighbours along z usually do: z
-            // is the lowest Morton bit) are searched as one range.
-            auto search = [&](NeighborGrid::SlotRange range) {
-                const std::size_t room = hits + (range.end - range.begin) + 8;
-                if (found.size() < room) {
-                    found.resize(std::max(room, 2 * found.size()));
-                    runStart.resize(found.size() + 9);
-                }
-                Index* dst = found.data();
-#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-                if (avx2) {
-                    const float q[3] = {qx, qy, qz};
-                    hits = searchRangeAvx2(X, Y, Z, range.begin, range.end, q, radius2, dst, hits);
-                    return;
-                }
-#endif
-                for (std::uint32_t s0 = range.begin; s0 < range.end; s0 += BATCH) {
-                    const std::size_t len = std::min<std::size_t>(BATCH, range.end - s0);
-                    const std::size_t padded = (len + 3) & ~std::size_t(3);
-                    const Real* xs = X + s0;
-                    const Real* ys = Y + s0;
-                    const Real* zs = Z + s0;
-                    // Distances first (vectorises; the grid pads its arrays, so reading up to
-                    // three slots past the range is safe), then the hits.
-                    for (std::size_t k = 0; k < padded; ++k) {
-                        const Real dx = qx - xs[k], dy = qy - ys[k], dz = qz - zs[k];
-                        r2[k] = dx * dx + dy * dy + dz * dz;
-                    }
-                    hits = appendHits(r2, len, radius2, s0, dst, hits);
-                }
-            };
-            NeighborGrid::SlotRange run;
-            for (int n = 0; n < stencil.count; ++n) {
-                const std::uint8_t* o = stencil.offset[n];
-                if (axis2[0][o[0]] + axis2[1][o[1]] + axis2[2][o[2]] >= radius2) continue;
-                const NeighborGrid::SlotRange range = stencil.range[n];
-                if (!run.empty() && range.begin == run.end) {
-                    run.end = range.end;
-                    continue;
-                }
-                if (!run.empty()) search(run);
-                run = range;
-            }
-            if (!run.empty()) search(run);
-            // Slots to particle indices (nothing to do for a grid over a sorted set), then
-            // runs of consecutive neighbours in one window of 256 indices.
-            Index* src = found.data();
-            if (!targets.identityOrder()) {
-                for (std::size_t k = 0; k < hits; ++k) src[k] = targets.particleAt(src[k]);
-            }
-            Index window = 0;
-            if (hits > 0) {
-                Index lo = RAW, hi = 0;
-                for (std::size_t k = 0; k < hits; ++k) {
-                    lo = std::min(lo, src[k]);
-                    hi = std::max(hi, src[k]);
-                }
-                window = lo >> 8;
-                // Where each run starts: where the window changes (branch-free).
-                std::size_t nRuns = 0;
-#if defined(__x86_64__) && !defined(GHOSTFX_DOUBLE)
-                if (avx2) {
-                    nRuns = findRunsAvx2(src, hits, runStart.data());
-                } else
-#endif
-                {
-                    Index previous = RAW;
-                    for (std::size_t k = 0; k < hits; ++k) {
-                        const Index w = src[k] >> 8;
-                        runStart[nRuns] = std::uint32_t(k);
-                        nRuns += std::size_t(w != previous);
-                        previous = w;
-                    }
-                }
-                const std::size_t HEADER = List::HEADER, COUNT = List::COUNT;
-                const std::size_t bytes = COUNT + HEADER * nRuns + hits;
-                if ((hi >> 8) - window <= 0xffff && nRuns <= 0xffff
-                    && bytes < sizeof(Index) * hits) {
-                    out.reserve(used + bytes + List::READ_PAST, used);
-                    std::uint8_t* at = out.bytes.get() + used;
-                    const std::uint16_t runs16 = std::uint16_t(nRuns);
-                    std::memcpy(at, &runs16, sizeof(runs16));
-                    std::uint8_t* header = at + COUNT;
-                    runStart[nRuns] = std::uint32_t(hits);
-                    for (std::size_t r = 0; r < nRuns; ++r, header += HEADER) {
-                        const std::uint32_t k = runStart[r];
-                        const std::uint16_t w = std::uint16_t((src[k] >> 8) - window);
-                        std::memcpy(header, &w, sizeof(w));
-                        header[2] =
-                            std::uint8_t(runStart[r + 1] - k - 1); // at most 256 in a window
-                    }
-                    std::uint8_t* __restrict entry = header;
-                    const Index* __restrict from = src;
-                    for (std::size_t k = 0; k < hits; ++k) entry[k] = std::uint8_t(from[k]);
-                    used += bytes;
-                } else {
-                    // Windows too far apart for 16 bits, or more runs than entries (targets
-                    // not sorted): 32-bit indices.
-                    window = RAW;
-                    out.reserve(used + sizeof(Index) * hits + List::READ_PAST, used);
-                    std::memcpy(out.bytes.get() + used, src, sizeof(Index) * hits);
-                    used += sizeof(Index) * hits;
-                }
-            }
-            if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
-                throw ValueError("neighbour lists: more than 2^32 entries in one chunk");
-            }
-            ends[q - qFirst] = {std::uint32_t(used), window};
-        }
-        if (used == 0) {
-            out.ends.reset();
-            out.bytes.reset();
-            out.capacity = 0;
-        } else {
-            if (!out.ends) out.ends.reset(new End[CHUNK]);
-            std::copy(ends, ends + (qEnd - qFirst), out.ends.get());
-        }
-        // Fit the chunk to its lists (they shrank since an earlier step, or it grew by a
-        // sixteenth while being filled): capacity is what the process holds. Most chunks are
-        // re-allocated in most steps; that costs less than a step's noise
-        // (bench/history/diary-2026-11.md, "Memory: lists fitted").
-        if (out.capacity > used + used / 64 + 64 + List::READ_PAST) out.shrink(used);
+        ChunkBuilder(in).fill(mChunks[chunk], chunk * CHUNK, std::min(count, (chunk + 1) * CHUNK));
         },
         1);
 }
@@ -416,26 +503,19 @@ void NeighborLists::Chunk::reserve(std::size_t size, std::size_t used)
 
 std::size_t NeighborLists::pairCount() const
 {
-    std::size_t total = 0;
-    for (std::size_t q = 0; q < mSize; ++q) total += (*this)[q].size();
-    return total;
+    return sumOverLists(*this, [](const List& list) { return list.size(); });
 }
 
 std::size_t NeighborLists::rawListCount() const
 {
-    std::size_t total = 0;
-    for (std::size_t q = 0; q < mSize; ++q) {
-        const List list = (*this)[q];
-        total += list.raw() != nullptr && !list.empty();
-    }
-    return total;
+    return sumOverLists(*this, [](const List& list) {
+        return std::size_t(list.raw() != nullptr && !list.empty());
+    });
 }
 
 std::size_t NeighborLists::runCount() const
 {
-    std::size_t total = 0;
-    for (std::size_t q = 0; q < mSize; ++q) total += (*this)[q].runs();
-    return total;
+    return sumOverLists(*this, [](const List& list) { return list.runs(); });
 }
 
 std::size_t NeighborLists::memoryBytes() const

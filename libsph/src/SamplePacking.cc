@@ -72,6 +72,188 @@ struct SampleCache
     bool valid = false;
 };
 
+/// The packing steps over one sample set. It works on a copy in the grid's cell order, so
+/// that neighbours are near in memory; moves of r / 5 per step keep it nearly sorted. The
+/// samples go back to their places in writeBack().
+class Packing
+{
+public:
+    /// Pack the samples with movable[i] (all when empty); the rest hold still.
+    Packing(const SampleSet& samples, const LevelSet& shape, const PoissonSettings& settings,
+            const std::vector<std::uint8_t>& movable)
+        : mShape(shape)
+        , mR(settings.radius)
+        , mH(mR / PoissonSettings::SB12_RADIUS_FACTOR)
+        , mKernel(SUPPORT_SPACINGS * mH)
+        , mSupport(mKernel.supportRadius())
+        , mGain(STEP_GAIN * mSupport * mSupport * mH * mH * mH)
+        , mMaxMove(MAX_MOVE_RADII * mR)
+        , mBand(samples, shape, settings.bandDepth, mR)
+        , mGrid(mSupport)
+    {
+        const std::size_t n = samples.size();
+        mGrid.build(samples.positions);
+        mOrder = mGrid.order();
+        if (mOrder.empty()) {
+            mOrder.resize(n);
+            for (std::size_t k = 0; k < n; ++k) mOrder[k] = Index(k);
+        }
+        mX.resize(n);
+        mNext.resize(n);
+        mSurface.resize(n);
+        mMoves.resize(n);
+        mKeep.resize(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            mX[k] = samples.positions[mOrder[k]];
+            mSurface[k] = samples.onSurface[mOrder[k]];
+            mMoves[k] = movable.empty() || movable[mOrder[k]];
+        }
+        mCache.resize(n);
+        mLimit2.resize(n);
+    }
+
+    /// One Jacobi step: every movable sample proposes a move, then keeps it if allowed.
+    void step()
+    {
+        const std::size_t n = mX.size();
+        mGrid.build(mX);
+        mLists.build(mGrid, mX.data(), n, mSupport, mMoves.data());
+        parallel::forEach(
+            0, n, [&](std::size_t k) { mNext[k] = mMoves[k] ? propose(k) : mX[k]; }, 256);
+        parallel::forEach(
+            0, n, [&](std::size_t k) { mKeep[k] = mNext[k] != mX[k] && allowed(k); }, 256);
+        for (std::size_t k = 0; k < n; ++k) {
+            if (!mKeep[k]) continue;
+            mX[k] = mNext[k];
+            mCache[k].valid = false;
+        }
+    }
+
+    /// The packed positions back into the set, in its order.
+    void writeBack(SampleSet& samples) const
+    {
+        for (std::size_t k = 0; k < mX.size(); ++k) samples.positions[mOrder[k]] = mX[k];
+    }
+
+private:
+    /// Where sample k would go: down the density gradient, within its constraints; x[k] itself
+    /// when it stays. Also sets mLimit2[k], the squared distance it must keep from the others.
+    Vec3 propose(std::size_t k)
+    {
+        const Vec3 xk = mX[k];
+        Vec3 step = densityStep(k);
+        if (mSurface[k]) {
+            const Vec3& normal = surfaceNormal(k);
+            step -= normal * step.dot(normal);
+        }
+        const Real length = step.length();
+        if (!(length > Real(0))) return xk;
+        if (length > mMaxMove) step *= mMaxMove / length;
+        const Vec3 to = xk + step;
+        return mSurface[k] ? ontoSurface(xk, to) : insideShape(k, xk, to);
+    }
+
+    /// -a R^2 h^3 sum_j grad W(x_k - x_j) over k's list; sets mLimit2[k] to the lesser of r^2
+    /// and the squared distance to its nearest neighbour.
+    Vec3 densityStep(std::size_t k)
+    {
+        const Vec3 xk = mX[k];
+        Vec3 gradient(0);
+        Real nearest2 = std::numeric_limits<Real>::max();
+        mLists[k].forEach([&](Index j) {
+            if (j == Index(k)) return;
+            const Vec3 xkj = xk - mX[j];
+            const Real r2 = xkj.lengthSqr();
+            gradient += mKernel.gradW(xkj, std::sqrt(r2));
+            nearest2 = std::min(nearest2, r2);
+        });
+        mLimit2[k] = std::min(mR * mR, nearest2);
+        return gradient * (-mGain);
+    }
+
+    /// The outward unit normal at surface sample k (cached until it moves).
+    const Vec3& surfaceNormal(std::size_t k)
+    {
+        SampleCache& c = mCache[k];
+        if (!c.valid) {
+            Vec3 g;
+            mShape.phiAndGradient(mX[k], g);
+            const Real len = g.length();
+            c.normal = len > Real(0) ? g / len : Vec3(0);
+            c.valid = true;
+        }
+        return c.normal;
+    }
+
+    /// A surface sample's move from xk to `to` (along the surface), projected back onto it;
+    /// xk when the projection fails or goes too far.
+    Vec3 ontoSurface(const Vec3& xk, const Vec3& to) const
+    {
+        Vec3 g;
+        const Real phi = mShape.phiAndGradient(to, g);
+        const SurfaceProjection proj = mShape.projectToSurface(to, phi, g);
+        if (!proj.converged || (proj.point - xk).lengthSqr() > Real(4) * mMaxMove * mMaxMove)
+            return xk;
+        return proj.point;
+    }
+
+    /// An interior sample k's move from xk to `to`, if `to` is inside the shape and within the
+    /// band; else xk.
+    Vec3 insideShape(std::size_t k, const Vec3& xk, const Vec3& to)
+    {
+        SampleCache& c = mCache[k];
+        if (!c.valid) {
+            c.phi = mShape.phi(xk);
+            c.valid = true;
+        }
+        // phi(to) where needed, looked up once.
+        Real phiTo = 0;
+        bool known = false;
+        auto phiOfTo = [&] {
+            if (!known) {
+                phiTo = mShape.phi(to);
+                known = true;
+            }
+            return phiTo;
+        };
+        if (c.phi + LIPSCHITZ * mMaxMove >= Real(0) && !(phiOfTo() < Real(0))) return xk;
+        if (mBand.limited() && !mBand.accepts(to, phiOfTo, c.bandHint)) return xk;
+        return to;
+    }
+
+    /// Whether k may move to next[k]: no closer than sqrt(limit2[k]) to any other sample, at
+    /// its old position or its new one. Any sample that could come that close is on k's list
+    /// (see MAX_MOVE_RADII).
+    bool allowed(std::size_t k) const
+    {
+        const Vec3 to = mNext[k];
+        bool ok = true;
+        mLists[k].forEach([&](Index j) {
+            if (j != Index(k)
+                && ((to - mX[j]).lengthSqr() < mLimit2[k]
+                    || (to - mNext[j]).lengthSqr() < mLimit2[k]))
+                ok = false;
+        });
+        return ok;
+    }
+
+    const LevelSet& mShape;
+    const Real mR; ///< Poisson radius (m)
+    const Real mH; ///< particle spacing (m)
+    const CubicSplineKernel mKernel;
+    const Real mSupport; ///< the kernel's support radius R (m)
+    const Real mGain;    ///< a R^2 h^3 (m^5)
+    const Real mMaxMove; ///< largest move per step (m)
+    const detail::DepthLimit mBand;
+    NeighborGrid mGrid;
+    NeighborLists mLists;
+    std::vector<Index> mOrder;   ///< sample index of each working slot
+    std::vector<Vec3> mX, mNext; ///< positions (m) at the step's start and proposed
+    std::vector<std::uint8_t> mSurface, mMoves, mKeep;
+    std::vector<SampleCache> mCache;
+    std::vector<Real> mLimit2; ///< per sample: the squared distance it must keep (m^2)
+};
+
 } // namespace
 
 void PoissonDiskSampler::pack(SampleSet& samples, const LevelSet& shape, int iterations) const
@@ -82,121 +264,10 @@ void PoissonDiskSampler::pack(SampleSet& samples, const LevelSet& shape, int ite
 void PoissonDiskSampler::packSome(SampleSet& samples, const LevelSet& shape, int iterations,
                                   const std::vector<std::uint8_t>& movable) const
 {
-    const std::size_t n = samples.size();
-    if (iterations <= 0 || n < 2) return;
-    const Real r = mSettings.radius;
-    const Real h = r / PoissonSettings::SB12_RADIUS_FACTOR;
-    const CubicSplineKernel kernel(SUPPORT_SPACINGS * h);
-    const Real support = kernel.supportRadius();
-    const Real gain = STEP_GAIN * support * support * h * h * h;
-    const Real maxMove = MAX_MOVE_RADII * r;
-    const detail::DepthLimit band(samples, shape, mSettings.bandDepth, r);
-
-    // Work on a copy in the grid's cell order, so that neighbours are near in memory; moves of
-    // r / 5 per step keep it nearly sorted. The samples go back to their places at the end.
-    NeighborGrid grid(support);
-    grid.build(samples.positions);
-    std::vector<Index> order = grid.order();
-    if (order.empty()) {
-        order.resize(n);
-        for (std::size_t k = 0; k < n; ++k) order[k] = Index(k);
-    }
-    std::vector<Vec3> x(n), next(n);
-    std::vector<std::uint8_t> surface(n), moves(n), keep(n);
-    for (std::size_t k = 0; k < n; ++k) {
-        x[k] = samples.positions[order[k]];
-        surface[k] = samples.onSurface[order[k]];
-        moves[k] = movable.empty() || movable[order[k]];
-    }
-    std::vector<SampleCache> cache(n);
-    std::vector<Real> limit2(n);
-    NeighborLists lists;
-
-    // Where sample k would go: down the density gradient, within its constraints; x[k] itself
-    // when it stays. Also sets limit2[k], the squared distance it must keep from the others.
-    auto propose = [&](std::size_t k) {
-        const Vec3 xk = x[k];
-        Vec3 gradient(0);
-        Real nearest2 = std::numeric_limits<Real>::max();
-        lists[k].forEach([&](Index j) {
-            if (j == Index(k)) return;
-            const Vec3 xkj = xk - x[j];
-            const Real r2 = xkj.lengthSqr();
-            gradient += kernel.gradW(xkj, std::sqrt(r2));
-            nearest2 = std::min(nearest2, r2);
-        });
-        limit2[k] = std::min(r * r, nearest2);
-        Vec3 step = gradient * (-gain);
-        SampleCache& c = cache[k];
-        if (surface[k]) {
-            if (!c.valid) {
-                Vec3 g;
-                shape.phiAndGradient(xk, g);
-                const Real len = g.length();
-                c.normal = len > Real(0) ? g / len : Vec3(0);
-                c.valid = true;
-            }
-            step -= c.normal * step.dot(c.normal);
-        }
-        const Real length = step.length();
-        if (!(length > Real(0))) return xk;
-        if (length > maxMove) step *= maxMove / length;
-        const Vec3 to = xk + step;
-        if (surface[k]) {
-            Vec3 g;
-            const Real phi = shape.phiAndGradient(to, g);
-            const SurfaceProjection proj = shape.projectToSurface(to, phi, g);
-            if (!proj.converged || (proj.point - xk).lengthSqr() > Real(4) * maxMove * maxMove)
-                return xk;
-            return proj.point;
-        }
-        if (!c.valid) {
-            c.phi = shape.phi(xk);
-            c.valid = true;
-        }
-        // phi(to) where needed, looked up once.
-        Real phiTo = 0;
-        bool known = false;
-        auto phiOfTo = [&] {
-            if (!known) {
-                phiTo = shape.phi(to);
-                known = true;
-            }
-            return phiTo;
-        };
-        if (c.phi + LIPSCHITZ * maxMove >= Real(0) && !(phiOfTo() < Real(0))) return xk;
-        if (band.limited() && !band.accepts(to, phiOfTo, c.bandHint)) return xk;
-        return to;
-    };
-
-    // Whether k may move to next[k]: no closer than sqrt(limit2[k]) to any other sample, at its
-    // old position or its new one. Any sample that could come that close is on k's list (see
-    // MAX_MOVE_RADII).
-    auto allowed = [&](std::size_t k) {
-        const Vec3 to = next[k];
-        bool ok = true;
-        lists[k].forEach([&](Index j) {
-            if (j != Index(k)
-                && ((to - x[j]).lengthSqr() < limit2[k] || (to - next[j]).lengthSqr() < limit2[k]))
-                ok = false;
-        });
-        return ok;
-    };
-
-    for (int step = 0; step < iterations; ++step) {
-        grid.build(x);
-        lists.build(grid, x.data(), n, support, moves.data());
-        parallel::forEach(
-            0, n, [&](std::size_t k) { next[k] = moves[k] ? propose(k) : x[k]; }, 256);
-        parallel::forEach(
-            0, n, [&](std::size_t k) { keep[k] = next[k] != x[k] && allowed(k); }, 256);
-        for (std::size_t k = 0; k < n; ++k) {
-            if (!keep[k]) continue;
-            x[k] = next[k];
-            cache[k].valid = false;
-        }
-    }
-    for (std::size_t k = 0; k < n; ++k) samples.positions[order[k]] = x[k];
+    if (iterations <= 0 || samples.size() < 2) return;
+    Packing packing(samples, shape, mSettings, movable);
+    for (int step = 0; step < iterations; ++step) packing.step();
+    packing.writeBack(samples);
 }
 
 } // namespace sph

@@ -221,6 +221,26 @@ private:
     template <typename Fn>
     void visitCell(const Cell& c, const Vec3& x, Real radius2, Fn& fn) const;
 
+    // The passes of build(), in order (NeighborGrid.cc).
+    /// Cell key and bucket of each position; throws on one the grid cannot represent.
+    void keyPositions(const Vec3* positions, std::size_t count, std::vector<std::uint64_t>& key,
+                      std::vector<std::uint32_t>& bucket) const;
+    /// Particle indices into mIndex by bucket (count, scan, scatter); returns where each of
+    /// the `tableSize` buckets starts, and the slot count after them.
+    std::vector<std::uint32_t> scatterByBucket(const std::vector<std::uint32_t>& bucket,
+                                               std::size_t tableSize);
+    /// Sort each bucket's slots by cell, then index; returns the cells in each bucket.
+    std::vector<std::uint32_t> sortBuckets(const std::vector<std::uint64_t>& key,
+                                           const std::vector<std::uint32_t>& bucketStart);
+    /// The table of occupied cells (mCellKey, mCellStart); returns each bucket's first cell.
+    std::vector<std::uint32_t> tabulateCells(const std::vector<std::uint64_t>& key,
+                                             const std::vector<std::uint32_t>& bucketStart,
+                                             const std::vector<std::uint32_t>& bucketCells);
+    /// The cell-lookup table (mBucketCell, mLookupShift) over the cells of the sort buckets.
+    void buildLookup(const std::vector<std::uint32_t>& bucketFirstCell);
+    /// The coordinates in slot order and the slot of each particle.
+    void gatherCoordinates(const Vec3* positions);
+
     Real mCellSize, mInvCellSize;
     /// Buckets of the sort table (minus one). Sorted order is by bucket, then key.
     std::uint64_t mTableMask = 63;

@@ -254,6 +254,8 @@ private:
                        const Real* queryRadius);
     /// `End::window` of a list kept as 32-bit indices.
     static constexpr Index RAW = ~Index(0);
+    /// Searches the queries of one chunk and writes their lists (NeighborLists.cc).
+    class ChunkBuilder;
 
     /// Per query: the end of its list within its chunk (bytes), and the window its runs'
     /// windows count from (RAW: 32-bit indices).

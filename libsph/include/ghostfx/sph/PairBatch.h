@@ -230,6 +230,16 @@ struct PairBatch
                                   _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
     }
 
+    /// The components of a vector, each in every lane.
+    struct Lanes3
+    {
+        __m256 x, y, z;
+    };
+    static Lanes3 broadcast(const Vec3& v)
+    {
+        return {_mm256_set1_ps(v[0]), _mm256_set1_ps(v[1]), _mm256_set1_ps(v[2])};
+    }
+
     /// fn(load, vx, vy, vz) for each group of LANES neighbours, with values[j[k + l]] gathered
     /// into the lanes and load(a) giving a[k + l] (the group's first neighbour k). In a last,
     /// partial group the lanes past the batch hold 0 in both, so the terms fn adds from them
@@ -277,12 +287,12 @@ struct PairBatch
     }
 
     /// (vi - v) . p lane by lane, in the scalar loops' order ((dx px + dy py) + dz pz).
-    static __m256 approach(__m256 ix, __m256 iy, __m256 iz, __m256 vx, __m256 vy, __m256 vz,
-                           __m256 px, __m256 py, __m256 pz)
+    static __m256 approach(const Lanes3& vi, __m256 vx, __m256 vy, __m256 vz, __m256 px, __m256 py,
+                           __m256 pz)
     {
-        return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(ix, vx), px),
-                                           _mm256_mul_ps(_mm256_sub_ps(iy, vy), py)),
-                             _mm256_mul_ps(_mm256_sub_ps(iz, vz), pz));
+        return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(vi.x, vx), px),
+                                           _mm256_mul_ps(_mm256_sub_ps(vi.y, vy), py)),
+                             _mm256_mul_ps(_mm256_sub_ps(vi.z, vz), pz));
     }
 
     /// The lanes' partial sums added in lane order from zero, as the scalar loops add theirs.
@@ -296,19 +306,56 @@ struct PairBatch
     }
 #endif
 
+    /// sum_k term(k) over the batch in LANES interleaved partial sums, then the lanes added in
+    /// order from zero: the order of every scalar sum here.
+    template <typename Term>
+    Real laneSum(Term&& term) const
+    {
+        Real lane[LANES] = {};
+        int k = 0;
+        for (; k + LANES <= n; k += LANES) {
+            for (int l = 0; l < LANES; ++l) lane[l] += term(k + l);
+        }
+        // Fewer than LANES terms are left; `l < LANES` says so to the compiler, which otherwise
+        // warns that lane[] could be overrun where it cannot bound n.
+        for (int l = 0; l < LANES && k < n; ++k, ++l) lane[l] += term(k);
+        Real total = 0;
+        for (int l = 0; l < LANES; ++l) total += lane[l];
+        return total;
+    }
+
+    /// laneSum of a vector term, each component in partial sums of its own.
+    template <typename Term>
+    Vec3 laneSum3(Term&& term) const
+    {
+        Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
+        auto add = [&](int l, const Vec3& t) {
+            lx[l] += t[0];
+            ly[l] += t[1];
+            lz[l] += t[2];
+        };
+        int k = 0;
+        for (; k + LANES <= n; k += LANES) {
+            for (int l = 0; l < LANES; ++l) add(l, term(k + l));
+        }
+        for (int l = 0; l < LANES && k < n; ++k, ++l) add(l, term(k));
+        Vec3 total(0);
+        for (int l = 0; l < LANES; ++l) total += Vec3(lx[l], ly[l], lz[l]);
+        return total;
+    }
+
     /// x_i - x_j and r for the n indices in j[].
     void gather(const Vec3& xi, const Vec3* x)
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
         // Eight neighbours at a time (the arrays hold SIZE, a multiple of LANES, so the last
         // group's stores stay inside them; entries past n are not read).
-        const __m256 ix = _mm256_set1_ps(xi[0]), iy = _mm256_set1_ps(xi[1]),
-                     iz = _mm256_set1_ps(xi[2]);
+        const Lanes3 i = broadcast(xi);
         for (int k = 0; k < n; k += LANES) {
             __m256 vx, vy, vz;
             loadLanes(x, j + k, std::min(LANES, n - k), vx, vy, vz);
-            const __m256 ox = _mm256_sub_ps(ix, vx), oy = _mm256_sub_ps(iy, vy),
-                         oz = _mm256_sub_ps(iz, vz);
+            const __m256 ox = _mm256_sub_ps(i.x, vx), oy = _mm256_sub_ps(i.y, vy),
+                         oz = _mm256_sub_ps(i.z, vz);
             _mm256_storeu_ps(dx + k, ox);
             _mm256_storeu_ps(dy + k, oy);
             _mm256_storeu_ps(dz + k, oz);
@@ -337,17 +384,7 @@ struct PairBatch
         if (k < n) acc = _mm256_add_ps(acc, _mm256_maskload_ps(a + k, tailMask(n - k)));
         return reduceLanes(acc);
 #else
-        Real lane[LANES] = {};
-        int k = 0;
-        for (; k + LANES <= n; k += LANES) {
-            for (int l = 0; l < LANES; ++l) lane[l] += a[k + l];
-        }
-        // Fewer than LANES terms are left; `l < LANES` says so to the compiler, which otherwise
-        // warns that lane[] could be overrun where it cannot bound n.
-        for (int l = 0; l < LANES && k < n; ++k, ++l) lane[l] += a[k];
-        Real total = 0;
-        for (int l = 0; l < LANES; ++l) total += lane[l];
-        return total;
+        return laneSum([a](int k) { return a[k]; });
 #endif
     }
 
@@ -355,36 +392,20 @@ struct PairBatch
     Vec3 sumScaledDifferences(const Real* a, const Vec3* values, const Vec3& vi) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
-                     iz = _mm256_set1_ps(vi[2]);
+        const Lanes3 i = broadcast(vi);
         __m256 lx = _mm256_setzero_ps(), ly = lx, lz = lx;
         forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
             const __m256 w = load(a);
-            lx = _mm256_add_ps(lx, _mm256_mul_ps(w, _mm256_sub_ps(vx, ix)));
-            ly = _mm256_add_ps(ly, _mm256_mul_ps(w, _mm256_sub_ps(vy, iy)));
-            lz = _mm256_add_ps(lz, _mm256_mul_ps(w, _mm256_sub_ps(vz, iz)));
+            lx = _mm256_add_ps(lx, _mm256_mul_ps(w, _mm256_sub_ps(vx, i.x)));
+            ly = _mm256_add_ps(ly, _mm256_mul_ps(w, _mm256_sub_ps(vy, i.y)));
+            lz = _mm256_add_ps(lz, _mm256_mul_ps(w, _mm256_sub_ps(vz, i.z)));
         });
         return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
 #else
-        Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
-        int k = 0;
-        for (; k + LANES <= n; k += LANES) {
-            for (int l = 0; l < LANES; ++l) {
-                const Vec3& v = values[j[k + l]];
-                lx[l] += a[k + l] * (v[0] - vi[0]);
-                ly[l] += a[k + l] * (v[1] - vi[1]);
-                lz[l] += a[k + l] * (v[2] - vi[2]);
-            }
-        }
-        for (int l = 0; l < LANES && k < n; ++k, ++l) {
+        return laneSum3([&](int k) {
             const Vec3& v = values[j[k]];
-            lx[l] += a[k] * (v[0] - vi[0]);
-            ly[l] += a[k] * (v[1] - vi[1]);
-            lz[l] += a[k] * (v[2] - vi[2]);
-        }
-        Vec3 total(0);
-        for (int l = 0; l < LANES; ++l) total += Vec3(lx[l], ly[l], lz[l]);
-        return total;
+            return Vec3(a[k] * (v[0] - vi[0]), a[k] * (v[1] - vi[1]), a[k] * (v[2] - vi[2]));
+        });
 #endif
     }
 
@@ -393,33 +414,19 @@ struct PairBatch
     Real sumScaledApproach(const Real* a, const Vec3* values, const Vec3& vi) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
-                     iz = _mm256_set1_ps(vi[2]);
+        const Lanes3 i = broadcast(vi);
         __m256 acc = _mm256_setzero_ps();
         forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
-            const __m256 t = approach(ix, iy, iz, vx, vy, vz, load(dx), load(dy), load(dz));
+            const __m256 t = approach(i, vx, vy, vz, load(dx), load(dy), load(dz));
             acc = _mm256_add_ps(acc, _mm256_mul_ps(load(a), t));
         });
         return reduceLanes(acc);
 #else
-        Real lane[LANES] = {};
-        int k = 0;
-        for (; k + LANES <= n; k += LANES) {
-            for (int l = 0; l < LANES; ++l) {
-                const Vec3& v = values[j[k + l]];
-                lane[l] += a[k + l]
-                           * ((vi[0] - v[0]) * dx[k + l] + (vi[1] - v[1]) * dy[k + l]
-                              + (vi[2] - v[2]) * dz[k + l]);
-            }
-        }
-        for (int l = 0; l < LANES && k < n; ++k, ++l) {
+        return laneSum([&](int k) {
             const Vec3& v = values[j[k]];
-            lane[l] +=
-                a[k] * ((vi[0] - v[0]) * dx[k] + (vi[1] - v[1]) * dy[k] + (vi[2] - v[2]) * dz[k]);
-        }
-        Real total = 0;
-        for (int l = 0; l < LANES; ++l) total += lane[l];
-        return total;
+            return a[k]
+                   * ((vi[0] - v[0]) * dx[k] + (vi[1] - v[1]) * dy[k] + (vi[2] - v[2]) * dz[k]);
+        });
 #endif
     }
 
@@ -448,23 +455,7 @@ struct PairBatch
         }
         return Vec3(reduceLanes(lx), reduceLanes(ly), reduceLanes(lz));
 #else
-        Real lx[LANES] = {}, ly[LANES] = {}, lz[LANES] = {};
-        int k = 0;
-        for (; k + LANES <= n; k += LANES) {
-            for (int l = 0; l < LANES; ++l) {
-                lx[l] += a[k + l] * x[k + l];
-                ly[l] += a[k + l] * y[k + l];
-                lz[l] += a[k + l] * z[k + l];
-            }
-        }
-        for (int l = 0; l < LANES && k < n; ++k, ++l) {
-            lx[l] += a[k] * x[k];
-            ly[l] += a[k] * y[k];
-            lz[l] += a[k] * z[k];
-        }
-        Vec3 total(0);
-        for (int l = 0; l < LANES; ++l) total += Vec3(lx[l], ly[l], lz[l]);
-        return total;
+        return laneSum3([&](int k) { return Vec3(a[k] * x[k], a[k] * y[k], a[k] * z[k]); });
 #endif
     }
 
@@ -474,30 +465,17 @@ struct PairBatch
                      const Real* z) const
     {
 #if GHOSTFX_PAIR_SUMS_AVX2
-        const __m256 ix = _mm256_set1_ps(vi[0]), iy = _mm256_set1_ps(vi[1]),
-                     iz = _mm256_set1_ps(vi[2]);
+        const Lanes3 i = broadcast(vi);
         __m256 acc = _mm256_setzero_ps();
         forEachLaneGroup(values, [&](auto load, __m256 vx, __m256 vy, __m256 vz) {
-            acc = _mm256_add_ps(acc, approach(ix, iy, iz, vx, vy, vz, load(x), load(y), load(z)));
+            acc = _mm256_add_ps(acc, approach(i, vx, vy, vz, load(x), load(y), load(z)));
         });
         return reduceLanes(acc);
 #else
-        Real lane[LANES] = {};
-        int k = 0;
-        for (; k + LANES <= n; k += LANES) {
-            for (int l = 0; l < LANES; ++l) {
-                const Vec3& v = values[j[k + l]];
-                lane[l] += (vi[0] - v[0]) * x[k + l] + (vi[1] - v[1]) * y[k + l]
-                           + (vi[2] - v[2]) * z[k + l];
-            }
-        }
-        for (int l = 0; l < LANES && k < n; ++k, ++l) {
+        return laneSum([&](int k) {
             const Vec3& v = values[j[k]];
-            lane[l] += (vi[0] - v[0]) * x[k] + (vi[1] - v[1]) * y[k] + (vi[2] - v[2]) * z[k];
-        }
-        Real total = 0;
-        for (int l = 0; l < LANES; ++l) total += lane[l];
-        return total;
+            return (vi[0] - v[0]) * x[k] + (vi[1] - v[1]) * y[k] + (vi[2] - v[2]) * z[k];
+        });
 #endif
     }
 };
