@@ -1,11 +1,12 @@
 /// @file   GasSolver.cc
-/// @brief  Fast SPH gas [RYY15] Secs. 3 and 5: set-up, sources, the ambient baseline's air and
-///         walls, the density and force passes (their models are the parts GasCompensation,
+/// @brief  Fast SPH gas [RYY15] Secs. 3 and 5: set-up, the ambient baseline's air and walls,
+///         the density and force passes (their models are the parts GasCompensation,
 ///         GasTemperature and GasVorticity), life strength, time stepping, blow-up detection,
 ///         save and restore.
 #include "ghostfx/gas/GasSolver.h"
 
 #include "GasPairs.h"
+#include "GasSource.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
@@ -47,23 +48,6 @@ inline Real lifeEpsilon(std::uint64_t seed, ParticleId id, std::uint64_t step)
 /// A solid: its level set (in its local frame) and its rigid motion.
 struct GasSolver::Solid : sph::MovingLevelSet
 {};
-
-/// A source and its emission budget (rate-limited sources).
-struct GasSolver::Source
-{
-    LevelSet shape;
-    GasSource params;
-    double budget = 0; ///< particles the rate still allows
-
-    RigidTransform at(double time) const
-    {
-        return params.motion ? params.motion(time) : RigidTransform();
-    }
-    bool active(double time) const { return time >= params.start && time < params.end; }
-    /// Add the step's allowance (dt in s) to a rate-limited source's budget; the particles it
-    /// may emit now (unlimited without a rate).
-    std::size_t allowance(Real dt);
-};
 
 namespace {
 /// The settings, after validate() accepted them (it throws ValueError otherwise).
@@ -296,27 +280,6 @@ Real GasSolver::referenceParticleMass() const
     return referenceMass();
 }
 
-void GasSolver::addSource(const LevelSet& shape, const GasSource& source)
-{
-    if (!isFinite(source.velocity) || !std::isfinite(source.temperature)) {
-        throw ValueError(msg("gas source '", shape.name(),
-                             "': velocity and temperature must be "
-                             "finite"));
-    }
-    if (!(source.rate >= Real(0)) || !std::isfinite(source.rate)) {
-        throw ValueError(msg("gas source '", shape.name(), "': rate = ", source.rate,
-                             " particles/s: expected >= 0 (0 = fill the source)"));
-    }
-    if (!(source.end > source.start) || !(source.start >= 0)) {
-        throw ValueError(msg("gas source '", shape.name(), "': start ", source.start, " s, end ",
-                             source.end, " s: expected 0 <= start < end"));
-    }
-    auto s = std::make_unique<Source>(Source{shape, source, 0.0});
-    const std::size_t k = mSources.size();
-    if (k < mRestoredBudgets.size()) s->budget = mRestoredBudgets[k];
-    mSources.push_back(std::move(s));
-}
-
 void GasSolver::setExternalBoundary(const std::vector<Vec3>& positions,
                                     const std::vector<Vec3>& velocities, Real mass)
 {
@@ -475,147 +438,6 @@ void GasSolver::fillAmbientAir()
     for (std::size_t i = first; i < mParticles.size(); ++i) {
         ambient[i] = Real(1);
         T[i] = mSettings.ambientTemperature;
-    }
-}
-
-// Sources ----------------------------------------------------------------------------------------
-
-/// A source placed at the step's time: its world box and its inside test.
-struct GasSolver::PlacedSource
-{
-    const Source& source;
-    RigidTransform xf; ///< local to world
-    Aabb box;          ///< world box: the source's local bounds' corners placed
-
-    PlacedSource(const Source& src, double time) : source(src), xf(src.at(time))
-    {
-        const Aabb lb = src.shape.bounds();
-        for (int c = 0; c < 8; ++c) {
-            box.expand(xf.toWorld(Vec3(c & 1 ? lb.max[0] : lb.min[0], c & 2 ? lb.max[1] : lb.min[1],
-                                       c & 4 ? lb.max[2] : lb.min[2])));
-        }
-    }
-    /// x (m, world) inside the source's level set.
-    bool inside(const Vec3& x) const { return source.shape.phi(xf.toLocal(x)) < Real(0); }
-    /// x (m, world) in the world box and inside the level set.
-    bool contains(const Vec3& x) const { return box.contains(x) && inside(x); }
-};
-
-std::size_t GasSolver::Source::allowance(Real dt)
-{
-    // Rate-limited sources accumulate their allowance; 0 = no limit.
-    if (!(params.rate > Real(0))) return std::numeric_limits<std::size_t>::max();
-    budget += double(params.rate) * double(dt);
-    return std::size_t(std::floor(budget));
-}
-
-void GasSolver::emit(Real dt)
-{
-    for (std::size_t e = 0; e < mSources.size(); ++e) {
-        Source& src = *mSources[e];
-        if (!src.active(mRun.time)) continue;
-        const PlacedSource at(src, mRun.time);
-        const std::size_t allowed = src.allowance(dt);
-        std::size_t added = convertAmbientAir(at, allowed);
-        added += addFreshGas(e, at, allowed - added);
-        if (src.params.rate > Real(0)) src.budget -= double(added);
-        mRun.emitted += added;
-        heatSourceGas(at);
-    }
-}
-
-std::size_t GasSolver::convertAmbientAir(const PlacedSource& at, std::size_t allowed)
-{
-    // The standard approach marks the air passing through the source as visible gas.
-    if (mSettings.method != Method::Ambient) return 0;
-    auto& ambient = mParticles.scalarChannel(channel::AMBIENT);
-    std::size_t added = 0;
-    for (std::size_t i = 0; i < mParticles.size() && added < allowed; ++i) {
-        if (mParticles.kinds()[i] != ParticleKind::Gas || ambient[i] == Real(0)) continue;
-        if (!at.contains(mParticles.positions()[i])) continue;
-        ambient[i] = Real(0);
-        mParticles.velocities()[i] = at.source.params.velocity;
-        ++added;
-    }
-    return added;
-}
-
-std::size_t GasSolver::addFreshGas(std::size_t e, const PlacedSource& at, std::size_t room)
-{
-    // The free room in the source is filled with new gas, in every method, so the baseline
-    // emits what the fast solver emits: its air, once converted, rises out of the source as the
-    // fast solver's gas does, and the room it leaves is not always refilled by air in time (the
-    // shipped plume's baseline stopped emitting at 143 particles).
-    std::vector<Vec3> seeds, obstacles;
-    const std::vector<Real>* air =
-        mSettings.method == Method::Ambient ? &mParticles.scalarChannel(channel::AMBIENT) : nullptr;
-    const Aabb near = at.box.padded(mSettings.supportRadius());
-    for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        const Vec3& x = mParticles.positions()[i];
-        if (!near.contains(x)) continue;
-        const bool visible =
-            mParticles.kinds()[i] == ParticleKind::Gas && !(air && (*air)[i] != Real(0));
-        if (visible && at.contains(x)) {
-            seeds.push_back(x);
-        } else {
-            obstacles.push_back(x);
-        }
-    }
-    std::vector<Vec3> fresh =
-        seeds.empty() ? fillSource(e, at, obstacles) : growFromSeeds(e, at, seeds, obstacles);
-    if (fresh.size() > room) fresh.resize(room);
-    if (!fresh.empty()) {
-        const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Gas);
-        for (std::size_t i = first; i < mParticles.size(); ++i) {
-            mParticles.velocities()[i] = at.source.params.velocity;
-        }
-    }
-    return fresh.size();
-}
-
-std::vector<Vec3> GasSolver::fillSource(std::size_t e, const PlacedSource& at,
-                                        const std::vector<Vec3>& obstacles) const
-{
-    // Nothing to grow from: fill the source like a block of gas.
-    const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
-    NeighborGrid grid(r);
-    grid.build(obstacles);
-    std::vector<Vec3> fresh;
-    for (const Vec3& xl :
-         sampleShape(at.source.shape, mSettings.seed + 31337ULL * (e + 1) + mRun.step)) {
-        const Vec3 x = at.xf.toWorld(xl);
-        bool clear = !blockedBySolid(x);
-        if (clear && !obstacles.empty()) {
-            grid.forEachInRadius(x, r, [&](Index, const Vec3&, Real) { clear = false; });
-        }
-        if (clear) fresh.push_back(x);
-    }
-    return fresh;
-}
-
-std::vector<Vec3> GasSolver::growFromSeeds(std::size_t e, const PlacedSource& at,
-                                           const std::vector<Vec3>& seeds,
-                                           const std::vector<Vec3>& obstacles) const
-{
-    PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-    ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
-    // [SB12] Sec. 4.5.2: emission during the run takes 8 attempts per seed, not 30.
-    ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
-    auto accept = [&](const Vec3& x) { return at.inside(x) && !blockedBySolid(x); };
-    return PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, at.box);
-}
-
-void GasSolver::heatSourceGas(const PlacedSource& at)
-{
-    // The source is a heater: visible gas inside it is held at the source temperature.
-    auto& T = mParticles.scalarChannel(channel::TEMPERATURE);
-    const std::vector<Real>* ambient = mParticles.hasScalarChannel(channel::AMBIENT)
-                                           ? &mParticles.scalarChannel(channel::AMBIENT)
-                                           : nullptr;
-    for (std::size_t i = 0; i < mParticles.size(); ++i) {
-        if (mParticles.kinds()[i] != ParticleKind::Gas) continue;
-        if (ambient && (*ambient)[i] != Real(0)) continue;
-        if (at.contains(mParticles.positions()[i])) T[i] = at.source.params.temperature;
     }
 }
 
@@ -913,13 +735,16 @@ void GasSolver::integrate(Real dt, const std::vector<Vec3>& accel)
     const auto& kind = mParticles.kinds();
     auto& x = mParticles.positions();
     auto& v = mParticles.velocities();
+    auto& T = mParticles.scalarChannel(channel::TEMPERATURE);
+    std::vector<Vec3>* omega =
+        mVorticity.enabled() ? &mParticles.vectorChannel(channel::VORTICITY) : nullptr;
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) return;
         v[i] += dt * accel[i];
         x[i] += dt * v[i];
+        mTemperature.advance(T, i, dt);
+        if (omega) mVorticity.advance(*omega, i, dt);
     });
-    mTemperature.integrate(dt, mParticles);
-    mVorticity.integrate(dt, mParticles);
     Real amax = 0;
     for (std::size_t i = 0; i < n; ++i) {
         if (kind[i] == ParticleKind::Gas) amax = std::max(amax, accel[i].length());

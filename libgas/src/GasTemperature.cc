@@ -2,10 +2,6 @@
 /// @brief  Temperature of the gas [RYY15] Sec. 3.3: settings and the explicit Euler update.
 #include "ghostfx/gas/GasTemperature.h"
 
-#include "ghostfx/gas/GasChannels.h"
-
-#include <ghostfx/sph/Parallel.h>
-
 namespace ghostfx {
 namespace gas {
 
@@ -18,16 +14,6 @@ GasTemperature::GasTemperature(const GasSettings& settings)
     , mBuoyancy(settings.buoyancy)
     , mDirection(settings.buoyancyDirection.unit())
 {}
-
-void GasTemperature::integrate(Real dt, sph::ParticleSet& particles) const
-{
-    const auto& kind = particles.kinds();
-    auto& T = particles.scalarChannel(channel::TEMPERATURE);
-    parallel::forEach(0, particles.size(), [&](std::size_t i) {
-        if (kind[i] != sph::ParticleKind::Gas) return;
-        T[i] += dt * mRate[i];
-    });
-}
 
 } // namespace gas
 } // namespace ghostfx

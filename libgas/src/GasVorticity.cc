@@ -4,8 +4,6 @@
 
 #include "ghostfx/gas/GasChannels.h"
 
-#include <ghostfx/sph/Parallel.h>
-
 namespace ghostfx {
 namespace gas {
 
@@ -29,17 +27,6 @@ GasVorticity::GasVorticity(const GasSettings& settings)
 void GasVorticity::addChannel(sph::ParticleSet& particles) const
 {
     if (mEnabled) particles.addVectorChannel(channel::VORTICITY);
-}
-
-void GasVorticity::integrate(Real dt, sph::ParticleSet& particles) const
-{
-    if (!mEnabled) return;
-    const auto& kind = particles.kinds();
-    auto& omega = particles.vectorChannel(channel::VORTICITY);
-    parallel::forEach(0, particles.size(), [&](std::size_t i) {
-        if (kind[i] != sph::ParticleKind::Gas) return;
-        omega[i] += dt * mRate[i];
-    });
 }
 
 } // namespace gas

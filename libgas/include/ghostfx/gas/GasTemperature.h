@@ -5,7 +5,7 @@
 ///          conserves sum_i m_i T_i; boundary particles are adiabatic (no exchange). Radiation
 ///          models the heat lost to the air that is not simulated, so the ambient-air baseline
 ///          has none. Buoyancy is Boussinesq: a_b = C_b (T_i - T_ambient) b. State: the rate
-///          dT_i/dt of the last force pass, applied by integrate().
+///          dT_i/dt of the last force pass, applied by advance().
 #pragma once
 
 #include <ghostfx/gas/GasSettings.h>
@@ -50,8 +50,8 @@ public:
         mRate[i] = rate;
     }
 
-    /// T_i += dt dT_i/dt (dt in s) on the gas particles of `particles`.
-    void integrate(Real dt, sph::ParticleSet& particles) const;
+    /// Explicit Euler on particle i's temperature T[i] (K) over dt (s) with the stored rate.
+    void advance(std::vector<Real>& T, std::size_t i, Real dt) const { T[i] += dt * mRate[i]; }
 
 private:
     /// gamma^2 of Eq. 15 as a fraction of the squared pair support ([RYY15]: "gamma^2 << 1";

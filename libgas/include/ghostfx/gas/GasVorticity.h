@@ -8,7 +8,7 @@
 ///          with S = GasSettings::vorticityStrength. Boundary particles carry no vorticity.
 ///          g is the gravity, or standard gravity against the buoyancy direction when the gas
 ///          has no weight (the default), so the boundary still generates vorticity.
-///          State: d omega_i / dt of the last force pass, applied by integrate().
+///          State: d omega_i / dt of the last force pass, applied by advance().
 #pragma once
 
 #include <ghostfx/gas/GasSettings.h>
@@ -63,8 +63,12 @@ public:
         mRate[i] = sph::toVec3(sums.stretch) + mGeneration * nI.cross(mGravity);
     }
 
-    /// omega_i += dt d omega_i / dt (dt in s) on the gas particles of `particles`.
-    void integrate(Real dt, sph::ParticleSet& particles) const;
+    /// Explicit Euler on particle i's vorticity omega[i] (1/s) over dt (s) with the stored
+    /// rate.
+    void advance(std::vector<Vec3>& omega, std::size_t i, Real dt) const
+    {
+        omega[i] += dt * mRate[i];
+    }
 
 private:
     bool mEnabled;
