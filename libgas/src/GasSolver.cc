@@ -1,8 +1,12 @@
 /// @file   GasSolver.cc
-/// @brief  Fast SPH gas [RYY15] Secs. 3 and 5: set-up, sources, the ambient baseline's air and
-///         walls, density correction, compensated forces, temperature, vorticity, life strength,
-///         time stepping, blow-up detection, save and restore.
+/// @brief  Fast SPH gas [RYY15] Secs. 3 and 5: set-up, the ambient baseline's air and walls,
+///         the density and force passes (their models are the parts GasCompensation,
+///         GasTemperature and GasVorticity), life strength, time stepping, blow-up detection,
+///         save and restore.
 #include "ghostfx/gas/GasSolver.h"
+
+#include "GasPairs.h"
+#include "GasSource.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
@@ -23,33 +27,9 @@ namespace ghostfx {
 namespace gas {
 
 using namespace sph;
+using namespace detail;
 
 namespace {
-
-/// A double-precision sum back to Real.
-inline Vec3 toReal(const Vec3d& v) { return Vec3(Real(v[0]), Real(v[1]), Real(v[2])); }
-/// Add a Real vector to a double-precision sum.
-inline void accumulate(Vec3d& sum, const Vec3& v) { sum += Vec3d(v[0], v[1], v[2]); }
-
-/// Pair support radius: symmetric in i and j, so every pair term is antisymmetric.
-inline Real pairSupport(Real hi, Real hj) { return Real(0.5) * (hi + hj); }
-
-/// Call fn(j, x_i - x_j, r) for each entry j of particle i's neighbour list (i itself included,
-/// at r = 0), in the list's fixed order.
-template <typename Fn>
-inline void forEachListed(const NeighborLists& lists, const std::vector<Vec3>& x, std::size_t i,
-                          Fn&& fn)
-{
-    const Vec3 xi = x[i];
-    lists[i].forEach([&](Index j) {
-        const Vec3 xij = xi - x[j];
-        fn(j, xij, xij.length());
-    });
-}
-
-/// gamma^2 of Eq. 15 as a fraction of the squared pair support ([RYY15]: "gamma^2 << 1"; the
-/// usual SPH choice 0.01 h^2 keeps it small against the smallest inter-particle distance).
-constexpr Real DIFFUSION_GAMMA2 = Real(0.01);
 
 /// Blow-up bound on |T - T_ambient| (K): diffusion (Eq. 15) and radiation (Eq. 16) obey a
 /// maximum principle, so only an unstable step takes a temperature this far from any source.
@@ -69,32 +49,34 @@ inline Real lifeEpsilon(std::uint64_t seed, ParticleId id, std::uint64_t step)
 struct GasSolver::Solid : sph::MovingLevelSet
 {};
 
-/// A source and its emission budget (rate-limited sources).
-struct GasSolver::Source
+namespace {
+/// The settings, after validate() accepted them (it throws ValueError otherwise).
+const GasSettings& validated(const GasSettings& settings)
 {
-    LevelSet shape;
-    GasSource params;
-    double budget = 0; ///< particles the rate still allows
-
-    RigidTransform at(double time) const
-    {
-        return params.motion ? params.motion(time) : RigidTransform();
-    }
-    bool active(double time) const { return time >= params.start && time < params.end; }
-};
+    settings.validate();
+    return settings;
+}
+} // namespace
 
 GasSolver::GasSolver(const GasSettings& settings)
-    : mSettings(settings)
-    , mBuoyancyDir((settings.validate(), settings.buoyancyDirection.unit()))
+    : mSettings(validated(settings))
+    , mCompensation(mSettings)
+    , mTemperature(mSettings)
+    , mVorticity(mSettings)
     , mGrid(settings.supportRadius())
 {
     mParticles.addScalarChannel(channel::TEMPERATURE, mSettings.ambientTemperature);
     mParticles.addScalarChannel(channel::SUPPORT, mSettings.supportRadius());
+    addStepChannels();
+}
+
+void GasSolver::addStepChannels()
+{
     mParticles.addScalarChannel(channel::DENSITY_UNCORRECTED, mSettings.restDensity);
     mParticles.addVectorChannel(channel::NORMAL);
     mParticles.addScalarChannel(channel::LIFE, mSettings.lifeStrength);
     if (mSettings.method == Method::Ambient) mParticles.addScalarChannel(channel::AMBIENT, Real(0));
-    if (mSettings.vorticity) mParticles.addVectorChannel(channel::VORTICITY);
+    mVorticity.addChannel(mParticles);
 }
 
 GasSolver::~GasSolver() = default;
@@ -298,27 +280,6 @@ Real GasSolver::referenceParticleMass() const
     return referenceMass();
 }
 
-void GasSolver::addSource(const LevelSet& shape, const GasSource& source)
-{
-    if (!isFinite(source.velocity) || !std::isfinite(source.temperature)) {
-        throw ValueError(msg("gas source '", shape.name(),
-                             "': velocity and temperature must be "
-                             "finite"));
-    }
-    if (!(source.rate >= Real(0)) || !std::isfinite(source.rate)) {
-        throw ValueError(msg("gas source '", shape.name(), "': rate = ", source.rate,
-                             " particles/s: expected >= 0 (0 = fill the source)"));
-    }
-    if (!(source.end > source.start) || !(source.start >= 0)) {
-        throw ValueError(msg("gas source '", shape.name(), "': start ", source.start, " s, end ",
-                             source.end, " s: expected 0 <= start < end"));
-    }
-    auto s = std::make_unique<Source>(Source{shape, source, 0.0});
-    const std::size_t k = mSources.size();
-    if (k < mRestoredBudgets.size()) s->budget = mRestoredBudgets[k];
-    mSources.push_back(std::move(s));
-}
-
 void GasSolver::setExternalBoundary(const std::vector<Vec3>& positions,
                                     const std::vector<Vec3>& velocities, Real mass)
 {
@@ -480,111 +441,6 @@ void GasSolver::fillAmbientAir()
     }
 }
 
-// Sources ----------------------------------------------------------------------------------------
-
-void GasSolver::emit(Real dt)
-{
-    auto& T = mParticles.scalarChannel(channel::TEMPERATURE);
-    for (std::size_t e = 0; e < mSources.size(); ++e) {
-        Source& src = *mSources[e];
-        if (!src.active(mRun.time)) continue;
-        const GasSource& par = src.params;
-        const RigidTransform xf = src.at(mRun.time);
-        auto inside = [&](const Vec3& x) { return src.shape.phi(xf.toLocal(x)) < Real(0); };
-        // Rate-limited sources accumulate their allowance; 0 = no limit.
-        std::size_t allowed = std::numeric_limits<std::size_t>::max();
-        if (par.rate > Real(0)) {
-            src.budget += double(par.rate) * double(dt);
-            allowed = std::size_t(std::floor(src.budget));
-        }
-        // World box of the source: its local bounds' corners placed.
-        Aabb box;
-        const Aabb lb = src.shape.bounds();
-        for (int c = 0; c < 8; ++c) {
-            box.expand(xf.toWorld(Vec3(c & 1 ? lb.max[0] : lb.min[0], c & 2 ? lb.max[1] : lb.min[1],
-                                       c & 4 ? lb.max[2] : lb.min[2])));
-        }
-        const Real R = mSettings.supportRadius();
-        const Aabb near = box.padded(R);
-
-        std::size_t added = 0;
-        const std::vector<Real>* air = nullptr;
-        if (mSettings.method == Method::Ambient) {
-            // The standard approach marks the air passing through the source as visible gas.
-            auto& ambient = mParticles.scalarChannel(channel::AMBIENT);
-            air = &ambient;
-            for (std::size_t i = 0; i < mParticles.size() && added < allowed; ++i) {
-                if (mParticles.kinds()[i] != ParticleKind::Gas || ambient[i] == Real(0)) continue;
-                const Vec3& x = mParticles.positions()[i];
-                if (!box.contains(x) || !inside(x)) continue;
-                ambient[i] = Real(0);
-                mParticles.velocities()[i] = par.velocity;
-                ++added;
-            }
-        }
-        // Then the free room in the source is filled with new gas, in every method, so the
-        // baseline emits what the fast solver emits: its air, once converted, rises out of the
-        // source as the fast solver's gas does, and the room it leaves is not always refilled
-        // by air in time (the shipped plume's baseline stopped emitting at 143 particles).
-        std::vector<Vec3> seeds, obstacles;
-        for (std::size_t i = 0; i < mParticles.size(); ++i) {
-            const Vec3& x = mParticles.positions()[i];
-            if (!near.contains(x)) continue;
-            const bool visible =
-                mParticles.kinds()[i] == ParticleKind::Gas && !(air && (*air)[i] != Real(0));
-            if (visible && box.contains(x) && inside(x)) {
-                seeds.push_back(x);
-            } else {
-                obstacles.push_back(x);
-            }
-        }
-        const Real r = PoissonSettings::SB12_RADIUS_FACTOR * mSettings.spacing;
-        std::vector<Vec3> fresh;
-        if (seeds.empty()) {
-            // Nothing to grow from: fill the source like a block of gas.
-            NeighborGrid grid(r);
-            grid.build(obstacles);
-            for (const Vec3& xl :
-                 sampleShape(src.shape, mSettings.seed + 31337ULL * (e + 1) + mRun.step)) {
-                const Vec3 x = xf.toWorld(xl);
-                bool clear = !blockedBySolid(x);
-                if (clear && !obstacles.empty()) {
-                    grid.forEachInRadius(x, r, [&](Index, const Vec3&, Real) { clear = false; });
-                }
-                if (clear) fresh.push_back(x);
-            }
-        } else {
-            PoissonSettings ps = PoissonSettings::forSpacing(mSettings.spacing);
-            ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
-            // [SB12] Sec. 4.5.2: emission during the run takes 8 attempts per seed, not 30.
-            ps.volumeAttempts = PoissonSettings::SB12_SEEDED_ATTEMPTS;
-            auto accept = [&](const Vec3& x) { return inside(x) && !blockedBySolid(x); };
-            fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
-        }
-        const std::size_t room = allowed - added;
-        if (fresh.size() > room) fresh.resize(room);
-        if (!fresh.empty()) {
-            const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Gas);
-            for (std::size_t i = first; i < mParticles.size(); ++i) {
-                mParticles.velocities()[i] = par.velocity;
-            }
-        }
-        added += fresh.size();
-        if (par.rate > Real(0)) src.budget -= double(added);
-        mRun.emitted += added;
-        // The source is a heater: visible gas inside it is held at the source temperature.
-        const std::vector<Real>* ambient = mParticles.hasScalarChannel(channel::AMBIENT)
-                                               ? &mParticles.scalarChannel(channel::AMBIENT)
-                                               : nullptr;
-        for (std::size_t i = 0; i < mParticles.size(); ++i) {
-            if (mParticles.kinds()[i] != ParticleKind::Gas) continue;
-            if (ambient && (*ambient)[i] != Real(0)) continue;
-            const Vec3& x = mParticles.positions()[i];
-            if (box.contains(x) && inside(x)) T[i] = par.temperature;
-        }
-    }
-}
-
 // Density: Eqs. 1, 5, 7, 8, 11 --------------------------------------------------------------------
 
 void GasSolver::sortParticles()
@@ -650,14 +506,18 @@ void GasSolver::expandSupports()
 
 void GasSolver::computeDensity()
 {
+    sumDensities();
+    correctDensities();
+}
+
+void GasSolver::sumDensities()
+{
     const std::size_t n = mParticles.size();
     const auto& x = mParticles.positions();
     const auto& m = mParticles.masses();
     const auto& kind = mParticles.kinds();
     const auto& h = mParticles.scalarChannel(channel::SUPPORT);
     auto& rhoBar = mParticles.scalarChannel(channel::DENSITY_UNCORRECTED);
-    auto& rho = mParticles.densities();
-    auto& p = mParticles.pressures();
     const Real rho0 = mSettings.restDensity;
 
     // Eq. 1 without the ambient air term: rho_bar_i = sum_j m_j W(r_ij, h_ij), over gas (and,
@@ -686,37 +546,32 @@ void GasSolver::computeDensity()
         0, n, [&](std::size_t i) { return kind[i] == ParticleKind::Gas ? 1.0 : 0.0; });
     mRun.meanNeighbors = parallel::sum(0, n, [&](std::size_t i) { return double(neighbours[i]); })
                          / std::max(1.0, gasCount);
+}
 
-    // Eq. 5: V_0 = |sum_j m_j / rho_bar_j grad W_ij| / |grad W_ik|, with the uncorrected
-    // neighbour densities as in Eq. 4 and the derivation of Eqs. 7 - 8 (Appendix A); the virtual
-    // particle k sits delta h_i away (Sec. 3.1), so |grad W_ik| and W_ik use the particle's own h.
-    // Eq. 8: rho_i = rho_bar_i (1 + V_0 W_ik). The baselines use rho_bar as it is (Eq. 21).
-    const bool correct = mSettings.method == Method::Fast;
-    const Real delta = mSettings.delta;
+void GasSolver::correctDensities()
+{
+    const std::size_t n = mParticles.size();
+    const auto& x = mParticles.positions();
+    const auto& m = mParticles.masses();
+    const auto& kind = mParticles.kinds();
+    const auto& h = mParticles.scalarChannel(channel::SUPPORT);
+    const auto& rhoBar = mParticles.scalarChannel(channel::DENSITY_UNCORRECTED);
+    auto& rho = mParticles.densities();
+    auto& p = mParticles.pressures();
+    const Real rho0 = mSettings.restDensity;
     const bool clampTension = mSettings.clampNegativePressure;
-    mNbar.assign(n, Vec3(0));
+
+    // Eqs. 5 and 8 in the fast method; the baselines use rho_bar as it is (Eq. 21).
+    if (mCompensation.enabled()) mCompensation.beginDensity(n);
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) {
             rho[i] = rho0;
             p[i] = Real(0);
             return;
         }
-        Vec3d nbar(0.0);
-        forEachListed(mLists, x, i, [&](Index j, const Vec3& xij, Real r) {
-            if (j == i) return;
-            const Real R = pairSupport(h[i], h[j]);
-            if (r >= R) return;
-            const Vec3 g = spikyGrad(xij, r, R);
-            const double vj = double(m[j]) / double(rhoBar[j]);
-            accumulate(nbar, g * Real(vj));
-        });
-        mNbar[i] = toReal(nbar);
-        Real rhoI = rhoBar[i];
-        if (correct) {
-            const Real rk = delta * h[i];
-            const Real V0 = mNbar[i].length() / spikySlope(rk, h[i]);
-            rhoI = rhoBar[i] * (Real(1) + V0 * poly6W(rk, h[i]));
-        }
+        const Real rhoI = mCompensation.enabled()
+                              ? mCompensation.correctedDensity(mLists, x, m, h, rhoBar, i)
+                              : rhoBar[i];
         rho[i] = rhoI;
         const Real excess = rhoI - rho0;
         p[i] = mSettings.kappa * (clampTension ? std::max(excess, Real(0)) : excess); // Eq. 11
@@ -725,131 +580,170 @@ void GasSolver::computeDensity()
 
 // Forces, temperature, vorticity and integration: Eqs. 9 - 17, 22 - 26 ----------------------------
 
-void GasSolver::computeForcesAndIntegrate(Real dt)
+namespace {
+
+/// Pair sums of one gas particle in the force pass, in double.
+struct ForceSums
+{
+    Vec3d pressure{0.0};  ///< Eq. 9 (N/m^3)
+    Vec3d normal{0.0};    ///< n_i of Eq. 12 (1/m)
+    Vec3d viscosity{0.0}; ///< F_v of Eq. 22 (N/m^3)
+    double heat = 0;      ///< Eq. 15 (K/s)
+    GasVorticity::Sums vorticity;
+};
+
+/// The force pass over the gas particles: the pair sums of pressure (Eq. 9), normal (Eq. 12)
+/// and viscosity (Eq. 22), and the terms the parts add (compensation, temperature, vorticity),
+/// assembled into the acceleration of Eq. 24.
+class ForcePass
+{
+public:
+    ForcePass(ParticleSet& particles, const NeighborLists& lists, const GasSettings& settings,
+              const GasCompensation& compensation, GasTemperature& temperature,
+              GasVorticity& vorticity)
+        : mLists(lists)
+        , mSettings(settings)
+        , mCompensation(compensation)
+        , mTemperature(temperature)
+        , mVorticity(vorticity)
+        , x(particles.positions())
+        , v(particles.velocities())
+        , m(particles.masses())
+        , kind(particles.kinds())
+        , h(particles.scalarChannel(channel::SUPPORT))
+        , rhoBar(particles.scalarChannel(channel::DENSITY_UNCORRECTED))
+        , rho(particles.densities())
+        , p(particles.pressures())
+        , T(particles.scalarChannel(channel::TEMPERATURE))
+        , normal(particles.vectorChannel(channel::NORMAL))
+        , omega(vorticity.enabled() ? &particles.vectorChannel(channel::VORTICITY) : nullptr)
+        , ambient(particles.hasScalarChannel(channel::AMBIENT)
+                      ? &particles.scalarChannel(channel::AMBIENT)
+                      : nullptr)
+    {}
+
+    /// Eq. 24: the acceleration (m/s^2) of gas particle i; stores its normal n_i and the
+    /// parts' rates.
+    Vec3 acceleration(std::size_t i);
+
+private:
+    /// Sum the pair terms over particle i's listed neighbours.
+    ForceSums sumPairs(std::size_t i) const;
+    /// Add the point attractors' pull (Fig. 7) to a, on visible gas only (GasSettings.h).
+    void attract(std::size_t i, Vec3& a) const;
+
+    const NeighborLists& mLists;
+    const GasSettings& mSettings;
+    const GasCompensation& mCompensation;
+    GasTemperature& mTemperature;
+    GasVorticity& mVorticity;
+    const std::vector<Vec3>& x;
+    const std::vector<Vec3>& v;
+    const std::vector<Real>& m;
+    const std::vector<ParticleKind>& kind;
+    const std::vector<Real>& h;
+    const std::vector<Real>& rhoBar;
+    const std::vector<Real>& rho;
+    const std::vector<Real>& p;
+    const std::vector<Real>& T;
+    std::vector<Vec3>& normal;
+    const std::vector<Vec3>* omega;
+    const std::vector<Real>* ambient;
+};
+
+ForceSums ForcePass::sumPairs(std::size_t i) const
+{
+    const Real pi = p[i];
+    const Vec3 vi = v[i];
+    const Real mu = mSettings.viscosity;
+    const Real rho0 = mSettings.restDensity;
+    const bool diffuses = mTemperature.diffuses();
+    ForceSums sums;
+    forEachListed(mLists, x, i, [&](Index j, const Vec3& xij, Real r) {
+        if (j == i) return;
+        const Real R = pairSupport(h[i], h[j]);
+        if (r >= R) return;
+        const Vec3 gradW = spikyGrad(xij, r, R);
+        const bool boundary = kind[j] != ParticleKind::Gas;
+        // Boundary particles: density rho0 and, in the pressure term, the pressure of the
+        // gas particle facing them (mirrored), so a wall pushes back as hard as the gas
+        // presses on it; they are adiabatic (no Eq. 15 exchange) and carry no vorticity.
+        const Real rhoJ = boundary ? rho0 : rho[j];
+        const Real Vj = m[j] / rhoJ;
+        const Real pj = boundary ? pi : p[j];
+        accumulate(sums.pressure, gradW * (-Vj * Real(0.5) * (pi + pj))); // Eq. 9
+        accumulate(sums.normal, gradW * Vj);                              // Eq. 12
+        if (mu > Real(0)) {
+            accumulate(sums.viscosity, (v[j] - vi) * (mu * Vj * viscosityLaplacian(r, R)));
+        }
+        if (boundary) return;
+        if (diffuses) {
+            sums.heat += mTemperature.pairRate(m[j], rho[i], rho[j], T[i], T[j], xij, gradW, r, R);
+        }
+        if (omega)
+            mVorticity.addPair(sums.vorticity, *omega, i, j, v[j] - vi, Vj, gradW, xij, r, R);
+    });
+    return sums;
+}
+
+void ForcePass::attract(std::size_t i, Vec3& a) const
+{
+    const std::vector<Attractor>& attractors = mSettings.attractors;
+    if (attractors.empty() || (ambient && (*ambient)[i] != Real(0))) return;
+    for (const Attractor& field : attractors) a += field.acceleration(x[i]);
+}
+
+Vec3 ForcePass::acceleration(std::size_t i)
+{
+    const ForceSums sums = sumPairs(i);
+    const Vec3 nI = toVec3(sums.normal);
+    normal[i] = nI;
+    const bool surface = nI.length() * h[i] > mSettings.normalThreshold; // |n_i| h_i > C_N
+    const bool compensate = mCompensation.enabled();
+    Vec3 F = toVec3(sums.pressure);
+    if (compensate) mCompensation.addForces(F, i, p[i], rhoBar[i], rho[i], nI, surface);
+    F += toVec3(sums.viscosity);
+    // Eq. 24 with gravity and the buoyancy of Eq. 17.
+    Vec3 a = F / rho[i] + mSettings.gravity + mTemperature.buoyancy(T[i]);
+    if (compensate) mCompensation.damp(a, v[i], surface); // Eq. 14
+    attract(i, a);
+    if (omega) mVorticity.finish(i, sums.vorticity, nI, a);
+    mTemperature.setRate(i, sums.heat, T[i], surface);
+    return a;
+}
+
+} // namespace
+
+std::vector<Vec3> GasSolver::computeAccelerations()
 {
     const std::size_t n = mParticles.size();
-    const auto& m = mParticles.masses();
+    mTemperature.begin(n);
+    if (mVorticity.enabled()) mVorticity.begin(n);
+    ForcePass pass(mParticles, mLists, mSettings, mCompensation, mTemperature, mVorticity);
     const auto& kind = mParticles.kinds();
-    const auto& h = mParticles.scalarChannel(channel::SUPPORT);
-    const auto& rhoBar = mParticles.scalarChannel(channel::DENSITY_UNCORRECTED);
-    const auto& rho = mParticles.densities();
-    const auto& p = mParticles.pressures();
+    std::vector<Vec3> accel(n, Vec3(0));
+    parallel::forEach(0, n, [&](std::size_t i) {
+        if (kind[i] == ParticleKind::Gas) accel[i] = pass.acceleration(i);
+    });
+    return accel;
+}
+
+void GasSolver::integrate(Real dt, const std::vector<Vec3>& accel)
+{
+    // Symplectic Euler on gas particles: velocity, then position with the new velocity.
+    const std::size_t n = mParticles.size();
+    const auto& kind = mParticles.kinds();
+    auto& x = mParticles.positions();
     auto& v = mParticles.velocities();
     auto& T = mParticles.scalarChannel(channel::TEMPERATURE);
-    auto& normal = mParticles.vectorChannel(channel::NORMAL);
     std::vector<Vec3>* omega =
-        mSettings.vorticity ? &mParticles.vectorChannel(channel::VORTICITY) : nullptr;
-
-    const Method method = mSettings.method;
-    const bool fast = method == Method::Fast;
-    // Radiation models heat lost to the missing air, so only the methods without air have it.
-    const bool radiate = method != Method::Ambient && mSettings.radiationTime > Real(0);
-    const Real mu = mSettings.viscosity;
-    const Real Dc = mSettings.diffusion;
-    const Real Tamb = mSettings.ambientTemperature;
-    const Real CN = mSettings.normalThreshold;
-    const Vec3 g = mSettings.gravity;
-    // g of Eq. 25: gravity, or standard gravity against the buoyancy direction when the gas has
-    // no weight (the default), so the boundary still generates vorticity.
-    const Vec3 gVort = g.lengthSqr() > Real(0) ? g : Real(-9.81) * mBuoyancyDir;
-    // Attractors pull the visible gas only, not the ambient baseline's air (GasSettings.h).
-    const std::vector<Attractor>& attractors = mSettings.attractors;
-    const std::vector<Real>* ambient = mParticles.hasScalarChannel(channel::AMBIENT)
-                                           ? &mParticles.scalarChannel(channel::AMBIENT)
-                                           : nullptr;
-    const auto& x = mParticles.positions();
-
-    std::vector<Vec3> accel(n, Vec3(0));
-    std::vector<Real> dTdt(n, Real(0));
-    std::vector<Vec3> dOmega(omega ? n : 0, Vec3(0));
-    parallel::forEach(0, n, [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Gas) return;
-        const Real pi = p[i];
-        const Vec3 vi = v[i];
-        Vec3d Fp(0.0), nI(0.0), Fv(0.0), vortex(0.0), stretch(0.0);
-        double heat = 0;
-        forEachListed(mLists, x, i, [&](Index j, const Vec3& xij, Real r) {
-            if (j == i) return;
-            const Real R = pairSupport(h[i], h[j]);
-            if (r >= R) return;
-            const Vec3 gradW = spikyGrad(xij, r, R);
-            const bool boundary = kind[j] != ParticleKind::Gas;
-            // Boundary particles: density rho0 and, in the pressure term, the pressure of the
-            // gas particle facing them (mirrored), so a wall pushes back as hard as the gas
-            // presses on it; they are adiabatic (no Eq. 15 exchange) and carry no vorticity.
-            const Real rhoJ = boundary ? mSettings.restDensity : rho[j];
-            const Real Vj = m[j] / rhoJ;
-            const Real pj = boundary ? pi : p[j];
-            const Vec3 fp = gradW * (-Vj * Real(0.5) * (pi + pj)); // Eq. 9
-            accumulate(Fp, fp);
-            const Vec3 nj = gradW * Vj; // Eq. 12
-            accumulate(nI, nj);
-            if (mu > Real(0)) {
-                const Vec3 fv = (v[j] - vi) * (mu * Vj * viscosityLaplacian(r, R));
-                accumulate(Fv, fv);
-            }
-            if (boundary) return;
-            if (Dc > Real(0)) {
-                // Eq. 15 (Cleary 1998): antisymmetric in i and j, so sum_i m_i T_i is conserved.
-                heat += double(m[j]) / (double(rho[i]) * double(rho[j])) * double(Dc)
-                        * double(T[i] - T[j]) * double(xij.dot(gradW))
-                        / (double(r) * double(r) + double(DIFFUSION_GAMMA2 * R * R));
-            }
-            if (omega) {
-                // Eq. 25: (omega_i . grad) v ~ sum_j V_j (v_j - v_i) (omega_i . grad W_ij).
-                const Vec3 s = (v[j] - vi) * (Vj * (*omega)[i].dot(gradW));
-                accumulate(stretch, s);
-                // Eq. 26, weighted by the neighbour volume V_j (resolution independent).
-                const Vec3 u = (*omega)[j].cross(xij) * (Vj * poly6W(r, R));
-                accumulate(vortex, u);
-            }
-        });
-        const Vec3 nVec = toReal(nI);
-        normal[i] = nVec;
-        const bool surface = nVec.length() * h[i] > CN; // |n_i| > C_N, made dimensionless
-        Vec3 F = toReal(Fp);
-        if (fast) {
-            // Eq. 10: the virtual particle k (mass m_k = V_0 rho_bar_i, Eq. 7; density and
-            // pressure those of i) adds + (m_k / rho_k) (p_i + p_k) / 2 grad W_ik. By Eq. 5,
-            // (m_k / rho_k) |grad W_ik| = (rho_bar_i / rho_i) |n_bar_i|, and grad W_ik points
-            // from i to k, against n_bar_i (Eq. 4), so the term is -p_i (rho_bar_i / rho_i)
-            // n_bar_i. We take the sign as printed. The other reading (the force a real particle
-            // at k would exert, -(m_k / rho_k) ... grad W_ik) cancels -p_i n_i, the background
-            // pressure that keeps particles evenly spaced, for every particle, and P_a n_i then
-            // pushes the surface in unopposed: a block at rest clumped and flew apart (RMS radius
-            // x3.6 in 2 s, tests/gas setting). As printed, the surface balances P_a n_i against
-            // about 2 p_i n_i: stable, the block holds (x0.97).
-            F -= mNbar[i] * (pi * rhoBar[i] / rho[i]);
-            // Eq. 13: atmospheric pressure P_a n_i, scaled by beta inside the gas (Sec. 5).
-            const Real Pa = mSettings.atmosphericPressure
-                            * (surface ? Real(1) : mSettings.interiorPressureScale);
-            F += Pa * nVec;
-        }
-        F += toReal(Fv);
-        // Eq. 24.
-        Vec3 a = F / rho[i] + g + mSettings.buoyancy * (T[i] - Tamb) * mBuoyancyDir; // Eq. 17
-        if (fast && surface) a -= mSettings.damping * vi;                            // Eq. 14
-        if (!attractors.empty() && !(ambient && (*ambient)[i] != Real(0))) {
-            for (const Attractor& field : attractors) a += field.acceleration(x[i]); // Fig. 7
-        }
-        if (omega) {
-            a += mSettings.vorticityStrength * toReal(vortex);
-            dOmega[i] = toReal(stretch) + mSettings.vorticityGeneration * nVec.cross(gVort);
-        }
-        accel[i] = a;
-        Real rate = Real(heat);
-        if (radiate && surface) rate -= (T[i] - Tamb) / mSettings.radiationTime; // Eq. 16
-        dTdt[i] = rate;
-    });
-
-    // Symplectic Euler on gas particles.
-    auto& xw = mParticles.positions();
+        mVorticity.enabled() ? &mParticles.vectorChannel(channel::VORTICITY) : nullptr;
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) return;
         v[i] += dt * accel[i];
-        xw[i] += dt * v[i];
-        T[i] += dt * dTdt[i];
-        if (omega) (*omega)[i] += dt * dOmega[i];
+        x[i] += dt * v[i];
+        mTemperature.advance(T, i, dt);
+        if (omega) mVorticity.advance(*omega, i, dt);
     });
     Real amax = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -1045,7 +939,7 @@ void GasSolver::step(Real dt)
     computeDensity();
     mTimings.density += secondsSince(t0);
     t0 = std::chrono::steady_clock::now();
-    computeForcesAndIntegrate(dt);
+    integrate(dt, computeAccelerations());
     expandSupports();
     mTimings.forces += secondsSince(t0);
 
@@ -1130,6 +1024,32 @@ void GasSolver::checkHoldsTogether() const
 
 // Save and restore ---------------------------------------------------------------------------------
 
+namespace {
+/// Throws ValueError unless the particles of a saved state have the gas channels and every
+/// boundary particle belongs to one of the state's `solids` solids or to the domain walls.
+void checkStateParticles(const ParticleSet& p, std::int64_t solids)
+{
+    for (const char* name : {channel::TEMPERATURE, channel::SUPPORT}) {
+        if (!p.hasScalarChannel(name)) {
+            throw ValueError(msg("restoreState: the gas state has no '", name, "' channel"));
+        }
+    }
+    if (p.count(ParticleKind::Boundary) == 0) return;
+    if (!p.hasScalarChannel(channel::SOLID_INDEX) || !p.hasVectorChannel(channel::SOLID_LOCAL)) {
+        throw ValueError("restoreState: the gas state has boundary particles but no solid "
+                         "channels");
+    }
+    const auto& index = p.scalarChannel(channel::SOLID_INDEX);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Boundary) continue;
+        if (index[i] >= Real(solids) || !(index[i] >= DOMAIN_WALL)) {
+            throw ValueError(msg("restoreState: boundary particle id ", p.ids()[i],
+                                 " belongs to no solid of the state (", solids, " solids)"));
+        }
+    }
+}
+} // namespace
+
 SolverState GasSolver::saveState() const
 {
     SolverState state;
@@ -1176,34 +1096,11 @@ void GasSolver::restoreState(const SolverState& state)
         budgets.push_back(state.real("source_budget_" + std::to_string(k)));
     }
     const ParticleSet& p = state.particles;
-    for (const char* name : {channel::TEMPERATURE, channel::SUPPORT}) {
-        if (!p.hasScalarChannel(name)) {
-            throw ValueError(msg("restoreState: the gas state has no '", name, "' channel"));
-        }
-    }
-    if (p.count(ParticleKind::Boundary) > 0) {
-        if (!p.hasScalarChannel(channel::SOLID_INDEX)
-            || !p.hasVectorChannel(channel::SOLID_LOCAL)) {
-            throw ValueError("restoreState: the gas state has boundary particles but no solid "
-                             "channels");
-        }
-        const auto& index = p.scalarChannel(channel::SOLID_INDEX);
-        for (std::size_t i = 0; i < p.size(); ++i) {
-            if (p.kinds()[i] != ParticleKind::Boundary) continue;
-            if (index[i] >= Real(solids) || !(index[i] >= DOMAIN_WALL)) {
-                throw ValueError(msg("restoreState: boundary particle id ", p.ids()[i],
-                                     " belongs to no solid of the state (", solids, " solids)"));
-            }
-        }
-    }
+    checkStateParticles(p, solids);
 
     mParticles = p;
     // Channels a fresh solver of these settings has; states saved by this solver have them.
-    mParticles.addScalarChannel(channel::DENSITY_UNCORRECTED, mSettings.restDensity);
-    mParticles.addVectorChannel(channel::NORMAL);
-    mParticles.addScalarChannel(channel::LIFE, mSettings.lifeStrength);
-    if (mSettings.method == Method::Ambient) mParticles.addScalarChannel(channel::AMBIENT, Real(0));
-    if (mSettings.vorticity) mParticles.addVectorChannel(channel::VORTICITY);
+    addStepChannels();
     mRun = run;
     mMass = Real(mass);
     mIsolatedRemoved = std::size_t(isolated);

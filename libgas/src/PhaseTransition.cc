@@ -159,19 +159,13 @@ void PhaseTransition::heat(Real dt)
     const Real R = mLiquid.supportRadius();
     const Real rho0 = mLiquid.restDensity();
     const sph::CubicSplineKernel kernel(R);
-    // One vectorised search into lists (the liquid solver left its particles sorted by cell).
-    sph::NeighborGrid grid(R);
-    grid.build(p.positions());
-    mHeatQueries.resize(n);
-    for (std::size_t i = 0; i < n; ++i) mHeatQueries[i] = p.kinds()[i] == ParticleKind::Liquid;
-    mHeatLists.build(grid, p.positions().data(), n, R, mHeatQueries.data());
+    searchHeatNeighbours();
 
     const auto& x = p.positions();
     const auto& m = p.masses();
     const auto& rho = p.densities();
     const auto& kind = p.kinds();
-    auto& T = p.scalarChannel(TEMPERATURE);
-    auto& latent = p.scalarChannel(LATENT);
+    const auto& T = p.scalarChannel(TEMPERATURE);
     const Real Dc = mSettings.conductivity;
     const Real gamma2 = mSettings.diffusionEpsilon * R * R;
     const Real band = mSettings.heaterBand;
@@ -184,8 +178,8 @@ void PhaseTransition::heat(Real dt)
         if (kind[i] != ParticleKind::Liquid) return;
         const Real rhoI = density(i);
         double dTdt = 0;
-        Vec3d colour(
-            0.0); // colour-field gradient sum_j V_j gradW_ij: ~0 inside, large at a surface
+        // Colour-field gradient sum_j V_j gradW_ij: about 0 inside, large at a surface.
+        Vec3d colour(0.0);
         for (const Index j : mHeatLists[i]) {
             const Vec3 xij = x[i] - x[j];
             const Real r = xij.length();
@@ -211,7 +205,30 @@ void PhaseTransition::heat(Real dt)
         Tnew[i] = Real(double(T[i]) + double(dt) * dTdt);
         mSurface[i] = colour.length() * double(R) > double(mSettings.surfaceThreshold);
     });
+    storeHeat(Tnew);
+}
+
+void PhaseTransition::searchHeatNeighbours()
+{
+    // One vectorised search into lists (the liquid solver left its particles sorted by cell).
+    ParticleSet& p = mLiquid.particles();
+    const std::size_t n = p.size();
+    const Real R = mLiquid.supportRadius();
+    sph::NeighborGrid grid(R);
+    grid.build(p.positions());
+    mHeatQueries.resize(n);
+    for (std::size_t i = 0; i < n; ++i) mHeatQueries[i] = p.kinds()[i] == ParticleKind::Liquid;
+    mHeatLists.build(grid, p.positions().data(), n, R, mHeatQueries.data());
+}
+
+void PhaseTransition::storeHeat(std::vector<Real>& Tnew)
+{
     // Heat beyond the boiling point goes into the latent store (L / c_p, K), T stays at T_b.
+    ParticleSet& p = mLiquid.particles();
+    const std::size_t n = p.size();
+    const auto& kind = p.kinds();
+    auto& T = p.scalarChannel(TEMPERATURE);
+    auto& latent = p.scalarChannel(LATENT);
     const Real Tb = mSettings.boilingPoint;
     for (std::size_t i = 0; i < n; ++i) {
         if (kind[i] != ParticleKind::Liquid) continue;
@@ -232,23 +249,48 @@ void PhaseTransition::heat(Real dt)
 
 std::size_t PhaseTransition::transfer(Real dt)
 {
+    const std::vector<Index> boil = selectBoiling();
+    const std::vector<sph::ParticleId> evaporate = selectEvaporation(dt, boil.size());
+    if (boil.empty() && evaporate.empty()) return 0;
+    splitLiquid(boil, evaporate);
+    mBoiled += boil.size();
+    mEvaporated += evaporate.size();
+    handVapourToGas();
+    return boil.size() + evaporate.size();
+}
+
+std::vector<Index> PhaseTransition::selectBoiling() const
+{
+    // A liquid particle boils when its latent store is full (at most maxTransitionsPerStep).
+    const ParticleSet& p = mLiquid.particles();
+    const auto& kind = p.kinds();
+    const auto& T = p.scalarChannel(TEMPERATURE);
+    const auto& latent = p.scalarChannel(LATENT);
+    const std::size_t cap = mSettings.maxTransitionsPerStep;
+    std::vector<Index> boil;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (kind[i] != ParticleKind::Liquid) continue;
+        if (cap && boil.size() >= cap) break;
+        if (T[i] >= mSettings.boilingPoint && latent[i] >= mSettings.latentHeat) {
+            boil.push_back(Index(i));
+        }
+    }
+    return boil;
+}
+
+std::vector<sph::ParticleId> PhaseTransition::selectEvaporation(Real dt, std::size_t boiling)
+{
+    // A surface particle above the onset accumulates evaporationRate f(T) dt pending splits;
+    // one whole split is due when the pending count passes its staggered threshold.
     ParticleSet& p = mLiquid.particles();
-    const std::size_t n = p.size();
     const auto& kind = p.kinds();
     const auto& T = p.scalarChannel(TEMPERATURE);
     const auto& latent = p.scalarChannel(LATENT);
     auto& pending = p.scalarChannel(EVAPORATION);
     const Real Tb = mSettings.boilingPoint, Ton = mSettings.evaporationOnset;
     const std::size_t cap = mSettings.maxTransitionsPerStep;
-
-    std::vector<Index> boil;
-    std::vector<sph::ParticleId> evapIds;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (kind[i] != ParticleKind::Liquid) continue;
-        if (cap && boil.size() >= cap) break;
-        if (T[i] >= Tb && latent[i] >= mSettings.latentHeat) boil.push_back(Index(i));
-    }
-    for (std::size_t i = 0; i < n; ++i) {
+    std::vector<sph::ParticleId> ids;
+    for (std::size_t i = 0; i < p.size(); ++i) {
         if (kind[i] != ParticleKind::Liquid || !mSurface[i] || !(T[i] > Ton)) continue;
         if (T[i] >= Tb && latent[i] >= mSettings.latentHeat) continue; // boils instead
         const Real f = std::min(Real(1), (T[i] - Ton) / (Tb - Ton));
@@ -256,45 +298,52 @@ std::size_t PhaseTransition::transfer(Real dt)
         // The threshold is staggered per particle by a hash of its id, so a surface that starts
         // with equal temperatures does not evaporate in lockstep (no quantisation of the rate).
         if (pending[i] + evaporationPhase(p.ids()[i]) >= Real(1)
-            && (!cap || boil.size() + evapIds.size() < cap)) {
+            && (!cap || boiling + ids.size() < cap)) {
             pending[i] -= Real(1);
-            evapIds.push_back(p.ids()[i]);
+            ids.push_back(p.ids()[i]);
         }
     }
-    if (boil.empty() && evapIds.empty()) return 0;
+    return ids;
+}
 
+void PhaseTransition::splitLiquid(const std::vector<Index>& boil,
+                                  const std::vector<sph::ParticleId>& evaporate)
+{
     // Boiling: every daughter becomes gas. Evaporation: the centre stays liquid.
+    ParticleSet& p = mLiquid.particles();
     SplitOptions boilOptions;
     boilOptions.outerKind = ParticleKind::Gas;
     boilOptions.centreKind = ParticleKind::Gas;
     if (!boil.empty()) splitParticles(p, boil, mBoilPattern, boilOptions);
-    if (!evapIds.empty()) {
-        const std::unordered_set<sph::ParticleId> wanted(evapIds.begin(), evapIds.end());
-        std::vector<Index> evap;
-        for (std::size_t i = 0; i < p.size(); ++i) {
-            if (p.kinds()[i] == ParticleKind::Liquid && wanted.count(p.ids()[i])) {
-                evap.push_back(Index(i));
-            }
+    if (evaporate.empty()) return;
+    // The boiling split moved the particles: find the evaporating ones again by id.
+    const std::unordered_set<sph::ParticleId> wanted(evaporate.begin(), evaporate.end());
+    std::vector<Index> evap;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] == ParticleKind::Liquid && wanted.count(p.ids()[i])) {
+            evap.push_back(Index(i));
         }
-        SplitOptions evapOptions;
-        evapOptions.outerKind = ParticleKind::Gas;
-        evapOptions.centreKind = ParticleKind::Liquid;
-        splitParticles(p, evap, mEvapPattern, evapOptions);
     }
-    mBoiled += boil.size();
-    mEvaporated += evapIds.size();
+    SplitOptions evapOptions;
+    evapOptions.outerKind = ParticleKind::Gas;
+    evapOptions.centreKind = ParticleKind::Liquid;
+    splitParticles(p, evap, mEvapPattern, evapOptions);
+}
 
+void PhaseTransition::handVapourToGas()
+{
     // Hand every gas daughter to the gas solver with its exact mass. Its support radius is the
     // one a gas particle of that mass has at its birth density, the liquid's: h_rest(m)
     // (rho0_gas / rho0_liquid)^(1/3), so a newborn vapour particle has the neighbour count of
     // a gas at rest (Sec. 4.2's volume expansion then grows h back to h_rest(m) as the vapour
     // expands, GasSolver::expandSupports). Sized for the gas at rest instead, the daughters of
     // a boiling layer, packed at the liquid's density, had about 1,300 neighbours each.
+    ParticleSet& p = mLiquid.particles();
     const double birth =
         std::cbrt(double(mGas.settings().restDensity) / double(mLiquid.restDensity()));
     const double hGas = double(mGas.settings().supportRadius());
     const double mGasRef = double(mGas.referenceParticleMass());
-    const auto& Tc = p.scalarChannel(TEMPERATURE);
+    const auto& T = p.scalarChannel(TEMPERATURE);
     std::vector<Vec3> xs, vs;
     std::vector<Real> Ts, ms, hs;
     std::vector<std::uint8_t> remove(p.size(), 0);
@@ -303,7 +352,7 @@ std::size_t PhaseTransition::transfer(Real dt)
         remove[i] = 1;
         xs.push_back(p.positions()[i]);
         vs.push_back(p.velocities()[i]);
-        Ts.push_back(Tc[i]);
+        Ts.push_back(T[i]);
         ms.push_back(p.masses()[i]);
         const double hRest = hGas * std::cbrt(double(p.masses()[i]) / mGasRef);
         hs.push_back(Real(hRest * std::min(1.0, birth)));
@@ -312,7 +361,6 @@ std::size_t PhaseTransition::transfer(Real dt)
     p.removeIf(remove);
     if (!xs.empty()) mGas.addGasParticles(xs, vs, Ts, ms, hs);
     mVapourCreated += xs.size();
-    return boil.size() + evapIds.size();
 }
 
 void PhaseTransition::mergeLiquid()

@@ -7,17 +7,22 @@
 ///          air is gas particles marked by the channel "ambient" = 1.
 ///
 ///          One step (Method::Fast; the baselines switch parts off, see GasSettings.h):
-///           1. emission from the sources;
-///           2. sort by cell, uncorrected density rho_bar_i = sum_j m_j W_ij (Eq. 1 without air);
-///           3. density correction: V_0 (Eq. 5) from n_bar_i = sum_j m_j / rho_bar_j grad W_ij,
-///              rho_i = rho_bar_i (1 + V_0 W_ik) (Eq. 8), p_i = kappa (rho_i - rho0) (Eq. 11);
-///           4. forces: pressure with the virtual particle (Eq. 10), atmospheric pressure
-///              P_a n_i (Eqs. 12 - 13, scaled by beta inside, Sec. 5), viscosity, gravity,
-///              damping (Eq. 14) and radiation (Eq. 16) where |n_i| h_i > C_N, temperature
-///              diffusion (Eq. 15), buoyancy (Eq. 17), optional vorticity (Eqs. 25 - 26): Eq. 24;
-///              plus the point attractors of GasSettings::attractors (Fig. 7) on visible gas;
-///           5. symplectic Euler; solids move; collision projection; kill box; life strength of
-///              isolated particles (Sec. 5); blow-up check.
+///           1. emission from the sources (emit);
+///           2. sort by cell and one neighbour search (sortParticles), uncorrected density
+///              rho_bar_i = sum_j m_j W_ij (Eq. 1 without air, sumDensities);
+///           3. density correction (GasCompensation): V_0 (Eq. 5) from
+///              n_bar_i = sum_j m_j / rho_bar_j grad W_ij, rho_i = rho_bar_i (1 + V_0 W_ik)
+///              (Eq. 8); p_i = kappa (rho_i - rho0) (Eq. 11);
+///           4. forces (computeAccelerations): pressure (Eq. 9), normal (Eq. 12), viscosity and
+///              gravity, with the parts' terms: the virtual particle's pressure (Eq. 10),
+///              atmospheric pressure P_a n_i (Eq. 13, scaled by beta inside, Sec. 5) and damping
+///              (Eq. 14) where |n_i| h_i > C_N (GasCompensation); temperature diffusion
+///              (Eq. 15), radiation (Eq. 16) and buoyancy (Eq. 17) (GasTemperature); optional
+///              vorticity (Eqs. 25 - 26, GasVorticity): Eq. 24; plus the point attractors of
+///              GasSettings::attractors (Fig. 7) on visible gas;
+///           5. symplectic Euler with the parts' temperature and vorticity updates (integrate);
+///              solids move; collision projection; kill box; life strength of isolated
+///              particles (Sec. 5); blow-up check.
 ///
 ///          Variable smoothing length: every particle carries its kernel support radius in the
 ///          channel "h" (the paper's h: W(r, h) vanishes for r >= h); a pair uses the symmetric
@@ -37,7 +42,11 @@
 ///          solids and sources in the same order (solids are not sampled again) and no gas.
 #pragma once
 
+#include <ghostfx/gas/GasChannels.h>
+#include <ghostfx/gas/GasCompensation.h>
 #include <ghostfx/gas/GasSettings.h>
+#include <ghostfx/gas/GasTemperature.h>
+#include <ghostfx/gas/GasVorticity.h>
 #include <ghostfx/sph/LevelSet.h>
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/NeighborLists.h>
@@ -60,20 +69,6 @@ using sph::Index;
 using sph::LevelSet;
 using sph::ParticleKind;
 using sph::ParticleSet;
-
-/// Names of the particle channels the gas solver keeps (exporters read them by name).
-namespace channel {
-constexpr const char* TEMPERATURE = "temperature"; ///< T (K), gas; boundaries: ambient
-constexpr const char* SUPPORT = "h";               ///< kernel support radius h_i (m)
-constexpr const char* DENSITY_UNCORRECTED = "density_uncorrected"; ///< rho_bar (kg/m^3)
-constexpr const char* NORMAL = "normal";       ///< n_i of Eq. 12 (1/m), points inwards
-constexpr const char* LIFE = "life";           ///< life strength l_s left (s), Sec. 5
-constexpr const char* AMBIENT = "ambient";     ///< 1 for ambient air (Method::Ambient only)
-constexpr const char* VORTICITY = "vorticity"; ///< omega of Eq. 25 (1/s), if enabled
-constexpr const char* SOLID_LOCAL = "solid_x"; ///< boundary: position in its solid's frame
-/// Boundary: index of its solid (>= 0), EXTERNAL_BOUNDARY or DOMAIN_WALL.
-constexpr const char* SOLID_INDEX = "solid_index";
-} // namespace channel
 
 /// solid_index of particles set by setExternalBoundary().
 constexpr Real EXTERNAL_BOUNDARY = Real(-1);
@@ -220,13 +215,42 @@ private:
     void sampleSolid(std::size_t solidIndex);
     void buildDomainWalls();
     void fillAmbientAir();
+    struct PlacedSource;
+    /// Sources (dt in s): convert air, add new gas, heat the gas inside.
     void emit(Real dt);
+    /// Ambient baseline: air inside the source turns into visible gas, at most `allowed`
+    /// particles. Returns how many.
+    std::size_t convertAmbientAir(const PlacedSource& at, std::size_t allowed);
+    /// Fill the free room of source e with new gas, at most `room` particles. Returns how many.
+    std::size_t addFreshGas(std::size_t e, const PlacedSource& at, std::size_t room);
+    /// Samples of an empty source e clear of solids and `obstacles` (m, world).
+    std::vector<Vec3> fillSource(std::size_t e, const PlacedSource& at,
+                                 const std::vector<Vec3>& obstacles) const;
+    /// New samples in source e grown from the gas already in it (`seeds`, m, world).
+    std::vector<Vec3> growFromSeeds(std::size_t e, const PlacedSource& at,
+                                    const std::vector<Vec3>& seeds,
+                                    const std::vector<Vec3>& obstacles) const;
+    /// Hold the visible gas inside the source at its temperature.
+    void heatSourceGas(const PlacedSource& at);
     bool blockedBySolid(const Vec3& x) const;
     Real referenceMass() const;
     void assignMissingMasses();
     void sortParticles();
+    /// Add the channels a step writes (those the constructor adds after "temperature" and
+    /// "h"); present ones are kept.
+    void addStepChannels();
+    /// Density pass: Eq. 1, the parts' correction, Eq. 11.
     void computeDensity();
-    void computeForcesAndIntegrate(Real dt);
+    /// Eq. 1 without air: rho_bar_i, the neighbour count and the isolated flags.
+    void sumDensities();
+    /// rho_i (Eq. 8 in the fast method, rho_bar_i otherwise) and p_i (Eq. 11).
+    void correctDensities();
+    /// The force pass (Eqs. 9 - 17, 22 - 26): every particle's acceleration (m/s^2, zero for
+    /// boundary particles); the parts keep their rates for integrate().
+    std::vector<Vec3> computeAccelerations();
+    /// Symplectic Euler over dt (s) with `accel`, the parts' temperature and vorticity updates
+    /// and the largest acceleration for the CFL limit.
+    void integrate(Real dt, const std::vector<Vec3>& accel);
     /// Grow the support of particles born denser than the gas (added with an h below the one
     /// their mass has at rest: vapour born at the liquid's density) as they expand.
     void expandSupports();
@@ -241,7 +265,9 @@ private:
     std::vector<Vec3> sampleShape(const LevelSet& shape, std::uint64_t seed) const;
 
     GasSettings mSettings;
-    Vec3 mBuoyancyDir;
+    GasCompensation mCompensation; ///< Eqs. 5, 8, 10, 13, 14 (Method::Fast)
+    GasTemperature mTemperature;   ///< Eqs. 15 - 17
+    GasVorticity mVorticity;       ///< Eqs. 25 - 26
     ParticleSet mParticles;
     sph::NeighborGrid mGrid;
     /// Each gas particle's neighbours (gas and boundary) within the grid's cell size, searched
@@ -251,7 +277,6 @@ private:
     std::vector<Real> mQueryRadius;       ///< search radius per particle: (h_i + h_max) / 2
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Source>> mSources;
-    std::vector<Vec3> mNbar;             ///< n_bar_i with uncorrected densities (Eq. 5), per step
     std::vector<std::uint8_t> mIsolated; ///< no neighbour this step (Sec. 5)
     Real mMass = 0;
     sph::RunCounters mRun; ///< clock and counters

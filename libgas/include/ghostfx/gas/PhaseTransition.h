@@ -246,8 +246,27 @@ private:
     };
 
     void ensureChannels();
+    /// Heater relaxation and Eq. 15 among liquid particles over dt (s); finds the surface.
     void heat(Real dt);
+    /// Build mHeatLists: every liquid particle's neighbours within the liquid support radius.
+    void searchHeatNeighbours();
+    /// Take the heat pass's new temperatures Tnew (K): T clamped at T_b, the excess stored as
+    /// latent heat. Throws NumericalError on a non-finite temperature.
+    void storeHeat(std::vector<Real>& Tnew);
+    /// Boiling and evaporation of the step (dt in s, Sec. 4.2): returns the liquid particles
+    /// turned.
     std::size_t transfer(Real dt);
+    /// Liquid-set indices of the particles that boil this step.
+    std::vector<sph::Index> selectBoiling() const;
+    /// Ids of the surface particles that evaporate this step (dt in s), `boiling` of the
+    /// step's transitions taken by boiling; advances their pending splits.
+    std::vector<sph::ParticleId> selectEvaporation(Real dt, std::size_t boiling);
+    /// Split the boiling particles (all daughters gas) and the evaporating ones (the centre
+    /// stays liquid).
+    void splitLiquid(const std::vector<sph::Index>& boil,
+                     const std::vector<sph::ParticleId>& evaporate);
+    /// Move every gas daughter from the liquid set to the gas solver.
+    void handVapourToGas();
     void mergeLiquid();
     void updateBoundary();
     double gasMass() const;
