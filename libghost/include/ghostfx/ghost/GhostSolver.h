@@ -389,7 +389,7 @@ private:
     bool blockedBySolid(const Vec3& x) const;
     void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;
     /// Resample the air in the blocks of `count` phases from `phase` on (phase < 0:
-    /// everywhere), see GhostAir.cc.
+    /// everywhere), see AirResampling.h.
     void resampleAir(int phase, int count = 1);
     /// Move every fading air particle's weight towards its target by span / airResampleSteps
     /// (span: GhostSettings::airResampleSpan).
