@@ -231,11 +231,11 @@ struct LeafSums
 };
 
 /// Step 2 of the file comment: the particles' sums on one candidate leaf, then its output leaves.
-class LeafGather
+class DensityGather
 {
 public:
     /// Gather `sel` (neighbour grid `grid`, cells of the kernel support) as `options` asks.
-    LeafGather(const Selected& sel, const sph::NeighborGrid& grid, const VolumeOptions& options)
+    DensityGather(const Selected& sel, const sph::NeighborGrid& grid, const VolumeOptions& options)
         : mSel(sel)
         , mGrid(grid)
         , mKernel{sph::Real(options.kernelSupport)}
@@ -386,7 +386,7 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     const std::vector<openvdb::Coord> leaves =
         leavesNearParticles(sel.x, grid.order(), options.fogVoxelSize(), R);
     std::vector<LeafOutput> results(leaves.size());
-    const LeafGather gather(sel, grid, options);
+    const DensityGather gather(sel, grid, options);
     parallel::forEach(
         0, leaves.size(), [&](std::size_t L) { results[L] = gather(leaves[L]); }, 1);
     attachLeaves(results, grids, options);
