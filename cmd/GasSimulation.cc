@@ -2,6 +2,7 @@
 /// @brief  A gas scene ([RYY15] fast gas, or its ambient-air and uncorrected baselines) behind
 ///         Simulation.
 #include "GasScene.h"
+#include "OneSolverSimulation.h"
 #include "SimulationParts.h"
 
 namespace ghostfx {
@@ -63,11 +64,11 @@ std::vector<std::pair<std::string, double>> gasStats(const gas::GasSolver& s,
 
 namespace {
 
-class GasSimulation : public Simulation
+class GasSimulation : public OneSolverSimulation<gas::GasSolver>
 {
 public:
     GasSimulation(const vdbio::Scene& scene, gas::Method method, const sph::SolverState* restored)
-        : mSolver(makeGasSolver(scene, readSettings(scene, method), restored))
+        : OneSolverSimulation(makeGasSolver(scene, readSettings(scene, method), restored))
     {}
 
     /// settings.gas, and then no other key of settings left unread.
@@ -85,30 +86,11 @@ public:
     }
 
     void advanceFrame() override { mSolver->advanceFrame(); }
-    int frame() const override { return mSolver->frame(); }
-    double time() const override { return mSolver->time(); }
-    std::uint64_t stepCount() const override { return mSolver->stepCount(); }
-    double fixedTimeStep() const override { return fixedStep(mSolver->settings()); }
-    double stabilityLimit() const override
-    {
-        return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
-    }
-
-    double cflTimeStep() const override { return double(mSolver->stableTimeStep()); }
-
-    void setStepObserver(std::function<void(double)> observer) override
-    {
-        mSolver->setStepObserver(
-            [observer](const gas::GasSolver&, Real dt) { observer(double(dt)); });
-    }
 
     vdbio::StatsRow statsRow(int frame, double dt) override
     {
         vdbio::StatsRow row;
-        row.values = {{"frame", frame},
-                      {"step", double(mSolver->stepCount())},
-                      {"time", mSolver->time()},
-                      {"dt", dt}};
+        row.values = stepColumns(frame, dt);
         for (auto& v : gasStats(*mSolver, mBefore)) row.values.push_back(v);
         row.values.push_back(bytesPerParticle(*this));
         mBefore = mSolver->timings();
@@ -133,10 +115,7 @@ public:
         return {{"gas", mSolver->visibleGasCount()}};
     }
 
-    std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
-
 private:
-    std::unique_ptr<gas::GasSolver> mSolver;
     gas::GasTimings mBefore;
     mutable sph::ParticleSet mVisible;
 };

@@ -1,6 +1,7 @@
 /// @file   LiquidSimulation.cc
 /// @brief  A liquid scene ([SB12] Ghost SPH or the Basic SPH baseline) behind Simulation.
 #include "LiquidScene.h"
+#include "OneSolverSimulation.h"
 #include "SimulationParts.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -39,13 +40,13 @@ OutputMedium liquidMedium(const GhostSolver& s)
 
 namespace {
 
-class LiquidSimulation : public Simulation
+class LiquidSimulation : public OneSolverSimulation<GhostSolver>
 {
 public:
     LiquidSimulation(const vdbio::Scene& scene, ghost::Method method,
                      const sph::SolverState* restored)
-        : mScene(scene)
-        , mSolver(makeLiquidSolver(scene, liquidSettings(scene, method), restored))
+        : OneSolverSimulation(makeLiquidSolver(scene, liquidSettings(scene, method), restored))
+        , mScene(scene)
     {}
 
     void advanceFrame() override
@@ -82,16 +83,7 @@ public:
                          double(d.divergenceError));
         }
     }
-    int frame() const override { return mSolver->frame(); }
-    double time() const override { return mSolver->time(); }
-    std::uint64_t stepCount() const override { return mSolver->stepCount(); }
     void beforeFrame(int frame) override { updateSolidSequences(mScene, *mSolver, frame); }
-    double fixedTimeStep() const override { return fixedStep(mSolver->settings()); }
-    double stabilityLimit() const override
-    {
-        return double(mSolver->stableTimeStep()) / double(mSolver->settings().cflNumber);
-    }
-    double cflTimeStep() const override { return double(mSolver->stableTimeStep()); }
     double boundaryLayerDepth() const override
     {
         return double(mSolver->settings().supportRadius());
@@ -115,11 +107,6 @@ public:
         return mSolver->addLiquid(shape, velocity);
     }
 
-    void setStepObserver(std::function<void(double)> observer) override
-    {
-        mSolver->setStepObserver([observer](const GhostSolver&, Real dt) { observer(double(dt)); });
-    }
-
     vdbio::StatsRow statsRow(int frame, double dt) override
     {
         const GhostSolver& s = *mSolver;
@@ -127,26 +114,25 @@ public:
             fieldStats(s.particles(), ParticleKind::Liquid, s.settings().restDensity, nullptr);
         const ghost::PhaseTimings& t = s.timings();
         vdbio::StatsRow row;
-        row.values = {
-            {"frame", frame},
-            {"step", double(s.stepCount())},
-            {"time", s.time()},
-            {"dt", dt},
-            {"count_liquid", double(f.count)},
-            {"count_ghost_air", double(s.count(ParticleKind::GhostAir))},
-            {"count_ghost_solid", double(s.count(ParticleKind::GhostSolid))},
-            {"count_boundary", double(s.count(ParticleKind::Boundary))},
-            {"max_speed", f.maxSpeed},
-            {"density_error_mean", f.errorMean},
-            {"density_error_max", f.errorMax},
-            {"t_neighbors_density", t.neighborsAndDensity - mBefore.neighborsAndDensity},
-            {"t_pressure_force", t.pressureForce - mBefore.pressureForce},
-            {"t_xsph_boundary", t.xsphAndBoundary - mBefore.xsphAndBoundary},
-            {"t_air_resampling", t.airResampling - mBefore.airResampling},
-            {"t_emission", t.emission - mBefore.emission},
-            {"t_step", t.total - mBefore.total},
-            bytesPerParticle(*this),
-        };
+        row.values = stepColumns(frame, dt);
+        row.values.insert(
+            row.values.end(),
+            {
+                {"count_liquid", double(f.count)},
+                {"count_ghost_air", double(s.count(ParticleKind::GhostAir))},
+                {"count_ghost_solid", double(s.count(ParticleKind::GhostSolid))},
+                {"count_boundary", double(s.count(ParticleKind::Boundary))},
+                {"max_speed", f.maxSpeed},
+                {"density_error_mean", f.errorMean},
+                {"density_error_max", f.errorMax},
+                {"t_neighbors_density", t.neighborsAndDensity - mBefore.neighborsAndDensity},
+                {"t_pressure_force", t.pressureForce - mBefore.pressureForce},
+                {"t_xsph_boundary", t.xsphAndBoundary - mBefore.xsphAndBoundary},
+                {"t_air_resampling", t.airResampling - mBefore.airResampling},
+                {"t_emission", t.emission - mBefore.emission},
+                {"t_step", t.total - mBefore.total},
+                bytesPerParticle(*this),
+            });
         if (s.settings().pressure == ghost::PressureModel::Dfsph) {
             // Iterations per step of the frame's DFSPH solves.
             const ghost::PressureSolveStats& st = s.pressureSolveStats();
@@ -207,7 +193,6 @@ public:
 
 private:
     const vdbio::Scene& mScene;
-    std::unique_ptr<GhostSolver> mSolver;
     ghost::PhaseTimings mBefore;
     ghost::PressureSolveStats mSolveBefore;
     bool mWarnedRecomputed = false; ///< the kept-gradient limit's warning was printed

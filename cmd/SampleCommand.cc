@@ -60,47 +60,39 @@ Command addSampleCommand(CLI::App& app)
 
 namespace {
 
-double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b)
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::time_point a, Clock::time_point b)
 {
     return std::chrono::duration<double>(b - a).count();
 }
 
-} // namespace
-
-int runSample(const SampleOptions& o)
+/// The level set of `o.shape` (named after it) of size `size` (m) and voxel `voxel` (m).
+openvdb::FloatGrid::Ptr makeShapeGrid(const SampleOptions& o, Real size, Real voxel)
 {
-    parallel::ThreadLimit threadLimit(o.threads);
-    const Real h = Real(o.spacing);
-    const Real voxel = Real(o.spacing * o.voxelFactor);
-    const Real size = Real(o.size);
-    if (size < 2 * h) {
-        throw ValueError(msg("sample --size = ", o.size,
-                             " m: expected at least two particle "
-                             "spacings (",
-                             2 * o.spacing, " m)"));
-    }
-
     openvdb::FloatGrid::Ptr grid;
     if (o.shape == "sphere") grid = makeSphereLevelSet(Vec3(0), size, voxel);
     else if (o.shape == "box") grid = makeBoxLevelSet(Vec3(-size), Vec3(size), voxel);
     else grid = makeTorusLevelSet(Vec3(0), size, size / 3, voxel);
     grid->setName(o.shape);
-    const LevelSet shape = makeLevelSet(grid);
+    return grid;
+}
 
+/// The sampler's settings for spacing `h` (m) with the seed, band depth and relaxation of `o`.
+PoissonSettings samplerSettings(const SampleOptions& o, Real h)
+{
     PoissonSettings settings = PoissonSettings::forSpacing(h);
     settings.seed = o.seed;
     if (o.bandDepth > 0) settings.bandDepth = Real(o.bandDepth);
-    const bool packing = o.relaxation == "packing";
-    settings.volumeRelaxation =
-        packing ? PoissonSettings::Relaxation::Packing : PoissonSettings::Relaxation::Sb12;
+    settings.volumeRelaxation = o.relaxation == "packing" ? PoissonSettings::Relaxation::Packing
+                                                          : PoissonSettings::Relaxation::Sb12;
+    return settings;
+}
+
+/// The particles of `shape` by the whole pipeline of `settings`, each stage's time printed.
+SampleSet sampleTimed(const LevelSet& shape, const PoissonSettings& settings)
+{
     PoissonDiskSampler sampler(settings);
-
-    std::printf("ghostfx sample: %s of size %g m, spacing h = %g m, Poisson radius r = %g m, "
-                "voxel %g m (%lld active voxels), %d thread(s)\n",
-                o.shape.c_str(), o.size, o.spacing, double(settings.radius), double(voxel),
-                static_cast<long long>(grid->activeVoxelCount()), parallel::maxThreads());
-
-    using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     SampleSet s = sampler.sampleSurface(shape);
     const auto t1 = Clock::now();
@@ -117,7 +109,7 @@ int runSample(const SampleOptions& o)
                 settings.surfaceRelaxSweeps, settings.relaxAttempts);
     std::printf("  interior sampling  %8.3f s  (Bridson 2007, t = %d)\n", seconds(t2, t3),
                 settings.volumeAttempts);
-    if (packing) {
+    if (settings.volumeRelaxation == PoissonSettings::Relaxation::Packing) {
         std::printf("  volume relaxation  %8.3f s  (SPH packing, %d steps)\n", seconds(t3, t4),
                     settings.packingIterations);
     } else {
@@ -126,9 +118,12 @@ int runSample(const SampleOptions& o)
     }
     std::printf("  particles          %8zu     (%zu on the surface), %.0f particles/s\n", s.size(),
                 s.surfaceCount(), double(s.size()) / seconds(t0, t4));
+    return s;
+}
 
-    // Spacing statistics.
-    const Real r = settings.radius;
+/// Print the nearest-neighbour distances of `s` in units of the Poisson radius `r` (m).
+void printSpacing(const SampleSet& s, Real r)
+{
     NeighborGrid nnGrid(2 * r);
     nnGrid.build(s.positions);
     double nnSum = 0, nnMin = 1e30;
@@ -144,11 +139,12 @@ int runSample(const SampleOptions& o)
     }
     std::printf("  nearest neighbour  min %.4f r, mean %.4f r (Poisson-disk: min >= r)\n",
                 nnMin / double(r), nnSum / double(s.size()) / double(r));
+}
 
-    // [SB12] Sec. 4.6 mass scaling, measured on particles whose kernel support is complete
-    // (farther than one support radius from every surface sample).
-    const CubicSplineKernel kernel = CubicSplineKernel::fromSpacing(h);
-    const Real R = kernel.supportRadius();
+/// Per particle of `s`: whether its kernel support (radius `R`, m) is complete, farther than
+/// `R` from every surface sample; empty (all particles count) when none is.
+std::vector<std::uint8_t> interiorParticles(const SampleSet& s, Real R)
+{
     NeighborGrid surfaceGrid(R);
     std::vector<Vec3> surfacePoints;
     for (std::size_t i = 0; i < s.size(); ++i) {
@@ -170,8 +166,16 @@ int runSample(const SampleOptions& o)
                     double(R));
         interior.clear();
     }
+    return interior;
+}
+
+/// Print the [SB12] Sec. 4.6 mass of the particles of `s` (spacing `h`, m) and the density it
+/// gives the `interior` ones (all, when empty).
+void printMassScaling(const SampleSet& s, const std::vector<std::uint8_t>& interior,
+                      const CubicSplineKernel& kernel, const SampleOptions& o)
+{
     const Real mass = massForRestDensity(s.positions, kernel, Real(o.restDensity), interior);
-    NeighborGrid densityGrid(R);
+    NeighborGrid densityGrid(kernel.supportRadius());
     densityGrid.build(s.positions);
     const std::vector<Real> rho =
         densitySum(s.positions, std::vector<Real>(s.size(), mass), densityGrid, kernel);
@@ -192,6 +196,35 @@ int runSample(const SampleOptions& o)
                 n, mean / o.restDensity,
                 100.0 * std::sqrt(std::max(0.0, sum2 / n - mean * mean)) / mean, lo / o.restDensity,
                 hi / o.restDensity);
+}
+
+} // namespace
+
+int runSample(const SampleOptions& o)
+{
+    parallel::ThreadLimit threadLimit(o.threads);
+    const Real h = Real(o.spacing);
+    const Real voxel = Real(o.spacing * o.voxelFactor);
+    const Real size = Real(o.size);
+    if (size < 2 * h) {
+        throw ValueError(msg("sample --size = ", o.size,
+                             " m: expected at least two particle "
+                             "spacings (",
+                             2 * o.spacing, " m)"));
+    }
+    const openvdb::FloatGrid::Ptr grid = makeShapeGrid(o, size, voxel);
+    const LevelSet shape = makeLevelSet(grid);
+    const PoissonSettings settings = samplerSettings(o, h);
+    std::printf("ghostfx sample: %s of size %g m, spacing h = %g m, Poisson radius r = %g m, "
+                "voxel %g m (%lld active voxels), %d thread(s)\n",
+                o.shape.c_str(), o.size, o.spacing, double(settings.radius), double(voxel),
+                static_cast<long long>(grid->activeVoxelCount()), parallel::maxThreads());
+
+    const SampleSet s = sampleTimed(shape, settings);
+    printSpacing(s, settings.radius);
+    // [SB12] Sec. 4.6 mass scaling, measured on particles whose kernel support is complete.
+    const CubicSplineKernel kernel = CubicSplineKernel::fromSpacing(h);
+    printMassScaling(s, interiorParticles(s, kernel.supportRadius()), kernel, o);
     return 0;
 }
 

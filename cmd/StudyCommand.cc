@@ -33,11 +33,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <sstream>
 #include <map>
 #include <memory>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include <fcntl.h>
@@ -105,31 +105,28 @@ std::vector<std::pair<std::string, Json>> assignments(const vdbio::JsonObject& o
     return out;
 }
 
-StudySpec readStudy(const std::string& path)
+/// The "-D" assignments of `root.set`, kept by every case.
+std::vector<std::string> fixedAssignments(const vdbio::JsonObject& root)
 {
-    auto shared = std::make_shared<const Json>(vdbio::readJsonFile(path, "study"));
-    const vdbio::JsonObject root(shared, shared.get(), "", path, "study");
-
-    StudySpec s;
-    s.file = path;
-    const int version = root.require<int>("ghostfx_study");
-    if (version != 1) root.failValue("ghostfx_study", "unsupported version: expected 1");
-    const fs::path folder = fs::path(path).parent_path();
-    s.scene = (folder / root.require<std::string>("scene")).lexically_normal().string();
-
-    // Cases: every combination of the sweep, times every entry of "runs".
     std::vector<std::string> fixed;
     for (const auto& [key, value] : assignments(root, "set")) {
         if (key == PRECISION_KEY) root.fail("set", "precision is chosen per case in sweep or runs");
         fixed.push_back(key + "=" + value.dump());
     }
+    return fixed;
+}
+
+/// Every combination of the values of `root.sweep`, its keys appended to `axes`.
+std::vector<std::map<std::string, Json>> sweepCombinations(const vdbio::JsonObject& root,
+                                                           std::vector<std::string>& axes)
+{
     std::vector<std::map<std::string, Json>> combos(1);
     for (const auto& [key, values] : assignments(root, "sweep")) {
         if (!values.is_array() || values.empty()) {
             root.fail("sweep", msg("'", key, "' = ", values.dump(),
                                    ": expected a non-empty array of values"));
         }
-        s.axes.push_back(key);
+        axes.push_back(key);
         std::vector<std::map<std::string, Json>> next;
         for (const auto& combo : combos) {
             for (const Json& v : values) {
@@ -139,59 +136,84 @@ StudySpec readStudy(const std::string& path)
         }
         combos = std::move(next);
     }
+    return combos;
+}
+
+/// The entries of `root.runs` (of the document `doc`), their keys appended to `axes` when new;
+/// one empty entry without runs.
+std::vector<std::map<std::string, Json>> readRuns(const vdbio::JsonObject& root, const Json& doc,
+                                                  std::vector<std::string>& axes)
+{
     std::vector<std::map<std::string, Json>> runs;
     for (const vdbio::JsonObject& run : root.objects("runs")) {
         std::map<std::string, Json> values;
-        const Json* raw = shared->contains("runs") ? &(*shared)["runs"][runs.size()] : nullptr;
+        const Json* raw = doc.contains("runs") ? &doc["runs"][runs.size()] : nullptr;
         for (auto it = raw->begin(); it != raw->end(); ++it) {
             values[it.key()] = it.value();
-            if (std::find(s.axes.begin(), s.axes.end(), it.key()) == s.axes.end())
-                s.axes.push_back(it.key());
+            if (std::find(axes.begin(), axes.end(), it.key()) == axes.end())
+                axes.push_back(it.key());
         }
         (void)run;
         runs.push_back(std::move(values));
     }
     if (runs.empty()) runs.emplace_back();
+    return runs;
+}
 
-    auto makeCase = [&](const std::map<std::string, Json>& values, bool reference) {
-        StudyCase c;
-        c.values = values;
-        c.reference = reference;
-        c.overrides = fixed;
-        for (const auto& [key, value] : values) {
-            c.label += (c.label.empty() ? "" : " ") + key + "=" + valueText(value);
-            if (key == PRECISION_KEY) {
-                if (value != "float" && value != "double") {
-                    root.fail(
-                        reference ? "reference" : "sweep",
-                        msg("precision = ", value.dump(), ": expected \"float\" or \"double\""));
-                }
-                c.precision = value.get<std::string>();
-            } else {
-                c.overrides.push_back(key + "=" + value.dump());
+/// The case of the swept `values` (the reference case with `reference`), after the `fixed`
+/// assignments; a precision value picks the build instead of becoming an assignment.
+StudyCase makeCase(const vdbio::JsonObject& root, const std::vector<std::string>& fixed,
+                   const std::map<std::string, Json>& values, bool reference)
+{
+    StudyCase c;
+    c.values = values;
+    c.reference = reference;
+    c.overrides = fixed;
+    for (const auto& [key, value] : values) {
+        c.label += (c.label.empty() ? "" : " ") + key + "=" + valueText(value);
+        if (key == PRECISION_KEY) {
+            if (value != "float" && value != "double") {
+                root.fail(reference ? "reference" : "sweep",
+                          msg("precision = ", value.dump(), ": expected \"float\" or \"double\""));
             }
+            c.precision = value.get<std::string>();
+        } else {
+            c.overrides.push_back(key + "=" + value.dump());
         }
-        if (reference) c.label = "reference" + (c.label.empty() ? "" : " " + c.label);
-        return c;
-    };
+    }
+    if (reference) c.label = "reference" + (c.label.empty() ? "" : " " + c.label);
+    return c;
+}
+
+/// The cases into `s.cases`, the reference first: every combination of the sweep, times every
+/// entry of "runs"; the swept keys into `s.axes`.
+void readCases(const vdbio::JsonObject& root, const Json& doc, StudySpec& s)
+{
+    const std::vector<std::string> fixed = fixedAssignments(root);
+    const std::vector<std::map<std::string, Json>> combos = sweepCombinations(root, s.axes);
+    const std::vector<std::map<std::string, Json>> runs = readRuns(root, doc, s.axes);
     if (root.has("reference")) {
         std::map<std::string, Json> values;
         for (const auto& [key, value] : assignments(root, "reference")) values[key] = value;
-        s.cases.push_back(makeCase(values, true));
+        s.cases.push_back(makeCase(root, fixed, values, true));
     }
     for (const auto& combo : combos) {
         for (const auto& run : runs) {
             std::map<std::string, Json> values = combo;
             for (const auto& [key, value] : run) values[key] = value;
-            s.cases.push_back(makeCase(values, false));
+            s.cases.push_back(makeCase(root, fixed, values, false));
         }
     }
+}
 
-    // Metrics: "name" or { "metric": "name", options... }.
+/// `root.metrics` of the study `path`: each "name" or { "metric": "name", options... }.
+std::vector<MetricSpec> readMetrics(const vdbio::JsonObject& root, const std::string& path)
+{
     const Json* metrics = root.raw("metrics");
     if (!metrics || !metrics->is_array() || metrics->empty()) {
         root.failValue("metrics", "expected a non-empty array of metric names (docs/study.md)");
     }
+    std::vector<MetricSpec> specs;
     for (std::size_t k = 0; k < metrics->size(); ++k) {
         const Json& m = (*metrics)[k];
         MetricSpec spec;
@@ -205,18 +227,34 @@ StudySpec readStudy(const std::string& path)
                                      ": expected a name or { \"metric\": name, ... }"));
         }
         makeMetric(spec, msg("study '", path, "': metrics[", k, "]")); // checks name and options
-        s.metrics.push_back(std::move(spec));
+        specs.push_back(std::move(spec));
     }
+    return specs;
+}
 
+/// `root.executables`: the program to run per precision.
+std::map<std::string, std::string> readExecutables(const vdbio::JsonObject& root)
+{
+    std::map<std::string, std::string> executables;
     for (const auto& [precision, program] : assignments(root, "executables")) {
         if (precision != "float" && precision != "double") {
             root.fail("executables", msg("'", precision, "': expected \"float\" or \"double\""));
         }
-        s.executables[precision] = valueText(program);
+        executables[precision] = valueText(program);
     }
-    s.maxSecondsPerRun = root.nonNegative("max_seconds_per_run", 0);
+    return executables;
+}
 
-    const vdbio::JsonObject out = root.has("output") ? root.object("output") : vdbio::JsonObject();
+/// The optional object `root.key`, or an empty one that answers every key with its default.
+vdbio::JsonObject optionalSection(const vdbio::JsonObject& root, const char* key)
+{
+    return root.has(key) ? root.object(key) : vdbio::JsonObject();
+}
+
+/// `root.output` of the study `path`: folder, table and plot file names.
+void readOutput(const vdbio::JsonObject& root, const std::string& path, StudySpec& s)
+{
+    const vdbio::JsonObject out = optionalSection(root, "output");
     s.directory = out.get<std::string>("directory", "out/study_" + fs::path(path).stem().string());
     s.table = out.get<std::string>("table", "study.csv");
     s.plot = out.get<std::string>("plot", "study.png");
@@ -224,8 +262,18 @@ StudySpec readStudy(const std::string& path)
     if (ext != ".png" && ext != ".pdf" && ext != ".svg")
         out.failValue("plot", "expected an image file name ending in .png, .pdf or .svg");
     out.finish();
+}
 
-    const vdbio::JsonObject plot = root.has("plot") ? root.object("plot") : vdbio::JsonObject();
+/// Whether `key` is one of the swept keys `axes`.
+bool isSwept(const std::vector<std::string>& axes, const std::string& key)
+{
+    return std::find(axes.begin(), axes.end(), key) != axes.end();
+}
+
+/// `root.plot` of the study `path`: the cost and error columns, the series and the title.
+void readPlot(const vdbio::JsonObject& root, const std::string& path, StudySpec& s)
+{
+    const vdbio::JsonObject plot = optionalSection(root, "plot");
     s.plotCost = plot.choice("cost", s.plotCost,
                              {"wall_per_sim_second", "cpu_per_sim_second", "wall_s", "cpu_s",
                               "peak_rss_mb", "particles_max", "particle_memory_mb", "steps"});
@@ -234,36 +282,39 @@ StudySpec readStudy(const std::string& path)
     s.plotSeries = plot.get<std::string>("series", "");
     s.plotTitle = plot.get<std::string>("title", fs::path(path).stem().string());
     plot.finish();
-    if (!s.plotSeries.empty()
-        && std::find(s.axes.begin(), s.axes.end(), s.plotSeries) == s.axes.end()) {
+    if (!s.plotSeries.empty() && !isSwept(s.axes, s.plotSeries)) {
         root.fail("plot", msg("series = \"", s.plotSeries, "\": not a swept key (swept: ",
                               s.axes.empty() ? std::string("none") : s.axes.front(),
                               s.axes.size() > 1 ? ", ..." : "", ")"));
     }
+}
 
-    const vdbio::JsonObject conv =
-        root.has("convergence") ? root.object("convergence") : vdbio::JsonObject();
-    const bool sweptSpacing =
-        std::find(s.axes.begin(), s.axes.end(), "settings.spacing") != s.axes.end();
+/// `root.convergence`: the step-size key (the spacing when swept), the error column, whether
+/// the step is 1 / key, and the keys that form groups.
+void readConvergence(const vdbio::JsonObject& root, StudySpec& s)
+{
+    const vdbio::JsonObject conv = optionalSection(root, "convergence");
+    const bool sweptSpacing = isSwept(s.axes, "settings.spacing");
     s.convergenceKey = conv.get<std::string>("key", sweptSpacing ? "settings.spacing" : "");
     s.convergenceError = conv.get<std::string>("error", s.plotError);
     s.convergenceInverse = conv.get<bool>("inverse", false);
     if (conv.has("group_by")) {
         s.convergenceGroupBy = conv.get<std::vector<std::string>>("group_by", {});
         for (const std::string& key : *s.convergenceGroupBy) {
-            if (std::find(s.axes.begin(), s.axes.end(), key) == s.axes.end()) {
+            if (!isSwept(s.axes, key)) {
                 conv.failValue("group_by", msg("'", key, "' is not a swept key"));
             }
         }
     }
     conv.finish();
-    if (!s.convergenceKey.empty()
-        && std::find(s.axes.begin(), s.axes.end(), s.convergenceKey) == s.axes.end()) {
+    if (!s.convergenceKey.empty() && !isSwept(s.axes, s.convergenceKey)) {
         root.fail("convergence", msg("key = \"", s.convergenceKey, "\": not a swept key"));
     }
-    root.finish();
+}
 
-    // Every column the plot or the convergence may name must be one the metrics produce.
+/// Every column the plot or the convergence names must be one the metrics produce.
+void checkErrorColumns(const StudySpec& s)
+{
     std::set<std::string> columns;
     for (const MetricSpec& m : s.metrics) {
         auto metric = makeMetric(m, "");
@@ -277,11 +328,34 @@ StudySpec readStudy(const std::string& path)
         if (!columns.count(*column)) {
             std::string list;
             for (const std::string& c : columns) list += (list.empty() ? "" : ", ") + c;
-            throw SceneError(msg(
-                "study '", path, "': ", column == &s.plotError ? "plot.error" : "convergence.error",
-                " = \"", *column, "\": not a column of these metrics (", list, ")"));
+            throw SceneError(msg("study '", s.file,
+                                 "': ", column == &s.plotError ? "plot.error" : "convergence.error",
+                                 " = \"", *column, "\": not a column of these metrics (", list,
+                                 ")"));
         }
     }
+}
+
+StudySpec readStudy(const std::string& path)
+{
+    auto shared = std::make_shared<const Json>(vdbio::readJsonFile(path, "study"));
+    const vdbio::JsonObject root(shared, shared.get(), "", path, "study");
+
+    StudySpec s;
+    s.file = path;
+    const int version = root.require<int>("ghostfx_study");
+    if (version != 1) root.failValue("ghostfx_study", "unsupported version: expected 1");
+    const fs::path folder = fs::path(path).parent_path();
+    s.scene = (folder / root.require<std::string>("scene")).lexically_normal().string();
+    readCases(root, *shared, s);
+    s.metrics = readMetrics(root, path);
+    s.executables = readExecutables(root);
+    s.maxSecondsPerRun = root.nonNegative("max_seconds_per_run", 0);
+    readOutput(root, path, s);
+    readPlot(root, path, s);
+    readConvergence(root, s);
+    root.finish();
+    checkErrorColumns(s);
     return s;
 }
 
@@ -299,6 +373,98 @@ double cpuSeconds()
            + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
+/// The metrics of `spec`, fresh for one run.
+std::vector<std::unique_ptr<Metric>> makeMetrics(const StudySpec& spec)
+{
+    std::vector<std::unique_ptr<Metric>> metrics;
+    for (std::size_t k = 0; k < spec.metrics.size(); ++k) {
+        metrics.push_back(
+            makeMetric(spec.metrics[k], msg("study '", spec.file, "': metrics[", k, "]")));
+    }
+    return metrics;
+}
+
+/// Show each metric the medium it watches in `sim` at frame `frame` (`first`: the initial
+/// state, which starts it).
+void sampleMetrics(const std::vector<std::unique_ptr<Metric>>& metrics, const Simulation& sim,
+                   const vdbio::Scene& scene, int frame, bool first)
+{
+    const std::vector<OutputMedium> media = sim.media();
+    for (const auto& metric : metrics) {
+        auto it = std::find_if(media.begin(), media.end(),
+                               [&](const OutputMedium& m) { return m.name == metric->medium(); });
+        if (it == media.end()) {
+            throw SceneError(msg("metric ", metric->name(), " watches the ", metric->medium(),
+                                 ", and scene '", scene.file, "' has none"));
+        }
+        MetricSample s{&*it, sim.time(), frame, scene.lastFrame};
+        if (first) metric->start(s);
+        else metric->frame(s);
+    }
+}
+
+/// What a case's frames cost, the metrics' own sampling left out.
+struct FramesCost
+{
+    double wall = 0, cpu = 0;                    ///< s
+    std::size_t particlesMax = 0, memoryMax = 0; ///< the most particles and bytes at a frame
+};
+
+/// Advance `sim` through every frame of `scene`, sampling `metrics` after each.
+FramesCost runFrames(Simulation& sim, const vdbio::Scene& scene,
+                     const std::vector<std::unique_ptr<Metric>>& metrics)
+{
+    FramesCost cost;
+    cost.particlesMax = sim.particleCount();
+    cost.memoryMax = sim.memoryBytes();
+    const double cpuStart = cpuSeconds();
+    const auto loopStart = Clock::now();
+    double sampling = 0;
+    for (int frame = 1; frame <= scene.lastFrame; ++frame) {
+        const auto frameStart = Clock::now();
+        sim.beforeFrame(frame);
+        sim.advanceFrame();
+        const auto sampleStart = Clock::now();
+        sampleMetrics(metrics, sim, scene, frame, false);
+        sampling += std::chrono::duration<double>(Clock::now() - sampleStart).count();
+        cost.particlesMax = std::max(cost.particlesMax, sim.particleCount());
+        cost.memoryMax = std::max(cost.memoryMax, sim.memoryBytes());
+        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %llu steps, %s, %.2f s\n", frame,
+                     scene.lastFrame, sim.time(), static_cast<unsigned long long>(sim.stepCount()),
+                     sim.counts().c_str(),
+                     std::chrono::duration<double>(Clock::now() - frameStart).count());
+    }
+    // The metrics' own sampling is not the solver's cost.
+    cost.wall = std::chrono::duration<double>(Clock::now() - loopStart).count() - sampling;
+    cost.cpu = cpuSeconds() - cpuStart - sampling;
+    return cost;
+}
+
+/// The "cost" of a result document: `setup` (s) and `frames`, per simulated second and per
+/// step, and the particles of each medium of `sim` at the end.
+Json costJson(const Simulation& sim, double setup, const FramesCost& frames)
+{
+    Json cost;
+    const double wall = frames.wall, cpu = frames.cpu;
+    cost["setup_s"] = setup;
+    cost["wall_s"] = wall;
+    cost["sim_s"] = sim.time();
+    cost["wall_per_sim_second"] = sim.time() > 0 ? wall / sim.time() : NAN;
+    cost["cpu_s"] = cpu;
+    cost["cpu_per_sim_second"] = sim.time() > 0 ? cpu / sim.time() : NAN;
+    cost["steps"] = double(sim.stepCount());
+    cost["steps_per_second"] = wall > 0 ? double(sim.stepCount()) / wall : NAN;
+    cost["particles_max"] = double(frames.particlesMax);
+    cost["particle_memory_mb"] = double(frames.memoryMax) / 1048576.0;
+    for (const OutputMedium& m : sim.media()) {
+        std::size_t n = 0;
+        for (sph::ParticleKind k : m.particles->kinds())
+            n += std::count(m.kinds.begin(), m.kinds.end(), k) > 0;
+        cost["count_" + m.name] = double(n);
+    }
+    return cost;
+}
+
 /// Run case `index` and return its result document. Throws like `ghostfx run`.
 Json runCase(const StudySpec& spec, std::size_t index)
 {
@@ -311,71 +477,14 @@ Json runCase(const StudySpec& spec, std::size_t index)
     const vdbio::Scene scene = vdbio::readScene(spec.scene, c.overrides);
     std::unique_ptr<Simulation> sim = makeSimulation(scene);
     checkSolidSequences(scene, 1, scene.lastFrame);
-
-    std::vector<std::unique_ptr<Metric>> metrics;
-    for (std::size_t k = 0; k < spec.metrics.size(); ++k) {
-        metrics.push_back(
-            makeMetric(spec.metrics[k], msg("study '", spec.file, "': metrics[", k, "]")));
-    }
-    auto sample = [&](int frame, bool first) {
-        const std::vector<OutputMedium> media = sim->media();
-        for (const auto& metric : metrics) {
-            auto it = std::find_if(media.begin(), media.end(), [&](const OutputMedium& m) {
-                return m.name == metric->medium();
-            });
-            if (it == media.end()) {
-                throw SceneError(msg("metric ", metric->name(), " watches the ", metric->medium(),
-                                     ", and scene '", scene.file, "' has none"));
-            }
-            MetricSample s{&*it, sim->time(), frame, scene.lastFrame};
-            if (first) metric->start(s);
-            else metric->frame(s);
-        }
-    };
-    sample(0, true);
+    const std::vector<std::unique_ptr<Metric>> metrics = makeMetrics(spec);
+    sampleMetrics(metrics, *sim, scene, 0, true);
     const double setup = std::chrono::duration<double>(Clock::now() - t0).count();
-
-    std::size_t particlesMax = sim->particleCount(), memoryMax = sim->memoryBytes();
-    const double cpuStart = cpuSeconds();
-    const auto loopStart = Clock::now();
-    double sampling = 0;
-    for (int frame = 1; frame <= scene.lastFrame; ++frame) {
-        const auto frameStart = Clock::now();
-        sim->beforeFrame(frame);
-        sim->advanceFrame();
-        const auto sampleStart = Clock::now();
-        sample(frame, false);
-        sampling += std::chrono::duration<double>(Clock::now() - sampleStart).count();
-        particlesMax = std::max(particlesMax, sim->particleCount());
-        memoryMax = std::max(memoryMax, sim->memoryBytes());
-        std::fprintf(stderr, "frame %d/%d: t = %.4f s, %llu steps, %s, %.2f s\n", frame,
-                     scene.lastFrame, sim->time(),
-                     static_cast<unsigned long long>(sim->stepCount()), sim->counts().c_str(),
-                     std::chrono::duration<double>(Clock::now() - frameStart).count());
-    }
-    // The metrics' own sampling is not the solver's cost.
-    const double wall = std::chrono::duration<double>(Clock::now() - loopStart).count() - sampling;
-    const double cpu = cpuSeconds() - cpuStart - sampling;
+    const FramesCost frames = runFrames(*sim, scene, metrics);
 
     Json result;
     result["status"] = "ok";
-    Json& cost = result["cost"];
-    cost["setup_s"] = setup;
-    cost["wall_s"] = wall;
-    cost["sim_s"] = sim->time();
-    cost["wall_per_sim_second"] = sim->time() > 0 ? wall / sim->time() : NAN;
-    cost["cpu_s"] = cpu;
-    cost["cpu_per_sim_second"] = sim->time() > 0 ? cpu / sim->time() : NAN;
-    cost["steps"] = double(sim->stepCount());
-    cost["steps_per_second"] = wall > 0 ? double(sim->stepCount()) / wall : NAN;
-    cost["particles_max"] = double(particlesMax);
-    cost["particle_memory_mb"] = double(memoryMax) / 1048576.0;
-    for (const OutputMedium& m : sim->media()) {
-        std::size_t n = 0;
-        for (sph::ParticleKind k : m.particles->kinds())
-            n += std::count(m.kinds.begin(), m.kinds.end(), k) > 0;
-        cost["count_" + m.name] = double(n);
-    }
+    result["cost"] = costJson(*sim, setup, frames);
     result["counts"] = sim->counts();
     for (const auto& metric : metrics) {
         for (const auto& [name, value] : metric->values()) result["values"][name] = value;
@@ -1000,22 +1109,12 @@ int listCases(const StudyOptions& o, const StudySpec& spec)
     return 0;
 }
 
-/// `--emit slurm`: an array job of the cases, a collect job, and a script that submits both
-/// (the collect job waits for every case to end, whether it succeeded or not).
-int emitSlurm(const StudyOptions& o, const StudySpec& spec)
+/// The Slurm array job of the cases of `spec`: task k runs case k with `cpus` threads (the
+/// task's CPUs) by `self` or the case's own program, its output under `folder`.
+std::string casesSbatch(const StudyOptions& o, const StudySpec& spec, const std::string& folder,
+                        const std::string& self, const std::string& name, int cpus)
 {
-    checkCases(spec);
-    const std::string folder = fs::absolute(outputFolder(o, spec)).lexically_normal().string();
     const std::string slurm = (fs::path(folder) / "slurm").string();
-    vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
-    vdbio::ensureWritableDirectory(slurm);
-    const std::string self = selfPath(), name = "ghostfx-" + fs::path(spec.file).stem().string();
-    const int cpus = std::max(1, o.threads);
-    auto write = [](const std::string& path, const std::string& text) {
-        vdbio::writeTextFile(path, text, "job script");
-        fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
-    };
-
     std::string cases = msg(
         "#!/bin/bash\n"
         "# ghostfx study '",
@@ -1038,32 +1137,60 @@ int emitSlurm(const StudyOptions& o, const StudySpec& spec)
                      " > ", shellQuoted(logPath(folder, k)), " 2>&1 ;;\n");
     }
     cases += "  *) echo \"no case $SLURM_ARRAY_TASK_ID in this study\" >&2; exit 1 ;;\nesac\n";
-    write((fs::path(slurm) / "cases.sbatch").string(), cases);
+    return cases;
+}
 
-    write((fs::path(slurm) / "collect.sbatch").string(),
-          msg("#!/bin/bash\n# ghostfx study '", spec.file,
-              "': the table, convergence and plot from every case's row file.\n"
-              "#SBATCH --job-name=",
-              name, "-collect\n#SBATCH --cpus-per-task=1\n#SBATCH --output=", slurm,
-              "/collect.slurm.out\nexec ", shellQuoted(self), " study ",
-              shellQuoted(fs::absolute(spec.file).string()), " --collect --out ",
-              shellQuoted(folder), "\n"));
+/// The Slurm job that collects the study `spec` in `folder` by `self`.
+std::string collectSbatch(const StudySpec& spec, const std::string& folder, const std::string& self,
+                          const std::string& name)
+{
+    const std::string slurm = (fs::path(folder) / "slurm").string();
+    return msg("#!/bin/bash\n# ghostfx study '", spec.file,
+               "': the table, convergence and plot from every case's row file.\n"
+               "#SBATCH --job-name=",
+               name, "-collect\n#SBATCH --cpus-per-task=1\n#SBATCH --output=", slurm,
+               "/collect.slurm.out\nexec ", shellQuoted(self), " study ",
+               shellQuoted(fs::absolute(spec.file).string()), " --collect --out ",
+               shellQuoted(folder), "\n");
+}
 
-    write((fs::path(slurm) / "submit.sh").string(),
-          msg("#!/bin/sh\n"
-              "# Submit the study's cases as an array job and the collection after them.\n"
-              "# Options go to both sbatch calls: ./submit.sh --partition=sim --mem=8G\n"
-              "set -e\n"
-              "cd ",
-              shellQuoted(slurm),
-              "\n"
-              "array=$(sbatch --parsable \"$@\" cases.sbatch)\n"
-              "array=${array%%;*}\n"
-              "collect=$(sbatch --parsable --dependency=afterany:\"$array\" \"$@\" "
-              "collect.sbatch)\n"
-              "echo \"cases: job $array (",
-              spec.cases.size(), " tasks); collect: job ${collect%%;*}\"\n"));
+/// The script that submits the cases of `spec` (scripts in `slurm`) and the collection after.
+std::string submitScript(const StudySpec& spec, const std::string& slurm)
+{
+    return msg("#!/bin/sh\n"
+               "# Submit the study's cases as an array job and the collection after them.\n"
+               "# Options go to both sbatch calls: ./submit.sh --partition=sim --mem=8G\n"
+               "set -e\n"
+               "cd ",
+               shellQuoted(slurm),
+               "\n"
+               "array=$(sbatch --parsable \"$@\" cases.sbatch)\n"
+               "array=${array%%;*}\n"
+               "collect=$(sbatch --parsable --dependency=afterany:\"$array\" \"$@\" "
+               "collect.sbatch)\n"
+               "echo \"cases: job $array (",
+               spec.cases.size(), " tasks); collect: job ${collect%%;*}\"\n");
+}
 
+/// `--emit slurm`: an array job of the cases, a collect job, and a script that submits both
+/// (the collect job waits for every case to end, whether it succeeded or not).
+int emitSlurm(const StudyOptions& o, const StudySpec& spec)
+{
+    checkCases(spec);
+    const std::string folder = fs::absolute(outputFolder(o, spec)).lexically_normal().string();
+    const std::string slurm = (fs::path(folder) / "slurm").string();
+    vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
+    vdbio::ensureWritableDirectory(slurm);
+    const std::string self = selfPath(), name = "ghostfx-" + fs::path(spec.file).stem().string();
+    const int cpus = std::max(1, o.threads);
+    auto write = [](const std::string& path, const std::string& text) {
+        vdbio::writeTextFile(path, text, "job script");
+        fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+    };
+    write((fs::path(slurm) / "cases.sbatch").string(),
+          casesSbatch(o, spec, folder, self, name, cpus));
+    write((fs::path(slurm) / "collect.sbatch").string(), collectSbatch(spec, folder, self, name));
+    write((fs::path(slurm) / "submit.sh").string(), submitScript(spec, slurm));
     if (!o.quiet) {
         std::fprintf(stderr,
                      "ghostfx study '%s': %zu cases; Slurm scripts in '%s' (cases.sbatch, "
@@ -1106,6 +1233,56 @@ int collectStudy(const StudyOptions& o, const StudySpec& spec)
     return finishStudy(o, spec, outcomes, folder);
 }
 
+/// The line a local study prints when case `k` of `spec` ended with `r`, `seconds` after it
+/// started (its log under `folder`).
+std::string caseEndLine(const StudySpec& spec, std::size_t k, const CaseOutcome& r, double seconds,
+                        const std::string& folder)
+{
+    const StudyCase& c = spec.cases[k];
+    std::string line = msg("[", k + 1, "/", spec.cases.size(), "] ",
+                           c.label.empty() ? "base scene" : c.label, ": ", r.status);
+    if (r.status == "ok") {
+        line +=
+            msg(", ", number(numberOr(r, "wall_s")), " s wall, ", number(numberOr(r, "cpu_s")),
+                " s CPU (", number(numberOr(r, "wall_per_sim_second")), " s per simulated s), ",
+                number(numberOr(r, "peak_rss_mb")), " MB, ", number(numberOr(r, "particles_max")),
+                " particles; ", spec.plotError, " = ", number(numberOr(r, spec.plotError)));
+    } else {
+        line += msg(" after ", number(seconds), " s: ", r.note, " (log: ", logPath(folder, k), ")");
+    }
+    return line;
+}
+
+/// A study without a step flag: each case as a child process, collected after every case.
+int runStudyLocally(const StudyOptions& o, const StudySpec& spec)
+{
+    checkCases(spec);
+    const std::string folder = outputFolder(o, spec);
+    vdbio::ensureWritableDirectory(folder);
+    vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
+    const std::string self = selfExecutable();
+    auto say = [&](const std::string& line) {
+        if (!o.quiet) std::fprintf(stderr, "%s\n", line.c_str());
+    };
+    say(msg("ghostfx study '", spec.file, "': scene '", spec.scene, "', ", spec.cases.size(),
+            " runs, ", spec.metrics.size(), " metrics, output in '", folder, "'"));
+
+    // Rows of an earlier run would be collected as this run's until their case runs again.
+    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
+        std::error_code ec;
+        fs::remove(rowPath(folder, k), ec);
+    }
+    std::vector<CaseOutcome> outcomes;
+    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
+        const auto start = Clock::now();
+        runChild(spec, k, programFor(spec, spec.cases[k], self), o.threads, folder);
+        outcomes = collectRows(spec, folder);
+        const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        say(caseEndLine(spec, k, outcomes[k], seconds, folder));
+    }
+    return finishStudy(o, spec, outcomes, folder);
+}
+
 int runStudy(const StudyOptions& options)
 {
     // One sample cache for every case: this process's, the child processes' (through the
@@ -1134,48 +1311,7 @@ int runStudy(const StudyOptions& options)
             readTable(spec, (fs::path(folder) / spec.table).string());
         return finishStudy(o, spec, outcomes, folder);
     }
-
-    // Local: each case as a child process, collected after every case.
-    checkCases(spec);
-    const std::string folder = outputFolder(o, spec);
-    vdbio::ensureWritableDirectory(folder);
-    vdbio::ensureWritableDirectory((fs::path(folder) / "runs").string());
-    const std::string self = selfExecutable();
-    auto say = [&](const std::string& line) {
-        if (!o.quiet) std::fprintf(stderr, "%s\n", line.c_str());
-    };
-    say(msg("ghostfx study '", spec.file, "': scene '", spec.scene, "', ", spec.cases.size(),
-            " runs, ", spec.metrics.size(), " metrics, output in '", folder, "'"));
-
-    // Rows of an earlier run would be collected as this run's until their case runs again.
-    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
-        std::error_code ec;
-        fs::remove(rowPath(folder, k), ec);
-    }
-    std::vector<CaseOutcome> outcomes;
-    for (std::size_t k = 0; k < spec.cases.size(); ++k) {
-        const StudyCase& c = spec.cases[k];
-        const auto start = Clock::now();
-        runChild(spec, k, programFor(spec, c, self), o.threads, folder);
-        outcomes = collectRows(spec, folder);
-        const CaseOutcome& r = outcomes[k];
-        std::string line = msg("[", k + 1, "/", spec.cases.size(), "] ",
-                               c.label.empty() ? "base scene" : c.label, ": ", r.status);
-        if (r.status == "ok") {
-            line += msg(
-                ", ", number(numberOr(r, "wall_s")), " s wall, ", number(numberOr(r, "cpu_s")),
-                " s CPU (", number(numberOr(r, "wall_per_sim_second")), " s per simulated s), ",
-                number(numberOr(r, "peak_rss_mb")), " MB, ", number(numberOr(r, "particles_max")),
-                " particles; ", spec.plotError, " = ", number(numberOr(r, spec.plotError)));
-        } else {
-            line +=
-                msg(" after ", number(std::chrono::duration<double>(Clock::now() - start).count()),
-                    " s: ", r.note, " (log: ", logPath(folder, k), ")");
-        }
-        say(line);
-    }
-
-    return finishStudy(o, spec, outcomes, folder);
+    return runStudyLocally(o, spec);
 }
 
 } // namespace

@@ -72,11 +72,7 @@ namespace detail {
 
 namespace {
 
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 using MaskLeaf = openvdb::MaskTree::LeafNodeType;
-
-constexpr int LEAF_DIM = int(FloatLeaf::DIM);           // 8 voxels per leaf edge
-constexpr int LEAF_VOXELS = int(FloatLeaf::NUM_VALUES); // 512
 
 /// Covariance eigenvalue of a full uniform neighbourhood per r^2, for the weights
 /// w = 1 - (d / r)^3: int_0^r w d^4 dd / (3 int_0^r w d^2 dd) = (3 r^5 / 40) / (r^3 / 2) = 0.15.
@@ -178,13 +174,6 @@ std::vector<Kernel> makeKernels(const sph::NeighborGrid& grid, const std::vector
     return kernels;
 }
 
-/// Voxel index range [lo, hi] on one axis whose centres i * dx lie within `reach` of `x`.
-inline void voxelRange(double x, double reach, double invDx, int& lo, int& hi)
-{
-    lo = int(std::ceil((x - reach) * invDx));
-    hi = int(std::floor((x + reach) * invDx));
-}
-
 /// Origins of the leaves that meet the bounding box of the kernels of some cell of `grid` (the
 /// particles' neighbour grid), sorted and unique: a few more leaves than the kernels' own boxes
 /// meet (those leaves sum to phi = 0 and are dropped), at a fiftieth of the keys to sort.
@@ -235,12 +224,7 @@ void splatKernel(const Kernel& k, const openvdb::Coord& origin, double dx,
 {
     const double invDx = 1.0 / dx;
     int lo[3], hi[3];
-    for (int d = 0; d < 3; ++d) {
-        voxelRange(k.centre[d], k.halfExtent[d], invDx, lo[d], hi[d]);
-        lo[d] = std::max(lo[d] - origin[d], 0);
-        hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
-        if (lo[d] > hi[d]) return; // the box misses this leaf
-    }
+    if (!boxInLeaf(k.centre.asPointer(), k.halfExtent.asPointer(), invDx, origin, lo, hi)) return;
     const openvdb::Vec3d gz = k.G.col(2); // u changes by gz per metre along z
     const double invGzz = 1.0 / gz.dot(gz);
     const float gzx = float(gz[0]), gzy = float(gz[1]), gzz = float(gz[2]);
@@ -282,8 +266,7 @@ public:
         mGrid.build(centres);
         // Half-diagonal of a leaf between its outermost voxel centres, plus float rounding of
         // the centres (m).
-        const double leafHalfDiagonal = 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx;
-        mSearchRadius = sph::Real((largestReach(kernels) + leafHalfDiagonal) * (1.0 + 1e-5));
+        mSearchRadius = sph::Real((largestReach(kernels) + leafHalfDiagonal(dx)) * (1.0 + 1e-5));
     }
 
     /// Add to `phi` the kernels near the leaf at `origin` in order of distance from the leaf's
@@ -293,10 +276,7 @@ public:
     /// calling again with the same `phi` and `next` and no stop completes the same sum.
     bool gather(const openvdb::Coord& origin, float stopAbove, float* phi, std::size_t& next) const
     {
-        const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * mDx),
-                               sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * mDx),
-                               sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * mDx));
-        const std::vector<sph::Index> near = nearestFirst(centre);
+        const std::vector<sph::Index> near = nearestFirst(leafCentre(origin, mDx));
         for (; next < near.size(); ++next) {
             splatKernel(mKernels[near[next]], origin, mDx, mUnit, phi);
             if (stopAbove >= 0.0f && next % SATURATION_CHECK == SATURATION_CHECK - 1
@@ -519,12 +499,7 @@ openvdb::FloatGrid::Ptr makeAnisotropicSurfaceGrid(const sph::ParticleSet& parti
 {
     const double dx = options.voxelSize;
     const double h = options.particleSpacing;
-    openvdb::FloatGrid::Ptr grid =
-        openvdb::createLevelSet<openvdb::FloatGrid>(dx, double(options.surfaceHalfWidthVoxels));
-    grid->setName("surface");
-    grid->setGridClass(openvdb::GRID_LEVEL_SET);
-    grid->insertMeta("units", openvdb::StringMetadata("m (signed distance, negative inside)"));
-    grid->insertMeta("particle_spacing", openvdb::FloatMetadata(float(h)));
+    openvdb::FloatGrid::Ptr grid = makeEmptySurfaceGrid(options);
     grid->insertMeta("surface_method", openvdb::StringMetadata("anisotropic"));
     if (selection.empty()) return grid;
 

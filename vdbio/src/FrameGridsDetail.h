@@ -13,12 +13,50 @@
 
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
 namespace ghostfx {
 namespace vdbio {
 namespace detail {
+
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+constexpr int LEAF_DIM = int(FloatLeaf::DIM);           // 8 voxels per leaf edge
+constexpr int LEAF_VOXELS = int(FloatLeaf::NUM_VALUES); // 512
+
+/// Voxel index range [lo, hi] on one axis whose centres i * dx lie within `reach` (m) of `x`.
+inline void voxelRange(double x, double reach, double invDx, int& lo, int& hi)
+{
+    lo = int(std::ceil((x - reach) * invDx));
+    hi = int(std::floor((x + reach) * invDx));
+}
+
+/// The voxels of the leaf at `origin` whose centres lie within `reach[d]` (m) of `x` on every
+/// axis d, as offsets [lo[d], hi[d]] inside the leaf; false when that box misses the leaf.
+inline bool boxInLeaf(const double x[3], const double reach[3], double invDx,
+                      const openvdb::Coord& origin, int lo[3], int hi[3])
+{
+    for (int d = 0; d < 3; ++d) {
+        voxelRange(x[d], reach[d], invDx, lo[d], hi[d]);
+        lo[d] = std::max(lo[d] - origin[d], 0);
+        hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
+        if (lo[d] > hi[d]) return false;
+    }
+    return true;
+}
+
+/// The centre of the leaf at `origin`, midway between its outermost voxel centres (m).
+inline sph::Vec3 leafCentre(const openvdb::Coord& origin, double dx)
+{
+    return sph::Vec3(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
+                     sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
+                     sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
+}
+
+/// Half the diagonal of a leaf between its outermost voxel centres (m).
+inline double leafHalfDiagonal(double dx) { return 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx; }
 
 /// Indices of the particles whose kind is in `kinds`, in increasing order.
 std::vector<sph::Index> selectKinds(const sph::ParticleSet& particles,
@@ -39,6 +77,10 @@ void validateFor(const Options& options, const std::string& where, const char* o
         throw ValueError(msg(where, ": ", e.what()));
     }
 }
+
+/// The empty level set "surface" both surface methods fill: voxel size, half width, class,
+/// units and particle spacing from `options`.
+openvdb::FloatGrid::Ptr makeEmptySurfaceGrid(const VolumeOptions& options);
 
 /// Liquid surface level set "surface" of the selected particles (options already validated).
 openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,

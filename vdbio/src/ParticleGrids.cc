@@ -42,11 +42,8 @@ namespace detail {
 
 namespace {
 
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 using VecLeaf = openvdb::Vec3STree::LeafNodeType;
 
-constexpr int LEAF_DIM = int(FloatLeaf::DIM);           // 8 voxels per leaf edge
-constexpr int LEAF_VOXELS = int(FloatLeaf::NUM_VALUES); // 512
 /// Particles per block when listing candidate leaves: large enough to amortise the local sort,
 /// small enough that a block's leaves stay few (particles are visited in cell order).
 constexpr std::size_t LEAF_KEY_BLOCK = 4096;
@@ -59,13 +56,6 @@ struct Selected
     std::vector<sph::Vec3> v;              ///< velocities (m/s), if "vel" is asked
     std::vector<std::vector<sph::Real>> a; ///< scalar channels, in the order asked
 };
-
-/// Voxel index range [lo, hi] on one axis whose centres i * dx lie within `reach` of `x`.
-inline void voxelRange(double x, double reach, double invDx, int& lo, int& hi)
-{
-    lo = int(std::ceil((x - reach) * invDx));
-    hi = int(std::floor((x + reach) * invDx));
-}
 
 /// The leaves of the output grids built for one candidate leaf (null where nothing is active).
 struct LeafOutput
@@ -138,30 +128,53 @@ std::vector<openvdb::Coord> leavesNearParticles(const std::vector<sph::Vec3>& x,
     return leaves;
 }
 
-openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
-                                      const std::vector<sph::Index>& selection,
-                                      const VolumeOptions& options)
-{
-    const double dx = options.fogVoxelSize();
-    const double R = options.kernelSupport;
-    const double rho0 = options.restDensity;
-    const bool wantVel = options.velocity;
-    const std::size_t nChannels = options.scalarChannels.size();
+namespace {
 
-    // Output grids (empty until leaves are attached).
-    const openvdb::math::Transform::Ptr xform = makeTransform(dx);
-    openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
-    density->setName("density");
-    density->setGridClass(openvdb::GRID_FOG_VOLUME);
-    density->insertMeta("rest_density", openvdb::FloatMetadata(float(rho0)));
-    density->insertMeta(
+/// The grids makeParticleGrids fills, empty until their leaves are attached.
+struct OutputGrids
+{
+    openvdb::FloatGrid::Ptr density;
+    openvdb::Vec3SGrid::Ptr vel;
+    std::vector<openvdb::FloatGrid::Ptr> channels; ///< in the order asked
+
+    /// The grids `options` asks for: "density", "vel", then the channels.
+    openvdb::GridPtrVec asked(const VolumeOptions& options) const
+    {
+        openvdb::GridPtrVec out;
+        if (options.density) out.push_back(density);
+        if (options.velocity) out.push_back(vel);
+        for (auto& g : channels) out.push_back(g);
+        return out;
+    }
+};
+
+/// Give `grid` the voxels of `xform` and the kernel support `R` (m) as metadata.
+void placeGrid(openvdb::GridBase& grid, const openvdb::math::Transform& xform, double R)
+{
+    grid.setTransform(xform.copy());
+    grid.insertMeta("kernel_support", openvdb::FloatMetadata(float(R)));
+}
+
+/// The empty output grids, named, described and placed (fog voxel size) as `options` asks.
+OutputGrids makeOutputGrids(const VolumeOptions& options)
+{
+    const openvdb::math::Transform::Ptr xform = makeTransform(options.fogVoxelSize());
+    const double R = options.kernelSupport;
+    OutputGrids grids;
+    grids.density = openvdb::FloatGrid::create(0.0f);
+    openvdb::FloatGrid& density = *grids.density;
+    density.setName("density");
+    density.setGridClass(openvdb::GRID_FOG_VOLUME);
+    density.insertMeta("rest_density", openvdb::FloatMetadata(float(options.restDensity)));
+    density.insertMeta(
         "units", openvdb::StringMetadata("rho/rho0 (dimensionless); kg/m^3 = value * rest_density; "
                                          "mass (kg) = rest_density * sum(values) * voxel_size^3"));
-    openvdb::Vec3SGrid::Ptr vel = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-    vel->setName("vel");
-    vel->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
-    vel->insertMeta("units", openvdb::StringMetadata("m/s"));
-    std::vector<openvdb::FloatGrid::Ptr> channels;
+    grids.vel = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    grids.vel->setName("vel");
+    grids.vel->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    grids.vel->insertMeta("units", openvdb::StringMetadata("m/s"));
+    placeGrid(density, *xform, R);
+    placeGrid(*grids.vel, *xform, R);
     for (const std::string& name : options.scalarChannels) {
         openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.0f);
         g->setName(name);
@@ -170,19 +183,18 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
             "normalisation",
             openvdb::StringMetadata(
                 "Shepard: sum m a W / sum m W over the particles within the kernel support"));
-        channels.push_back(g);
+        placeGrid(*g, *xform, R);
+        grids.channels.push_back(g);
     }
-    for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(density.get()),
-                                 static_cast<openvdb::GridBase*>(vel.get())}) {
-        g->setTransform(xform->copy());
-        g->insertMeta("kernel_support", openvdb::FloatMetadata(float(R)));
-    }
-    for (auto& g : channels) {
-        g->setTransform(xform->copy());
-        g->insertMeta("kernel_support", openvdb::FloatMetadata(float(R)));
-    }
+    return grids;
+}
 
-    // Dense copies of what the grids need.
+/// Dense copies of what the asked grids need of the particles `selection` of `particles`.
+Selected selectParticles(const sph::ParticleSet& particles,
+                         const std::vector<sph::Index>& selection, const VolumeOptions& options)
+{
+    const bool wantVel = options.velocity;
+    const std::size_t nChannels = options.scalarChannels.size();
     Selected sel;
     const std::size_t n = selection.size();
     sel.x.resize(n);
@@ -207,126 +219,178 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
         for (std::size_t c = 0; c < nChannels; ++c) sel.a[c][k] = (*source[c])[i];
         },
         4096);
+    return sel;
+}
 
-    openvdb::GridPtrVec out;
-    auto collect = [&]() {
-        if (options.density) out.push_back(density);
-        if (wantVel) out.push_back(vel);
-        for (auto& g : channels) out.push_back(g);
-    };
-    if (n == 0) {
-        collect();
-        return out;
+/// One leaf's sums over the particles, in double: a hundred-odd terms each, in a fixed order.
+struct LeafSums
+{
+    std::vector<double> rho;        ///< sum m_j W per voxel
+    std::vector<openvdb::Vec3d> mv; ///< sum m_j v_j W per voxel, if "vel" is asked
+    std::vector<double> ma;         ///< sum m_j a_j W per channel and voxel
+};
+
+/// Step 2 of the file comment: the particles' sums on one candidate leaf, then its output leaves.
+class DensityGather
+{
+public:
+    /// Gather `sel` (neighbour grid `grid`, cells of the kernel support) as `options` asks.
+    DensityGather(const Selected& sel, const sph::NeighborGrid& grid, const VolumeOptions& options)
+        : mSel(sel)
+        , mGrid(grid)
+        , mKernel{sph::Real(options.kernelSupport)}
+        , mDx(options.fogVoxelSize())
+        , mInvDx(1.0 / mDx)
+        , mR(options.kernelSupport)
+        , mR2(mR * mR)
+        , mRho0(options.restDensity)
+        , mCutoff(options.densityCutoff)
+        , mWantVel(options.velocity)
+        , mChannels(options.scalarChannels.size())
+        , mSearchRadius(sph::Real(mR + leafHalfDiagonal(mDx)))
+    {}
+
+    /// The output leaves of the leaf at `origin`.
+    LeafOutput operator()(const openvdb::Coord& origin) const
+    {
+        LeafSums sums;
+        sums.rho.assign(LEAF_VOXELS, 0.0);
+        sums.mv.assign(mWantVel ? LEAF_VOXELS : 0, openvdb::Vec3d(0.0));
+        sums.ma.assign(mChannels * LEAF_VOXELS, 0.0);
+        mGrid.forEachInRadius(leafCentre(origin, mDx), mSearchRadius,
+                              [&](sph::Index j, const sph::Vec3&, sph::Real) {
+            addParticle(j, origin, sums);
+        });
+        return keptVoxels(origin, sums);
     }
 
-    const sph::CubicSplineKernel kernel{sph::Real(R)};
-    sph::NeighborGrid grid{sph::Real(R)};
-    grid.build(sel.x);
-
-    const std::vector<openvdb::Coord> leaves = leavesNearParticles(sel.x, grid.order(), dx, R);
-    std::vector<LeafOutput> results(leaves.size());
-
-    const double invDx = 1.0 / dx;
-    const double R2 = R * R;
-    const double cutoff = options.densityCutoff;
-    // Half-diagonal of a leaf measured between its outermost voxel centres (m).
-    const double leafHalfDiagonal = 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx;
-    const sph::Real searchRadius = sph::Real(R + leafHalfDiagonal);
-
-    parallel::forEach(
-        0, leaves.size(),
-        [&](std::size_t L) {
-        const openvdb::Coord origin = leaves[L];
-        // Per-leaf accumulators, in double: sums of a hundred-odd terms in a fixed order.
-        std::vector<double> rho(LEAF_VOXELS, 0.0);
-        std::vector<openvdb::Vec3d> mv(wantVel ? LEAF_VOXELS : 0, openvdb::Vec3d(0.0));
-        std::vector<double> ma(nChannels * LEAF_VOXELS, 0.0);
-
-        const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
-        grid.forEachInRadius(centre, searchRadius, [&](sph::Index j, const sph::Vec3&, sph::Real) {
-            const double xj[3] = {double(sel.x[j][0]), double(sel.x[j][1]), double(sel.x[j][2])};
-            int lo[3], hi[3];
-            for (int d = 0; d < 3; ++d) {
-                voxelRange(xj[d], R, invDx, lo[d], hi[d]);
-                lo[d] = std::max(lo[d] - origin[d], 0);
-                hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
-                if (lo[d] > hi[d]) return; // support box misses this leaf
+private:
+    /// Add particle j's m_j W (and its velocity's and channels' shares) to the voxels of the
+    /// leaf at `origin` inside its support: the rows of its support's box that meet its sphere.
+    void addParticle(sph::Index j, const openvdb::Coord& origin, LeafSums& sums) const
+    {
+        const double xj[3] = {double(mSel.x[j][0]), double(mSel.x[j][1]), double(mSel.x[j][2])};
+        const double reach[3] = {mR, mR, mR};
+        int lo[3], hi[3];
+        if (!boxInLeaf(xj, reach, mInvDx, origin, lo, hi)) return;
+        const double mj = double(mSel.m[j]);
+        for (int a = lo[0]; a <= hi[0]; ++a) {
+            const double dxa = (origin.x() + a) * mDx - xj[0];
+            const double ra2 = dxa * dxa;
+            for (int b = lo[1]; b <= hi[1]; ++b) {
+                const double dyb = (origin.y() + b) * mDx - xj[1];
+                const double rab2 = ra2 + dyb * dyb;
+                if (rab2 >= mR2) continue;
+                addRow(j, origin, xj, mj, rab2, (a << 6) | (b << 3), lo[2], hi[2], sums);
             }
-            const double mj = double(sel.m[j]);
-            for (int a = lo[0]; a <= hi[0]; ++a) {
-                const double dxa = (origin.x() + a) * dx - xj[0];
-                const double ra2 = dxa * dxa;
-                for (int b = lo[1]; b <= hi[1]; ++b) {
-                    const double dyb = (origin.y() + b) * dx - xj[1];
-                    const double rab2 = ra2 + dyb * dyb;
-                    if (rab2 >= R2) continue;
-                    // The whole row of the support's box, weights first (a loop the compiler
-                    // vectorises: W is branch-free and 0 outside the support, which adds
-                    // nothing), then the sums. Cheaper than finding the row's z range inside
-                    // the sphere (a square root and two roundings) when rows are a few voxels.
-                    const int clo = lo[2], chi = hi[2];
-                    const int row = (a << 6) | (b << 3); // LeafNode::coordToOffset
-                    double w[LEAF_DIM];
-                    for (int c = clo; c <= chi; ++c) {
-                        const double dzc = (origin.z() + c) * dx - xj[2];
-                        const double r = std::sqrt(rab2 + dzc * dzc);
-                        w[c] = mj * double(kernel.W(sph::Real(r)));
-                    }
-                    for (int c = clo; c <= chi; ++c) rho[row | c] += w[c];
-                    if (wantVel) {
-                        const openvdb::Vec3d vj(sel.v[j][0], sel.v[j][1], sel.v[j][2]);
-                        for (int c = clo; c <= chi; ++c) mv[row | c] += w[c] * vj;
-                    }
-                    for (std::size_t ch = 0; ch < nChannels; ++ch) {
-                        const double aj = double(sel.a[ch][j]);
-                        double* sums = &ma[ch * LEAF_VOXELS + row];
-                        for (int c = clo; c <= chi; ++c) sums[c] += w[c] * aj;
-                    }
-                }
-            }
-        });
+        }
+    }
 
-        // Keep the voxels whose density reaches the cutoff; normalise.
-        LeafOutput& res = results[L];
-        bool any = false;
+    /// Particle j's shares on the voxels [clo, chi] of the leaf row at offset `row`
+    /// (LeafNode::coordToOffset), `rab2` its squared distance (m^2) off the row's axis. The
+    /// whole row of the support's box, weights first (a loop the compiler vectorises: W is
+    /// branch-free and 0 outside the support, which adds nothing), then the sums. Cheaper than
+    /// finding the row's z range inside the sphere (a square root and two roundings) when rows
+    /// are a few voxels.
+    void addRow(sph::Index j, const openvdb::Coord& origin, const double xj[3], double mj,
+                double rab2, int row, int clo, int chi, LeafSums& sums) const
+    {
+        double w[LEAF_DIM];
+        for (int c = clo; c <= chi; ++c) {
+            const double dzc = (origin.z() + c) * mDx - xj[2];
+            const double r = std::sqrt(rab2 + dzc * dzc);
+            w[c] = mj * double(mKernel.W(sph::Real(r)));
+        }
+        for (int c = clo; c <= chi; ++c) sums.rho[row | c] += w[c];
+        if (mWantVel) {
+            const openvdb::Vec3d vj(mSel.v[j][0], mSel.v[j][1], mSel.v[j][2]);
+            for (int c = clo; c <= chi; ++c) sums.mv[row | c] += w[c] * vj;
+        }
+        for (std::size_t ch = 0; ch < mChannels; ++ch) {
+            const double aj = double(mSel.a[ch][j]);
+            double* channel = &sums.ma[ch * LEAF_VOXELS + row];
+            for (int c = clo; c <= chi; ++c) channel[c] += w[c] * aj;
+        }
+    }
+
+    /// Step 3 of the file comment: the voxels of `sums` whose density reaches the cutoff,
+    /// normalised, as leaves at `origin` (none where no voxel is kept).
+    LeafOutput keptVoxels(const openvdb::Coord& origin, const LeafSums& sums) const
+    {
+        LeafOutput res;
         for (int voxel = 0; voxel < LEAF_VOXELS; ++voxel) {
-            const double ratio = rho[voxel] / rho0;
-            if (!(ratio > 0.0) || ratio < cutoff) continue;
-            if (!any) {
-                any = true;
+            const double ratio = sums.rho[voxel] / mRho0;
+            if (!(ratio > 0.0) || ratio < mCutoff) continue;
+            if (!res.density) {
                 res.density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                if (wantVel) {
+                if (mWantVel) {
                     res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
                 }
-                res.channels.resize(nChannels);
+                res.channels.resize(mChannels);
                 for (auto& leaf : res.channels) {
                     leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
                 }
             }
             const openvdb::Index offset = openvdb::Index(voxel);
             res.density->setValueOn(offset, float(ratio));
-            const double invRho = 1.0 / rho[voxel];
-            if (wantVel) res.vel->setValueOn(offset, openvdb::Vec3s(mv[voxel] * invRho));
-            for (std::size_t ch = 0; ch < nChannels; ++ch) {
-                res.channels[ch]->setValueOn(offset, float(ma[ch * LEAF_VOXELS + voxel] * invRho));
+            const double invRho = 1.0 / sums.rho[voxel];
+            if (mWantVel) res.vel->setValueOn(offset, openvdb::Vec3s(sums.mv[voxel] * invRho));
+            for (std::size_t ch = 0; ch < mChannels; ++ch) {
+                const double ma = sums.ma[ch * LEAF_VOXELS + voxel];
+                res.channels[ch]->setValueOn(offset, float(ma * invRho));
             }
         }
-        },
-        1);
+        return res;
+    }
 
-    // Attach the leaves in leaf order (serial: tree insertion is not thread-safe).
+    const Selected& mSel;
+    const sph::NeighborGrid& mGrid;
+    const sph::CubicSplineKernel mKernel;
+    const double mDx, mInvDx;
+    const double mR, mR2; ///< kernel support (m), its square
+    const double mRho0, mCutoff;
+    const bool mWantVel;
+    const std::size_t mChannels;
+    /// The kernel support plus a leaf's half-diagonal: the particles that may reach a leaf (m).
+    const sph::Real mSearchRadius;
+};
+
+/// Attach the built leaves to `grids` in leaf order (serial: tree insertion is not
+/// thread-safe); the density leaves only where "density" is asked.
+void attachLeaves(std::vector<LeafOutput>& results, OutputGrids& grids,
+                  const VolumeOptions& options)
+{
     for (LeafOutput& res : results) {
         if (!res.density) continue;
-        if (options.density) density->tree().addLeaf(res.density.release());
-        if (wantVel) vel->tree().addLeaf(res.vel.release());
-        for (std::size_t ch = 0; ch < nChannels; ++ch) {
-            channels[ch]->tree().addLeaf(res.channels[ch].release());
+        if (options.density) grids.density->tree().addLeaf(res.density.release());
+        if (options.velocity) grids.vel->tree().addLeaf(res.vel.release());
+        for (std::size_t ch = 0; ch < grids.channels.size(); ++ch) {
+            grids.channels[ch]->tree().addLeaf(res.channels[ch].release());
         }
     }
-    collect();
-    return out;
+}
+
+} // namespace
+
+openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
+                                      const std::vector<sph::Index>& selection,
+                                      const VolumeOptions& options)
+{
+    OutputGrids grids = makeOutputGrids(options);
+    const Selected sel = selectParticles(particles, selection, options);
+    if (sel.x.empty()) return grids.asked(options);
+
+    const double R = options.kernelSupport;
+    sph::NeighborGrid grid{sph::Real(R)};
+    grid.build(sel.x);
+    const std::vector<openvdb::Coord> leaves =
+        leavesNearParticles(sel.x, grid.order(), options.fogVoxelSize(), R);
+    std::vector<LeafOutput> results(leaves.size());
+    const DensityGather gather(sel, grid, options);
+    parallel::forEach(
+        0, leaves.size(), [&](std::size_t L) { results[L] = gather(leaves[L]); }, 1);
+    attachLeaves(results, grids, options);
+    return grids.asked(options);
 }
 
 } // namespace detail

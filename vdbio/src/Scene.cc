@@ -178,84 +178,95 @@ Vec3d point(const JsonObject& s, const char* key, double voxel)
     return x;
 }
 
+/// A shape from a .vdb file, `g.file` with grid `g.grid`: a level set or, with `allowFog`, a
+/// fog volume whose region is where the density exceeds `g.threshold`.
+sph::LevelSet readFileGeometry(const JsonObject& g, const Scene& scene, std::string& description,
+                               bool allowFog)
+{
+    const std::string path = resolve(scene.folder, g.require<std::string>("file"));
+    const std::string grid = g.require<std::string>("grid");
+    description = path + ":" + grid;
+    const std::string context = msg("scene '", scene.file, "': ", g.path());
+    if (allowFog) {
+        // A gas source may be a fog volume: its region is where the density exceeds `threshold`.
+        const double threshold = g.nonNegative("threshold", 0.5);
+        g.finish();
+        openvdb::FloatGrid::Ptr fog = loadFloatGrid(path, grid, context);
+        if (fog->getGridClass() == openvdb::GRID_FOG_VOLUME) {
+            try {
+                return fogRegionToLevelSet(*fog, float(threshold), grid);
+            } catch (const GridError& e) {
+                throw GridError(msg(context, ": '", path, "': ", e.what()));
+            }
+        }
+        return loadLevelSet(path, grid, context);
+    }
+    g.finish();
+    return loadLevelSet(path, grid, context);
+}
+
+/// The built-in sphere `s` ({center, radius}) as a level set of voxel `voxel` (m).
+openvdb::FloatGrid::Ptr readSphere(const JsonObject& s, double voxel, std::string& description)
+{
+    const Vec3d c = point(s, "center", voxel);
+    const double r = s.positive("radius", 0);
+    s.finish();
+    if (r < 2 * voxel) s.failValue("radius", msg("expected at least 2 voxels (", 2 * voxel, " m)"));
+    description = msg("sphere r = ", r, " m");
+    return sph::makeSphereLevelSet(sph::Vec3(c), sph::Real(r), sph::Real(voxel));
+}
+
+/// The built-in box `b` ({min, max}) or, with `container`, a closed tank around that empty box
+/// (walls of thickness `b.wall`, default three spacings), as a level set of voxel `voxel` (m).
+openvdb::FloatGrid::Ptr readBox(const JsonObject& b, bool container, double voxel, double spacing,
+                                std::string& description)
+{
+    const Vec3d lo = point(b, "min", voxel);
+    const Vec3d hi = point(b, "max", voxel);
+    for (int a = 0; a < 3; ++a) {
+        if (!(hi[a] - lo[a] >= 2 * voxel)) {
+            b.failValue("max", msg("expected max > min + 2 voxels on every axis (axis ", a, ")"));
+        }
+    }
+    if (!container) {
+        b.finish();
+        description = "box";
+        return sph::makeBoxLevelSet(sph::Vec3(lo), sph::Vec3(hi), sph::Real(voxel));
+    }
+    const double wall = b.positive("wall", 3 * spacing);
+    b.finish();
+    const Vec3d w(wall);
+    description = msg("container, wall ", wall, " m");
+    // Walls: outside the inner box and inside the outer one, max(-inner, outer).
+    return sph::levelSetFromSdf(
+        [lo, hi, w](const openvdb::Vec3d& x) {
+        return std::max(-sph::boxSignedDistance(x, lo, hi),
+                        sph::boxSignedDistance(x, lo - w, hi + w));
+        },
+        sph::Aabb{sph::Vec3(lo - w), sph::Vec3(hi + w)}, sph::Real(voxel));
+}
+
 /// A shape: a grid in a file, or a built-in sphere, box or container (a closed tank: solid walls
 /// of thickness `wall` around the empty box [min, max]).
 sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string& description,
                            Sampled sampled, bool allowFog = false)
 {
-    const double defaultVoxel = 0.5 * scene.spacing;
     const bool file = g.has("file"), sphere = g.has("sphere"), box = g.has("box"),
                container = g.has("container");
     if (int(file) + int(sphere) + int(box) + int(container) != 1) {
         g.fail("", "expected exactly one of 'file' (with 'grid'), 'sphere', 'box' or 'container'");
     }
-    if (file) {
-        const std::string path = resolve(scene.folder, g.require<std::string>("file"));
-        const std::string grid = g.require<std::string>("grid");
-        description = path + ":" + grid;
-        const std::string context = msg("scene '", scene.file, "': ", g.path());
-        if (allowFog) {
-            // A gas source may be a fog volume: its region is where the density exceeds `threshold`.
-            const double threshold = g.nonNegative("threshold", 0.5);
-            g.finish();
-            openvdb::FloatGrid::Ptr fog = loadFloatGrid(path, grid, context);
-            if (fog->getGridClass() == openvdb::GRID_FOG_VOLUME) {
-                try {
-                    return fogRegionToLevelSet(*fog, float(threshold), grid);
-                } catch (const GridError& e) {
-                    throw GridError(msg(context, ": '", path, "': ", e.what()));
-                }
-            }
-            return loadLevelSet(path, grid, context);
-        }
-        g.finish();
-        return loadLevelSet(path, grid, context);
-    }
-    const double voxel = g.positive("voxel_size", defaultVoxel);
+    if (file) return readFileGeometry(g, scene, description, allowFog);
+    const double voxel = g.positive("voxel_size", 0.5 * scene.spacing);
     if (voxel < MIN_SPACING / 2) {
         g.failValue("voxel_size", msg("expected at least ", MIN_SPACING / 2,
                                       " m (OpenVDB's smallest usable voxel)"));
     }
-    checkParticleBudget(g, scene.spacing, voxel, sampled,
-                        sphere ? "sphere" : box ? "box" : "container");
-    openvdb::FloatGrid::Ptr grid;
-    if (sphere) {
-        const JsonObject s = g.object("sphere");
-        const Vec3d c = point(s, "center", voxel);
-        const double r = s.positive("radius", 0);
-        s.finish();
-        if (r < 2 * voxel)
-            s.failValue("radius", msg("expected at least 2 voxels (", 2 * voxel, " m)"));
-        grid = sph::makeSphereLevelSet(sph::Vec3(c), sph::Real(r), sph::Real(voxel));
-        description = msg("sphere r = ", r, " m");
-    } else {
-        const JsonObject b = g.object(box ? "box" : "container");
-        const Vec3d lo = point(b, "min", voxel);
-        const Vec3d hi = point(b, "max", voxel);
-        for (int a = 0; a < 3; ++a) {
-            if (!(hi[a] - lo[a] >= 2 * voxel)) {
-                b.failValue("max",
-                            msg("expected max > min + 2 voxels on every axis (axis ", a, ")"));
-            }
-        }
-        if (box) {
-            b.finish();
-            grid = sph::makeBoxLevelSet(sph::Vec3(lo), sph::Vec3(hi), sph::Real(voxel));
-            description = "box";
-        } else {
-            const double wall = b.positive("wall", 3 * scene.spacing);
-            b.finish();
-            const Vec3d w(wall);
-            // Walls: outside the inner box and inside the outer one, max(-inner, outer).
-            grid = sph::levelSetFromSdf(
-                [lo, hi, w](const openvdb::Vec3d& x) {
-                return std::max(-sph::boxSignedDistance(x, lo, hi),
-                                sph::boxSignedDistance(x, lo - w, hi + w));
-                },
-                sph::Aabb{sph::Vec3(lo - w), sph::Vec3(hi + w)}, sph::Real(voxel));
-            description = msg("container, wall ", wall, " m");
-        }
-    }
+    const char* kind = sphere ? "sphere" : box ? "box" : "container";
+    checkParticleBudget(g, scene.spacing, voxel, sampled, kind);
+    const openvdb::FloatGrid::Ptr grid =
+        sphere ? readSphere(g.object(kind), voxel, description)
+               : readBox(g.object(kind), container, voxel, scene.spacing, description);
     g.finish();
     try {
         return sph::makeLevelSet(grid, g.path());
@@ -312,8 +323,8 @@ std::string outputFile(const JsonObject& s, const char* key, const std::string& 
     if (std::find(extensions.begin(), extensions.end(), ext) != extensions.end()) return file;
     std::string names;
     for (const std::string& e : extensions) names += (names.empty() ? "" : " or ") + e;
-    s.failValue(key, msg("this output is written as ", what, ": expected a name ending in ",
-                         names, ext.empty() ? "" : msg(", not ", ext)));
+    s.failValue(key, msg("this output is written as ", what, ": expected a name ending in ", names,
+                         ext.empty() ? "" : msg(", not ", ext)));
 }
 
 /// One section of `outputs`: an object that `read` reads, false or null to switch the output
@@ -371,9 +382,11 @@ void readPreview(const JsonObject& s, SceneOutputs& out)
 void readVolume(const JsonObject& s, SceneOutputs& out)
 {
     out.volumeFile = outputFile(s, "file", out.volumeFile, {".vdb"}, "OpenVDB grids");
-    out.volumeGrids = readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
-    const std::string method = s.choice(
-        "surface_method", sph::nameOf(SURFACE_METHOD_NAMES, out.surfaceMethod), surfaceMethodNames());
+    out.volumeGrids =
+        readGridNames(s, out.volumeGrids, {"surface", "density", "vel", "temperature"});
+    const std::string method =
+        s.choice("surface_method", sph::nameOf(SURFACE_METHOD_NAMES, out.surfaceMethod),
+                 surfaceMethodNames());
     out.surfaceMethod = sph::valueOf(SURFACE_METHOD_NAMES, method, "surface method");
     out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
     out.densityVoxelSize = s.nonNegative("density_voxel_size", out.densityVoxelSize);
@@ -395,7 +408,8 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     });
     readSection(o, "gas_volume", out.gasVolumeFile, [&](const JsonObject& s) {
         out.gasVolumeFile = outputFile(s, "file", out.gasVolumeFile, vdb, "OpenVDB grids");
-        out.gasVolumeGrids = readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature"});
+        out.gasVolumeGrids =
+            readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature"});
         out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
     });
     out.previewFile.clear();
@@ -578,7 +592,8 @@ SceneSolid readSolid(const JsonObject& o, const Scene& scene)
 
 SceneGasSource readGasSource(const JsonObject& o, const Scene& scene)
 {
-    SceneGasSource source = readShaped<SceneGasSource>(o, scene, Sampled::Volume, /*allowFog=*/true);
+    SceneGasSource source =
+        readShaped<SceneGasSource>(o, scene, Sampled::Volume, /*allowFog=*/true);
     source.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
     source.temperature = o.positive("temperature", source.temperature);
     source.rate = o.nonNegative("rate", 0);
@@ -594,8 +609,9 @@ SceneForceField readForceField(const JsonObject& o)
     field.name = o.get<std::string>("name", o.path());
     if (!o.has("attractor")) {
         o.finish(); // a misspelt kind is reported as an unknown key with the closest one
-        o.fail("attractor", "missing; expected a field kind: 'attractor' { \"position\": [x, y, z], "
-                            "\"strength\": S, \"radius\": R }");
+        o.fail("attractor",
+               "missing; expected a field kind: 'attractor' { \"position\": [x, y, z], "
+               "\"strength\": S, \"radius\": R }");
     }
     const JsonObject a = o.object("attractor");
     SceneAttractor& at = field.attractor;
@@ -654,7 +670,8 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     readLiquidEntries(root, scene);
     for (const JsonObject& o : root.objects("gas_sources"))
         scene.gasSources.push_back(readGasSource(o, scene));
-    for (const JsonObject& o : root.objects("heaters")) scene.heaters.push_back(readHeater(o, scene));
+    for (const JsonObject& o : root.objects("heaters"))
+        scene.heaters.push_back(readHeater(o, scene));
     for (const JsonObject& o : root.objects("force_fields"))
         scene.forceFields.push_back(readForceField(o));
     if (auto phase = root.optionalObject("phase_transition")) {

@@ -122,113 +122,131 @@ struct Tracers
     }
 };
 
-} // namespace
-
-ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
-                                       const PreviewOptions& options, const openvdb::BBoxd& bounds,
-                                       const std::string& path, PreviewCache* cache)
+/// Where the layers lie: each in its own frame (fog is marched inside it), and the world box
+/// the camera frames.
+struct LayerBoxes
 {
-    options.validate();
-    if (layers.empty()) throw ValueError(msg("preview '", path, "': nothing to draw"));
-    for (const PreviewLayer& l : layers) checkLayer(l);
-    detail::checkImagePath(path);
+    std::vector<openvdb::BBoxd> local; ///< per layer: its active voxels in its own frame
+    std::vector<double> voxel;         ///< per layer: its voxel size (m)
+    openvdb::BBoxd frame;              ///< what the camera frames (world, m)
+};
 
-    // Fog layers are marched inside their own box (in the layer's frame).
-    std::vector<openvdb::BBoxd> localBoxes;
-    std::vector<double> voxel;
+/// The active voxel box (index space) of `layer`'s grid. The walk covers the whole tree, so a
+/// fixed layer's box is taken from `cache` when it is there and kept in it when it is not.
+openvdb::CoordBBox activeBox(const PreviewLayer& layer, PreviewCache* cache)
+{
+    const bool kept = cache && layer.fixed;
+    if (kept) {
+        for (const auto& [grid, box] : cache->activeBoxes) {
+            if (grid == layer.grid.get()) return box;
+        }
+    }
+    const openvdb::CoordBBox ibox = layer.grid->evalActiveVoxelBoundingBox();
+    if (kept) cache->activeBoxes.emplace_back(layer.grid.get(), ibox);
+    return ibox;
+}
+
+/// Every layer's box and voxel size; the frame is `bounds`, or with an empty `bounds` the
+/// union of the placed layers' boxes.
+LayerBoxes measureLayers(const std::vector<PreviewLayer>& layers, const openvdb::BBoxd& bounds,
+                         PreviewCache* cache)
+{
+    LayerBoxes boxes;
     const bool frameLayers = !(bounds.max().x() > bounds.min().x());
-    openvdb::BBoxd frame = frameLayers ? openvdb::BBoxd() : bounds;
+    boxes.frame = frameLayers ? openvdb::BBoxd() : bounds;
     for (const PreviewLayer& l : layers) {
-        // The active voxel box walks the whole tree: a fixed layer's is kept in the cache.
-        openvdb::CoordBBox ibox;
-        bool known = false;
-        if (cache && l.fixed) {
-            for (const auto& [grid, box] : cache->activeBoxes) {
-                if (grid == l.grid.get()) ibox = box, known = true;
-            }
-        }
-        if (!known) {
-            ibox = l.grid->evalActiveVoxelBoundingBox();
-            if (cache && l.fixed) cache->activeBoxes.emplace_back(l.grid.get(), ibox);
-        }
-        localBoxes.push_back(layerBox(l, ibox, false));
-        voxel.push_back(l.grid->voxelSize()[0]);
+        const openvdb::CoordBBox ibox = activeBox(l, cache);
+        boxes.local.push_back(layerBox(l, ibox, false));
+        boxes.voxel.push_back(l.grid->voxelSize()[0]);
         const openvdb::BBoxd placed = layerBox(l, ibox, true);
-        if (frameLayers && !isEmpty(placed)) frame.expand(placed);
+        if (frameLayers && !isEmpty(placed)) boxes.frame.expand(placed);
     }
-    if (isEmpty(frame)) {
-        throw GridError(msg("preview '", path, "': every layer is empty, nothing to frame"));
-    }
-    const detail::CameraSetup setup = detail::frameBox(frame.min(), frame.max(), options);
-    Film film(std::size_t(options.width), std::size_t(options.height),
-              Film::RGBA(0.0f, 0.0f, 0.0f, 0.0f));
-    openvdb::tools::PerspectiveCamera camera(film, Vec3d(0.0), setup.eye, detail::FOCAL_LENGTH_MM,
-                                             detail::APERTURE_MM, setup.nearPlane, setup.farPlane);
-    camera.lookAt(setup.target, setup.up);
+    return boxes;
+}
 
+/// The surface layers whose hits a cache may keep, and what those hits depend on.
+struct FixedLayers
+{
+    std::vector<std::uint8_t> fixed; ///< per layer: a fixed surface layer
+    std::vector<const void*> grids;  ///< the fixed layers' grids
+    /// The camera, the image size, the layer count, the background and each fixed layer's
+    /// index, placement and cutaway flag.
+    std::vector<double> key;
+};
+
+/// The fixed surface layers of `layers` seen by the camera `setup` on `film`.
+FixedLayers fixedLayers(const std::vector<PreviewLayer>& layers, const detail::CameraSetup& setup,
+                        const Film& film, const PreviewOptions& options)
+{
     const std::size_t n = layers.size();
-    // Fixed surface layers are intersected first, then the others: the same order with or
-    // without a cache, so the nearest hit (ties included) does not depend on it.
-    std::vector<std::uint8_t> fixed(n, 0);
-    std::vector<double> key = {setup.eye.x(),         setup.eye.y(),    setup.eye.z(),
-                               setup.target.x(),      setup.target.y(), setup.target.z(),
-                               setup.up.x(),          setup.up.y(),     setup.up.z(),
-                               setup.nearPlane,       setup.farPlane,   double(film.width()),
-                               double(film.height()), double(n)};
-    for (float c : options.background) key.push_back(double(c));
-    std::vector<const void*> fixedGrids;
+    FixedLayers f;
+    f.fixed.assign(n, 0);
+    f.key = {setup.eye.x(),         setup.eye.y(),    setup.eye.z(),  setup.target.x(),
+             setup.target.y(),      setup.target.z(), setup.up.x(),   setup.up.y(),
+             setup.up.z(),          setup.nearPlane,  setup.farPlane, double(film.width()),
+             double(film.height()), double(n)};
+    for (float c : options.background) f.key.push_back(double(c));
     for (std::size_t k = 0; k < n; ++k) {
-        fixed[k] = layers[k].fixed && layers[k].kind == PreviewLayer::Kind::Surface;
-        if (!fixed[k]) continue;
-        fixedGrids.push_back(layers[k].grid.get());
-        key.push_back(double(k));
+        f.fixed[k] = layers[k].fixed && layers[k].kind == PreviewLayer::Kind::Surface;
+        if (!f.fixed[k]) continue;
+        f.grids.push_back(layers[k].grid.get());
+        f.key.push_back(double(k));
         for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) key.push_back(layers[k].rotation(i, j));
-            key.push_back(layers[k].translation[i]);
+            for (int j = 0; j < 3; ++j) f.key.push_back(layers[k].rotation(i, j));
+            f.key.push_back(layers[k].translation[i]);
         }
-        key.push_back(layers[k].cutaway ? 1.0 : 0.0);
+        f.key.push_back(layers[k].cutaway ? 1.0 : 0.0);
     }
-    const std::size_t pixelCount = film.width() * film.height();
+    return f;
+}
+
+/// Whether `cache` holds the hits of `fixed` for `pixelCount` pixels; if not, it is emptied
+/// for them (no hit anywhere) to be filled by this preview. Counts the use in `cache`.
+bool prepareCache(PreviewCache* cache, const FixedLayers& fixed, std::size_t pixelCount,
+                  std::size_t layerCount)
+{
+    if (!cache) return false;
     const bool reuse =
-        cache && cache->key == key && cache->grids == fixedGrids && cache->t.size() == pixelCount;
-    if (cache && !reuse) {
-        cache->key = key;
-        cache->grids = fixedGrids;
+        cache->key == fixed.key && cache->grids == fixed.grids && cache->t.size() == pixelCount;
+    if (!reuse) {
+        cache->key = fixed.key;
+        cache->grids = fixed.grids;
         cache->t.assign(pixelCount, std::numeric_limits<double>::max());
-        cache->layer.assign(pixelCount, std::uint32_t(n));
+        cache->layer.assign(pixelCount, std::uint32_t(layerCount));
         cache->normal.assign(pixelCount, Vec3d(0.0));
         cache->direction.assign(pixelCount, openvdb::Vec3f(0.0f));
         cache->base.assign(pixelCount, {0.0f, 0.0f, 0.0f, 0.0f});
     }
-    // A kept pixel whose ray cannot meet any other layer is the fixed layers' colour, copied
-    // without casting its ray: when no surface layer moves, and the ray's line misses every fog
-    // layer's box (grown by a rounding margin, so a ray the full test would count as a hit is
-    // never skipped). The picture is the same (ScenePreview tests).
-    bool copyable = reuse;
-    for (std::size_t k = 0; k < n; ++k) {
-        if (layers[k].kind == PreviewLayer::Kind::Surface && !fixed[k]) copyable = false;
-    }
-    struct FogBox
+    ++(reuse ? cache->reused : cache->computed);
+    return reuse;
+}
+
+/// The fog layers' boxes, to tell whether a camera ray's line misses all of them.
+class FogBoxes
+{
+public:
+    /// The non-empty fog layers of `layers` (boxes `local`) seen from `eye` (world, m).
+    FogBoxes(const std::vector<PreviewLayer>& layers, const std::vector<openvdb::BBoxd>& local,
+             const Vec3d& eye)
     {
-        openvdb::math::Mat3d back; ///< world to layer rotation
-        Vec3d eye;                 ///< the camera in the layer's frame
-        Vec3d lo, hi;              ///< the layer's box, grown by a margin
-    };
-    std::vector<FogBox> fogBoxes;
-    for (std::size_t k = 0; copyable && k < n; ++k) {
-        if (layers[k].kind == PreviewLayer::Kind::Surface || isEmpty(localBoxes[k])) continue;
-        FogBox f;
-        f.back = layers[k].rotation.transpose();
-        f.eye = f.back * (setup.eye - layers[k].translation);
-        const Vec3d size = localBoxes[k].max() - localBoxes[k].min();
-        const double margin = 1e-6 * (size.length() + f.eye.length()) + 1e-9;
-        f.lo = localBoxes[k].min() - Vec3d(margin);
-        f.hi = localBoxes[k].max() + Vec3d(margin);
-        fogBoxes.push_back(f);
+        for (std::size_t k = 0; k < layers.size(); ++k) {
+            if (layers[k].kind == PreviewLayer::Kind::Surface || isEmpty(local[k])) continue;
+            FogBox f;
+            f.back = layers[k].rotation.transpose();
+            f.eye = f.back * (eye - layers[k].translation);
+            const Vec3d size = local[k].max() - local[k].min();
+            const double margin = 1e-6 * (size.length() + f.eye.length()) + 1e-9;
+            f.lo = local[k].min() - Vec3d(margin);
+            f.hi = local[k].max() + Vec3d(margin);
+            mBoxes.push_back(f);
+        }
     }
-    auto missesFog = [&](const openvdb::Vec3f& dirF) {
+
+    /// Whether the line from the eye along `dirF` (world) misses every box (slab test).
+    bool missedBy(const openvdb::Vec3f& dirF) const
+    {
         const Vec3d dir(dirF.x(), dirF.y(), dirF.z());
-        for (const FogBox& f : fogBoxes) {
+        for (const FogBox& f : mBoxes) {
             const Vec3d d = f.back * dir;
             double tmin = 0, tmax = std::numeric_limits<double>::max();
             for (int a = 0; a < 3; ++a) {
@@ -246,133 +264,255 @@ ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
             if (tmax >= tmin * (1 - 1e-6) - 1e-9) return false;
         }
         return true;
+    }
+
+private:
+    struct FogBox
+    {
+        openvdb::math::Mat3d back; ///< world to layer rotation
+        Vec3d eye;                 ///< the camera in the layer's frame
+        Vec3d lo, hi;              ///< the layer's box, grown by a margin
     };
-    if (cache) ++(reuse ? cache->reused : cache->computed);
-    // The colour of a pixel with only its fixed-layer hit and no fog, over the background: the
-    // same arithmetic as the full path below with transmittance 1, so a copied pixel is
-    // bit-identical to one traced.
-    auto fixedColour = [&](std::size_t hitLayer, const Vec3d& hitNormal, const Vec3d& dir) {
-        float r = 0, g = 0, b = 0, surfaceAlpha = 0;
-        if (hitLayer < n) {
-            const float shade = detail::keyLightShade(setup, hitNormal, dir);
-            const auto& a = layers[hitLayer].albedo;
-            r = a[0] * shade, g = a[1] * shade, b = a[2] * shade, surfaceAlpha = 1;
+    std::vector<FogBox> mBoxes;
+};
+
+/// The nearest surface along a ray: its distance (m), its layer (the layer count for none) and
+/// its world normal.
+struct SurfaceHit
+{
+    double t;
+    std::size_t layer;
+    Vec3d normal;
+};
+
+/// What reaches the camera along a ray: the shaded surface (alpha 1 where there is one), the
+/// light the fog scatters and the fog's transmittance in front of the surface.
+struct PixelLight
+{
+    float r = 0, g = 0, b = 0, surfaceAlpha = 0;
+    float fr = 0, fg = 0, fb = 0;
+    float tr = 1.0f;
+};
+
+/// `light` over the background `bg` (premultiplied RGBA): what the surface leaves uncovered
+/// shows it.
+std::array<float, 4> overBackground(const PixelLight& light, const std::array<float, 4>& bg)
+{
+    const PixelLight& l = light;
+    const float behind = l.tr * (1 - l.surfaceAlpha);
+    return {l.fr + l.tr * l.r + behind * bg[0] * bg[3], l.fg + l.tr * l.g + behind * bg[1] * bg[3],
+            l.fb + l.tr * l.b + behind * bg[2] * bg[3],
+            (1 - l.tr) + l.tr * l.surfaceAlpha + behind * bg[3]};
+}
+
+/// One preview's ray caster: the layers, the camera and the cache whose hits it reads or fills.
+class Raycaster
+{
+public:
+    Raycaster(const std::vector<PreviewLayer>& layers, const PreviewOptions& options,
+              const detail::CameraSetup& setup, const LayerBoxes& boxes, const FixedLayers& fixed,
+              PreviewCache* cache, bool reuse)
+        : mLayers(layers)
+        , mOptions(options)
+        , mSetup(setup)
+        , mBoxes(boxes)
+        , mFixed(fixed.fixed)
+        , mCache(cache)
+        , mReuse(reuse)
+        , mN(layers.size())
+    {
+        // A kept pixel whose ray cannot meet any other layer is the fixed layers' colour,
+        // copied without casting its ray: when no surface layer moves and the ray's line misses
+        // every fog layer's box (grown by a rounding margin, so a ray the full test would count
+        // as a hit is never skipped). The picture is the same (ScenePreview tests).
+        mCopyable = reuse;
+        for (std::size_t k = 0; k < mN; ++k) {
+            if (layers[k].kind == PreviewLayer::Kind::Surface && !mFixed[k]) mCopyable = false;
         }
-        const float tr = 1.0f, fr = 0.0f, fg = 0.0f, fb = 0.0f;
-        const float behind = tr * (1 - surfaceAlpha);
-        const auto& bg = options.background;
-        return std::array<float, 4>{
-            fr + tr * r + behind * bg[0] * bg[3], fg + tr * g + behind * bg[1] * bg[3],
-            fb + tr * b + behind * bg[2] * bg[3], (1 - tr) + tr * surfaceAlpha + behind * bg[3]};
-    };
-    std::vector<std::atomic<std::size_t>> pixels(n);
-    for (auto& p : pixels) p = 0;
-    const auto t0 = std::chrono::steady_clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, film.height()), [&](const auto& rows) {
-        Tracers tracers(layers);
-        std::vector<std::size_t> counts(n, 0);
+        if (mCopyable) mFogBoxes = std::make_unique<FogBoxes>(layers, boxes.local, setup.eye);
+    }
+
+    /// Draw rows `rows` of `film` seen by `camera`, adding to `counts` the pixels per layer
+    /// (ScenePreviewSummary::pixels).
+    void drawRows(const tbb::blocked_range<std::size_t>& rows, Film& film,
+                  const openvdb::tools::PerspectiveCamera& camera,
+                  std::vector<std::size_t>& counts) const
+    {
+        Tracers tracers(mLayers);
         for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
             for (std::size_t x = 0; x < film.width(); ++x) {
                 const std::size_t pixel = y * film.width() + x;
-                if (copyable && missesFog(cache->direction[pixel])) {
-                    const auto& c = cache->base[pixel];
-                    film.pixel(x, y) = Film::RGBA(c[0], c[1], c[2], c[3]);
-                    if (cache->layer[pixel] < n) ++counts[cache->layer[pixel]];
-                    continue;
-                }
-                const Ray ray = camera.getRay(x, y);
-                // The nearest surface: the fixed layers' hit (kept, or computed and stored),
-                // then the other surface layers.
-                double nearest = std::numeric_limits<double>::max();
-                std::size_t hitLayer = n;
-                Vec3d hitNormal(0.0);
-                auto nearestOf = [&](bool fixedPass) {
-                    for (std::size_t k = 0; k < n; ++k) {
-                        if (!tracers.surfaces[k] || bool(fixed[k]) != fixedPass) continue;
-                        Ray local = intoLayer(ray, layers[k]);
-                        Vec3d xyz, normal;
-                        bool hit = false;
-                        for (int crossing = 0; crossing < MAX_CUTAWAY_CROSSINGS; ++crossing) {
-                            if (!tracers.surfaces[k]->intersectsWS(local, xyz, normal)) break;
-                            if (!layers[k].cutaway
-                                || isInnerFace(xyz, normal, local.dir(), localBoxes[k], voxel[k],
-                                               double(layers[k].grid->background()))) {
-                                hit = true;
-                                break;
-                            }
-                            // Past this crossing, and look for the next one.
-                            const double along =
-                                (xyz - local.eye()).dot(local.dir()) / local.dir().lengthSqr();
-                            local.setTimes(along + 1.5 * voxel[k] / local.dir().length(),
-                                           local.t1());
-                        }
-                        if (!hit) continue;
-                        const double t = (xyz - local.eye()).length();
-                        if (t < nearest) {
-                            nearest = t;
-                            hitLayer = k;
-                            hitNormal = layers[k].rotation * normal;
-                        }
-                    }
-                };
-                if (reuse) {
-                    nearest = cache->t[pixel];
-                    hitLayer = cache->layer[pixel];
-                    hitNormal = cache->normal[pixel];
+                std::array<float, 4> c;
+                if (mCopyable && mFogBoxes->missedBy(mCache->direction[pixel])) {
+                    c = mCache->base[pixel];
+                    if (mCache->layer[pixel] < mN) ++counts[mCache->layer[pixel]];
                 } else {
-                    nearestOf(true);
-                    if (cache) {
-                        cache->t[pixel] = nearest;
-                        cache->layer[pixel] = std::uint32_t(hitLayer);
-                        cache->normal[pixel] = hitNormal;
-                        cache->direction[pixel] = openvdb::Vec3f(ray.dir());
-                        cache->base[pixel] = fixedColour(hitLayer, hitNormal, ray.dir());
-                    }
+                    c = trace(camera.getRay(x, y), pixel, tracers, counts);
                 }
-                nearestOf(false);
-                float r = 0, g = 0, b = 0, surfaceAlpha = 0;
-                if (hitLayer < n) {
-                    const float shade = detail::keyLightShade(setup, hitNormal, ray.dir());
-                    const auto& a = layers[hitLayer].albedo;
-                    r = a[0] * shade, g = a[1] * shade, b = a[2] * shade, surfaceAlpha = 1;
-                    ++counts[hitLayer];
-                }
-                // Fog in front of it: march each fog layer's box up to the surface.
-                double transmittance = 1;
-                float fr = 0, fg = 0, fb = 0;
-                for (std::size_t k = 0; k < n; ++k) {
-                    if (!tracers.fogs[k]) continue;
-                    const Ray local = intoLayer(ray, layers[k]);
-                    double tin = 0, tout = 0;
-                    if (isEmpty(localBoxes[k]) || !local.intersects(localBoxes[k], tin, tout))
-                        continue;
-                    tout = std::min(tout, nearest);
-                    const double step = FOG_STEP_VOXELS * layers[k].grid->voxelSize()[0];
-                    const double before = transmittance;
-                    for (double t = std::max(tin, 0.0) + 0.5 * step; t < tout; t += step) {
-                        const double d = tracers.fogs[k]->wsSample(local(t));
-                        if (!(d > 0)) continue;
-                        const double pass = std::exp(-options.extinction * d * step);
-                        const float scattered = float(transmittance * (1 - pass)) * FOG_SHADE;
-                        fr += scattered * layers[k].albedo[0];
-                        fg += scattered * layers[k].albedo[1];
-                        fb += scattered * layers[k].albedo[2];
-                        transmittance *= pass;
-                        if (transmittance < OPAQUE_TRANSMITTANCE) break;
-                    }
-                    if (before - transmittance > 0.05) ++counts[k];
-                }
-                const float tr = float(transmittance);
-                // The scene over the background: what the surface leaves uncovered shows it.
-                const float behind = tr * (1 - surfaceAlpha);
-                const auto& bg = options.background;
-                film.pixel(x, y) = Film::RGBA(fr + tr * r + behind * bg[0] * bg[3],
-                                              fg + tr * g + behind * bg[1] * bg[3],
-                                              fb + tr * b + behind * bg[2] * bg[3],
-                                              (1 - tr) + tr * surfaceAlpha + behind * bg[3]);
+                film.pixel(x, y) = Film::RGBA(c[0], c[1], c[2], c[3]);
             }
         }
-        for (std::size_t k = 0; k < n; ++k) pixels[k] += counts[k];
+    }
+
+private:
+    /// The colour of `pixel` seen along `ray`: its nearest surface (the fixed layers' hit kept
+    /// in the cache, or computed and stored there, then the other surface layers), shaded, with
+    /// the fog in front of it.
+    std::array<float, 4> trace(const Ray& ray, std::size_t pixel, Tracers& tracers,
+                               std::vector<std::size_t>& counts) const
+    {
+        SurfaceHit hit{std::numeric_limits<double>::max(), mN, Vec3d(0.0)};
+        if (mReuse) {
+            hit.t = mCache->t[pixel];
+            hit.layer = mCache->layer[pixel];
+            hit.normal = mCache->normal[pixel];
+        } else {
+            nearestSurface(ray, tracers, true, hit);
+            if (mCache) {
+                mCache->t[pixel] = hit.t;
+                mCache->layer[pixel] = std::uint32_t(hit.layer);
+                mCache->normal[pixel] = hit.normal;
+                mCache->direction[pixel] = openvdb::Vec3f(ray.dir());
+                mCache->base[pixel] = overBackground(shade(hit, ray.dir()), mOptions.background);
+            }
+        }
+        nearestSurface(ray, tracers, false, hit);
+        PixelLight light = shade(hit, ray.dir());
+        if (hit.layer < mN) ++counts[hit.layer];
+        marchFog(ray, tracers, hit.t, light, counts);
+        return overBackground(light, mOptions.background);
+    }
+
+    /// `hit` shaded by the key light, seen along `dir`, without fog.
+    PixelLight shade(const SurfaceHit& hit, const Vec3d& dir) const
+    {
+        PixelLight light;
+        if (hit.layer < mN) {
+            const float s = detail::keyLightShade(mSetup, hit.normal, dir);
+            const auto& a = mLayers[hit.layer].albedo;
+            light.r = a[0] * s, light.g = a[1] * s, light.b = a[2] * s, light.surfaceAlpha = 1;
+        }
+        return light;
+    }
+
+    /// Bring `hit` to the nearest crossing of `ray` with a fixed (`fixedPass`) or a moving
+    /// surface layer, if one is nearer.
+    void nearestSurface(const Ray& ray, Tracers& tracers, bool fixedPass, SurfaceHit& hit) const
+    {
+        for (std::size_t k = 0; k < mN; ++k) {
+            if (!tracers.surfaces[k] || bool(mFixed[k]) != fixedPass) continue;
+            const Ray local = intoLayer(ray, mLayers[k]);
+            Vec3d xyz, normal;
+            if (!drawnCrossing(local, *tracers.surfaces[k], k, xyz, normal)) continue;
+            const double t = (xyz - local.eye()).length();
+            if (t < hit.t) {
+                hit.t = t;
+                hit.layer = k;
+                hit.normal = mLayers[k].rotation * normal;
+            }
+        }
+    }
+
+    /// The first crossing of `local` (in layer `k`'s frame) with its surface that is drawn:
+    /// any crossing, or for a cutaway layer an inner face. Its point and normal go to `xyz` and
+    /// `normal`; false when there is none.
+    bool drawnCrossing(Ray local, const Intersector& surface, std::size_t k, Vec3d& xyz,
+                       Vec3d& normal) const
+    {
+        const PreviewLayer& layer = mLayers[k];
+        const double voxel = mBoxes.voxel[k];
+        for (int crossing = 0; crossing < MAX_CUTAWAY_CROSSINGS; ++crossing) {
+            if (!surface.intersectsWS(local, xyz, normal)) return false;
+            if (!layer.cutaway
+                || isInnerFace(xyz, normal, local.dir(), mBoxes.local[k], voxel,
+                               double(layer.grid->background()))) {
+                return true;
+            }
+            // Past this crossing, and look for the next one.
+            const double along = (xyz - local.eye()).dot(local.dir()) / local.dir().lengthSqr();
+            local.setTimes(along + 1.5 * voxel / local.dir().length(), local.t1());
+        }
+        return false;
+    }
+
+    /// The fog in front of the surface at distance `nearest` along `ray`: each fog layer's box
+    /// marched up to it, its light and transmittance added to `light`.
+    void marchFog(const Ray& ray, Tracers& tracers, double nearest, PixelLight& light,
+                  std::vector<std::size_t>& counts) const
+    {
+        double transmittance = 1;
+        for (std::size_t k = 0; k < mN; ++k) {
+            if (!tracers.fogs[k]) continue;
+            const Ray local = intoLayer(ray, mLayers[k]);
+            double tin = 0, tout = 0;
+            if (isEmpty(mBoxes.local[k]) || !local.intersects(mBoxes.local[k], tin, tout)) continue;
+            tout = std::min(tout, nearest);
+            const double step = FOG_STEP_VOXELS * mLayers[k].grid->voxelSize()[0];
+            const double before = transmittance;
+            for (double t = std::max(tin, 0.0) + 0.5 * step; t < tout; t += step) {
+                const double d = tracers.fogs[k]->wsSample(local(t));
+                if (!(d > 0)) continue;
+                const double pass = std::exp(-mOptions.extinction * d * step);
+                const float scattered = float(transmittance * (1 - pass)) * FOG_SHADE;
+                light.fr += scattered * mLayers[k].albedo[0];
+                light.fg += scattered * mLayers[k].albedo[1];
+                light.fb += scattered * mLayers[k].albedo[2];
+                transmittance *= pass;
+                if (transmittance < OPAQUE_TRANSMITTANCE) break;
+            }
+            if (before - transmittance > 0.05) ++counts[k];
+        }
+        light.tr = float(transmittance);
+    }
+
+    const std::vector<PreviewLayer>& mLayers;
+    const PreviewOptions& mOptions;
+    const detail::CameraSetup& mSetup;
+    const LayerBoxes& mBoxes;
+    const std::vector<std::uint8_t>& mFixed;
+    PreviewCache* mCache;
+    bool mReuse;
+    bool mCopyable;
+    std::unique_ptr<FogBoxes> mFogBoxes;
+    std::size_t mN;
+};
+
+} // namespace
+
+ScenePreviewSummary renderScenePreview(const std::vector<PreviewLayer>& layers,
+                                       const PreviewOptions& options, const openvdb::BBoxd& bounds,
+                                       const std::string& path, PreviewCache* cache)
+{
+    options.validate();
+    if (layers.empty()) throw ValueError(msg("preview '", path, "': nothing to draw"));
+    for (const PreviewLayer& l : layers) checkLayer(l);
+    detail::checkImagePath(path);
+
+    const LayerBoxes boxes = measureLayers(layers, bounds, cache);
+    if (isEmpty(boxes.frame)) {
+        throw GridError(msg("preview '", path, "': every layer is empty, nothing to frame"));
+    }
+    const detail::CameraSetup setup =
+        detail::frameBox(boxes.frame.min(), boxes.frame.max(), options);
+    Film film(std::size_t(options.width), std::size_t(options.height),
+              Film::RGBA(0.0f, 0.0f, 0.0f, 0.0f));
+    openvdb::tools::PerspectiveCamera camera(film, Vec3d(0.0), setup.eye, detail::FOCAL_LENGTH_MM,
+                                             detail::APERTURE_MM, setup.nearPlane, setup.farPlane);
+    camera.lookAt(setup.target, setup.up);
+
+    // Fixed surface layers are intersected first, then the others: the same order with or
+    // without a cache, so the nearest hit (ties included) does not depend on it.
+    const FixedLayers fixed = fixedLayers(layers, setup, film, options);
+    const bool reuse = prepareCache(cache, fixed, film.width() * film.height(), layers.size());
+    const Raycaster raycaster(layers, options, setup, boxes, fixed, cache, reuse);
+
+    std::vector<std::atomic<std::size_t>> pixels(layers.size());
+    for (auto& p : pixels) p = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, film.height()), [&](const auto& rows) {
+        std::vector<std::size_t> counts(layers.size(), 0);
+        raycaster.drawRows(rows, film, camera, counts);
+        for (std::size_t k = 0; k < counts.size(); ++k) pixels[k] += counts[k];
     });
     ScenePreviewSummary summary;
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

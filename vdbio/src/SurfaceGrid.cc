@@ -73,10 +73,6 @@ namespace detail {
 
 namespace {
 
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
-constexpr int LEAF_DIM = int(FloatLeaf::DIM);           // 8 voxels per leaf edge
-constexpr int LEAF_VOXELS = int(FloatLeaf::NUM_VALUES); // 512
-
 /// Four doubles, for the rasterisation's row minima.
 using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
 
@@ -165,12 +161,114 @@ Shell surfaceParticles(const std::vector<sph::Vec3>& x, const std::vector<sph::I
     return shell;
 }
 
-/// Voxel index range [lo, hi] on one axis whose centres i * dx lie within `reach` (m) of `x`.
-inline void voxelRange(double x, double reach, double invDx, int& lo, int& hi)
+/// Step 1 of the file comment on one leaf: the union of spheres of radius `radius` (m) about
+/// the shell's particles, from the squared distances to their centres.
+class UnionRaster
 {
-    lo = int(std::ceil((x - reach) * invDx));
-    hi = int(std::floor((x + reach) * invDx));
-}
+public:
+    /// The spheres about `x` (the shell's particles; neighbour grid `neighbours`, cells of
+    /// `reach`), in a grid of voxel `dx` and background `background` (m): `reach` is `radius`
+    /// plus the background, past which a voxel is +background.
+    UnionRaster(const std::vector<sph::Vec3>& x, const sph::NeighborGrid& neighbours,
+                const Shell& shell, double dx, double radius, float background)
+        : mX(x)
+        , mNeighbours(neighbours)
+        , mShell(shell)
+        , mDx(dx)
+        , mInvDx(1.0 / dx)
+        , mRadius(radius)
+        , mBackground(background)
+        , mReach(radius + double(background))
+        , mReach2(mReach * mReach)
+        , mSearchRadius(sph::Real(mReach + leafHalfDiagonal(dx)))
+    {}
+
+    /// The level set's leaf at `origin`; null where every voxel is beyond the band.
+    std::unique_ptr<FloatLeaf> operator()(const openvdb::Coord& origin) const
+    {
+        double d2[LEAF_VOXELS]; // min over particles of |voxel - x_j|^2 (m^2)
+        std::fill(d2, d2 + LEAF_VOXELS, mReach2);
+        mNeighbours.forEachInRadius(leafCentre(origin, mDx), mSearchRadius,
+                                    [&](sph::Index j, const sph::Vec3&, sph::Real) {
+            addSphere(mX[j], origin, d2);
+        });
+        return leafFromDistances(origin, d2);
+    }
+
+private:
+    /// Lower the squared distances `d2` of the leaf at `origin` to those from `x`, within the
+    /// box of the sphere of radius `reach` about it.
+    void addSphere(const sph::Vec3& x, const openvdb::Coord& origin, double* d2) const
+    {
+        const double xj[3] = {double(x[0]), double(x[1]), double(x[2])};
+        const double reach[3] = {mReach, mReach, mReach};
+        int lo[3], hi[3];
+        if (!boxInLeaf(xj, reach, mInvDx, origin, lo, hi)) return;
+        // Squared offsets per axis, then every row of the sphere's box in the leaf, all eight
+        // lanes: a row or lane outside the sphere holds squared distances of at least reach2,
+        // which the minimum (started at reach2) ignores, and a branch-free loop beats skipping
+        // them (the skip was mispredicted).
+        double da2[LEAF_DIM], db2[LEAF_DIM], dc2[LEAF_DIM];
+        for (int k = 0; k < LEAF_DIM; ++k) {
+            const double da = (origin.x() + k) * mDx - xj[0];
+            const double db = (origin.y() + k) * mDx - xj[1];
+            const double dc = (origin.z() + k) * mDx - xj[2];
+            da2[k] = da * da;
+            db2[k] = db * db;
+            dc2[k] = dc * dc;
+        }
+        // A row as two four-lane vectors (GCC's vector extension, lowered to SSE2 where AVX is
+        // not enabled): GCC left the scalar minima unvectorised.
+        Lanes dcLow, dcHigh;
+        std::memcpy(&dcLow, dc2, sizeof(Lanes));
+        std::memcpy(&dcHigh, dc2 + 4, sizeof(Lanes));
+        for (int a = lo[0]; a <= hi[0]; ++a) {
+            for (int b = lo[1]; b <= hi[1]; ++b) {
+                const double dab2 = da2[a] + db2[b];
+                const Lanes base = {dab2, dab2, dab2, dab2};
+                double* row = d2 + ((a << 6) | (b << 3));
+                Lanes low, high;
+                std::memcpy(&low, row, sizeof(Lanes));
+                std::memcpy(&high, row + 4, sizeof(Lanes));
+                const Lanes low2 = base + dcLow, high2 = base + dcHigh;
+                low = low2 < low ? low2 : low; // std::min(row, d^2), lane by lane
+                high = high2 < high ? high2 : high;
+                std::memcpy(row, &low, sizeof(Lanes));
+                std::memcpy(row + 4, &high, sizeof(Lanes));
+            }
+        }
+    }
+
+    /// The leaf at `origin` from its squared distances `d2`: distance less radius in the band,
+    /// the deep interior inside; null when no voxel is within the band.
+    std::unique_ptr<FloatLeaf> leafFromDistances(const openvdb::Coord& origin,
+                                                 const double* d2) const
+    {
+        const openvdb::MaskTree::LeafNodeType* exterior =
+            mShell.exteriorReach.probeConstLeaf(origin);
+        std::unique_ptr<FloatLeaf> leaf;
+        for (int v = 0; v < LEAF_VOXELS; ++v) {
+            if (!(d2[v] < mReach2)) continue; // beyond the band: left to the flood fill
+            float phi = float(std::sqrt(d2[v]) - mRadius);
+            if (phi >= 0.0f && !(exterior && exterior->isValueOn(openvdb::Index(v)))) {
+                phi = -mBackground; // inside a deep particle's sphere (file comment)
+            }
+            if (!leaf) leaf = std::make_unique<FloatLeaf>(origin, mBackground, false);
+            leaf->setValueOn(openvdb::Index(v), std::max(phi, -mBackground));
+        }
+        return leaf;
+    }
+
+    const std::vector<sph::Vec3>& mX;
+    const sph::NeighborGrid& mNeighbours;
+    const Shell& mShell;
+    const double mDx, mInvDx;
+    const double mRadius;    ///< R (m)
+    const float mBackground; ///< the level set's background (m)
+    const double mReach, mReach2;
+    /// The reach plus a leaf's half-diagonal: the particles that may reach a leaf (m).
+    const sph::Real mSearchRadius;
+};
 
 /// Step 1 of the file comment into the empty level set `grid`: the union of spheres of radius
 /// `radius` (m) about the shell's particles, with the deep interior set inside.
@@ -178,89 +276,18 @@ void rasterizeUnion(openvdb::FloatGrid& grid, const std::vector<sph::Vec3>& posi
                     const Shell& shell, double radius)
 {
     const double dx = grid.voxelSize()[0];
-    const double invDx = 1.0 / dx;
-    const float background = grid.background();
-    const double reach = radius + double(background); // farther: +background
-    const double reach2 = reach * reach;
-
+    const double reach = radius + double(grid.background()); // farther: +background
     std::vector<sph::Vec3> x(shell.particles.size());
     for (std::size_t k = 0; k < x.size(); ++k) x[k] = positions[shell.particles[k]];
     sph::NeighborGrid neighbours{sph::Real(reach)};
     neighbours.build(x);
     const std::vector<openvdb::Coord> leaves =
         leavesNearParticles(x, neighbours.order(), dx, reach);
-    const double leafHalfDiagonal = 0.5 * std::sqrt(3.0) * (LEAF_DIM - 1) * dx;
-    const sph::Real searchRadius = sph::Real(reach + leafHalfDiagonal);
 
+    const UnionRaster raster(x, neighbours, shell, dx, radius, grid.background());
     std::vector<std::unique_ptr<FloatLeaf>> built(leaves.size());
     parallel::forEach(
-        0, leaves.size(),
-        [&](std::size_t L) {
-        const openvdb::Coord origin = leaves[L];
-        double d2[LEAF_VOXELS]; // min over particles of |voxel - x_j|^2 (m^2)
-        std::fill(d2, d2 + LEAF_VOXELS, reach2);
-        const sph::Vec3 centre(sph::Real((origin.x() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.y() + 0.5 * (LEAF_DIM - 1)) * dx),
-                               sph::Real((origin.z() + 0.5 * (LEAF_DIM - 1)) * dx));
-        neighbours.forEachInRadius(centre, searchRadius,
-                                   [&](sph::Index j, const sph::Vec3&, sph::Real) {
-            const double xj[3] = {double(x[j][0]), double(x[j][1]), double(x[j][2])};
-            int lo[3], hi[3];
-            for (int d = 0; d < 3; ++d) {
-                voxelRange(xj[d], reach, invDx, lo[d], hi[d]);
-                lo[d] = std::max(lo[d] - origin[d], 0);
-                hi[d] = std::min(hi[d] - origin[d], LEAF_DIM - 1);
-                if (lo[d] > hi[d]) return; // the sphere's box misses this leaf
-            }
-            // Squared offsets per axis, then every row of the sphere's box in the leaf, all
-            // eight lanes: a row or lane outside the sphere holds squared distances of at
-            // least reach2, which the minimum (started at reach2) ignores, and a branch-free
-            // loop beats skipping them (the skip was mispredicted).
-            double da2[LEAF_DIM], db2[LEAF_DIM], dc2[LEAF_DIM];
-            for (int k = 0; k < LEAF_DIM; ++k) {
-                const double da = (origin.x() + k) * dx - xj[0];
-                const double db = (origin.y() + k) * dx - xj[1];
-                const double dc = (origin.z() + k) * dx - xj[2];
-                da2[k] = da * da;
-                db2[k] = db * db;
-                dc2[k] = dc * dc;
-            }
-            // A row as two four-lane vectors (GCC's vector extension, lowered to SSE2 where
-            // AVX is not enabled): GCC left the scalar minima unvectorised.
-            Lanes dcLow, dcHigh;
-            std::memcpy(&dcLow, dc2, sizeof(Lanes));
-            std::memcpy(&dcHigh, dc2 + 4, sizeof(Lanes));
-            for (int a = lo[0]; a <= hi[0]; ++a) {
-                for (int b = lo[1]; b <= hi[1]; ++b) {
-                    const double dab2 = da2[a] + db2[b];
-                    const Lanes base = {dab2, dab2, dab2, dab2};
-                    double* row = d2 + ((a << 6) | (b << 3));
-                    Lanes low, high;
-                    std::memcpy(&low, row, sizeof(Lanes));
-                    std::memcpy(&high, row + 4, sizeof(Lanes));
-                    const Lanes low2 = base + dcLow, high2 = base + dcHigh;
-                    low = low2 < low ? low2 : low; // std::min(row, d^2), lane by lane
-                    high = high2 < high ? high2 : high;
-                    std::memcpy(row, &low, sizeof(Lanes));
-                    std::memcpy(row + 4, &high, sizeof(Lanes));
-                }
-            }
-        });
-        const openvdb::MaskTree::LeafNodeType* exterior =
-            shell.exteriorReach.probeConstLeaf(origin);
-        std::unique_ptr<FloatLeaf> leaf;
-        for (int v = 0; v < LEAF_VOXELS; ++v) {
-            if (!(d2[v] < reach2)) continue; // beyond the band: left to the flood fill
-            float phi = float(std::sqrt(d2[v]) - radius);
-            if (phi >= 0.0f && !(exterior && exterior->isValueOn(openvdb::Index(v)))) {
-                phi = -background; // inside a deep particle's sphere (file comment)
-            }
-            if (!leaf) leaf = std::make_unique<FloatLeaf>(origin, background, false);
-            leaf->setValueOn(openvdb::Index(v), std::max(phi, -background));
-        }
-        built[L] = std::move(leaf);
-        },
-        1);
+        0, leaves.size(), [&](std::size_t L) { built[L] = raster(leaves[L]); }, 1);
     for (auto& leaf : built) {
         if (leaf) grid.tree().addLeaf(leaf.release());
     }
@@ -354,6 +381,17 @@ void trimInterior(openvdb::FloatGrid& grid, int halfWidthVoxels)
 
 } // namespace
 
+openvdb::FloatGrid::Ptr makeEmptySurfaceGrid(const VolumeOptions& options)
+{
+    openvdb::FloatGrid::Ptr grid = openvdb::createLevelSet<openvdb::FloatGrid>(
+        options.voxelSize, double(options.surfaceHalfWidthVoxels));
+    grid->setName("surface");
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+    grid->insertMeta("units", openvdb::StringMetadata("m (signed distance, negative inside)"));
+    grid->insertMeta("particle_spacing", openvdb::FloatMetadata(float(options.particleSpacing)));
+    return grid;
+}
+
 openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,
                                         const std::vector<sph::Index>& selection,
                                         const VolumeOptions& options)
@@ -364,12 +402,7 @@ openvdb::FloatGrid::Ptr makeSurfaceGrid(const sph::ParticleSet& particles,
     const double closing = options.surfaceClosingSpacings * h;
     const double offset = options.surfaceOffsetSpacings * h;
 
-    openvdb::FloatGrid::Ptr grid =
-        openvdb::createLevelSet<openvdb::FloatGrid>(dx, double(options.surfaceHalfWidthVoxels));
-    grid->setName("surface");
-    grid->setGridClass(openvdb::GRID_LEVEL_SET);
-    grid->insertMeta("units", openvdb::StringMetadata("m (signed distance, negative inside)"));
-    grid->insertMeta("particle_spacing", openvdb::FloatMetadata(float(h)));
+    openvdb::FloatGrid::Ptr grid = makeEmptySurfaceGrid(options);
     if (selection.empty()) return grid;
 
     const std::vector<sph::Vec3>& x = particles.positions();

@@ -128,8 +128,8 @@ public:
     {
         std::ofstream out(file, std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
         if (!out) {
-            throw IoError(msg(what, " '", target, "': cannot create it (", std::strerror(errno),
-                              ")"));
+            throw IoError(
+                msg(what, " '", target, "': cannot create it (", std::strerror(errno), ")"));
         }
         Archive::write(out, grids, /*seekable=*/true, fileMetadata);
         out.close();
@@ -173,78 +173,86 @@ void checkOutputFolder(const std::string& path, const char* what)
 // VolumeOptions
 // ---------------------------------------------------------------------------------------------
 
-void VolumeOptions::validate() const
+namespace {
+
+/// The gathered grids' fields (density, vel, scalar channels); `where` prefixes messages.
+void validateGathered(const VolumeOptions& o, const char* where)
 {
-    const char* where = "volume output: ";
-    if (!isPositiveFinite(voxelSize)) {
-        throw ValueError(msg(where, "voxel size = ", voxelSize, " m: expected > 0"));
+    if (!isPositiveFinite(o.kernelSupport)) {
+        throw ValueError(msg(where, "kernel support = ", o.kernelSupport,
+                             " m: expected > 0 (the SPH support radius, 3 h in [SB12])"));
     }
-    const bool gathered = density || velocity || !scalarChannels.empty();
-    if (gathered) {
-        if (!isPositiveFinite(kernelSupport)) {
-            throw ValueError(msg(where, "kernel support = ", kernelSupport,
-                                 " m: expected > 0 (the SPH support radius, 3 h in [SB12])"));
-        }
-        if (!isPositiveFinite(restDensity)) {
-            throw ValueError(msg(where, "rest density = ", restDensity, " kg/m^3: expected > 0"));
-        }
-        if (!(std::isfinite(densityVoxelSize) && densityVoxelSize >= 0.0)) {
-            throw ValueError(msg(where, "density voxel size = ", densityVoxelSize,
-                                 " m: expected > 0, or 0 for the particle spacing"));
-        }
-        if (densityVoxelSize == 0.0 && !isPositiveFinite(particleSpacing)) {
-            throw ValueError(msg(where, "particle spacing = ", particleSpacing,
-                                 " m: expected > 0 (the density voxel defaults to it)"));
-        }
-        if (!(densityCutoff >= 0.0 && densityCutoff < 1.0)) {
-            throw ValueError(msg(where, "density cutoff = ", densityCutoff,
-                                 ": expected in [0, 1) (a fraction of the rest density)"));
-        }
+    if (!isPositiveFinite(o.restDensity)) {
+        throw ValueError(msg(where, "rest density = ", o.restDensity, " kg/m^3: expected > 0"));
     }
-    if (surface) {
-        if (!isPositiveFinite(particleSpacing)) {
-            throw ValueError(
-                msg(where, "particle spacing = ", particleSpacing, " m: expected > 0"));
-        }
-        if (!isPositiveFinite(surfaceRadiusSpacings)) {
-            throw ValueError(
-                msg(where, "surface radius = ", surfaceRadiusSpacings, " spacings: expected > 0"));
-        }
-        const double radius = surfaceRadiusSpacings * particleSpacing;
-        if (surfaceMethod == SurfaceMethod::Spheres && radius < voxelSize) {
-            throw ValueError(msg(where, "surface sphere radius = ", radius, " m (",
-                                 surfaceRadiusSpacings, " spacings) is below one voxel (",
-                                 voxelSize, " m): lower the voxel size (h / 2 is typical)"));
-        }
-        if (!(std::isfinite(surfaceClosingSpacings) && surfaceClosingSpacings >= 0.0)) {
-            throw ValueError(msg(where, "surface closing = ", surfaceClosingSpacings,
-                                 " spacings: expected >= 0"));
-        }
-        if (surfaceSmoothingIterations < 0) {
-            throw ValueError(msg(where, "surface smoothing iterations = ",
-                                 surfaceSmoothingIterations, ": expected >= 0"));
-        }
-        if (!std::isfinite(surfaceOffsetSpacings)
-            || surfaceOffsetSpacings > surfaceRadiusSpacings + surfaceClosingSpacings) {
-            throw ValueError(msg(where, "surface offset = ", surfaceOffsetSpacings,
-                                 " spacings: expected finite and <= radius + closing = ",
-                                 surfaceRadiusSpacings + surfaceClosingSpacings));
-        }
-        if (!(std::isfinite(surfaceSprayRadiusSpacings) && surfaceSprayRadiusSpacings >= 0.0)) {
-            throw ValueError(msg(where, "surface spray radius = ", surfaceSprayRadiusSpacings,
-                                 " spacings: expected >= 0 (0 leaves spray out)"));
-        }
-        if (surfaceHalfWidthVoxels < 3) {
-            throw ValueError(msg(where, "surface half width = ", surfaceHalfWidthVoxels,
-                                 " voxels: expected >= 3 (the level-set filters' stencils)"));
-        }
-        if (surfaceMethod == SurfaceMethod::Anisotropic) {
-            validateAnisotropic(*this, where);
-        } else if (surfaceMethod != SurfaceMethod::Spheres) {
-            throw ValueError(msg(where, "surface method = ", int(surfaceMethod), ": expected ",
-                                 sph::quotedNames(SURFACE_METHOD_NAMES)));
-        }
+    if (!(std::isfinite(o.densityVoxelSize) && o.densityVoxelSize >= 0.0)) {
+        throw ValueError(msg(where, "density voxel size = ", o.densityVoxelSize,
+                             " m: expected > 0, or 0 for the particle spacing"));
     }
+    if (o.densityVoxelSize == 0.0 && !isPositiveFinite(o.particleSpacing)) {
+        throw ValueError(msg(where, "particle spacing = ", o.particleSpacing,
+                             " m: expected > 0 (the density voxel defaults to it)"));
+    }
+    if (!(o.densityCutoff >= 0.0 && o.densityCutoff < 1.0)) {
+        throw ValueError(msg(where, "density cutoff = ", o.densityCutoff,
+                             ": expected in [0, 1) (a fraction of the rest density)"));
+    }
+}
+
+/// The surface's size fields: spacing, radius, closing, smoothing, offset, spray, half width.
+void validateSurfaceSizes(const VolumeOptions& o, const char* where)
+{
+    if (!isPositiveFinite(o.particleSpacing)) {
+        throw ValueError(msg(where, "particle spacing = ", o.particleSpacing, " m: expected > 0"));
+    }
+    if (!isPositiveFinite(o.surfaceRadiusSpacings)) {
+        throw ValueError(
+            msg(where, "surface radius = ", o.surfaceRadiusSpacings, " spacings: expected > 0"));
+    }
+    const double radius = o.surfaceRadiusSpacings * o.particleSpacing;
+    if (o.surfaceMethod == SurfaceMethod::Spheres && radius < o.voxelSize) {
+        throw ValueError(msg(where, "surface sphere radius = ", radius, " m (",
+                             o.surfaceRadiusSpacings, " spacings) is below one voxel (",
+                             o.voxelSize, " m): lower the voxel size (h / 2 is typical)"));
+    }
+    if (!(std::isfinite(o.surfaceClosingSpacings) && o.surfaceClosingSpacings >= 0.0)) {
+        throw ValueError(
+            msg(where, "surface closing = ", o.surfaceClosingSpacings, " spacings: expected >= 0"));
+    }
+    if (o.surfaceSmoothingIterations < 0) {
+        throw ValueError(msg(where, "surface smoothing iterations = ", o.surfaceSmoothingIterations,
+                             ": expected >= 0"));
+    }
+    const double outermost = o.surfaceRadiusSpacings + o.surfaceClosingSpacings;
+    if (!std::isfinite(o.surfaceOffsetSpacings) || o.surfaceOffsetSpacings > outermost) {
+        throw ValueError(msg(where, "surface offset = ", o.surfaceOffsetSpacings,
+                             " spacings: expected finite and <= radius + closing = ", outermost));
+    }
+    if (!(std::isfinite(o.surfaceSprayRadiusSpacings) && o.surfaceSprayRadiusSpacings >= 0.0)) {
+        throw ValueError(msg(where, "surface spray radius = ", o.surfaceSprayRadiusSpacings,
+                             " spacings: expected >= 0 (0 leaves spray out)"));
+    }
+    if (o.surfaceHalfWidthVoxels < 3) {
+        throw ValueError(msg(where, "surface half width = ", o.surfaceHalfWidthVoxels,
+                             " voxels: expected >= 3 (the level-set filters' stencils)"));
+    }
+}
+
+/// The surface's fields: its sizes, then those of its method.
+void validateSurface(const VolumeOptions& o, const char* where)
+{
+    validateSurfaceSizes(o, where);
+    if (o.surfaceMethod == SurfaceMethod::Anisotropic) {
+        validateAnisotropic(o, where);
+    } else if (o.surfaceMethod != SurfaceMethod::Spheres) {
+        throw ValueError(msg(where, "surface method = ", int(o.surfaceMethod), ": expected ",
+                             sph::quotedNames(SURFACE_METHOD_NAMES)));
+    }
+}
+
+/// The scalar channels' names: not empty, not a built-in grid's, each once.
+void validateChannelNames(const std::vector<std::string>& scalarChannels, const char* where)
+{
     std::set<std::string> seen;
     for (const std::string& name : scalarChannels) {
         if (name.empty()) throw ValueError(msg(where, "scalar channel with an empty name"));
@@ -259,6 +267,19 @@ void VolumeOptions::validate() const
             throw ValueError(msg(where, "scalar channel '", name, "' listed twice"));
         }
     }
+}
+
+} // namespace
+
+void VolumeOptions::validate() const
+{
+    const char* where = "volume output: ";
+    if (!isPositiveFinite(voxelSize)) {
+        throw ValueError(msg(where, "voxel size = ", voxelSize, " m: expected > 0"));
+    }
+    if (density || velocity || !scalarChannels.empty()) validateGathered(*this, where);
+    if (surface) validateSurface(*this, where);
+    validateChannelNames(scalarChannels, where);
 }
 
 // ---------------------------------------------------------------------------------------------
