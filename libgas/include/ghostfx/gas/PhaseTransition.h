@@ -2,7 +2,7 @@
 /// @brief  Liquid-gas phase transition of [RYY15] Sec. 4: heating, boiling and evaporation by
 ///         particle splitting, merging of over-split liquid, and the liquid as a gas boundary.
 /// @details A driver that advances a liquid solver (seen through the narrow `LiquidSide`
-///          interface, so libgas never includes libghost, DESIGN.md) and a GasSolver in lockstep.
+///          interface, so libgas never includes libghost, docs/architecture.md) and a GasSolver in lockstep.
 ///          One step(dt):
 ///           1. the liquid advances (LiquidSide::step);
 ///           2. heat: liquid particles within `heaterBand` of a heater level set relax towards
@@ -99,7 +99,8 @@ public:
     virtual void particlesChanged() {}
 };
 
-/// Settings of the phase transition (plain struct, STYLE.md rule 3).
+/// Settings of the phase transition (plain struct; each scene key of `phase_transition` is
+/// declared once in phaseSettingTable(), GasSettings.cc).
 struct PhaseSettings
 {
     // Temperatures ------------------------------------------------------------------------------
@@ -158,9 +159,13 @@ struct PhaseSettings
     /// Most liquid particles turned (boiled or evaporated) per step; 0 = no limit.
     std::size_t maxTransitionsPerStep = 0;
 
-    /// Throws ValueError naming the field and the bad value.
+    /// Throws ValueError naming the field, the bad value and the range expected; also for
+    /// evaporationOnset not below boilingPoint and an evaporation pattern without a centre.
     void validate() const;
 };
+
+/// The settings of scene object `phase_transition` that PhaseSettings holds.
+const sph::SettingTable<PhaseSettings>& phaseSettingTable();
 
 /// Wall-clock seconds per phase of PhaseTransition::step, accumulated since the last reset.
 struct PhaseTransitionTimings
