@@ -183,6 +183,19 @@ TEST_F(Cli, CheckpointFromOtherSettingsIsRefused)
     EXPECT_CONTAINS(line, "5000");
 }
 
+// A setting whose declaration says a checkpoint need not match it (the blow-up bound
+// max_speed) may change on resume; the others may not (above).
+TEST_F(Cli, ResumeMayChangeASettingDeclaredFreeOnResume)
+{
+    const std::string path = write(smallScene());
+    ASSERT_EQ(run("run " + path + " --out " + (mDir / "out").string() + " -q --frames 1-2").code,
+              0);
+    const Result resumed =
+        run("run " + path + " -D settings.max_speed=100 --out " + (mDir / "out").string()
+            + " -q --frames 1-3 --resume " + (mDir / "out" / "checkpoint.0002.h5").string());
+    EXPECT_EQ(resumed.code, 0) << resumed.err;
+}
+
 TEST_F(Cli, BadInputGetsOneClearLine)
 {
     const std::string out = " --out " + (mDir / "out").string();
