@@ -67,7 +67,7 @@ using G = GasSettings;
 /// The rows of the gas's own keys: discretisation, Eqs. 11-17, vorticity, isolated particles.
 std::vector<Row> gasRows()
 {
-    std::vector<Row> rows = {
+    return {
         Row::number("spacing", "spacing", &G::spacing, sph::positive(), "m", "gas particle spacing")
             .shownDefault("settings.spacing (boiling: h (rho_l / rho_g / 12)^(1/3))"),
         Row::number(nullptr, "frameRate", &G::frameRate, sph::positive(), "frames/s",
@@ -114,16 +114,13 @@ std::vector<Row> gasRows()
         Row::number("life_strength", "lifeStrength", &G::lifeStrength, sph::nonNegative(), "s",
                     "how long an isolated particle lives (Sec. 5); 0 = forever"),
     };
-    const std::vector<Row> steps = sph::stepSettingRows<GasSettings>();
-    rows.insert(rows.end(), steps.begin(), steps.end());
-    return rows;
 }
 
 } // namespace
 
 const sph::SettingTable<GasSettings>& gasSettingTable()
 {
-    static const sph::SettingTable<GasSettings> table{"gas setting", gasRows()};
+    static const sph::SettingTable<GasSettings> table = sph::withStepRows("gas setting", gasRows());
     return table;
 }
 

@@ -111,7 +111,7 @@ const sph::EnumName<Relaxation> RELAXATION_NAMES[] = {{Relaxation::Sb12, "sb12"}
 /// The rows of the liquid's own keys (discretisation, liquid, ghosts, Basic SPH, sampling).
 std::vector<LiquidRow> liquidRows()
 {
-    std::vector<LiquidRow> rows = {
+    return {
         LiquidRow::number(nullptr, "spacing", &G::spacing, sph::positive(), "m",
                           "particle spacing h (settings.spacing of the scene)"),
         LiquidRow::number(nullptr, "frameRate", &G::frameRate, sph::positive(), "frames/s",
@@ -158,16 +158,14 @@ std::vector<LiquidRow> liquidRows()
         LiquidRow::flag("tiled_sampling", "tiledSampling", &G::tiledSampling,
                         "sample deep interiors from a relaxed periodic tile"),
     };
-    const std::vector<LiquidRow> steps = sph::stepSettingRows<GhostSettings>();
-    rows.insert(rows.end(), steps.begin(), steps.end());
-    return rows;
 }
 
 } // namespace
 
 const sph::SettingTable<GhostSettings>& liquidSettingTable()
 {
-    static const sph::SettingTable<GhostSettings> table{"liquid setting", liquidRows()};
+    static const sph::SettingTable<GhostSettings> table =
+        sph::withStepRows("liquid setting", liquidRows());
     return table;
 }
 

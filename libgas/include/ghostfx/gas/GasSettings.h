@@ -13,6 +13,7 @@
 ///          -> `buoyancy`, beta of Eq. 25 -> `vorticityGeneration`, l_s (Sec. 5) -> `lifeStrength`.
 #pragma once
 
+#include <ghostfx/sph/SettingSpec.h>
 #include <ghostfx/sph/Types.h>
 
 #include <cstdint>
@@ -20,11 +21,6 @@
 #include <vector>
 
 namespace ghostfx {
-namespace sph {
-template <typename S>
-struct SettingTable;
-} // namespace sph
-
 namespace gas {
 
 using sph::Real;

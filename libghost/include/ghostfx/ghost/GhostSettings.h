@@ -8,17 +8,13 @@
 #pragma once
 
 #include <ghostfx/sph/PoissonSampler.h>
+#include <ghostfx/sph/SettingSpec.h>
 #include <ghostfx/sph/Types.h>
 
 #include <cstdint>
 #include <string>
 
 namespace ghostfx {
-namespace sph {
-template <typename S>
-struct SettingTable;
-} // namespace sph
-
 namespace ghost {
 
 using sph::Real;

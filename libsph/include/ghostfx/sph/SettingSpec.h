@@ -338,6 +338,15 @@ std::vector<SettingSpec<S>> stepSettingRows()
     };
 }
 
+/// The table of `rows` followed by the step-control rows (stepSettingRows()).
+template <typename S>
+SettingTable<S> withStepRows(const char* what, std::vector<SettingSpec<S>> rows)
+{
+    const std::vector<SettingSpec<S>> steps = stepSettingRows<S>();
+    rows.insert(rows.end(), steps.begin(), steps.end());
+    return SettingTable<S>{what, std::move(rows)};
+}
+
 /// Throw ValueError "<what> <field> = <value>: expected <range>" for the first Number or Whole
 /// row of `table` whose field `s` holds out of range (an automatic one may be negative), or
 /// for the first Vector with a component that is not finite.
