@@ -75,8 +75,8 @@ struct DfsphSettings
     /// the 98k dam break (bench/history/diary-2026-11.md, "DFSPH: a peak limit"): 10 and 20 also
     /// hold the landing but cost 45 % and 17 % more per step; 30 costs nothing measurable.
     static constexpr double PEAK_FACTOR = 30;
-    /// How a ghost solid's pressure enters the solves (GhostDfsph.cc, file comment). Chosen by
-    /// name in scenes (settings.dfsph.wall_pressure).
+    /// How a ghost solid's pressure enters the solves (GhostDfsph.cc, file comment). Scenes
+    /// always use Mirror; Own is for library code that compares with SPlisHSPlasH's term.
     enum class WallPressure : std::uint8_t {
         /// The liquid particle's mirror image: its pressure term, extrapolated down the
         /// hydrostatic gradient, and its reflected velocity (Adami et al. 2012's wall pressure
@@ -166,7 +166,8 @@ enum class SolidSlip {
 };
 
 /// How the ghost air's weights (its mass over a liquid particle's) are set at a resampling
-/// (GhostAir.cc, step 6). Chosen by name in scenes (settings.air_weights).
+/// (GhostAir.cc, step 6). Scenes always use Complete; Matched is for library code that
+/// compares with the weights nearest [SB12]'s.
 enum class AirWeights {
     /// min(1, n0 / sigma_a): an air particle weighs less where the air around it is packed
     /// closer than the liquid ([SB12]'s weight 1 elsewhere), the weights nearest the paper's:
