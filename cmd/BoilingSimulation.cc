@@ -4,6 +4,7 @@
 #include "GasScene.h"
 #include "GhostLiquidSide.h"
 #include "LiquidScene.h"
+#include "SettingReader.h"
 #include "SimulationParts.h"
 
 #include <ghostfx/gas/PhaseTransition.h>
@@ -22,22 +23,15 @@ using sph::Real;
 
 namespace {
 
-gas::PhaseSettings phaseSettings(const vdbio::JsonObject& p, double spacing, double heaterBandLimit)
+/// The `phase_transition` keys of a boiling scene; the heated layer defaults to 1.5 spacings,
+/// kept inside the heaters' narrow bands (phi is clamped beyond them).
+gas::PhaseSettings phaseSettings(const vdbio::Scene& scene, double heaterBandLimit)
 {
     gas::PhaseSettings s;
-    s.boilingPoint = Real(p.positive("boiling_point", s.boilingPoint));
-    s.initialTemperature = Real(p.positive("initial_temperature", s.initialTemperature));
-    s.latentHeat = Real(p.nonNegative("latent_heat", s.latentHeat));
-    // Heated layer: 1.5 spacings, kept inside the heaters' narrow bands (phi is clamped beyond).
-    s.heaterBand = Real(p.positive("heater_band", std::min(1.5 * spacing, 0.9 * heaterBandLimit)));
-    s.heatingTime = Real(p.positive("heating_time", s.heatingTime));
-    s.conductivity = Real(p.nonNegative("conductivity", s.conductivity));
-    s.evaporationRate = Real(p.nonNegative("evaporation_rate", s.evaporationRate));
-    s.evaporationOnset = Real(p.positive("evaporation_onset", s.evaporationOnset));
-    s.surfaceThreshold = Real(p.nonNegative("surface_threshold", s.surfaceThreshold));
-    s.mergeEverySteps = int(p.inRange("merge_every_steps", s.mergeEverySteps, 1, 100000));
-    p.finish();
-    s.validate();
+    s.heaterBand = Real(std::min(1.5 * scene.spacing, 0.9 * heaterBandLimit));
+    readSettingTable(scene.phaseTransition, gas::phaseSettingTable(), s);
+    scene.phaseTransition.finish();
+    validateSceneSettings(scene.file, s);
     return s;
 }
 
@@ -66,8 +60,7 @@ public:
         double band = std::numeric_limits<double>::max();
         for (const vdbio::SceneHeater& h : scene.heaters)
             band = std::min(band, double(h.shape.bandWidth()));
-        mPhase = std::make_unique<gas::PhaseTransition>(
-            *mGas, *mSide, phaseSettings(scene.phaseTransition, scene.spacing, band));
+        mPhase = std::make_unique<gas::PhaseTransition>(*mGas, *mSide, phaseSettings(scene, band));
         for (const vdbio::SceneHeater& h : scene.heaters)
             mPhase->addHeater(h.shape, Real(h.temperature));
         if (restored) mPhase->restoreState((*restored)[2]);
@@ -177,8 +170,7 @@ public:
     }
     std::vector<MediumCount> mediumCounts() const override
     {
-        return {{"liquid", mLiquid->count(ParticleKind::Liquid)},
-                {"gas", mGas->visibleGasCount()}};
+        return {{"liquid", mLiquid->count(ParticleKind::Liquid)}, {"gas", mGas->visibleGasCount()}};
     }
 
     std::vector<sph::SolverState> saveStates() const override
@@ -222,7 +214,7 @@ std::unique_ptr<Simulation> makeBoilingSimulation(const vdbio::Scene& scene, gho
 void checkBoilingSimulation(const vdbio::Scene& scene, ghost::Method method)
 {
     BoilingSimulation::readSettings(scene, method);
-    phaseSettings(scene.phaseTransition, scene.spacing, std::numeric_limits<double>::max());
+    phaseSettings(scene, std::numeric_limits<double>::max());
 }
 
 } // namespace cmd

@@ -2,7 +2,7 @@
 #include "GasScene.h"
 
 #include "LiquidScene.h"
-#include "StepSettings.h"
+#include "SettingReader.h"
 
 #include <ghostfx/sph/Exceptions.h>
 
@@ -42,33 +42,8 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
                "or 'gas_uncorrected' (for a boiling scene's vapour: settings.gas.method)");
     }
     s.method = method;
-    s.spacing = Real(g.positive("spacing", defaultSpacing));
-    s.supportFactor = Real(g.inRange("kernel_support", s.supportFactor, 1.5, 5));
-    s.particleMass = Real(g.nonNegative("particle_mass", s.particleMass));
-    s.restDensity = Real(g.positive("rest_density", s.restDensity));
-    s.kappa = Real(g.positive("kappa", s.kappa));
-    s.clampNegativePressure = g.get<bool>("clamp_negative_pressure", s.clampNegativePressure);
-    s.delta = Real(g.inRange("delta", s.delta, 0.4, 0.7));
-    s.atmosphericPressure = Real(g.nonNegative("atmospheric_pressure", s.atmosphericPressure));
-    s.interiorPressureScale =
-        Real(g.inRange("interior_pressure_scale", s.interiorPressureScale, 0, 1));
-    s.normalThreshold = Real(g.nonNegative("normal_threshold", s.normalThreshold));
-    s.damping = Real(g.nonNegative("damping", s.damping));
-    s.viscosity = Real(g.nonNegative("viscosity", s.viscosity));
-    const auto gravity =
-        g.get<std::array<double, 3>>("gravity", {s.gravity[0], s.gravity[1], s.gravity[2]});
-    s.gravity = Vec3(Real(gravity[0]), Real(gravity[1]), Real(gravity[2]));
-    s.ambientTemperature = Real(g.positive("ambient_temperature", s.ambientTemperature));
-    s.diffusion = Real(g.nonNegative("diffusion", s.diffusion));
-    s.radiationTime = Real(g.nonNegative("radiation_time", s.radiationTime));
-    s.buoyancy = Real(g.nonNegative("buoyancy", s.buoyancy));
-    const auto up = g.get<std::array<double, 3>>("buoyancy_direction", {0, 1, 0});
-    s.buoyancyDirection = Vec3(Real(up[0]), Real(up[1]), Real(up[2]));
-    s.vorticity = g.get<bool>("vorticity", s.vorticity);
-    s.vorticityGeneration = Real(g.nonNegative("vorticity_generation", s.vorticityGeneration));
-    s.vorticityStrength = Real(g.nonNegative("vorticity_strength", s.vorticityStrength));
-    s.lifeStrength = Real(g.nonNegative("life_strength", s.lifeStrength));
-    readStepSettings(g, s);
+    s.spacing = Real(defaultSpacing);
+    readSettingTable(g, gas::gasSettingTable(), s);
     s.frameRate = Real(scene.frameRate);
     s.domain = scene.killBox;
     // force_fields ([RYY15] Fig. 7): point attractors act on the gas.
@@ -87,7 +62,7 @@ gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject&
         if (g.has("method")) g.failValue("method", what);
         scene.settings.failValue("method", what);
     }
-    s.validate();
+    validateSceneSettings(scene.file, s);
     return s;
 }
 

@@ -1,7 +1,9 @@
 /// @file   LiquidScene.cc
 #include "LiquidScene.h"
 
-#include "StepSettings.h"
+#include "SettingReader.h"
+
+#include <ghostfx/gas/PhaseTransition.h>
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
@@ -26,83 +28,31 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.method = method;
     g.spacing = Real(scene.spacing);
     g.frameRate = Real(scene.frameRate);
-    g.supportFactor = Real(s.inRange("kernel_support", g.supportFactor, 1.5, 5));
-    g.restDensity = Real(s.positive("rest_density", g.restDensity));
-    g.pressure = ghost::pressureFromName(s.choice("pressure", "tait", {"tait", "dfsph"}));
-    if (g.pressure == ghost::PressureModel::Dfsph && method == ghost::Method::Basic) {
-        s.failValue("pressure", "expected 'tait' with method 'basic' ([SB12]'s weakly "
-                                "compressible baseline has no air for a pressure solve's free "
-                                "surface)");
-    }
+    readSettingTable(s, ghost::liquidSettingTable(), g);
     if (s.has("dfsph")) {
         const vdbio::JsonObject d = s.object("dfsph");
-        ghost::DfsphSettings& o = g.dfsph;
-        o.densityError = Real(d.inRange("density_error", o.densityError, 1e-7, 0.1));
-        o.divergenceError = Real(d.inRange("divergence_error", o.divergenceError, 1e-7, 1));
-        o.densityRelaxation = Real(d.inRange("density_relaxation", o.densityRelaxation, 1e-6, 1));
-        o.maxIterations = int(d.inRange("max_iterations", o.maxIterations, 1, 100000));
-        o.minTimeStep = Real(d.inRange("min_dt", o.minTimeStep, 1e-9, 1));
-        o.maxTimeStep = Real(d.inRange("max_dt", o.maxTimeStep, 1e-9, 1));
-        if (o.maxTimeStep < o.minTimeStep)
-            d.failValue("max_dt",
-                        "expected at least min_dt (" + std::to_string(o.minTimeStep) + " s)");
-        o.warmStart = d.get<bool>("warm_start", o.warmStart);
-        o.divergenceWarmStart = d.get<bool>("divergence_warm_start", o.divergenceWarmStart);
-        o.keepGradients = d.get<bool>("keep_gradients", o.keepGradients);
-        o.wallPressure = d.choice("wall_pressure", "mirror", {"mirror", "own"}) == "mirror"
-                             ? ghost::DfsphSettings::WallPressure::Mirror
-                             : ghost::DfsphSettings::WallPressure::Own;
-        o.airDensity = d.choice("air_density", "full", {"full", "fill"}) == "fill"
-                           ? ghost::DfsphSettings::AirDensity::Fill
-                           : ghost::DfsphSettings::AirDensity::Full;
-        o.airResampling = d.choice("air_resampling", "step", {"step", "time"}) == "time"
-                              ? ghost::DfsphSettings::AirResampling::Time
-                              : ghost::DfsphSettings::AirResampling::Step;
-        constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
-        o.keptGradientLimit =
-            GiB * d.inRange("kept_gradients_gb", o.keptGradientLimit / GiB, 0, 1e6);
+        readSettingTable(d, ghost::dfsphSettingTable(), g.dfsph);
         d.finish();
     }
-    g.stiffness = Real(s.positive("stiffness", g.stiffness));
-    const auto gravity =
-        s.get<std::array<double, 3>>("gravity", {g.gravity[0], g.gravity[1], g.gravity[2]});
-    g.gravity = Vec3(Real(gravity[0]), Real(gravity[1]), Real(gravity[2]));
-    g.xsphEpsilon = Real(s.inRange("xsph_epsilon", g.xsphEpsilon, 0, 1));
-    g.solidEpsilon = Real(s.inRange("solid_epsilon", g.solidEpsilon, 0, 1));
-    // Absent: automatic (GhostSettings::relaxationPasses()).
-    if (s.has("initial_relaxation")) {
-        g.initialRelaxation = int(s.inRange("initial_relaxation", 0, 0, 1000));
-        if (double(g.initialRelaxation) != s.get<double>("initial_relaxation", 0))
-            s.failValue("initial_relaxation", "expected a whole number of passes, 0 to 1000");
-    }
-    // Absent: automatic (GhostSettings::shifting()).
-    if (s.has("shifting")) g.shiftingCoefficient = Real(s.inRange("shifting", 0, 0, 20));
-    g.solidSlip = s.choice("solid_slip", "free", {"free", "no_slip"}) == "free"
-                      ? ghost::SolidSlip::Free
-                      : ghost::SolidSlip::NoSlip;
-    g.airResampleSteps = int(s.inRange("air_resample_steps", g.airResampleSteps, 1, 1000));
-    g.airKeepFraction = Real(s.inRange("air_keep_fraction", g.airKeepFraction, 0, 10));
-    g.airWeights =
-        s.choice("air_weights", g.airWeights == ghost::AirWeights::Matched ? "matched" : "complete",
-                 {"matched", "complete"})
-                == "matched"
-            ? ghost::AirWeights::Matched
-            : ghost::AirWeights::Complete;
-    g.basicXsphEpsilon = Real(s.inRange("basic_xsph_epsilon", g.basicXsphEpsilon, 0, 1));
-    g.basicViscosityAlpha = Real(s.nonNegative("basic_viscosity_alpha", g.basicViscosityAlpha));
-    g.lennardJonesStrength = Real(s.nonNegative("lennard_jones_strength", g.lennardJonesStrength));
-    readStepSettings(s, g);
-    g.tiledSampling = s.get<bool>("tiled_sampling", g.tiledSampling);
-    using Relaxation = sph::PoissonSettings::Relaxation;
-    const char* relaxation = g.samplingRelaxation == Relaxation::Packing ? "packing" : "sb12";
-    g.samplingRelaxation =
-        s.choice("sampling_relaxation", relaxation, {"sb12", "packing"}) == "packing"
-            ? Relaxation::Packing
-            : Relaxation::Sb12;
     g.killBox = scene.killBox;
     s.finish();
-    g.validate();
+    validateSceneSettings(scene.file, g);
     return g;
+}
+
+std::vector<std::string> settingsFreeOnResume()
+{
+    std::vector<std::string> pointers;
+    addFreeOnResume(ghost::liquidSettingTable(), "/settings", pointers);
+    addFreeOnResume(ghost::dfsphSettingTable(), "/settings/dfsph", pointers);
+    addFreeOnResume(gas::gasSettingTable(), "/settings/gas", pointers);
+    addFreeOnResume(gas::phaseSettingTable(), "/phase_transition", pointers);
+    return pointers;
+}
+
+std::string checkpointFingerprint(const vdbio::Scene& scene)
+{
+    return scene.simulationFingerprint(settingsFreeOnResume());
 }
 
 namespace {

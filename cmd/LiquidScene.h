@@ -17,6 +17,14 @@ namespace cmd {
 /// already read), then check that no key of `settings` is left unread. Errors name the scene key.
 ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method method);
 
+/// The JSON pointers of the scene keys a resumed run may change ("/settings/max_speed"): the
+/// rows of the liquid, DFSPH, gas and phase-transition tables that a checkpoint need not match.
+std::vector<std::string> settingsFreeOnResume();
+
+/// What a checkpoint of `scene` carries and a resume compares: the scene's simulation
+/// fingerprint without the keys of settingsFreeOnResume().
+std::string checkpointFingerprint(const vdbio::Scene& scene);
+
 /// A liquid solver set up for `scene`: solids (static, moving or keyed), liquid bodies,
 /// emitters. With `restored`, the solver continues from that state: liquid bodies are not
 /// sampled again and solids take over their restored ghosts.

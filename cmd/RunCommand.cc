@@ -210,7 +210,7 @@ private:
         mLast = mScene.lastFrame;
         if (!mOptions.frames.empty()) parseFrames(mOptions.frames, mFirst, mLast);
         mFolder = mOptions.out.empty() ? mScene.outputs.directory : mOptions.out;
-        mFingerprint = mScene.simulationFingerprint();
+        mFingerprint = checkpointFingerprint(mScene);
     }
 
     /// The solvers the scene needs, fresh or from a checkpoint.

@@ -180,7 +180,7 @@ public:
     static PySimulation resume(const PyScene& scene, const std::string& path)
     {
         const std::vector<sph::SolverState> states =
-            vdbio::readCheckpointStates(path, scene.scene->simulationFingerprint());
+            vdbio::readCheckpointStates(path, cmd::checkpointFingerprint(*scene.scene));
         return PySimulation(scene.scene, cmd::makeSimulation(*scene.scene, &states));
     }
 
@@ -262,7 +262,7 @@ public:
     /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames.
     void saveCheckpoint(const std::string& path) const
     {
-        vdbio::writeCheckpoint(path, mSim->saveStates(), mScene->simulationFingerprint(),
+        vdbio::writeCheckpoint(path, mSim->saveStates(), cmd::checkpointFingerprint(*mScene),
                                mSim->frame());
     }
 

@@ -50,47 +50,6 @@ bool isSolidKind(ParticleKind k)
 
 // Settings ----------------------------------------------------------------------------------------
 
-void PhaseSettings::validate() const
-{
-    auto positive = [](const char* name, Real v) {
-        if (!(v > Real(0)) || !std::isfinite(v)) {
-            throw ValueError(
-                msg("phase settings: ", name, " = ", v, ": expected a finite value > 0"));
-        }
-    };
-    auto nonNegative = [](const char* name, Real v) {
-        if (!(v >= Real(0)) || !std::isfinite(v)) {
-            throw ValueError(
-                msg("phase settings: ", name, " = ", v, ": expected a finite value >= 0"));
-        }
-    };
-    positive("boilingPoint", boilingPoint);
-    positive("initialTemperature", initialTemperature);
-    nonNegative("latentHeat", latentHeat);
-    nonNegative("heaterBand", heaterBand);
-    positive("heatingTime", heatingTime);
-    nonNegative("conductivity", conductivity);
-    positive("diffusionEpsilon", diffusionEpsilon);
-    nonNegative("evaporationRate", evaporationRate);
-    positive("evaporationOnset", evaporationOnset);
-    if (!(evaporationOnset < boilingPoint)) {
-        throw ValueError(msg("phase settings: evaporationOnset = ", evaporationOnset,
-                             " K: expected below boilingPoint = ", boilingPoint, " K"));
-    }
-    positive("surfaceThreshold", surfaceThreshold);
-    positive("liquidResplitEpsilon", liquidResplitEpsilon);
-    if (mergeEverySteps < 1) {
-        throw ValueError(
-            msg("phase settings: mergeEverySteps = ", mergeEverySteps, ": expected >= 1"));
-    }
-    if (evaporationPattern && !evaporationPattern->hasCentre) {
-        throw ValueError(msg("phase settings: evaporationPattern '", evaporationPattern->name,
-                             "' has no centre daughter: evaporation keeps the centre as liquid "
-                             "([RYY15] Sec. 4.2)"));
-    }
-    merge.validate();
-}
-
 // Set-up ------------------------------------------------------------------------------------------
 
 PhaseTransition::PhaseTransition(GasSolver& gas, LiquidSide& liquid, const PhaseSettings& settings)

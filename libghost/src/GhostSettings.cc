@@ -1,10 +1,11 @@
 /// @file   GhostSettings.cc
-/// @brief  Method names and validation of the liquid solver settings.
+/// @brief  Method names, the settings tables and validation of the liquid solver settings.
 #include "ghostfx/ghost/GhostSettings.h"
 
 #include <ghostfx/sph/EnumNames.h>
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/SettingCheck.h>
+#include <ghostfx/sph/SettingSpec.h>
 
 #include <algorithm>
 #include <cmath>
@@ -94,65 +95,147 @@ Real GhostSettings::speedLimit() const
     return maxSpeed > Real(0) ? maxSpeed : Real(20) * soundSpeed();
 }
 
+namespace {
+
+using LiquidRow = sph::SettingSpec<GhostSettings>;
+using DfsphRow = sph::SettingSpec<DfsphSettings>;
+using G = GhostSettings;
+using D = DfsphSettings;
+
+const sph::EnumName<SolidSlip> SOLID_SLIP_NAMES[] = {{SolidSlip::Free, "free"},
+                                                     {SolidSlip::NoSlip, "no_slip"}};
+using Relaxation = sph::PoissonSettings::Relaxation;
+const sph::EnumName<Relaxation> RELAXATION_NAMES[] = {{Relaxation::Sb12, "sb12"},
+                                                      {Relaxation::Packing, "packing"}};
+
+/// The rows of the liquid's own keys (discretisation, liquid, ghosts, Basic SPH, sampling).
+std::vector<LiquidRow> liquidRows()
+{
+    return {
+        LiquidRow::number(nullptr, "spacing", &G::spacing, sph::positive(), "m",
+                          "particle spacing h (settings.spacing of the scene)"),
+        LiquidRow::number(nullptr, "frameRate", &G::frameRate, sph::positive(), "frames/s",
+                          "frames per second (settings.frame_rate of the scene)"),
+        LiquidRow::choice<&G::pressure>("pressure", "pressure", sph::choicesOf(PRESSURE_NAMES),
+                                        "liquid pressure model of method ghost"),
+        LiquidRow::number("stiffness", "stiffness", &G::stiffness, sph::positive(), "Pa",
+                          "Tait k: p = k ((rho / rho0)^7 - 1) ([SB12]: 2000)"),
+        LiquidRow::number("rest_density", "restDensity", &G::restDensity, sph::positive(), "kg/m^3",
+                          "rest density rho0"),
+        LiquidRow::vector("gravity", "gravity", &G::gravity, "m/s^2", "gravity"),
+        LiquidRow::number("kernel_support", "supportFactor", &G::supportFactor,
+                          sph::between(1.5, 5), "h", "kernel support radius / h ([SB12]: 3)"),
+        LiquidRow::number("xsph_epsilon", "xsphEpsilon", &G::xsphEpsilon, sph::between(0, 1), "",
+                          "XSPH epsilon of [SB12] Eq. 2 among liquid particles"),
+        LiquidRow::number("solid_epsilon", "solidEpsilon", &G::solidEpsilon, sph::between(0, 1), "",
+                          "XSPH epsilon towards ghost solids, per reference step"),
+        LiquidRow::number("initial_relaxation", "initialRelaxation", &G::initialRelaxation,
+                          sph::between(0, 1000), "passes",
+                          "relaxation passes towards rest density before the first step")
+            .automaticWhenNegative(),
+        LiquidRow::number("shifting", "shiftingCoefficient", &G::shiftingCoefficient,
+                          sph::between(0, 20), "", "particle shifting coefficient A; 0 = off")
+            .automaticWhenNegative(),
+        LiquidRow::choice<&G::solidSlip>("solid_slip", "solidSlip",
+                                         sph::choicesOf(SOLID_SLIP_NAMES),
+                                         "boundary condition at solids ([SB12] Sec. 4.4)"),
+        LiquidRow::number("air_resample_steps", "airResampleSteps", &G::airResampleSteps,
+                          sph::between(1, 1000), "steps",
+                          "ghost air resampling interval ([SB12]: about 10)"),
+        LiquidRow::number("air_keep_fraction", "airKeepFraction", &G::airKeepFraction,
+                          sph::between(0, 10), "r",
+                          "air closer than this to the liquid is replaced at a resampling"),
+        LiquidRow::number("basic_xsph_epsilon", "basicXsphEpsilon", &G::basicXsphEpsilon,
+                          sph::between(0, 1), "", "Basic SPH: XSPH on positions ([SB12]: 0.5)"),
+        LiquidRow::number("basic_viscosity_alpha", "basicViscosityAlpha", &G::basicViscosityAlpha,
+                          sph::nonNegative(), "", "Basic SPH: Becker-Teschner viscosity alpha"),
+        LiquidRow::number("lennard_jones_strength", "lennardJonesStrength",
+                          &G::lennardJonesStrength, sph::nonNegative(), "m^2/s^2",
+                          "Basic SPH: wall strength D; 0 = 5 |g| H"),
+        LiquidRow::choice<&G::samplingRelaxation>("sampling_relaxation", "samplingRelaxation",
+                                                  sph::choicesOf(RELAXATION_NAMES),
+                                                  "volume relaxation of sampled bodies"),
+        LiquidRow::flag("tiled_sampling", "tiledSampling", &G::tiledSampling,
+                        "sample deep interiors from a relaxed periodic tile"),
+    };
+}
+
+} // namespace
+
+const sph::SettingTable<GhostSettings>& liquidSettingTable()
+{
+    static const sph::SettingTable<GhostSettings> table =
+        sph::withStepRows("liquid setting", liquidRows());
+    return table;
+}
+
+namespace {
+
+/// The rows of settings.dfsph.
+std::vector<DfsphRow> dfsphRows()
+{
+    constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
+    return {
+        DfsphRow::number("density_error", "dfsph.densityError", &D::densityError,
+                         sph::between(1e-7, 0.1), "",
+                         "mean density error the constant-density solve stops at"),
+        DfsphRow::number("divergence_error", "dfsph.divergenceError", &D::divergenceError,
+                         sph::between(1e-7, 1), "",
+                         "mean density change per step the divergence solve stops at"),
+        DfsphRow::number("density_relaxation", "dfsph.densityRelaxation", &D::densityRelaxation,
+                         sph::between(1e-6, 1), "",
+                         "share of the density error removed per step at CFL 0.4"),
+        DfsphRow::choice<&D::airDensity>(
+            "air_density", "dfsph.airDensity",
+            {{"full", int(D::AirDensity::Full)}, {"fill", int(D::AirDensity::Fill)}},
+            "how much of the ghost air a density counts"),
+        DfsphRow::choice<&D::airResampling>(
+            "air_resampling", "dfsph.airResampling",
+            {{"step", int(D::AirResampling::Step)}, {"time", int(D::AirResampling::Time)}},
+            "how often the ghost air is resampled"),
+        DfsphRow::number("max_iterations", "dfsph.maxIterations", &D::maxIterations,
+                         sph::between(1, 100000), "", "iteration cap of each solve"),
+        DfsphRow::number("min_dt", "dfsph.minTimeStep", &D::minTimeStep, sph::between(1e-9, 1), "s",
+                         "shortest CFL step"),
+        DfsphRow::number("max_dt", "dfsph.maxTimeStep", &D::maxTimeStep, sph::between(1e-9, 1), "s",
+                         "longest CFL step, at least min_dt"),
+        DfsphRow::flag("warm_start", "dfsph.warmStart", &D::warmStart,
+                       "start each solve from the last step's pressure"),
+        DfsphRow::flag("divergence_warm_start", "dfsph.divergenceWarmStart",
+                       &D::divergenceWarmStart,
+                       "with warm_start: the divergence solve from its last pressure too"),
+        DfsphRow::flag("keep_gradients", "dfsph.keepGradients", &D::keepGradients,
+                       "keep the pairs' kernel gradients for the step's passes")
+            .freeOnResume(),
+        DfsphRow::number("kept_gradients_gb", "dfsph.keptGradientLimit", &D::keptGradientLimit,
+                         sph::between(0, 1e6), "GiB",
+                         "most memory the kept gradients may take; 0 = never keep")
+            .scaled(GiB)
+            .freeOnResume(),
+    };
+}
+
+} // namespace
+
+const sph::SettingTable<DfsphSettings>& dfsphSettingTable()
+{
+    static const sph::SettingTable<DfsphSettings> table{"liquid setting", dfsphRows()};
+    return table;
+}
+
 void GhostSettings::validate() const
 {
-    const sph::SettingCheck check("liquid setting");
-    check.require(spacing > 0 && check.finite(spacing), "spacing", spacing,
-                  "a finite value > 0 (m)");
-    check.require(supportFactor >= Real(1.5) && supportFactor <= Real(6), "supportFactor",
-                  supportFactor, "1.5 to 6 particle spacings ([SB12]: 3)");
-    check.require(restDensity > 0 && check.finite(restDensity), "restDensity", restDensity,
-                  "> 0 (kg/m^3)");
-    check.require(stiffness > 0 && check.finite(stiffness), "stiffness", stiffness, "> 0 (Pa)");
-    check.require(sph::isFinite(gravity), "gravity", gravity.length(), "finite components (m/s^2)");
-    check.require(xsphEpsilon >= 0 && xsphEpsilon <= 1, "xsphEpsilon", xsphEpsilon,
-                  "0 to 1 ([SB12]: 0.05)");
-    check.require(solidEpsilon >= 0 && solidEpsilon <= 1, "solidEpsilon", solidEpsilon, "0 to 1");
-    check.require(shiftingCoefficient <= 20 && check.finite(shiftingCoefficient),
-                  "shiftingCoefficient", shiftingCoefficient,
-                  "0 (off) to 20, or negative (automatic)");
-    check.require(initialRelaxation <= 1000, "initialRelaxation", initialRelaxation,
-                  "0 (off) to 1000 passes, or negative (automatic)");
-    check.require(airResampleSteps >= 1, "airResampleSteps", airResampleSteps,
-                  ">= 1 ([SB12]: about 10)");
-    check.require(airKeepFraction >= 0 && check.finite(airKeepFraction), "airKeepFraction",
-                  airKeepFraction, ">= 0 (fraction of the Poisson radius)");
-    check.require(basicXsphEpsilon >= 0 && basicXsphEpsilon <= 1, "basicXsphEpsilon",
-                  basicXsphEpsilon, "0 to 1 ([SB12]: 0.5)");
-    check.require(basicViscosityAlpha >= 0 && check.finite(basicViscosityAlpha),
-                  "basicViscosityAlpha", basicViscosityAlpha, ">= 0 ([SB12]: 0.0005)");
-    check.require(lennardJonesStrength >= 0 && check.finite(lennardJonesStrength),
-                  "lennardJonesStrength", lennardJonesStrength, ">= 0 (m^2/s^2; 0 = automatic)");
-    check.require(frameRate > 0 && check.finite(frameRate), "frameRate", frameRate,
-                  "> 0 (frames/s)");
-    check.require(substeps >= 0 && substeps <= 100000, "substeps", substeps,
-                  "0 (CFL-adaptive) to 100000");
-    check.require(cflNumber > 0 && cflNumber <= 2, "cflNumber", cflNumber, "0 < cfl <= 2");
-    if (pressure == PressureModel::Dfsph) {
-        if (method != Method::Ghost) {
-            throw ValueError("liquid setting pressure = 'dfsph' with method 'basic': "
-                             "expected 'tait' (Basic SPH is [SB12]'s weakly compressible "
-                             "baseline, with no air for a pressure solve's free surface)");
-        }
-        check.require(dfsph.densityError >= Real(1e-7) && dfsph.densityError <= Real(0.1),
-                      "dfsph.densityError", dfsph.densityError, "1e-7 to 0.1 (a fraction)");
-        check.require(dfsph.divergenceError >= Real(1e-7) && dfsph.divergenceError <= Real(1),
-                      "dfsph.divergenceError", dfsph.divergenceError, "1e-7 to 1 (a fraction)");
-        check.require(dfsph.densityRelaxation > 0 && dfsph.densityRelaxation <= 1,
-                      "dfsph.densityRelaxation", dfsph.densityRelaxation, "in (0, 1]");
-        check.require(dfsph.keptGradientLimit >= 0 && check.finite(dfsph.keptGradientLimit),
-                      "dfsph.keptGradientLimit", dfsph.keptGradientLimit,
-                      "a finite value >= 0 (bytes)");
-        check.require(dfsph.maxIterations >= 1 && dfsph.maxIterations <= 100000,
-                      "dfsph.maxIterations", dfsph.maxIterations, "1 to 100000");
-        check.require(dfsph.minTimeStep > 0 && check.finite(dfsph.minTimeStep), "dfsph.minTimeStep",
-                      dfsph.minTimeStep, "a finite value > 0 (s)");
-        check.require(dfsph.maxTimeStep >= dfsph.minTimeStep && check.finite(dfsph.maxTimeStep),
-                      "dfsph.maxTimeStep", dfsph.maxTimeStep,
-                      "finite and >= dfsph.minTimeStep (s)");
+    sph::validateTable(liquidSettingTable(), *this);
+    if (pressure != PressureModel::Dfsph) return;
+    if (method != Method::Ghost) {
+        throw ValueError("liquid setting pressure = 'dfsph' with method 'basic': "
+                         "expected 'tait' (Basic SPH is [SB12]'s weakly compressible "
+                         "baseline, with no air for a pressure solve's free surface)");
     }
-    check.require(maxSpeed >= 0 && check.finite(maxSpeed), "maxSpeed", maxSpeed,
-                  ">= 0 (m/s; 0 = 20 x sound speed)");
+    sph::validateTable(dfsphSettingTable(), dfsph);
+    const sph::SettingCheck check("liquid setting");
+    check.require(dfsph.maxTimeStep >= dfsph.minTimeStep, "dfsph.maxTimeStep", dfsph.maxTimeStep,
+                  msg("at least dfsph.minTimeStep (", dfsph.minTimeStep, " s)").c_str());
 }
 
 } // namespace ghost

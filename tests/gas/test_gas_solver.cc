@@ -576,7 +576,7 @@ TEST(GasSettingsTest, ValidationNamesTheSettingValueAndRange)
     } catch (const ValueError& e) {
         EXPECT_NE(std::string(e.what()).find("gas setting delta = 0.3"), std::string::npos)
             << e.what();
-        EXPECT_NE(std::string(e.what()).find("0.4 to 0.7"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("a number in [0.4, 0.7]"), std::string::npos) << e.what();
     }
     s = GasSettings();
     s.method = Method::Ambient; // no domain

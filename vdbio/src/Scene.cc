@@ -498,12 +498,17 @@ void readInterval(const JsonObject& o, double& start, double& end)
 
 } // namespace
 
-std::string Scene::simulationFingerprint() const
+std::string Scene::simulationFingerprint(const std::vector<std::string>& freeOnResume) const
 {
     Json copy = *document;
     copy.erase("outputs");
     if (copy.contains("settings") && copy["settings"].is_object())
         copy["settings"].erase("frame_range");
+    for (const std::string& pointer : freeOnResume) {
+        const Json::json_pointer key(pointer);
+        if (copy.contains(key) && copy[key.parent_pointer()].is_object())
+            copy[key.parent_pointer()].erase(key.back());
+    }
     return copy.dump();
 }
 

@@ -1,8 +1,9 @@
 /// @file   GasSettings.h
 /// @brief  Settings of the gas solver: fast SPH gas without ambient air [RYY15] and its baselines.
-/// @details Plain struct with documented defaults; `validate()` throws a one-line ValueError naming
-///          the field, the bad value and the range expected (STYLE.md rule 3). The solver copies its
-///          settings at construction. Where [RYY15] gives a value the default cites it; where the
+/// @details Plain struct with documented defaults. Each scene key's range, unit and meaning is
+///          declared once, in gasSettingTable() (GasSettings.cc): the scene reader, `validate()` (a
+///          one-line ValueError naming the field, the bad value and the range expected) and
+///          docs/scene-format.md follow it. The solver copies its settings at construction. Where [RYY15] gives a value the default cites it; where the
 ///          paper is silent the comment says how the default was chosen.
 ///
 ///          Symbols (paper -> field): kappa (Eq. 11) -> `kappa`, rho0 -> `restDensity`, delta
@@ -12,6 +13,7 @@
 ///          -> `buoyancy`, beta of Eq. 25 -> `vorticityGeneration`, l_s (Sec. 5) -> `lifeStrength`.
 #pragma once
 
+#include <ghostfx/sph/SettingSpec.h>
 #include <ghostfx/sph/Types.h>
 
 #include <cstdint>
@@ -188,8 +190,13 @@ struct GasSettings
     /// Blow-up speed bound (m/s) for a step of length dt (s).
     Real speedLimit(Real dt) const;
 
+    /// Throws ValueError for a field outside its declared range, a zero buoyancy direction, a bad
+    /// attractor, or method ambient without a domain at least two kernel radii wide.
     void validate() const;
 };
+
+/// The settings of scene object `settings.gas` (a gas scene's `settings`) GasSettings holds.
+const sph::SettingTable<GasSettings>& gasSettingTable();
 
 } // namespace gas
 } // namespace ghostfx

@@ -2,7 +2,7 @@
 /// @brief  Liquid-gas phase transition of [RYY15] Sec. 4: heating, boiling and evaporation by
 ///         particle splitting, merging of over-split liquid, and the liquid as a gas boundary.
 /// @details A driver that advances a liquid solver (seen through the narrow `LiquidSide`
-///          interface, so libgas never includes libghost, DESIGN.md) and a GasSolver in lockstep.
+///          interface, so libgas never includes libghost, docs/architecture.md) and a GasSolver in lockstep.
 ///          One step(dt):
 ///           1. the liquid advances (LiquidSide::step);
 ///           2. heat: liquid particles within `heaterBand` of a heater level set relax towards
@@ -99,36 +99,29 @@ public:
     virtual void particlesChanged() {}
 };
 
-/// Settings of the phase transition (plain struct, STYLE.md rule 3).
+/// Settings of the phase transition (plain struct; each scene key of `phase_transition` is
+/// declared once in phaseSettingTable(), GasSettings.cc).
 struct PhaseSettings
 {
-    // Temperatures ------------------------------------------------------------------------------
-    /// Boiling point T_b (K). Water at 1 atm.
-    Real boilingPoint = Real(373.15);
-    /// Temperature of liquid particles that had none (K), when the channel is created.
-    Real initialTemperature = Real(293.15);
-    /// L / c_p (K): heat, in kelvin of the liquid's own heat capacity, a particle at T_b must
-    /// absorb before it boils. Water: 2.26e6 / 4186 = 540 K. 0 boils at once at T_b.
+    // Temperatures (K) and heat transfer --------------------------------------------------------
+    Real boilingPoint = Real(373.15);       ///< T_b: water at 1 atm
+    Real initialTemperature = Real(293.15); ///< of liquid particles that had none
+    /// L / c_p: the heat, in kelvin of the liquid's own heat capacity, that a particle at T_b
+    /// absorbs before it boils (water: 2.26e6 / 4186 = 540 K); 0 boils at once at T_b.
     Real latentHeat = Real(540);
-
-    // Heat transfer -----------------------------------------------------------------------------
-    /// Liquid within this distance (m) of a heater's surface, or inside it, is heated.
-    Real heaterBand = Real(0.02);
-    /// Relaxation time (s) of heated particles towards the heater temperature (> 0).
-    Real heatingTime = Real(0.5);
+    Real heaterBand = Real(0.02); ///< liquid this close (m) to a heater, or inside it, is heated
+    Real heatingTime = Real(0.5); ///< relaxation time (s) towards the heater temperature
     /// D_c of [RYY15] Eq. 15 among liquid particles (kg/(m s)); D_c / (2 rho0) is the thermal
     /// diffusivity. The default 0.2 gives 1e-4 m^2/s, an effective (convective) diffusivity:
     /// still water's 1.4e-7 m^2/s would not move heat a particle spacing in a minute.
     Real conductivity = Real(0.2);
-    /// gamma^2 of Eq. 15 as a fraction of the squared support radius.
-    Real diffusionEpsilon = Real(0.01);
+    Real diffusionEpsilon = Real(0.01); ///< gamma^2 of Eq. 15 / the squared support radius
 
     // Evaporation -------------------------------------------------------------------------------
     /// Evaporation splits per second of a surface particle at T_b (1/s, >= 0). Each split turns
     /// (1 - lambda_centre) of the particle's mass into vapour (0.008 with the paper's ratios).
     Real evaporationRate = Real(0.5);
-    /// Temperature (K) below which nothing evaporates; f(T) is linear from here to T_b.
-    Real evaporationOnset = Real(273.15);
+    Real evaporationOnset = Real(273.15); ///< (K) no evaporation below; f(T) linear up to T_b
     /// A liquid particle is at the free surface when its colour-field gradient over liquid and
     /// solid neighbours, |sum_j V_j gradW_ij| R (dimensionless, R the liquid support radius,
     /// V_j = m_j / rho_j), exceeds this. Measured in a settled Ghost SPH pan: interior
@@ -158,9 +151,13 @@ struct PhaseSettings
     /// Most liquid particles turned (boiled or evaporated) per step; 0 = no limit.
     std::size_t maxTransitionsPerStep = 0;
 
-    /// Throws ValueError naming the field and the bad value.
+    /// Throws ValueError naming the field, the bad value and the range expected; also for
+    /// evaporationOnset not below boilingPoint and an evaporation pattern without a centre.
     void validate() const;
 };
+
+/// The settings of scene object `phase_transition` that PhaseSettings holds.
+const sph::SettingTable<PhaseSettings>& phaseSettingTable();
 
 /// Wall-clock seconds per phase of PhaseTransition::step, accumulated since the last reset.
 struct PhaseTransitionTimings

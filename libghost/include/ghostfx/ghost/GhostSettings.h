@@ -1,10 +1,14 @@
 /// @file   GhostSettings.h
 /// @brief  Settings of the liquid solver: Ghost SPH [SB12] or the "Basic SPH" baseline (Sec. 3).
-/// @details Plain struct with the paper's defaults; `validate()` throws ValueError naming the field
-///          and the bad value (STYLE.md rule 3). The solver copies its settings at construction.
+/// @details Plain struct with the paper's defaults. Each scene key's range, unit and meaning is
+///          declared once, in liquidSettingTable() and dfsphSettingTable() (GhostSettings.cc):
+///          the scene reader, `validate()` (a ValueError naming the field, the bad value and the
+///          range) and docs/scene-format.md's tables follow them. The solver copies its
+///          settings at construction.
 #pragma once
 
 #include <ghostfx/sph/PoissonSampler.h>
+#include <ghostfx/sph/SettingSpec.h>
 #include <ghostfx/sph/Types.h>
 
 #include <cstdint>
@@ -54,7 +58,7 @@ struct DfsphSettings
     /// full). 1 is [BK15]'s solve; at 0.2 the few-percent errors of emitted particles become
     /// velocity kicks (a tap poured 29 % more at CFL 0.4 than at 0.1, its fastest particle at
     /// 4.1 m/s), and larger shares grow without bound (bench/history/diary-2026-11.md, "DFSPH").
-    /// 0.1 since the mirrored walls: at 0.05 a still tank's settled density error stayed at
+    /// 0.1 with the mirrored walls: at 0.05 a still tank's settled density error stays at
     /// 0.5-0.7 % (a solve that stops at its limit leaves up to limit / beta;
     /// bench/history/diary-2026-11.md, "DFSPH: ghost solids as mirror images").
     /// This share is per step of the length that CFL number RELAXATION_CFL (the default, 0.4)
@@ -71,8 +75,8 @@ struct DfsphSettings
     /// the 98k dam break (bench/history/diary-2026-11.md, "DFSPH: a peak limit"): 10 and 20 also
     /// hold the landing but cost 45 % and 17 % more per step; 30 costs nothing measurable.
     static constexpr double PEAK_FACTOR = 30;
-    /// How a ghost solid's pressure enters the solves (GhostDfsph.cc, file comment). Chosen by
-    /// name in scenes (settings.dfsph.wall_pressure).
+    /// How a ghost solid's pressure enters the solves (GhostDfsph.cc, file comment). Scenes
+    /// always use Mirror; Own is for library code that compares with SPlisHSPlasH's term.
     enum class WallPressure : std::uint8_t {
         /// The liquid particle's mirror image: its pressure term, extrapolated down the
         /// hydrostatic gradient, and its reflected velocity (Adami et al. 2012's wall pressure
@@ -162,7 +166,8 @@ enum class SolidSlip {
 };
 
 /// How the ghost air's weights (its mass over a liquid particle's) are set at a resampling
-/// (GhostAir.cc, step 6). Chosen by name in scenes (settings.air_weights).
+/// (GhostAir.cc, step 6). Scenes always use Complete; Matched is for library code that
+/// compares with the weights nearest [SB12]'s.
 enum class AirWeights {
     /// min(1, n0 / sigma_a): an air particle weighs less where the air around it is packed
     /// closer than the liquid ([SB12]'s weight 1 elsewhere), the weights nearest the paper's:
@@ -241,7 +246,7 @@ struct GhostSettings
     /// packing up to about 1 % off the layer near the surface. Off: [SB12]'s pipeline throughout.
     bool tiledSampling = false;
     /// Volume relaxation of sampled liquid bodies, emitters and solids
-    /// (PoissonSettings::volumeRelaxation): SPH packing (default since 2026-11-28), about a
+    /// (PoissonSettings::volumeRelaxation): SPH packing (the default), about a
     /// third of the sampling time of [SB12]'s Algorithm 2 with half its interior density noise,
     /// or Algorithm 2 itself (Relaxation::Sb12, the paper's pipeline;
     /// bench/history/diary-2026-11.md, "Sampler: SPH packing" and "Tests that hold over sample
@@ -279,8 +284,15 @@ struct GhostSettings
     /// proportional to dt, at most 1.
     Real solidEpsilonForStep(Real dt, Real vmax) const;
 
+    /// Throws ValueError for a field outside its declared range, and for the pairs of fields
+    /// that do not go together (DFSPH with method basic; dfsph.maxTimeStep < minTimeStep).
     void validate() const;
 };
+
+/// The settings of scene object `settings` that GhostSettings holds, one row each.
+const sph::SettingTable<GhostSettings>& liquidSettingTable();
+/// The settings of scene object `settings.dfsph`.
+const sph::SettingTable<DfsphSettings>& dfsphSettingTable();
 
 } // namespace ghost
 } // namespace ghostfx

@@ -209,9 +209,10 @@ struct Scene
     JsonObject phaseTransition;
     SceneOutputs outputs;
 
-    /// Canonical JSON text of everything that changes the simulation (all but `outputs` and
-    /// the frame range): stored in checkpoints, compared on resume.
-    std::string simulationFingerprint() const;
+    /// Canonical JSON text of everything that changes the simulation (all but `outputs`, the
+    /// frame range and the keys at the JSON pointers `freeOnResume`, "/settings/max_speed"):
+    /// stored in checkpoints, compared on resume.
+    std::string simulationFingerprint(const std::vector<std::string>& freeOnResume = {}) const;
 };
 
 /// Read a scene: a .json scene file, or a .vdb whose level-set grids carry a ROLE_METADATA
