@@ -829,9 +829,10 @@ void GhostSolver::checkStateFits(const SolverState& state) const
     const bool savedComplete = state.integer("air_weights_complete", 0, 1) != 0;
     if (savedComplete != (mSettings.airWeights == AirWeights::Complete)) {
         const char* saved = savedComplete ? "complete" : "matched";
-        throw ValueError(msg("restoreState: the state was saved with settings.air_weights = '",
-                             saved, "', this run has '", savedComplete ? "matched" : "complete",
-                             "'; resume with -D settings.air_weights=", saved));
+        throw ValueError(msg("restoreState: the state was saved with ", saved,
+                             " air weights (GhostSettings::airWeights), this solver has ",
+                             savedComplete ? "matched" : "complete",
+                             "; resume with the weights the run started with"));
     }
 }
 

@@ -623,11 +623,11 @@ TEST(Dfsph, ResumeIsBitIdenticalAndATaitStateIsRefused)
     GhostSettings tait = scene.settings;
     tait.pressure = PressureModel::Tait;
     expectRestoreRefused(saved, tait, "settings.pressure = 'dfsph'", "'tait'");
-    // So is one saved with the other air weights (the default changed on 2026-11-25; states
-    // from before say nothing and were saved with matched weights).
+    // So is one saved with the other air weights, and one that does not say which.
     GhostSettings matched = scene.settings;
     matched.airWeights = AirWeights::Matched;
-    expectRestoreRefused(saved, matched, "settings.air_weights = 'complete'", "'matched'");
+    expectRestoreRefused(saved, matched, "saved with complete air weights",
+                         "this solver has matched");
     SolverState old = saved;
     old.integers.erase("air_weights_complete");
     GhostSolver fromOld(scene.settings);

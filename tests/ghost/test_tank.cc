@@ -138,7 +138,7 @@ TEST(HydrostaticTank, PressureGrowsAsRhoGDepthAndNoParticleEntersTheWalls)
     expectHydrostaticTank(GhostSettings().airWeights);
 }
 
-// settings.air_weights "matched" must keep the tank too.
+// Matched air weights (GhostSettings::airWeights) must keep the tank too.
 // Measured: slope -0.08 %, 0.061 m/s (float); +0.84 %, 0.083 m/s (double).
 TEST(HydrostaticTank, MatchedAirWeightsHoldTheTankToo)
 {

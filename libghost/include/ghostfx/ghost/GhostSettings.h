@@ -75,7 +75,7 @@ struct DfsphSettings
     /// the 98k dam break (bench/history/diary-2026-11.md, "DFSPH: a peak limit"): 10 and 20 also
     /// hold the landing but cost 45 % and 17 % more per step; 30 costs nothing measurable.
     static constexpr double PEAK_FACTOR = 30;
-    /// How a ghost solid's pressure enters the solves (GhostDfsph.cc, file comment). Scenes
+    /// How a ghost solid's pressure enters the solves (DfsphPressure.cc, file comment). Scenes
     /// always use Mirror; Own is for library code that compares with SPlisHSPlasH's term.
     enum class WallPressure : std::uint8_t {
         /// The liquid particle's mirror image: its pressure term, extrapolated down the
