@@ -19,17 +19,19 @@ namespace ghost {
 using namespace sph;
 using namespace detail;
 
-void BasicPressure::accelerate(LiquidStep& step, Real dt)
+BasicPressure::Channels::Channels(ParticleSet& set)
+    : n(set.size())
+    , x(set.positions())
+    , m(set.masses())
+    , rho(set.densities())
+    , p(set.pressures())
+    , kind(set.kinds())
+    , v(set.velocities())
+    , vnew(set.vectorChannel(VSTAR))
+{}
+
+void BasicPressure::accelerate(LiquidStep& step, Real dt, const Channels& ch)
 {
-    ParticleSet& set = step.particles();
-    const std::size_t n = set.size();
-    const auto& x = set.positions();
-    const auto& m = set.masses();
-    const auto& rho = set.densities();
-    const auto& p = set.pressures();
-    const auto& kind = set.kinds();
-    const auto& v = set.velocities();
-    auto& vnew = set.vectorChannel(VSTAR);
     const GhostSettings& settings = step.settings();
     const NeighborLists& lists = step.lists();
     const CubicSplineKernel& kernel = step.kernel();
@@ -45,32 +47,32 @@ void BasicPressure::accelerate(LiquidStep& step, Real dt)
     const Real r0 = Real(0.5) * settings.spacing;
     const Real D = step.lennardJones();
 
-    std::vector<Real> accel(n, Real(0));
+    std::vector<Real> accel(ch.n, Real(0));
     parallel::forEach(
-        0, n,
+        0, ch.n,
         [&](std::size_t i) {
-        if (kind[i] != ParticleKind::Liquid) {
-            vnew[i] = v[i];
+        if (ch.kind[i] != ParticleKind::Liquid) {
+            ch.vnew[i] = ch.v[i];
             return;
         }
-        const Real pi = p[i] / sqr(rho[i]);
+        const Real pi = ch.p[i] / sqr(ch.rho[i]);
         Vec3 a = g;
         lists[i].forEach([&](Index j) {
             if (j == i) return;
-            const Vec3 xij = x[i] - x[j];
+            const Vec3 xij = ch.x[i] - ch.x[j];
             const Real r = xij.length();
-            Real term = pi + p[j] / sqr(rho[j]);
-            const Real vx = (v[i] - v[j]).dot(xij);
+            Real term = pi + ch.p[j] / sqr(ch.rho[j]);
+            const Real vx = (ch.v[i] - ch.v[j]).dot(xij);
             if (vx < Real(0)) {
-                const Real nu = Real(2) * alpha * s * c / (rho[i] + rho[j]);
+                const Real nu = Real(2) * alpha * s * c / (ch.rho[i] + ch.rho[j]);
                 term += -nu * vx / (r * r + Real(0.01) * s * s);
             }
-            a -= m[j] * term * kernel.gradW(xij, r);
+            a -= ch.m[j] * term * kernel.gradW(xij, r);
         });
         for (const LiquidStep::Block b : {LiquidStep::STATIC, LiquidStep::MOVING}) {
             const Vec3* y = step.solids(b).positions().data();
             step.solidLists(b)[i].forEach([&](Index k) {
-                const Vec3 xik = x[i] - y[k];
+                const Vec3 xik = ch.x[i] - y[k];
                 const Real r = xik.length();
                 if (!(r < r0) || !(r > Real(0))) return;
                 const Real q = r0 / r;
@@ -78,48 +80,40 @@ void BasicPressure::accelerate(LiquidStep& step, Real dt)
                 a += (D * (q4 * q4 * q4 - q4) / (r * r)) * xik;
             });
         }
-        vnew[i] = v[i] + dt * a;
+        ch.vnew[i] = ch.v[i] + dt * a;
         accel[i] = a.length();
         },
         512);
-    step.setMaxAcceleration(n ? *std::max_element(accel.begin(), accel.end()) : Real(0));
+    step.setMaxAcceleration(ch.n ? *std::max_element(accel.begin(), accel.end()) : Real(0));
 }
 
-void BasicPressure::move(LiquidStep& step, Real dt)
+void BasicPressure::move(LiquidStep& step, Real dt, const Channels& ch)
 {
     // XSPH on positions: x += dt (v + eps sum_j 2 m_j / (rho_i + rho_j) (v_j - v_i) W_ij).
-    ParticleSet& set = step.particles();
-    const std::size_t n = set.size();
-    const auto& x = set.positions();
-    const auto& m = set.masses();
-    const auto& rho = set.densities();
-    const auto& kind = set.kinds();
-    auto& v = set.velocities();
-    const auto& vnew = set.vectorChannel(VSTAR);
     const NeighborLists& lists = step.lists();
     const CubicSplineKernel& kernel = step.kernel();
     const Real eps = step.settings().basicXsphEpsilon;
-    auto& xw = set.positions();
-    std::vector<Vec3> xnew(n);
+    std::vector<Vec3> xnew(ch.n);
     parallel::forEach(
-        0, n,
+        0, ch.n,
         [&](std::size_t i) {
-        xnew[i] = x[i];
-        if (kind[i] != ParticleKind::Liquid) return;
+        xnew[i] = ch.x[i];
+        if (ch.kind[i] != ParticleKind::Liquid) return;
         Vec3 dv(0);
         lists[i].forEach([&](Index j) {
-            if (j == i || kind[j] != ParticleKind::Liquid) return;
-            const Real r = (x[i] - x[j]).length();
-            dv += (Real(2) * m[j] / (rho[i] + rho[j]) * kernel.W(r)) * (vnew[j] - vnew[i]);
+            if (j == i || ch.kind[j] != ParticleKind::Liquid) return;
+            const Real r = (ch.x[i] - ch.x[j]).length();
+            dv += (Real(2) * ch.m[j] / (ch.rho[i] + ch.rho[j]) * kernel.W(r))
+                  * (ch.vnew[j] - ch.vnew[i]);
         });
-        xnew[i] = x[i] + dt * (vnew[i] + eps * dv);
+        xnew[i] = ch.x[i] + dt * (ch.vnew[i] + eps * dv);
         },
         512);
     parallel::forEach(
-        0, n,
+        0, ch.n,
         [&](std::size_t i) {
-        xw[i] = xnew[i];
-        if (kind[i] == ParticleKind::Liquid) v[i] = vnew[i];
+        ch.x[i] = xnew[i];
+        if (ch.kind[i] == ParticleKind::Liquid) ch.v[i] = ch.vnew[i];
         },
         4096);
 }
@@ -131,10 +125,11 @@ void BasicPressure::step(LiquidStep& step, Real dt)
     pass.solids = false;
     step.searchAndDensity(pass);
     auto t0 = std::chrono::steady_clock::now();
-    accelerate(step, dt);
+    const Channels ch(step.particles());
+    accelerate(step, dt, ch);
     step.timings().pressureForce += secondsSince(t0);
     t0 = std::chrono::steady_clock::now();
-    move(step, dt);
+    move(step, dt, ch);
     step.timings().xsphAndBoundary += secondsSince(t0);
 }
 

@@ -4,6 +4,8 @@
 
 #include "TaitPressure.h"
 
+#include <vector>
+
 namespace ghostfx {
 namespace ghost {
 
@@ -16,10 +18,23 @@ public:
     void step(LiquidStep& step, Real dt) override;
 
 private:
+    /// The channels of the liquid (and boundary-free set) the step's passes read and write.
+    struct Channels
+    {
+        explicit Channels(sph::ParticleSet& set);
+        std::size_t n;
+        std::vector<Vec3>& x;
+        const std::vector<Real>& m;
+        const std::vector<Real>& rho;
+        const std::vector<Real>& p;
+        const std::vector<sph::ParticleKind>& kind;
+        std::vector<Vec3>& v;
+        std::vector<Vec3>& vnew; ///< v* (LiquidStep::VELOCITY_STAR)
+    };
     /// v* = v + dt (g + pressure, viscosity and Lennard-Jones forces) of the liquid.
-    void accelerate(LiquidStep& step, Real dt);
+    void accelerate(LiquidStep& step, Real dt, const Channels& ch);
     /// XSPH on the positions, which take v*; the liquid's velocities too.
-    void move(LiquidStep& step, Real dt);
+    void move(LiquidStep& step, Real dt, const Channels& ch);
 };
 
 } // namespace ghost

@@ -527,8 +527,7 @@ TEST(DistributedGhost, MovingAndReshapedSolidsOnSeveralRanksFollowOneRank)
     // two-spacing gap under the moving paddle, where which way it goes is a coin toss: over
     // 12 sample realisations at 2 ranks (the seed salted, both volume relaxations; bench/history/
     // diary-2026-11.md, "Tests that hold over sample realisations") rms 0.04-0.12 h, worst
-    // 0.18-2.47 h (above 1 h only at the floor beside the paddle). Bound for the worst: 3 h (2 h
-    // until 2026-11-28).
+    // 0.18-2.47 h (above 1 h only at the floor beside the paddle). Bound for the worst: 3 h.
     EXPECT_LT(late.rms, 0.3 * h);
     EXPECT_LT(late.worst, 3 * h);
     EXPECT_LT(late.com, 0.1 * h);
