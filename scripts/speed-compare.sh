@@ -5,6 +5,7 @@
 # comes and, at the end, the median of each build and B / A.
 #
 #   scripts/speed-compare.sh BUILD_A BUILD_B [ROUNDS]     (ROUNDS: default 3)
+#   ONLY=dfsph_ms scripts/speed-compare.sh ...              (the cases whose names match)
 #
 # Figures: ms per measured step (bench_liquid's dam break, Tait and DFSPH; bench_plume's fast
 # gas; bench_gas's coupled boiling step) and wall seconds of the column tank's 0.25 s (DFSPH).
@@ -25,6 +26,7 @@ CASES=(
 
 for entry in "${CASES[@]}"; do
     IFS='|' read -r name command reader <<< "$entry"
+    [[ -n "${ONLY:-}" && ! "$name" =~ ${ONLY} ]] && continue
     for round in $(seq "$rounds"); do
         for build in "$a" "$b"; do
             rm -rf "$out/col"
