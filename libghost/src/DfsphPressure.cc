@@ -729,23 +729,8 @@ void DfsphPressure::recordSolves(int densityIterations, int divergenceIterations
     mStats.largestDivergenceError = std::max(mStats.largestDivergenceError, divergencePeak);
 }
 
-void DfsphPressure::step(LiquidStep& step, Real dt)
+void DfsphPressure::solveStep(LiquidStep& step, Real dt)
 {
-    // Line 1 and the density of lines 2-7, as in the Tait step, with step 1's factors found in
-    // the density's pass.
-    const bool shifting = step.settings().shifting() > Real(0);
-    std::vector<Vec3> gradMass(shifting ? step.particles().size() : 0, Vec3(0));
-    mFactors.gradMass = shifting ? &gradMass : nullptr;
-    DensityPass pass;
-    pass.airSpan = airSpan(step, dt);
-    pass.factors = &mFactors;
-    pass.beforeDensity = [&] {
-        computeMovingWallGravity(step, dt);
-        prepareFactors(step);
-    };
-    step.searchAndDensity(pass);
-
-    const auto t0 = std::chrono::steady_clock::now();
     ParticleSet& set = step.particles();
     const std::size_t n = set.size();
     if (step.exchange()) {
@@ -789,6 +774,25 @@ void DfsphPressure::step(LiquidStep& step, Real dt)
     if (step.reportsPressure()) reportPressure(step);
     recordSolves(densityIterations, divergenceIterations, densityError, divergenceError,
                  densityPeak, divergencePeak);
+}
+
+void DfsphPressure::step(LiquidStep& step, Real dt)
+{
+    // Line 1 and the density of lines 2-7, as in the Tait step, with step 1's factors found in
+    // the density's pass.
+    const bool shifting = step.settings().shifting() > Real(0);
+    std::vector<Vec3> gradMass(shifting ? step.particles().size() : 0, Vec3(0));
+    mFactors.gradMass = shifting ? &gradMass : nullptr;
+    DensityPass pass;
+    pass.airSpan = airSpan(step, dt);
+    pass.factors = &mFactors;
+    pass.beforeDensity = [&] {
+        computeMovingWallGravity(step, dt);
+        prepareFactors(step);
+    };
+    step.searchAndDensity(pass);
+    const auto t0 = std::chrono::steady_clock::now();
+    solveStep(step, dt);
     step.timings().pressureForce += secondsSince(t0);
 
     step.finish(dt, gradMass);

@@ -78,6 +78,9 @@ private:
     int solve(LiquidStep& step, Real dt, bool density, std::vector<Real>& total, double& error,
               double& largest);
     void reportPressure(LiquidStep& step);
+    /// After the density pass: the divergence solve, gravity and the density solve on v*,
+    /// the pressure reported when the step asks for it, and the statistics.
+    void solveStep(LiquidStep& step, Real dt);
     void recordSolves(int densityIterations, int divergenceIterations, double densityError,
                       double divergenceError, double densityPeak, double divergencePeak);
 

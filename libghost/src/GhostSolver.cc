@@ -231,6 +231,34 @@ PoissonSettings GhostSolver::bodySampling(std::uint64_t seed) const
     return ps;
 }
 
+namespace {
+
+/// The outward normal (in the solid's frame) of each sample of a solid's band, from its nearest
+/// surface sample within 2 R: phi is clamped beyond the narrow band, which is often thinner
+/// than a kernel radius. Zero where no surface sample is that near.
+std::vector<Vec3> bandNormals(const SampleSet& samples, const LevelSet& solid, Real R)
+{
+    std::vector<Vec3> surface;
+    std::vector<Vec3> surfaceNormal;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        if (samples.onSurface[i]) {
+            surface.push_back(samples.positions[i]);
+            surfaceNormal.push_back(solid.normal(samples.positions[i]));
+        }
+    }
+    NeighborGrid surfaceGrid(R);
+    surfaceGrid.build(surface);
+    std::vector<Vec3> normals(samples.size());
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+        const Index s =
+            surfaceGrid.nearest(samples.positions[k], Real(2) * R, [](Index) { return true; });
+        normals[k] = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
+    }
+    return normals;
+}
+
+} // namespace
+
 void GhostSolver::sampleSolid(std::size_t solidIndex)
 {
     const Solid& body = *mSolids[solidIndex];
@@ -248,28 +276,17 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     ps.bandDepth = mSettings.supportRadius();
     const SampleSet samples = sph::sampleVolumeStored(ps, solid, mSampleStore);
 
-    // Outward normal of each particle from its nearest surface sample: phi is clamped beyond
-    // the narrow band, which is often thinner than a kernel radius.
-    std::vector<Vec3> surface;
-    std::vector<Vec3> surfaceNormal;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-        if (samples.onSurface[i]) {
-            surface.push_back(samples.positions[i]);
-            surfaceNormal.push_back(solid.normal(samples.positions[i]));
-        }
-    }
-    NeighborGrid surfaceGrid(mSettings.supportRadius());
-    surfaceGrid.build(surface);
+    const std::vector<Vec3> localNormals = bandNormals(samples, solid, mSettings.supportRadius());
 
     SolidBlock& target = blockOf(solidIndex);
     ParticleSet& set = target.block.particles();
     auto& normals = set.addVectorChannel(SOLID_NORMAL);
     auto& index = set.addScalarChannel(SOLID_INDEX, Real(-1));
-    std::vector<Vec3>* localNormals = nullptr;
+    std::vector<Vec3>* localNormalChannel = nullptr;
     std::vector<Vec3>* locals = nullptr;
     std::vector<Vec3>* solidV = nullptr;
     if (body.moving) {
-        localNormals = &set.addVectorChannel(SOLID_LOCAL_NORMAL);
+        localNormalChannel = &set.addVectorChannel(SOLID_LOCAL_NORMAL);
         locals = &set.addVectorChannel(SOLID_LOCAL);
         solidV = &set.addVectorChannel(SOLID_VELOCITY);
     }
@@ -285,16 +302,13 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
         mSettings.method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary;
     const Index first = set.addBatch(positions, mMass, kind);
     continueIdsFrom(set.nextId());
-    const Real R = mSettings.supportRadius();
     for (std::size_t k = 0; k < samples.size(); ++k) {
-        const Index s =
-            surfaceGrid.nearest(samples.positions[k], Real(2) * R, [](Index) { return true; });
-        const Vec3 localNormal = s == INVALID_INDEX ? Vec3(0) : surfaceNormal[s];
+        const Vec3& localNormal = localNormals[k];
         normals[first + k] = xf.rotation * localNormal;
         index[first + k] = Real(solidIndex);
         set.densities()[first + k] = mSettings.restDensity;
         if (body.moving) {
-            (*localNormals)[first + k] = localNormal;
+            (*localNormalChannel)[first + k] = localNormal;
             (*locals)[first + k] = samples.positions[k];
             (*solidV)[first + k] = body.velocity(samples.positions[k], mRun.time);
             set.velocities()[first + k] = (*solidV)[first + k];
