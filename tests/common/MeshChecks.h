@@ -1,6 +1,6 @@
 /// @file   MeshChecks.h
 /// @brief  Test helpers for triangle meshes: edge counts (open, non-manifold, inconsistently
-///         wound edges), and Assimp's reading of a mesh file.
+///         wound edges), the volume a level set encloses, and Assimp's reading of a mesh file.
 #pragma once
 
 #include <ghostfx/vdbio/MeshFile.h>
@@ -8,6 +8,8 @@
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Interpolation.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -50,6 +52,28 @@ inline EdgeCounts countEdges(const vdbio::SurfaceMesh& mesh)
         else if (u.first != 1) ++c.misoriented;
     }
     return c;
+}
+
+/// The volume (m^3) where the trilinear interpolant of `phi` is negative, from `n`^3 samples
+/// per voxel over the active bounding box: the region the mesh's vertices and faces
+/// approximate. On the liquid balls of tests/vdbio/test_mesh_file.cc (radius 6.5 h at h / 2
+/// voxels) 4^3 and 6^3 samples per voxel agree within 0.05 % (measured).
+inline double trilinearVolume(const openvdb::FloatGrid& phi, int n)
+{
+    const openvdb::CoordBBox box = phi.evalActiveVoxelBoundingBox();
+    const openvdb::FloatGrid::ConstAccessor acc = phi.getConstAccessor();
+    std::size_t inside = 0;
+    const double step = 1.0 / n;
+    for (int i = box.min().x() * n; i <= box.max().x() * n; ++i) {
+        for (int j = box.min().y() * n; j <= box.max().y() * n; ++j) {
+            for (int k = box.min().z() * n; k <= box.max().z() * n; ++k) {
+                const openvdb::Vec3d x(i * step, j * step, k * step);
+                if (openvdb::tools::BoxSampler::sample(acc, x) < 0) ++inside;
+            }
+        }
+    }
+    const double dx = phi.voxelSize()[0] * step;
+    return double(inside) * dx * dx * dx;
 }
 
 /// What Assimp reads of a mesh file: vertices and faces of its meshes, summed.

@@ -15,7 +15,6 @@
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
-#include <openvdb/tools/Interpolation.h>
 
 #include <cmath>
 #include <cstdio>
@@ -69,28 +68,6 @@ openvdb::Vec3SGrid::Ptr velocityGrid(double dx, Flow flow)
         }
     }
     return grid;
-}
-
-/// The volume (m^3) where the trilinear interpolant of `phi` is negative, from `n`^3 samples
-/// per voxel over the active bounding box: the region the mesh's vertices and faces
-/// approximate. On the liquid balls below (radius 6.5 h at h / 2 voxels) 4^3 and 6^3 samples
-/// per voxel agree within 0.05 % (measured).
-double trilinearVolume(const openvdb::FloatGrid& phi, int n)
-{
-    const openvdb::CoordBBox box = phi.evalActiveVoxelBoundingBox();
-    const openvdb::FloatGrid::ConstAccessor acc = phi.getConstAccessor();
-    std::size_t inside = 0;
-    const double step = 1.0 / n;
-    for (int i = box.min().x() * n; i <= box.max().x() * n; ++i) {
-        for (int j = box.min().y() * n; j <= box.max().y() * n; ++j) {
-            for (int k = box.min().z() * n; k <= box.max().z() * n; ++k) {
-                const openvdb::Vec3d x(i * step, j * step, k * step);
-                if (openvdb::tools::BoxSampler::sample(acc, x) < 0) ++inside;
-            }
-        }
-    }
-    const double dx = phi.voxelSize()[0] * step;
-    return double(inside) * dx * dx * dx;
 }
 
 fs::path testDir() { return ghostfx::testing::freshTestDir("mesh"); }
@@ -245,11 +222,11 @@ TEST(MeshFile, LiquidBallSurfaceMeshEnclosesItsLevelSetVolume)
         const auto phi = openvdb::gridPtrCast<openvdb::FloatGrid>(grids[0]);
         const auto vel = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grids[1]);
         const vdbio::SurfaceMesh mesh = vdbio::makeSurfaceMesh(*phi, vel.get(), {});
-        // The level set's volume by integrating its voxels (trilinearVolume). Not
+        // The level set's volume by integrating its voxels (testing::trilinearVolume). Not
         // tools::levelSetVolume: its smeared delta function assumes |grad phi| = 1, which the
         // sphere method's filtered band only roughly holds (measured +1.5 % above this there,
         // 0.5 % below it for the anisotropic method's redistanced band).
-        const double levelSet = trilinearVolume(*phi, 4);
+        const double levelSet = ghostfx::testing::trilinearVolume(*phi, 4);
         const ghostfx::testing::EdgeCounts edges = ghostfx::testing::countEdges(mesh);
         double drifting = 0; // the largest difference of a vertex velocity from the drift
         for (const openvdb::Vec3s& v : mesh.velocities)
