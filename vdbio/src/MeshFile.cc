@@ -46,8 +46,9 @@ double SurfaceMesh::enclosedVolume() const
 namespace {
 
 /// The polygons of tools::volumeToMesh as triangles wound counter-clockwise from outside:
-/// volumeToMesh winds a level set's polygons the other way (tests/vdbio/test_mesh_file.cc
-/// measures a negative volume otherwise), so each is reversed. A quad (a, b, c, d) becomes
+/// volumeToMesh winds a level set's polygons the other way (kept as they come, a sphere's
+/// enclosed volume is negative; tests/vdbio/test_mesh_file.cc checks the sign), so each is
+/// reversed. A quad (a, b, c, d) becomes
 /// (a, d, c) and (a, c, b); corners that coincide (an adaptive mesh's collapsed quads) leave
 /// no triangle.
 std::vector<openvdb::Vec3I> windTriangles(const std::vector<openvdb::Vec3I>& triangles,
@@ -250,6 +251,15 @@ void writeMeshFile(const std::string& path, const SurfaceMesh& mesh,
     writeAtomically(path, [&](const std::string& tmp) { writeBytes(tmp, path, bytes); });
 }
 
+std::vector<std::string> meshComments(const openvdb::MetaMap& fileMetadata)
+{
+    std::vector<std::string> lines;
+    for (auto it = fileMetadata.beginMeta(); it != fileMetadata.endMeta(); ++it) {
+        lines.push_back(it->first + " " + it->second->str());
+    }
+    return lines;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Reading PLY back
 // ---------------------------------------------------------------------------------------------
@@ -367,15 +377,6 @@ SurfaceMesh readPlyMeshFile(const std::string& path)
     }
     if (!in) throw IoError(msg("mesh file '", path, "': shorter than its header says"));
     return mesh;
-}
-
-std::vector<std::string> meshComments(const openvdb::MetaMap& fileMetadata)
-{
-    std::vector<std::string> lines;
-    for (auto it = fileMetadata.beginMeta(); it != fileMetadata.endMeta(); ++it) {
-        lines.push_back(it->first + " " + it->second->str());
-    }
-    return lines;
 }
 
 } // namespace vdbio
