@@ -17,6 +17,8 @@
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -118,7 +120,8 @@ typename GridT::Ptr gridNamed(const openvdb::GridPtrVec& grids, const std::strin
 
 /// Write the liquid's mesh file `path` of `frame` from the "surface" and "vel" grids of the
 /// volume file (`volumeGrids`) when it holds both, else from grids made for the mesh
-/// (meshVolumeOptions: the same surface and velocity); returns the log line.
+/// (meshVolumeOptions: the same surface and velocity); returns the log line (its counts, the
+/// volume it encloses, and the seconds meshing and writing took).
 std::string writeMesh(const OutputMedium& m, const vdbio::SceneOutputs& out,
                       const openvdb::GridPtrVec& volumeGrids, const std::string& path, int frame,
                       const openvdb::MetaMap& fileMeta, const BuiltGrids* built)
@@ -139,10 +142,16 @@ std::string writeMesh(const OutputMedium& m, const vdbio::SceneOutputs& out,
     }
     vdbio::MeshOptions options;
     options.adaptivity = out.meshAdaptivity;
+    const auto start = std::chrono::steady_clock::now();
     const vdbio::SurfaceMesh mesh = vdbio::makeSurfaceMesh(*surface, vel.get(), options);
     vdbio::writeMeshFile(path, mesh, vdbio::meshComments(fileMeta));
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    char took[32];
+    std::snprintf(took, sizeof(took), "%.2f s", seconds);
     return msg("mesh of frame ", frame, " '", path, "': ", mesh.points.size(), " vertices, ",
-               mesh.triangles.size(), " triangles, ", mesh.enclosedVolume(), " m^3 enclosed");
+               mesh.triangles.size(), " triangles, ", mesh.enclosedVolume(), " m^3 enclosed, ",
+               took);
 }
 
 /// The file metadata every frame file carries: the scene, its method, the frame and its time.

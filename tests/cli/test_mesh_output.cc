@@ -105,8 +105,7 @@ TEST_F(MeshOutput, RunWritesOneClosedMeshPerFrameOfTheVolumeSurface)
     double vy = 0;
     for (const openvdb::Vec3s& v : mesh.velocities) vy += v.y();
     vy /= double(mesh.velocities.size());
-    std::printf("[measured] mean vertex velocity y %.4f m/s (free fall: %.4f)\n", vy,
-                -9.81 * 0.1);
+    std::printf("[measured] mean vertex velocity y %.4f m/s (free fall: %.4f)\n", vy, -9.81 * 0.1);
     EXPECT_NEAR(vy, -9.81 * 0.1, 0.05 * 9.81 * 0.1);
 }
 
@@ -154,7 +153,8 @@ TEST_F(MeshOutput, BadMeshSettingsAreRefusedBeforeTheFirstStep)
         return errorLine("run " + scene + " --out " + out.string() + " -D '" + define + "'");
     };
     EXPECT_CONTAINS(refused("outputs.mesh.file=liquid.$F4.stl"),
-                    "outputs.mesh.file = \"liquid.$F4.stl\": this output is written as a PLY or OBJ triangle mesh: "
+                    "outputs.mesh.file = \"liquid.$F4.stl\": this output is written as a PLY or "
+                    "OBJ triangle mesh: "
                     "expected a name ending in .ply or .obj, not .stl");
     EXPECT_CONTAINS(refused("outputs.mesh.file=liquid.ply"),
                     "outputs.mesh.file = \"liquid.ply\": expected a frame pattern with $F");

@@ -55,10 +55,10 @@ openvdb::Vec3SGrid::Ptr velocityGrid(double dx, Flow flow)
     grid->setName("vel");
     grid->setTransform(openvdb::math::Transform::createLinearTransform(dx));
     const double reach = RADIUS + 2 * dx;
-    const openvdb::Coord lo = grid->transform().worldToIndexCellCentered(
-        openvdb::Vec3d(CENTRE) - openvdb::Vec3d(reach));
-    const openvdb::Coord hi = grid->transform().worldToIndexCellCentered(
-        openvdb::Vec3d(CENTRE) + openvdb::Vec3d(reach));
+    const openvdb::Coord lo =
+        grid->transform().worldToIndexCellCentered(openvdb::Vec3d(CENTRE) - openvdb::Vec3d(reach));
+    const openvdb::Coord hi =
+        grid->transform().worldToIndexCellCentered(openvdb::Vec3d(CENTRE) + openvdb::Vec3d(reach));
     auto acc = grid->getAccessor();
     for (openvdb::Coord c = lo; c.x() <= hi.x(); ++c.x()) {
         for (c.y() = lo.y(); c.y() <= hi.y(); ++c.y()) {
@@ -148,9 +148,8 @@ TEST(MeshFile, PlyVelocitiesAreTheFlowAtTheVertices)
     // A uniform flow: trilinear interpolation of equal values gives that value, so every
     // vertex reads it back exactly (float rounding at most: one ulp of the largest component).
     const openvdb::Vec3s uniform(1.5f, -0.25f, 3.0f);
-    const auto still = velocityGrid(2 * VOXEL, [&](const openvdb::Vec3d&) {
-        return openvdb::Vec3d(uniform);
-    });
+    const auto still =
+        velocityGrid(2 * VOXEL, [&](const openvdb::Vec3d&) { return openvdb::Vec3d(uniform); });
     const std::string path = (dir / "uniform.ply").string();
     vdbio::writeMeshFile(path, vdbio::makeSurfaceMesh(*phi, still.get(), vdbio::MeshOptions()));
     const vdbio::SurfaceMesh uniformBack = vdbio::readPlyMeshFile(path);
@@ -269,9 +268,9 @@ TEST(MeshFile, BadInputNamesTheValueAndTheFile)
     auto fog = openvdb::FloatGrid::create(0.0f);
     fog->setName("density");
     fog->setGridClass(openvdb::GRID_FOG_VOLUME);
-    EXPECT_EQ(ghostfx::testing::errorOf<ValueError>(
-                  [&] { vdbio::makeSurfaceMesh(*fog, nullptr, {}); }),
-              "mesh output: grid 'density' is not a level set (class fog volume)");
+    EXPECT_EQ(
+        ghostfx::testing::errorOf<ValueError>([&] { vdbio::makeSurfaceMesh(*fog, nullptr, {}); }),
+        "mesh output: grid 'density' is not a level set (class fog volume)");
     EXPECT_EQ(ghostfx::testing::errorOf<IoError>(
                   [&] { vdbio::readPlyMeshFile((dir / "none.ply").string()); }),
               "mesh file '" + (dir / "none.ply").string() + "': cannot open it");

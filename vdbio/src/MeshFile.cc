@@ -271,7 +271,7 @@ struct PlyLayout
 {
     std::size_t vertices = 0, faces = 0;
     std::vector<std::string> vertexProperties; ///< float properties, in file order
-    bool faceList = false;                      ///< `property list uchar int vertex_indices`
+    bool faceList = false;                     ///< `property list uchar int vertex_indices`
 };
 
 /// The header of the PLY stream `in` (through `end_header`); IoError naming `path` for another
