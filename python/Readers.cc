@@ -43,6 +43,7 @@ struct PyVolume
     double voxelSize = 0;
     std::array<double, 3> voxelSizes{};
     py::object background, transform, values;
+    py::dict metadata;
     py::object origin = py::none(), indexMin = py::none(), ijk = py::none(), world = py::none();
 };
 
@@ -57,6 +58,14 @@ void fillHeader(PyVolume& v, const vdbio::VolumeHeader& h)
     py::array_t<double> m({4, 4});
     std::copy(h.indexToWorld.begin(), h.indexToWorld.end(), m.mutable_data());
     v.transform = m;
+    for (const vdbio::VolumeHeader::Meta& meta : h.metadata) {
+        const std::string& t = meta.type;
+        py::object value = py::str(meta.text);
+        if (t == "float" || t == "double") value = py::float_(std::stod(meta.text));
+        else if (t == "int32" || t == "int64") value = py::int_(std::stoll(meta.text));
+        else if (t == "bool") value = py::bool_(meta.text == "true" || meta.text == "1");
+        v.metadata[py::str(meta.name)] = value;
+    }
 }
 
 PyVolume readVolume(const std::string& file, const std::string& grid, bool active)
@@ -221,6 +230,9 @@ void bindVolume(py::module_& m)
         .def_readonly("background", &PyVolume::background,
                       "the value outside the active voxels (a level set's: its narrow-band "
                       "half-width, m)")
+        .def_readonly("metadata", &PyVolume::metadata,
+                      "the grid's metadata: name -> float, int, bool or str (e.g. 'units', "
+                      "'rest_density' in kg/m^3 on ghostfx's density grid)")
         .def_readonly("transform", &PyVolume::transform,
                       "4x4 float64, grid index to world (m) for row vectors: world = [i, j, k, "
                       "1] @ transform")
@@ -258,7 +270,8 @@ void bindReaders(py::module_& m)
           "OSError, a missing grid or one that is not a point grid ValueError, naming both");
     m.def("read_volume", &readVolume, py::arg("file"), py::arg("grid"), py::arg("active") = false,
           "The volume grid `grid` of a .vdb (float, double, int32, int64, bool, vec3s, vec3d or "
-          "vec3i values; level sets in m, density in kg/m^3, vel in m/s as ghostfx writes them) "
+          "vec3i values; as ghostfx writes them: surface in m (signed distance), density as "
+          "rho/rho0 (times metadata['rest_density'] for kg/m^3), vel in m/s) "
           "as a Volume: dense over the box of its active voxels, or with active=True its active "
           "voxels (ijk, world, values)");
     m.def("read_stats", &readStats, py::arg("file"),

@@ -89,6 +89,14 @@ VolumeHeader headerOf(const GridT& grid)
     }
     h.background = columnOf<typename GridT::ValueType>("background", h.valueType, 1);
     store(h.background, 0, grid.background());
+    for (auto it = grid.beginMeta(); it != grid.endMeta(); ++it) {
+        const std::string& key = it->first;
+        if (key == openvdb::GridBase::META_GRID_NAME || key == openvdb::GridBase::META_GRID_CLASS
+            || key.rfind("file_", 0) == 0) {
+            continue;
+        }
+        h.metadata.push_back({key, it->second->typeName(), it->second->str()});
+    }
     return h;
 }
 

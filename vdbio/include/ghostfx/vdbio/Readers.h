@@ -85,6 +85,13 @@ struct VolumeHeader
     std::array<double, 3> voxelSize{};
     std::array<double, 16> indexToWorld{}; ///< row-major 4x4: world = [i j k 1] * M (row vectors)
     Column background;      ///< one row, the grid's type
+    /// The grid's own metadata (not OpenVDB's name, class and file_* statistics): name, value
+    /// type name ("float", "int64", "string"...) and the value as text.
+    struct Meta
+    {
+        std::string name, type, text;
+    };
+    std::vector<Meta> metadata;
 };
 
 /// The values over the active voxels' index bounding box: values[i][j][k] (x slowest, z
