@@ -5,6 +5,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/vdbio/FrameFiles.h>
+#include <ghostfx/vdbio/Info.h>
 #include <ghostfx/vdbio/Readers.h>
 
 #include <openvdb/io/File.h>
@@ -322,4 +323,37 @@ TEST(Readers, ErrorsNameTheFileAndTheGrid)
     std::ofstream(text) << "hello\n";
     EXPECT_TRUE(ghostfx::testing::contains(errorOf<IoError>([&] { vdbio::readPoints(text, "", "read_points"); }),
                                   "read_points: file '" + text + "' is not a readable .vdb file ("));
+}
+
+TEST(Readers, AnAttributeOfAnotherTypeIsNamedAndInfoStillDescribesTheFile)
+{
+    const fs::path dir = freshDir("readers_unsupported");
+    const std::string written = (dir / "points.vdb").string();
+    vdbio::writePointsFile(written, latticeParticles(), vdbio::PointsOptions());
+    openvdb::io::File in(written);
+    in.open();
+    const PointDataGrid::Ptr grid = openvdb::gridPtrCast<PointDataGrid>(in.readGrid("particles"));
+    in.close();
+    openvdb::points::appendAttribute<openvdb::math::Mat4s>(grid->tree(), "xform");
+    const std::string file = (dir / "matrices.vdb").string();
+    openvdb::io::File(file).write({grid});
+    const std::string expected =
+        "attribute 'xform' of point grid 'particles' holds mat4s values, expected float, double, "
+        "int8 to int64, uint8 to uint64, bool, vec3s, vec3d or vec3i";
+    EXPECT_EQ(errorOf<GridError>([&] { vdbio::readPoints(file, "", "read_points"); }),
+              "read_points: '" + file + "': " + expected);
+    const std::string info = vdbio::describeFile(file);
+    EXPECT_TRUE(ghostfx::testing::contains(
+        info, "  attribute ranges: not read (ghostfx info: " + expected + ")\n"))
+        << info;
+    EXPECT_TRUE(ghostfx::testing::contains(info, "points:          1000\n")) << info;
+
+    // A grid without points: an empty P, (0, 3).
+    const std::string empty = (dir / "empty.vdb").string();
+    vdbio::writePointsFile(empty, sph::ParticleSet(), vdbio::PointsOptions());
+    const vdbio::PointsData none = vdbio::readPoints(empty, "particles", "read_points");
+    ASSERT_EQ(none.columns.size(), 1u);
+    EXPECT_EQ(none.columns[0].name, "P");
+    EXPECT_EQ(none.columns[0].rows, 0u);
+    EXPECT_EQ(none.columns[0].components, 3);
 }

@@ -109,7 +109,13 @@ std::string components(const std::vector<double>& v)
 /// mean of each component.
 void describeRanges(std::ostream& os, const openvdb::points::PointDataGrid& grid)
 {
-    const PointsData data = readPointsGrid(grid, "ghostfx info");
+    PointsData data;
+    try {
+        data = readPointsGrid(grid, "ghostfx info");
+    } catch (const GridError& e) { // an attribute type the reader does not take
+        os << "  attribute ranges: not read (" << e.what() << ")\n";
+        return;
+    }
     if (data.count == 0) return;
     os << "  attribute ranges (min .. max, mean; P in world space, m):\n";
     for (const Column& column : data.columns) {

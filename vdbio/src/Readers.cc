@@ -354,7 +354,10 @@ PointsData readPointsGrid(const openvdb::GridBase& base, const std::string& cont
     data.grid = grid->getName();
     data.voxelSize = grid->voxelSize().x();
     const std::vector<LeafRows> leaves = leafRows(grid->tree(), data.count);
-    if (leaves.empty()) return data;
+    if (leaves.empty()) { // no points: no attribute descriptor, only an empty "P"
+        data.columns.push_back(makeColumn("P", "vec3s", ScalarType::Float64, 3, 0));
+        return data;
+    }
     const auto& descriptor = leaves.front().leaf->attributeSet().descriptor();
     std::vector<std::pair<std::size_t, std::string>> byPosition;
     for (const auto& entry : descriptor.map()) byPosition.emplace_back(entry.second, entry.first);

@@ -66,7 +66,9 @@ struct PointsData
     std::string grid;            ///< the grid's name
     std::size_t count = 0;       ///< points (rows of every column)
     double voxelSize = 0;        ///< m (x axis of the transform)
-    std::vector<Column> columns; ///< "P" first (world space, float64), then the others in storage order
+    /// "P" first (world space, float64), then the others in storage order, then the groups;
+    /// a grid without points has no attribute list: only an empty "P"
+    std::vector<Column> columns;
 };
 
 /// The point grid `grid` of `file` (empty: the file's first point grid). `context` starts every
