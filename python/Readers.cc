@@ -10,6 +10,7 @@
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/Checkpoint.h>
+#include <ghostfx/vdbio/MeshFile.h>
 #include <ghostfx/vdbio/Readers.h>
 #include <ghostfx/vdbio/Stats.h>
 
@@ -214,6 +215,51 @@ py::list readCheckpoint(const std::string& file)
     return out;
 }
 
+/// A mesh as a dict of arrays: points, normals (N, 3) float32, triangles (M, 3) int64 and
+/// velocities (N, 3) float32 where the mesh has them.
+py::dict meshArrays(const vdbio::SurfaceMesh& mesh)
+{
+    auto rows = [](const auto& v, const char* dtype) {
+        const py::ssize_t n = py::ssize_t(v.size());
+        py::array a(py::dtype(dtype), std::vector<py::ssize_t>{n, 3});
+        std::copy_n(reinterpret_cast<const char*>(v.data()), a.nbytes(),
+                    static_cast<char*>(a.mutable_data()));
+        return a;
+    };
+    py::dict d;
+    d["points"] = rows(mesh.points, "float32");
+    d["normals"] = rows(mesh.normals, "float32");
+    d["triangles"] = rows(mesh.triangles, "uint32").attr("astype")("int64");
+    if (!mesh.velocities.empty()) d["velocities"] = rows(mesh.velocities, "float32");
+    return d;
+}
+
+py::dict readMesh(const std::string& file)
+{
+    vdbio::SurfaceMesh mesh;
+    {
+        py::gil_scoped_release release;
+        mesh = vdbio::readPlyMeshFile(file);
+    }
+    return meshArrays(mesh);
+}
+
+/// The mesh of the level set `grid` of a .vdb, with the velocity of its `velocity` grid (if
+/// given and present) at each vertex, as `outputs.mesh` makes it.
+py::dict meshVolume(const std::string& file, const std::string& grid, double adaptivity,
+                    const std::string& velocity)
+{
+    vdbio::SurfaceMesh mesh;
+    {
+        py::gil_scoped_release release;
+        vdbio::MeshOptions options;
+        options.adaptivity = adaptivity;
+        options.validate();
+        mesh = vdbio::meshOfVdbFile(file, grid, velocity, options, "mesh_volume");
+    }
+    return meshArrays(mesh);
+}
+
 void bindVolume(py::module_& m)
 {
     py::class_<PyVolume>(m, "Volume",
@@ -284,4 +330,14 @@ void bindReaders(py::module_& m)
           "'mass' kg, 'density' kg/m^3, 'pressure' Pa, 'kind' uint8, 'id' int64, and every "
           "named channel; floats in the build's precision), 'reals' and 'integers' (the "
           "solver's scalars, e.g. 'time' in s, 'step')");
+    m.def("read_mesh", &readMesh, py::arg("file"),
+          "A .ply mesh as outputs.mesh writes it, as a dict: 'points' (m) and 'normals' (N, 3) "
+          "float32, 'triangles' (M, 3) int64 vertex indices (counter-clockwise seen from "
+          "outside), and 'velocities' (m/s) (N, 3) float32 when the file has them");
+    m.def("mesh_volume", &meshVolume, py::arg("file"), py::arg("grid") = "surface",
+          py::arg("adaptivity") = 0.0, py::arg("velocity") = "vel",
+          "The zero crossing of the level set `grid` of a .vdb as a triangle mesh, as "
+          "outputs.mesh makes it (OpenVDB's volumeToMesh; `adaptivity` in [0, 1] merges flat "
+          "parts into fewer triangles), with the `velocity` grid read at each vertex where the "
+          "file has it: the dict read_mesh returns");
 }

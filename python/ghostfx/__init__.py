@@ -8,7 +8,8 @@
 The same code as the `ghostfx` command line: scene errors raise ValueError with its message.
 Particle arrays are float64 NumPy copies (the solver reorders its storage every step).
 The files a run writes read back as NumPy arrays: read_points (points .vdb), read_volume
-(volume grids), read_stats (stats.h5), read_checkpoint (checkpoint .h5).
+(volume grids), read_stats (stats.h5), read_checkpoint (checkpoint .h5), read_mesh (.ply
+meshes); mesh_volume meshes a level set of a .vdb as outputs.mesh does.
 """
 import csv as _csv
 import json as _json
@@ -20,11 +21,13 @@ import tempfile as _tempfile
 from ._ghostfx import LevelSet, Scene, Simulation, sample, __version__
 from ._ghostfx import load_scene as _load_scene_file
 from ._ghostfx import sample_cache_counts, set_sample_cache
-from ._ghostfx import Volume, read_checkpoint, read_points, read_stats, read_volume
+from ._ghostfx import (Volume, mesh_volume, read_checkpoint, read_mesh, read_points, read_stats,
+                       read_volume)
 
 __all__ = ["Interrupted", "LevelSet", "Scene", "Simulation", "Volume", "load_scene",
-           "read_checkpoint", "read_points", "read_stats", "read_volume", "sample",
-           "sample_cache_counts", "set_sample_cache", "study", "__version__"]
+           "mesh_volume", "read_checkpoint", "read_mesh", "read_points", "read_stats",
+           "read_volume", "sample", "sample_cache_counts", "set_sample_cache", "study",
+           "__version__"]
 
 
 class Interrupted(SystemExit):

@@ -4,6 +4,7 @@
 #include <ghostfx/vdbio/MeshFile.h>
 
 #include "FrameGridsDetail.h"
+#include "ReadersDetail.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
@@ -377,6 +378,27 @@ SurfaceMesh readPlyMeshFile(const std::string& path)
     }
     if (!in) throw IoError(msg("mesh file '", path, "': shorter than its header says"));
     return mesh;
+}
+
+SurfaceMesh meshOfVdbFile(const std::string& file, const std::string& grid,
+                          const std::string& velocityGrid, const MeshOptions& options,
+                          const std::string& context)
+{
+    const auto anyGrid = [](const openvdb::GridBase&) { return true; };
+    const auto surface = openvdb::GridBase::grid<openvdb::FloatGrid>(
+        detail::readGridOf(file, grid, context, "level set", anyGrid));
+    if (!surface || surface->getGridClass() != openvdb::GRID_LEVEL_SET) {
+        throw GridError(msg(context, ": grid '", grid, "' of '", file,
+                            "' is not a float level set, expected one to mesh"));
+    }
+    openvdb::Vec3SGrid::Ptr velocity;
+    if (!velocityGrid.empty()) {
+        openvdb::io::File vdb(file);
+        vdb.open(/*delayLoad=*/false);
+        if (vdb.hasGrid(velocityGrid))
+            velocity = openvdb::GridBase::grid<openvdb::Vec3SGrid>(vdb.readGrid(velocityGrid));
+    }
+    return makeSurfaceMesh(*surface, velocity.get(), options);
 }
 
 } // namespace vdbio

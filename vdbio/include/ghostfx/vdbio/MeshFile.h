@@ -82,6 +82,15 @@ void writeMeshFile(const std::string& path, const SurfaceMesh& mesh,
 /// @throw IoError naming the path for a missing file or another layout.
 SurfaceMesh readPlyMeshFile(const std::string& path);
 
+/// The mesh of the level set `grid` of the .vdb `file` (makeSurfaceMesh), with the vec3s grid
+/// `velocityGrid` of the same file read at each vertex where the file has one ("" for none).
+/// @throw IoError for a missing or unreadable file, GridError naming the file's grids for a
+///        missing grid and for a grid that is not a float level set; messages start with
+///        `context`.
+SurfaceMesh meshOfVdbFile(const std::string& file, const std::string& grid,
+                          const std::string& velocityGrid, const MeshOptions& options,
+                          const std::string& context);
+
 /// The file metadata of a frame (FrameFiles.h's fileMetadata: frame, time, scene, method) as
 /// "key value" comment lines for writeMeshFile.
 std::vector<std::string> meshComments(const openvdb::MetaMap& fileMetadata);
