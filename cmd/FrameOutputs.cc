@@ -83,18 +83,20 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
 }
 
 /// Write one medium's points and volume files for `frame`; returns its grids (for previews).
-/// `built`: the grids already built (a run over several processes), else built here.
+/// `time` (s): the frame's time. `built`: the grids already built (a run over several processes),
+/// else built here.
 openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
                                 const std::string& pointsPath, const std::string& volumePath,
-                                const openvdb::MetaMap& fileMeta, const BuiltGrids* built)
+                                const openvdb::MetaMap& fileMeta, double time,
+                                const BuiltGrids* built)
 {
     if (!pointsPath.empty()) {
         if (built) {
             vdbio::writePointsGridFile(pointsPath, built->points, fileMeta);
         } else if (out.pointGhosts && m.withGhosts) {
-            vdbio::writePointsFile(pointsPath, m.withGhosts(), pointsOptions(m, out), fileMeta);
+            vdbio::writePointsFile(pointsPath, m.withGhosts(), pointsOptions(m, out, time), fileMeta);
         } else {
-            vdbio::writePointsFile(pointsPath, *m.particles, pointsOptions(m, out), fileMeta);
+            vdbio::writePointsFile(pointsPath, *m.particles, pointsOptions(m, out, time), fileMeta);
         }
     }
     if (volumePath.empty()) return {};
@@ -194,7 +196,7 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
         const OutputMedium& m = snapshot.media[index];
         const openvdb::GridPtrVec grids =
             writeMedium(m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
-                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
+                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta, snapshot.time,
                         index < snapshot.built.size() ? &snapshot.built[index] : nullptr);
         if (out.previewFile.empty()) continue;
         if (auto layer = mediumLayer(m, grids, out.previewGrid, namedGridFound))

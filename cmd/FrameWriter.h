@@ -50,7 +50,9 @@ struct FrameSnapshot
 
 /// The options a medium's points and volume outputs are built with, from the scene's outputs
 /// (the liquid's surface at h / 2 unless the scene says otherwise, its gathered grids at h).
-vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
+/// `time` (s): the state the points hold, for their "age".
+vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out,
+                                   double time);
 vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
 
 /// Copy what the scene's outputs of `frame` read from `sim` (with the ghosts only where the

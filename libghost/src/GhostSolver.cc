@@ -10,6 +10,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/ParticleAge.h>
 #include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/Random.h>
 #include <ghostfx/sph/SphDensity.h>
@@ -41,6 +42,7 @@ GhostSolver::GhostSolver(const GhostSettings& settings, std::unique_ptr<Pressure
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
+    sph::stampBirthTimes(mParticles, mRun.time);
 }
 
 GhostSolver::~GhostSolver() = default;
@@ -912,6 +914,7 @@ void GhostSolver::restoreState(const SolverState& state)
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
     mRun = run;
+    sph::stampBirthTimes(mParticles, mRun.time);
     mAirPhase = airPhase;
     mAirPhaseCredit = airPhaseCredit;
     mRestoredEmitterFills = emitterFills;

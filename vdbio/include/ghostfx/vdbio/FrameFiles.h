@@ -51,8 +51,10 @@ struct PointsOptions
     /// Channels written besides P. Built-ins: "v" (m/s, vec3f), "id" (int64), "density"
     /// (kg/m^3), "pressure" (Pa), "mass" (kg), "kind" (int32, ParticleKind value; the grid
     /// metadata "kind_names" lists the names). Any named scalar (float) or vector (vec3f)
-    /// channel of the ParticleSet may be added (e.g. "temperature"). Unknown names throw
-    /// ValueError naming the channel and listing those available.
+    /// channel of the ParticleSet may be added (e.g. "temperature"); a channel of the set
+    /// takes the place of a render attribute of the same name. Render attributes (float,
+    /// RenderAttributes.h): "age" (s), "pscale" (m) and, on liquid points, "vorticity" (1/s).
+    /// Unknown names throw ValueError naming the channel and listing those available.
     std::vector<std::string> channels = {"v", "id", "density", "pressure"};
     /// Particle kinds written. Ghost particles are never written unless listed here.
     std::vector<sph::ParticleKind> kinds = {sph::ParticleKind::Liquid};
@@ -60,6 +62,14 @@ struct PointsOptions
     /// than two points are selected). The voxel size only affects how points are bucketed,
     /// not their positions.
     double voxelSize = 0;
+
+    /// Time of the particles' state (s): "age" is this minus each particle's birth time.
+    double time = 0;
+    /// Rest density rho0 of the medium (kg/m^3), for "pscale" and the neighbour volumes
+    /// m_j / rho0 of "vorticity"; 0 refuses those channels.
+    double restDensity = 0;
+    /// Kernel support radius R of the medium (m), for "vorticity"; 0 refuses it.
+    double kernelSupport = 0;
 
     /// Throw ValueError naming the first bad field (negative voxel size, duplicate channel,
     /// no kind).
