@@ -904,7 +904,8 @@ void GhostSolver::restoreState(const SolverState& state)
          {SOLID_NORMAL, SOLID_INDEX, SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) {
         mParticles.removeChannel(c);
     }
-    for (const char* c : {VSTAR, AIR_WEIGHT, AIR_TARGET}) mPendingSolids.removeChannel(c);
+    for (const char* c : {VSTAR, AIR_WEIGHT, AIR_TARGET, sph::BIRTH_TIME_CHANNEL})
+        mPendingSolids.removeChannel(c);
     // States saved by this solver have these channels; a missing one gets what a fresh solver
     // would have.
     mParticles.addVectorChannel(VSTAR);

@@ -324,7 +324,7 @@ TEST_F(Robustness, EveryOutputOptionIsCheckedBeforeTheFirstStep)
     EXPECT_CONTAINS(errorLine(run + " -D 'outputs.points.channels=[\"v\",\"foam\"]'"),
                     "scene '" + scene + "': outputs.points.channels: channel 'foam' not found: "
                                         "available: v, id, density, pressure, mass, kind, age, "
-                                        "pscale, vorticity");
+                                        "pscale, vorticity, curvature");
     EXPECT_CONTAINS(errorLine(run + " -D outputs.preview.file=p.\\$F4.exr -D outputs.preview.grid=vel"),
                     "outputs.preview.grid = 'vel': the volume output has no such grid");
     EXPECT_CONTAINS(errorLine(run + " -D 'outputs.volume.grids=[\"temperature\"]'"),

@@ -855,7 +855,7 @@ TEST(FrameFiles, ErrorsNameTheOptionAndTheValue)
     const std::string points = messageOf(
         [&] { vdbio::writePointsFile((freshDir("errors") / "p.vdb").string(), sc.particles, po); });
     EXPECT_NE(points.find("channel 'foam' not found: available: v, id, density, pressure, "
-                          "mass, kind, age, pscale, vorticity, temperature, normal"),
+                          "mass, kind, age, pscale, vorticity, curvature, temperature, normal"),
               std::string::npos)
         << points;
 

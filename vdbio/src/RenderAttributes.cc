@@ -50,7 +50,10 @@ std::vector<float> radii(const sph::ParticleSet& p, const std::vector<sph::Index
 std::vector<std::string> renderAttributeNames(const PointsOptions& options)
 {
     std::vector<std::string> names{"age", "pscale"};
-    if (holdsLiquid(options)) names.push_back("vorticity");
+    if (holdsLiquid(options)) {
+        names.push_back("vorticity");
+        names.push_back("curvature");
+    }
     return names;
 }
 
@@ -70,7 +73,7 @@ bool checkRenderAttribute(const sph::ParticleSet& particles, const PointsOptions
         throw ValueError(msg(where, ": channel '", name, "': rest density = ", options.restDensity,
                              " kg/m^3: expected a finite value > 0"));
     }
-    if (name == "vorticity" && (!(options.kernelSupport > 0) || !std::isfinite(options.kernelSupport))) {
+    if (name != "pscale" && (!(options.kernelSupport > 0) || !std::isfinite(options.kernelSupport))) {
         throw ValueError(msg(where, ": channel '", name, "': kernel support = ",
                              options.kernelSupport, " m: expected a finite value > 0"));
     }
@@ -87,10 +90,66 @@ std::vector<float> renderAttribute(const sph::ParticleSet& particles,
     es.supportRadius = sph::Real(options.kernelSupport);
     es.restDensity = sph::Real(options.restDensity);
     es.kind = sph::ParticleKind::Liquid;
-    const std::vector<sph::Real> values = sph::vorticityMagnitude(particles, selection, es);
+    const std::vector<sph::Real> values = name == "vorticity"
+                                              ? sph::vorticityMagnitude(particles, selection, es)
+                                              : sph::meanCurvature(particles, selection, es);
     return std::vector<float>(values.begin(), values.end());
 }
 
 } // namespace detail
+
+namespace {
+
+/// The render attributes `options` asks for that sum over neighbours and that `particles`
+/// does not carry as channels.
+std::vector<std::string> neighbourAttributes(const sph::ParticleSet& particles,
+                                             const PointsOptions& options)
+{
+    const std::vector<std::string> names = detail::renderAttributeNames(options);
+    std::vector<std::string> out;
+    for (const std::string& name : options.channels) {
+        if ((name == "vorticity" || name == "curvature")
+            && std::find(names.begin(), names.end(), name) != names.end()
+            && !particles.hasScalarChannel(name) && !particles.hasVectorChannel(name)) {
+            out.push_back(name);
+        }
+    }
+    return out;
+}
+
+} // namespace
+
+bool needsNeighbourAttributes(const sph::ParticleSet& particles, const PointsOptions& options)
+{
+    return !neighbourAttributes(particles, options).empty();
+}
+
+double neighbourAttributeReach(const sph::ParticleSet& particles, const PointsOptions& options)
+{
+    // Curvature differentiates normals that differentiate the colour field, itself a sum over
+    // neighbours: three support radii in all.
+    double reach = 0;
+    for (const std::string& name : neighbourAttributes(particles, options))
+        reach = std::max(reach, (name == "curvature" ? 3.0 : 1.0) * options.kernelSupport);
+    return reach;
+}
+
+sph::ParticleSet withNeighbourAttributes(const sph::ParticleSet& particles, std::size_t count,
+                                         const PointsOptions& options)
+{
+    std::vector<sph::Index> first(std::min(count, particles.size()));
+    for (std::size_t k = 0; k < first.size(); ++k) first[k] = sph::Index(k);
+    std::vector<std::uint8_t> keep(particles.size(), 0);
+    std::fill(keep.begin(), keep.begin() + first.size(), std::uint8_t(1));
+    sph::ParticleSet out = particles.select(keep);
+    for (const std::string& name : neighbourAttributes(particles, options)) {
+        detail::checkRenderAttribute(particles, options, name, "points output");
+        const std::vector<float> values = detail::renderAttribute(particles, first, options, name);
+        std::vector<sph::Real>& channel = out.addScalarChannel(name);
+        for (std::size_t k = 0; k < values.size(); ++k) channel[k] = sph::Real(values[k]);
+    }
+    return out;
+}
+
 } // namespace vdbio
 } // namespace ghostfx

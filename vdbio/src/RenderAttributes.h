@@ -1,6 +1,7 @@
 /// @file   RenderAttributes.h
-/// @brief  Point attributes computed at output time for rendering: "age", "pscale" and
-///         "vorticity" (PointsOptions::channels; docs/scene-format.md, outputs.points).
+/// @brief  Point attributes computed at output time for rendering: "age", "pscale",
+///         "vorticity" and "curvature" (PointsOptions::channels; docs/scene-format.md,
+///         outputs.points).
 /// @details None of them is a solver quantity; each is computed from the particle set as it is
 ///          when the points are written:
 ///          - age (s) = PointsOptions::time - the particle's birth time (sph::BIRTH_TIME_CHANNEL,
@@ -8,7 +9,9 @@
 ///          - pscale (m) = (3 m / (4 pi rho0))^(1/3), the radius of the sphere of the particle's
 ///            own volume m / rho0 (Houdini's pscale is a radius);
 ///          - vorticity (1/s) = |curl v|, the corrected SPH estimate over the liquid neighbours
-///            within the kernel support (sph::vorticityMagnitude, RenderEstimates.h).
+///            within the kernel support (sph::vorticityMagnitude, RenderEstimates.h);
+///          - curvature (1/m): the mean curvature of the liquid surface at the particles of its
+///            surface layer, 0 inside (sph::meanCurvature).
 #pragma once
 
 #include <ghostfx/sph/ParticleSet.h>
@@ -21,7 +24,8 @@ namespace ghostfx {
 namespace vdbio {
 namespace detail {
 
-/// The render attributes `options` can write (vorticity only on points that hold liquid).
+/// The render attributes `options` can write (vorticity and curvature only on points that
+/// hold liquid).
 std::vector<std::string> renderAttributeNames(const PointsOptions& options);
 
 /// True when `name` is a render attribute of `options`. Throws ValueError (prefixed by

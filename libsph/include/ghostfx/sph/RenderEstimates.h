@@ -34,5 +34,15 @@ std::vector<Real> vorticityMagnitude(const ParticleSet& particles,
                                      const std::vector<Index>& selection,
                                      const EstimateSettings& settings);
 
+/// Mean curvature H = (kappa_1 + kappa_2) / 2 = div(n) / 2 (1/m) of the surface at each
+/// particle `selection[k]` of `settings.kind` in the surface layer: positive where the liquid
+/// is convex (1 / r on a ball of radius r), 0 inside and for other kinds. The layer and its
+/// outward normals n come from the colour field c = sum_j V_j W_ij: the particles where
+/// |grad c| R >= 0.2 (c falls by about 1/2 over R across a free surface), n = -grad c / |grad c|;
+/// div(n) is the corrected estimate over the layer's particles. Throws like
+/// vorticityMagnitude.
+std::vector<Real> meanCurvature(const ParticleSet& particles, const std::vector<Index>& selection,
+                                const EstimateSettings& settings);
+
 } // namespace sph
 } // namespace ghostfx
