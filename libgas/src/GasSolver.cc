@@ -69,7 +69,7 @@ GasSolver::GasSolver(const GasSettings& settings)
     mParticles.addScalarChannel(channel::TEMPERATURE, mSettings.ambientTemperature);
     mParticles.addScalarChannel(channel::SUPPORT, mSettings.supportRadius());
     addStepChannels();
-    sph::stampBirthTimes(mParticles, mRun.time);
+    sph::ensureBirthTimes(mParticles, mRun.time);
 }
 
 void GasSolver::addStepChannels()
@@ -951,6 +951,7 @@ void GasSolver::step(Real dt)
     const double t1 = mRun.time + double(dt);
     moveSolids(t1);
     mRun.time = t1;
+    sph::stampBirthTimes(mParticles, mRun.time); // vapour added before the next step
     projectOutOfSolids(dt);
     checkBlowUp(dt);
     ++mRun.step;
@@ -1106,7 +1107,7 @@ void GasSolver::restoreState(const SolverState& state)
     // Channels a fresh solver of these settings has; states saved by this solver have them.
     addStepChannels();
     mRun = run;
-    sph::stampBirthTimes(mParticles, mRun.time);
+    sph::ensureBirthTimes(mParticles, mRun.time);
     mMass = Real(mass);
     mIsolatedRemoved = std::size_t(isolated);
     mRestoredSolids = std::size_t(solids);

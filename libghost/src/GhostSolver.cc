@@ -42,7 +42,7 @@ GhostSolver::GhostSolver(const GhostSettings& settings, std::unique_ptr<Pressure
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
-    sph::stampBirthTimes(mParticles, mRun.time);
+    sph::ensureBirthTimes(mParticles, mRun.time);
 }
 
 GhostSolver::~GhostSolver() = default;
@@ -915,7 +915,7 @@ void GhostSolver::restoreState(const SolverState& state)
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
     mRun = run;
-    sph::stampBirthTimes(mParticles, mRun.time);
+    sph::ensureBirthTimes(mParticles, mRun.time);
     mAirPhase = airPhase;
     mAirPhaseCredit = airPhaseCredit;
     mRestoredEmitterFills = emitterFills;

@@ -10,5 +10,10 @@ void stampBirthTimes(ParticleSet& set, double time)
     set.setScalarChannelDefault(BIRTH_TIME_CHANNEL, Real(time));
 }
 
+void ensureBirthTimes(ParticleSet& set, double time)
+{
+    set.addScalarChannel(BIRTH_TIME_CHANNEL, Real(time));
+}
+
 } // namespace sph
 } // namespace ghostfx
