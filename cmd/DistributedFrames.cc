@@ -75,9 +75,21 @@ openvdb::GridBase::Ptr pointsPiece(dist::MpiExchange& exchange, const sph::Parti
 {
     const auto xform = openvdb::math::Transform::createLinearTransform(po.voxelSize);
     const sph::DomainDecomposition& parts = exchange.decomposition();
+    // Attributes summed over neighbours are computed here, over copies of the other
+    // processes' particles near this region, before the points move.
+    sph::ParticleSet estimated;
+    const sph::ParticleSet* source = &set;
+    if (vdbio::needsNeighbourAttributes(set, po)) {
+        std::size_t own = 0;
+        const sph::ParticleSet near = exchange.surroundings(
+            set, po.kinds, sph::Real(vdbio::neighbourAttributeReach(set, po)), &own);
+        estimated = vdbio::withNeighbourAttributes(near, own, po);
+        source = &estimated;
+    }
     std::size_t sent = 0;
     const sph::ParticleSet leaves = exchange.redistribute(
-        set, po.kinds, [&](const sph::Vec3& x) { return leafOwner(x, *xform, parts); }, &sent);
+        *source, po.kinds, [&](const sph::Vec3& x) { return leafOwner(x, *xform, parts); },
+        &sent);
     mine.moved = sent;
     return vdbio::makePointsGrid(leaves, po);
 }

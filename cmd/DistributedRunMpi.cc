@@ -75,7 +75,7 @@ public:
         for (OutputMedium m : sim.media()) {
             const bool points = !(m.liquid ? outputs.pointsFile : outputs.gasPointsFile).empty();
             const bool volumes = !(m.liquid ? outputs.volumeFile : outputs.gasVolumeFile).empty();
-            const vdbio::PointsOptions po = pointsOptions(m, outputs);
+            const vdbio::PointsOptions po = pointsOptions(m, outputs, s.time);
             const vdbio::VolumeOptions vo = volumeOptions(m, outputs);
             BuiltGrids built =
                 buildFrameGrids(*mExchange, *m.particles, m.kinds, points ? &po : nullptr,

@@ -87,18 +87,20 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
 }
 
 /// Write one medium's points and volume files for `frame`; returns its grids (for previews).
-/// `built`: the grids already built (a run over several processes), else built here.
+/// `time` (s): the frame's time. `built`: the grids already built (a run over several processes),
+/// else built here.
 openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
                                 const std::string& pointsPath, const std::string& volumePath,
-                                const openvdb::MetaMap& fileMeta, const BuiltGrids* built)
+                                const openvdb::MetaMap& fileMeta, double time,
+                                const BuiltGrids* built)
 {
     if (!pointsPath.empty()) {
         if (built) {
             vdbio::writePointsGridFile(pointsPath, built->points, fileMeta);
         } else if (out.pointGhosts && m.withGhosts) {
-            vdbio::writePointsFile(pointsPath, m.withGhosts(), pointsOptions(m, out), fileMeta);
+            vdbio::writePointsFile(pointsPath, m.withGhosts(), pointsOptions(m, out, time), fileMeta);
         } else {
-            vdbio::writePointsFile(pointsPath, *m.particles, pointsOptions(m, out), fileMeta);
+            vdbio::writePointsFile(pointsPath, *m.particles, pointsOptions(m, out, time), fileMeta);
         }
     }
     if (volumePath.empty()) return {};
@@ -248,7 +250,8 @@ std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,
         const BuiltGrids* built = index < snapshot.built.size() ? &snapshot.built[index] : nullptr;
         const openvdb::GridPtrVec grids =
             writeMedium(m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
-                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta, built);
+                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
+                        snapshot.time, built);
         if (m.liquid && !out.meshFile.empty()) {
             notes.push_back(writeMesh(m, out, grids, inFolder(out.meshFile), snapshot.frame,
                                       fileMeta, built));

@@ -8,11 +8,15 @@
 namespace ghostfx {
 namespace cmd {
 
-vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out)
+vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out,
+                                   double time)
 {
     vdbio::PointsOptions po;
     po.channels = m.liquid ? out.pointChannels : out.gasPointChannels;
     po.kinds = m.kinds;
+    po.time = time;
+    po.restDensity = m.restDensity;
+    po.kernelSupport = m.support;
     if (out.pointGhosts && !m.ghostKinds.empty()) {
         po.kinds.insert(po.kinds.end(), m.ghostKinds.begin(), m.ghostKinds.end());
         if (std::find(po.channels.begin(), po.channels.end(), "kind") == po.channels.end()) {

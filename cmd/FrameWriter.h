@@ -53,7 +53,9 @@ struct FrameSnapshot
 
 /// The options a medium's points and volume outputs are built with, from the scene's outputs
 /// (the liquid's surface at h / 2 unless the scene says otherwise, its gathered grids at h).
-vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
+/// `time` (s): the state the points hold, for their "age".
+vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out,
+                                   double time);
 vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
 /// The grids the liquid's mesh output is made from: the volume output's options with only
 /// "surface" and "vel" asked for, the surface method and voxel size of outputs.mesh (the

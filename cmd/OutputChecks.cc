@@ -108,7 +108,7 @@ void checkOutputs(const vdbio::Scene& scene, const Simulation& sim)
     for (const OutputMedium& m : media) {
         const std::string key = msg("scene '", scene.file, "': outputs.", m.liquid ? "" : "gas_");
         if (!(m.liquid ? out.pointsFile : out.gasPointsFile).empty()) {
-            vdbio::checkPointsOutput(*m.particles, pointsOptions(m, out), key + "points.channels");
+            vdbio::checkPointsOutput(*m.particles, pointsOptions(m, out, sim.time()), key + "points.channels");
         }
         if (!(m.liquid ? out.volumeFile : out.gasVolumeFile).empty()) {
             const vdbio::VolumeOptions vo = volumeOptions(m, out);

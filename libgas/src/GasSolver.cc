@@ -13,6 +13,7 @@
 #include <ghostfx/sph/Kernels.h>
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/ParticleAge.h>
 #include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/Random.h>
 #include <ghostfx/sph/Timing.h>
@@ -68,6 +69,7 @@ GasSolver::GasSolver(const GasSettings& settings)
     mParticles.addScalarChannel(channel::TEMPERATURE, mSettings.ambientTemperature);
     mParticles.addScalarChannel(channel::SUPPORT, mSettings.supportRadius());
     addStepChannels();
+    sph::ensureBirthTimes(mParticles, mRun.time);
 }
 
 void GasSolver::addStepChannels()
@@ -925,6 +927,8 @@ void GasSolver::step(Real dt)
         throw ValueError(msg("gas step: dt = ", dt, " s: expected a finite value > 0"));
     }
     checkRestoredInputs();
+    // Whatever this step adds (sources, ambient air) is born now.
+    sph::stampBirthTimes(mParticles, mRun.time);
     initialize();
     const auto start = std::chrono::steady_clock::now();
     auto t0 = start;
@@ -947,6 +951,7 @@ void GasSolver::step(Real dt)
     const double t1 = mRun.time + double(dt);
     moveSolids(t1);
     mRun.time = t1;
+    sph::stampBirthTimes(mParticles, mRun.time); // vapour added before the next step
     projectOutOfSolids(dt);
     checkBlowUp(dt);
     ++mRun.step;
@@ -1102,6 +1107,7 @@ void GasSolver::restoreState(const SolverState& state)
     // Channels a fresh solver of these settings has; states saved by this solver have them.
     addStepChannels();
     mRun = run;
+    sph::ensureBirthTimes(mParticles, mRun.time);
     mMass = Real(mass);
     mIsolatedRemoved = std::size_t(isolated);
     mRestoredSolids = std::size_t(solids);

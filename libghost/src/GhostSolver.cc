@@ -10,6 +10,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/ParticleAge.h>
 #include <ghostfx/sph/PoissonSampler.h>
 #include <ghostfx/sph/Random.h>
 #include <ghostfx/sph/SphDensity.h>
@@ -41,6 +42,7 @@ GhostSolver::GhostSolver(const GhostSettings& settings, std::unique_ptr<Pressure
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
+    sph::ensureBirthTimes(mParticles, mRun.time);
 }
 
 GhostSolver::~GhostSolver() = default;
@@ -902,7 +904,8 @@ void GhostSolver::restoreState(const SolverState& state)
          {SOLID_NORMAL, SOLID_INDEX, SOLID_VELOCITY, SOLID_LOCAL, SOLID_LOCAL_NORMAL}) {
         mParticles.removeChannel(c);
     }
-    for (const char* c : {VSTAR, AIR_WEIGHT, AIR_TARGET}) mPendingSolids.removeChannel(c);
+    for (const char* c : {VSTAR, AIR_WEIGHT, AIR_TARGET, sph::BIRTH_TIME_CHANNEL})
+        mPendingSolids.removeChannel(c);
     // States saved by this solver have these channels; a missing one gets what a fresh solver
     // would have.
     mParticles.addVectorChannel(VSTAR);
@@ -912,6 +915,7 @@ void GhostSolver::restoreState(const SolverState& state)
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
     mRun = run;
+    sph::ensureBirthTimes(mParticles, mRun.time);
     mAirPhase = airPhase;
     mAirPhaseCredit = airPhaseCredit;
     mRestoredEmitterFills = emitterFills;

@@ -17,6 +17,7 @@
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/PairBatch.h>
 #include <ghostfx/sph/Parallel.h>
+#include <ghostfx/sph/ParticleAge.h>
 
 #include <algorithm>
 #include <atomic>
@@ -464,6 +465,8 @@ void GhostSolver::step(Real dt, bool reportPressure)
         throw ValueError(msg("liquid step: dt = ", dt, " s: expected a finite value > 0"));
     }
     checkRestoredInputs();
+    // Whatever this step adds (emitters, resampled air) is born now.
+    sph::stampBirthTimes(mParticles, mRun.time);
     mReportPressure = reportPressure;
     const bool fresh = !mRun.initialized;
     const auto start = std::chrono::steady_clock::now();

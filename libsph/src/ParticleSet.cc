@@ -311,6 +311,12 @@ Real ParticleSet::scalarChannelDefault(const std::string& name) const
     return mScalars.find(name)->second.defaultValue;
 }
 
+void ParticleSet::setScalarChannelDefault(const std::string& name, Real value)
+{
+    scalarChannel(name);
+    mScalars.find(name)->second.defaultValue = value;
+}
+
 Vec3 ParticleSet::vectorChannelDefault(const std::string& name) const
 {
     vectorChannel(name);

@@ -321,9 +321,10 @@ TEST_F(Robustness, EveryOutputOptionIsCheckedBeforeTheFirstStep)
     const std::string scene = write(fallingBlock());
     const fs::path out = mDir / "out";
     const std::string run = "run " + scene + " --out " + out.string();
-    EXPECT_CONTAINS(errorLine(run + " -D 'outputs.points.channels=[\"v\",\"age\"]'"),
-                    "scene '" + scene + "': outputs.points.channels: channel 'age' not found: "
-                                        "available: v, id, density, pressure, mass, kind");
+    EXPECT_CONTAINS(errorLine(run + " -D 'outputs.points.channels=[\"v\",\"foam\"]'"),
+                    "scene '" + scene + "': outputs.points.channels: channel 'foam' not found: "
+                                        "available: v, id, density, pressure, mass, kind, age, "
+                                        "pscale, vorticity, curvature");
     EXPECT_CONTAINS(errorLine(run + " -D outputs.preview.file=p.\\$F4.exr -D outputs.preview.grid=vel"),
                     "outputs.preview.grid = 'vel': the volume output has no such grid");
     EXPECT_CONTAINS(errorLine(run + " -D 'outputs.volume.grids=[\"temperature\"]'"),

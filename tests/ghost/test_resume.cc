@@ -172,7 +172,8 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     liquidOnly.advanceFrame();
     const ParticleSet& p = liquidOnly.particles();
     EXPECT_EQ(p.vectorChannelNames(), (std::vector<std::string>{"vstar"}));
-    EXPECT_EQ(p.scalarChannelNames(), (std::vector<std::string>{"air_target", "air_weight"}));
+    EXPECT_EQ(p.scalarChannelNames(),
+              (std::vector<std::string>{"air_target", "air_weight", "birth_time"}));
     EXPECT_EQ(liquidOnly.count(ParticleKind::GhostSolid), 0u);
     EXPECT_EQ(liquidOnly.count(ParticleKind::Boundary), 0u);
     EXPECT_GT(liquidOnly.count(ParticleKind::GhostAir), 0u);
@@ -187,7 +188,7 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     basic.advanceFrame();
     const ParticleSet& q = basic.particles();
     EXPECT_EQ(q.vectorChannelNames(), (std::vector<std::string>{"vstar"}));
-    EXPECT_TRUE(q.scalarChannelNames().empty());
+    EXPECT_EQ(q.scalarChannelNames(), (std::vector<std::string>{"birth_time"}));
     const ParticleSet solids = basic.solidParticles();
     EXPECT_EQ(solids.vectorChannelNames(), (std::vector<std::string>{"normal"}));
     EXPECT_EQ(solids.scalarChannelNames(), (std::vector<std::string>{"solid_index"}));
@@ -204,12 +205,12 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     EXPECT_EQ(paddle.solidParticles().vectorChannelNames(),
               (std::vector<std::string>{"normal", "solid_n", "solid_v", "solid_x"}));
 
-    // Basic SPH, liquid only: one channel.
+    // Basic SPH, liquid only: v* and the birth times (sph::BIRTH_TIME_CHANNEL, for "age").
     GhostSolver bare(basicSettings);
     bare.addLiquid(scene.liquid);
     bare.advanceFrame();
     EXPECT_EQ(bare.particles().vectorChannelNames(), (std::vector<std::string>{"vstar"}));
-    EXPECT_TRUE(bare.particles().scalarChannelNames().empty());
+    EXPECT_EQ(bare.particles().scalarChannelNames(), (std::vector<std::string>{"birth_time"}));
 
     // Bytes per particle of the particle storage: built-in channels 2 Vec3 + 3 Real + kind + id,
     // plus the named ones.
@@ -217,12 +218,13 @@ TEST(Channels, OnlyWhatTheSceneRequires)
     auto perParticle = [](const ParticleSet& s) {
         return double(s.memoryBytes()) / double(s.size());
     };
-    const double ghostSize = builtIn + sizeof(Vec3) + 2 * sizeof(Real);
+    const double ghostSize = builtIn + sizeof(Vec3) + 3 * sizeof(Real);
     const double staticSolidSize = builtIn + sizeof(Vec3) + sizeof(Real);
     std::printf("[measured] bytes per particle: ghost liquid-only %.1f (size-based %.0f), static "
                 "solid particles %.1f (%.0f), basic liquid-only %.1f (%.0f)\n",
                 perParticle(liquidOnly.particles()), ghostSize, perParticle(solids),
-                staticSolidSize, perParticle(bare.particles()), builtIn + sizeof(Vec3));
+                staticSolidSize, perParticle(bare.particles()),
+                builtIn + sizeof(Vec3) + sizeof(Real));
     // memoryBytes counts capacity: at least the size-based bytes, and at most twice that
     // (vectors grow by doubling), plus the scratch of a sort that may be a little larger.
     EXPECT_GE(perParticle(liquidOnly.particles()), ghostSize);

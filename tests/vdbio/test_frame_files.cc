@@ -851,11 +851,11 @@ TEST(FrameFiles, ErrorsNameTheOptionAndTheValue)
     EXPECT_NE(unknown.find("temperature"), std::string::npos) << unknown;
 
     vdbio::PointsOptions po;
-    po.channels = {"v", "vorticity"};
+    po.channels = {"v", "foam"};
     const std::string points = messageOf(
         [&] { vdbio::writePointsFile((freshDir("errors") / "p.vdb").string(), sc.particles, po); });
-    EXPECT_NE(points.find("channel 'vorticity' not found: available: v, id, density, pressure, "
-                          "mass, kind, temperature, normal"),
+    EXPECT_NE(points.find("channel 'foam' not found: available: v, id, density, pressure, "
+                          "mass, kind, age, pscale, vorticity, curvature, temperature, normal"),
               std::string::npos)
         << points;
 

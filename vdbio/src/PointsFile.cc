@@ -8,6 +8,7 @@
 ///          through the same index grid so the attribute arrays follow the point order of "P".
 ///          Only this translation unit instantiates the points templates (STACK.md).
 #include "FrameGridsDetail.h"
+#include "RenderAttributes.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/Parallel.h>
@@ -19,6 +20,7 @@
 #include <openvdb/points/PointDataGrid.h>
 #include <openvdb/tools/PointIndexGrid.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -84,6 +86,41 @@ std::string kindNamesList()
     return out;
 }
 
+/// Append channel `name` (checked by checkPointsOutput) of the selected particles: a built-in,
+/// a named channel of the set, else a render attribute.
+void addChannel(PointDataTree& tree, const PointIndexTree& indexTree,
+                const sph::ParticleSet& particles, const std::vector<sph::Index>& selection,
+                const PointsOptions& options, const std::string& name)
+{
+    if (name == "v") {
+        addAttribute(tree, indexTree, name, gatherSelected3(particles.velocities(), selection));
+    } else if (name == "id") {
+        addAttribute(tree, indexTree, name,
+                     gatherSelected<std::int64_t>(particles.ids(), selection));
+    } else if (name == "density") {
+        addAttribute(tree, indexTree, name, gatherSelected<float>(particles.densities(), selection));
+    } else if (name == "pressure") {
+        addAttribute(tree, indexTree, name, gatherSelected<float>(particles.pressures(), selection));
+    } else if (name == "mass") {
+        addAttribute(tree, indexTree, name, gatherSelected<float>(particles.masses(), selection));
+    } else if (name == "kind") {
+        std::vector<std::int32_t> kinds(selection.size());
+        for (std::size_t k = 0; k < selection.size(); ++k) {
+            kinds[k] = std::int32_t(particles.kinds()[selection[k]]);
+        }
+        addAttribute(tree, indexTree, name, kinds);
+    } else if (particles.hasScalarChannel(name)) {
+        addAttribute(tree, indexTree, name,
+                     gatherSelected<float>(particles.scalarChannel(name), selection));
+    } else if (particles.hasVectorChannel(name)) {
+        addAttribute(tree, indexTree, name,
+                     gatherSelected3(particles.vectorChannel(name), selection));
+    } else {
+        addAttribute(tree, indexTree, name,
+                     detail::renderAttribute(particles, selection, options, name));
+    }
+}
+
 } // namespace
 
 void PointsOptions::validate() const
@@ -121,13 +158,19 @@ void checkPointsOutput(const sph::ParticleSet& particles, const PointsOptions& o
     for (const std::string& name : options.channels) {
         bool builtin = false;
         for (const char* b : BUILTIN_CHANNELS) builtin = builtin || name == b;
-        if (builtin || particles.hasScalarChannel(name) || particles.hasVectorChannel(name)) {
+        if (builtin || particles.hasScalarChannel(name) || particles.hasVectorChannel(name)
+            || detail::checkRenderAttribute(particles, options, name, where)) {
             continue;
         }
         std::vector<std::string> available(std::begin(BUILTIN_CHANNELS),
                                            std::end(BUILTIN_CHANNELS));
-        for (const std::string& n : particles.scalarChannelNames()) available.push_back(n);
-        for (const std::string& n : particles.vectorChannelNames()) available.push_back(n);
+        auto offer = [&](const std::string& n) {
+            if (std::find(available.begin(), available.end(), n) == available.end())
+                available.push_back(n);
+        };
+        for (const std::string& n : detail::renderAttributeNames(options)) offer(n);
+        for (const std::string& n : particles.scalarChannelNames()) offer(n);
+        for (const std::string& n : particles.vectorChannelNames()) offer(n);
         throw ValueError(msg(where, ": channel '", name,
                              "' not found: available: ", detail::joinNames(available)));
     }
@@ -168,35 +211,8 @@ openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
     PointDataTree& tree = grid->tree();
     const PointIndexTree& indexTree = indexGrid->tree();
 
-    for (const std::string& name : options.channels) {
-        if (name == "v") {
-            addAttribute(tree, indexTree, name, gatherSelected3(particles.velocities(), selection));
-        } else if (name == "id") {
-            addAttribute(tree, indexTree, name,
-                         gatherSelected<std::int64_t>(particles.ids(), selection));
-        } else if (name == "density") {
-            addAttribute(tree, indexTree, name,
-                         gatherSelected<float>(particles.densities(), selection));
-        } else if (name == "pressure") {
-            addAttribute(tree, indexTree, name,
-                         gatherSelected<float>(particles.pressures(), selection));
-        } else if (name == "mass") {
-            addAttribute(tree, indexTree, name,
-                         gatherSelected<float>(particles.masses(), selection));
-        } else if (name == "kind") {
-            std::vector<std::int32_t> kinds(selection.size());
-            for (std::size_t k = 0; k < selection.size(); ++k) {
-                kinds[k] = std::int32_t(particles.kinds()[selection[k]]);
-            }
-            addAttribute(tree, indexTree, name, kinds);
-        } else if (particles.hasScalarChannel(name)) {
-            addAttribute(tree, indexTree, name,
-                         gatherSelected<float>(particles.scalarChannel(name), selection));
-        } else {
-            addAttribute(tree, indexTree, name,
-                         gatherSelected3(particles.vectorChannel(name), selection));
-        }
-    }
+    for (const std::string& name : options.channels)
+        addChannel(tree, indexTree, particles, selection, options, name);
 
     grid->setName("particles");
     grid->setCreator("ghostfx");

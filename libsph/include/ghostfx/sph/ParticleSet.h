@@ -122,6 +122,9 @@ public:
     /// channel is missing. Checkpoints store it so a resumed set fills new particles alike.
     Real scalarChannelDefault(const std::string& name) const;
     Vec3 vectorChannelDefault(const std::string& name) const;
+    /// Change the value particles added from now on get in a scalar channel (those already in
+    /// the set keep theirs). Throws ValueError like scalarChannel() if the channel is missing.
+    void setScalarChannelDefault(const std::string& name, Real value);
 
     /// Bytes held by the arrays of every channel, built-in and named: the sum of each vector's
     /// capacity() times its element size. Capacity, not size, because that is what the process

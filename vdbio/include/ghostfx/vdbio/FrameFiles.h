@@ -51,8 +51,11 @@ struct PointsOptions
     /// Channels written besides P. Built-ins: "v" (m/s, vec3f), "id" (int64), "density"
     /// (kg/m^3), "pressure" (Pa), "mass" (kg), "kind" (int32, ParticleKind value; the grid
     /// metadata "kind_names" lists the names). Any named scalar (float) or vector (vec3f)
-    /// channel of the ParticleSet may be added (e.g. "temperature"). Unknown names throw
-    /// ValueError naming the channel and listing those available.
+    /// channel of the ParticleSet may be added (e.g. "temperature"); a channel of the set
+    /// takes the place of a render attribute of the same name. Render attributes (float,
+    /// RenderAttributes.h): "age" (s), "pscale" (m) and, on liquid points, "vorticity" (1/s)
+    /// and "curvature" (1/m).
+    /// Unknown names throw ValueError naming the channel and listing those available.
     std::vector<std::string> channels = {"v", "id", "density", "pressure"};
     /// Particle kinds written. Ghost particles are never written unless listed here.
     std::vector<sph::ParticleKind> kinds = {sph::ParticleKind::Liquid};
@@ -60,6 +63,15 @@ struct PointsOptions
     /// than two points are selected). The voxel size only affects how points are bucketed,
     /// not their positions.
     double voxelSize = 0;
+
+    /// Time of the particles' state (s): "age" is this minus each particle's birth time.
+    double time = 0;
+    /// Rest density rho0 of the medium (kg/m^3), for "pscale" and the neighbour volumes
+    /// m_j / rho0 of "vorticity" and "curvature"; 0 refuses those channels.
+    double restDensity = 0;
+    /// Kernel support radius R of the medium (m), for "vorticity" and "curvature"; 0 refuses
+    /// them.
+    double kernelSupport = 0;
 
     /// Throw ValueError naming the first bad field (negative voxel size, duplicate channel,
     /// no kind).
@@ -92,6 +104,22 @@ openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
 /// run calls it before its first step, so no output is written before such an error.
 void checkPointsOutput(const sph::ParticleSet& particles, const PointsOptions& options,
                        const std::string& where = "points output");
+
+/// True when `options` asks for a render attribute that sums over neighbours ("vorticity",
+/// "curvature") and that `particles` does not carry as a channel.
+bool needsNeighbourAttributes(const sph::ParticleSet& particles, const PointsOptions& options);
+
+/// How far (m) from a particle the neighbours that its attributes of needsNeighbourAttributes
+/// read can lie: the kernel support, three times it for "curvature"; 0 when none is asked.
+double neighbourAttributeReach(const sph::ParticleSet& particles, const PointsOptions& options);
+
+/// The first `count` particles of `particles`, with each render attribute of `options` that
+/// sums over neighbours computed over all of `particles` and kept as a scalar channel of that
+/// name, which makePointsGrid then writes as it is. A run over several processes passes its
+/// own particles followed by copies of the others' within the kernel support, so that the
+/// estimate sees across the border before the points travel to the process that writes them.
+sph::ParticleSet withNeighbourAttributes(const sph::ParticleSet& particles, std::size_t count,
+                                         const PointsOptions& options);
 
 /// The voxel size PointsOptions::voxelSize = 0 picks for these positions (OpenVDB's
 /// points::computeVoxelSize at AUTO_POINTS_PER_VOXEL; 0.1 m for fewer than two).
