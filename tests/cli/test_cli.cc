@@ -20,7 +20,9 @@
 #include <openvdb/points/PointDataGrid.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -574,6 +576,107 @@ TEST_F(Cli, InfoPreviewAndSceneFromRoleTaggedVdb)
                   .code,
               0);
     EXPECT_TRUE(fs::exists(mDir / "p.exr"));
+}
+
+namespace {
+
+/// A closed box [lo, hi] (m) as OBJ text.
+std::string boxObj(const std::array<double, 3>& lo, const std::array<double, 3>& hi)
+{
+    std::ostringstream obj;
+    for (int c = 0; c < 8; ++c) {
+        obj << "v " << (c & 1 ? hi : lo)[0] << " " << (c & 2 ? hi : lo)[1] << " "
+            << (c & 4 ? hi : lo)[2] << "\n";
+    }
+    obj << "f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
+    return obj.str();
+}
+
+/// A closed UV sphere of `radius` (m) around `centre`: 12 rings of 24 vertices and the poles.
+std::string ballObj(const std::array<double, 3>& centre, double radius)
+{
+    constexpr int RINGS = 12, SLICES = 24;
+    std::ostringstream obj;
+    obj << "v " << centre[0] << " " << centre[1] + radius << " " << centre[2] << "\n";
+    for (int i = 1; i < RINGS; ++i) {
+        const double polar = M_PI * i / RINGS;
+        for (int j = 0; j < SLICES; ++j) {
+            const double azimuth = 2 * M_PI * j / SLICES;
+            obj << "v " << centre[0] + radius * std::sin(polar) * std::cos(azimuth) << " "
+                << centre[1] + radius * std::cos(polar) << " "
+                << centre[2] + radius * std::sin(polar) * std::sin(azimuth) << "\n";
+        }
+    }
+    obj << "v " << centre[0] << " " << centre[1] - radius << " " << centre[2] << "\n";
+    const int south = 2 + (RINGS - 1) * SLICES;
+    auto ring = [](int i, int j) { return 2 + (i - 1) * SLICES + j % SLICES; }; // 1-based
+    for (int j = 0; j < SLICES; ++j) {
+        obj << "f 1 " << ring(1, j + 1) << " " << ring(1, j) << "\n";
+        for (int i = 1; i + 1 < RINGS; ++i) {
+            obj << "f " << ring(i, j) << " " << ring(i, j + 1) << " " << ring(i + 1, j + 1) << " "
+                << ring(i + 1, j) << "\n";
+        }
+        obj << "f " << south << " " << ring(RINGS - 1, j) << " " << ring(RINGS - 1, j + 1)
+            << "\n";
+    }
+    return obj.str();
+}
+
+} // namespace
+
+TEST_F(Cli, Mesh2SdfAppendsASolidAndALiquidIntoOneVdbScene)
+{
+    // Two meshes, two calls: a floor slab (solid) and a ball of water above it (liquid), both
+    // into scene.vdb with --append; the .vdb is then a scene that runs with both.
+    std::ofstream(mDir / "floor.obj") << boxObj({0, 0, 0}, {0.3, 0.05, 0.3});
+    std::ofstream(mDir / "ball.obj") << ballObj({0.15, 0.12, 0.15}, 0.05);
+    const std::string vdb = (mDir / "scene.vdb").string();
+    const std::string common = " -o " + vdb + " --voxel-size 0.0075 --append";
+    ASSERT_EQ(run("mesh2sdf " + (mDir / "floor.obj").string() + common + " --role solid --name floor")
+                  .code,
+              0);
+    ASSERT_EQ(run("mesh2sdf " + (mDir / "ball.obj").string() + common + " --role liquid --name water")
+                  .code,
+              0);
+    EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "(appended)");
+    const auto grids = gridBytes(mDir / "scene.vdb");
+    ASSERT_EQ(grids.size(), 2u);
+    EXPECT_EQ(grids.count("floor"), 1u);
+    EXPECT_EQ(grids.count("water"), 1u);
+
+    // The same name again is one line and leaves the file as it was; --replace replaces it.
+    EXPECT_CONTAINS(errorLine("mesh2sdf " + (mDir / "floor.obj").string() + common
+                              + " --role liquid --name water"),
+                    "'" + vdb + "' already has a grid 'water': expected a new name (--name) or "
+                    "--replace");
+    EXPECT_EQ(gridBytes(mDir / "scene.vdb"), grids);
+    ASSERT_EQ(run("mesh2sdf " + (mDir / "ball.obj").string() + common
+                  + " --role liquid --name water --replace")
+                  .code,
+              0);
+    EXPECT_EQ(gridBytes(mDir / "scene.vdb").size(), 2u);
+
+    // The scene: spacing twice the voxel (0.015 m); the log's frame line counts the media.
+    const Result ran = run("run " + vdb + " --out " + (mDir / "out").string()
+                           + " --frames 1-1 --progress log");
+    ASSERT_EQ(ran.code, 0) << ran.err;
+    std::size_t liquid = 0, air = 0, solid = 0;
+    const std::size_t at = ran.err.find("frame 1/1: ");
+    ASSERT_NE(at, std::string::npos) << ran.err;
+    ASSERT_EQ(std::sscanf(ran.err.c_str() + ran.err.find("steps, ", at),
+                          "steps, %zu liquid, %zu air, %zu solid ghosts", &liquid, &air, &solid),
+              3)
+        << ran.err;
+    // The ball's volume (4/3 pi 0.05^3 = 5.24e-4 m^3, less the polygon's 2 %) over h^3 is 152
+    // particles; the sampler packs 1.1-1.2 per h^3 (the 0.1 m cube of smallScene: 346 for
+    // 296). Bounds 0.9-1.4 of it. The floor's ghosts: at least one layer under the ball.
+    const double perCube = 5.24e-4 / (0.015 * 0.015 * 0.015);
+    std::printf("[measured] .vdb scene from two appended meshes: %zu liquid (%.2f per h^3 of the "
+                "ball), %zu air, %zu solid ghosts\n",
+                liquid, liquid / perCube, air, solid);
+    EXPECT_GT(liquid, 0.9 * perCube);
+    EXPECT_LT(liquid, 1.4 * perCube);
+    EXPECT_GT(solid, 100u);
 }
 
 namespace {
