@@ -571,11 +571,30 @@ TEST_F(Cli, InfoPreviewAndSceneFromRoleTaggedVdb)
     EXPECT_CONTAINS(text, "density");
     EXPECT_EQ(run("info " + (out / "checkpoint.0001.h5").string()).code, 0);
     EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "schema_version");
+    // The frame holds density, surface and vel: by default the preview draws the liquid's
+    // surface, and the extension chooses the format.
     EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o "
                   + (mDir / "p.exr").string() + " --width 64 --height 48")
                   .code,
               0);
     EXPECT_TRUE(fs::exists(mDir / "p.exr"));
+    EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "grid 'surface' (level set");
+    EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o "
+                  + (mDir / "p.png").string() + " --width 64 --height 48 --grid density")
+                  .code,
+              0);
+    EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "grid 'density' (fog volume");
+    std::ifstream png(mDir / "p.png", std::ios::binary);
+    char magic[4] = {};
+    png.read(magic, 4);
+    EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "a .png output is a PNG file";
+    // The help says which formats it writes and how one is chosen.
+    ASSERT_EQ(run("preview --help").code, 0);
+    const std::string help = slurp(mDir / "stdout.txt");
+    EXPECT_CONTAINS(help, ".exr");
+    EXPECT_CONTAINS(help, ".png");
+    EXPECT_CONTAINS(help, "extension chooses the format");
+    EXPECT_CONTAINS(help, "default: 'surface'");
 }
 
 namespace {
