@@ -738,6 +738,11 @@ TEST_F(Cli, GasPlumeRunsToDensityAndTemperatureVolumes)
     std::printf("[measured] hottest temperature voxel %.1f K\n", hottest);
     EXPECT_GT(hottest, 400.f);
     EXPECT_LE(hottest, 600.5f);
+    // Outside the plume the grid reads the scene's ambient temperature (the default 293.15 K),
+    // which its metadata also gives.
+    EXPECT_EQ(temperature->background(), 293.15f);
+    EXPECT_EQ(temperature->metaValue<float>("ghostfx_ambient_temperature"), 293.15f);
+    EXPECT_EQ(temperature->tree().getValue(openvdb::Coord(100000, 100000, 100000)), 293.15f);
     EXPECT_FALSE(fs::exists(out / "liquid.0001.vdb")) << "no liquid output in a gas scene";
     EXPECT_GT(pointCount(out / "gas_points.0003.vdb"), 0u);
 
@@ -800,6 +805,15 @@ TEST_F(Cli, BoilingPanRunsLiquidAndVapour)
     const std::size_t vapour = pointCount(out / "gas_points.0002.vdb");
     std::printf("[measured] %zu vapour particles after 2 frames\n", vapour);
     EXPECT_GT(vapour, 0u);
+    // The vapour's temperature grid reads the gas's ambient temperature outside the vapour.
+    openvdb::io::File gas((out / "gas.0002.vdb").string());
+    gas.open();
+    auto vapourTemperature =
+        openvdb::gridPtrCast<openvdb::FloatGrid>(gas.readGrid("temperature"));
+    gas.close();
+    ASSERT_TRUE(vapourTemperature);
+    EXPECT_EQ(vapourTemperature->background(), 293.15f);
+    EXPECT_EQ(vapourTemperature->metaValue<float>("ghostfx_ambient_temperature"), 293.15f);
     // Mass budget per step in the statistics: liquid + gas stays constant (float round-off).
     const std::string csv = slurp(out / "stats.csv");
     EXPECT_NE(csv.find("mass_liquid"), std::string::npos);
