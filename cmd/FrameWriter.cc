@@ -55,6 +55,7 @@ vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutp
                                  " particles carry no temperature in this scene"));
         }
         vo.scalarChannels.push_back("temperature");
+        vo.ambientTemperature = m.ambientTemperature;
     }
     return vo;
 }

@@ -34,6 +34,7 @@ OutputMedium gasMedium(const gas::GasSolver& s, const sph::ParticleSet& visible)
     m.restDensity = s.settings().restDensity;
     m.gravity = s.settings().gravity;
     m.liquid = false;
+    m.ambientTemperature = double(s.settings().ambientTemperature);
     return m;
 }
 

@@ -189,7 +189,8 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
         }
     }
     for (const vdbio::SceneEmitter& e : scene.emitters) {
-        solver->addEmitter(e.shape, Vec3(e.velocity), e.start, e.end);
+        if (e.motion.keys.empty()) solver->addEmitter(e.shape, Vec3(e.velocity), e.start, e.end);
+        else solver->addMovingEmitter(e.shape, Vec3(e.velocity), e.motion.motion(), e.start, e.end);
     }
     return solver;
 }

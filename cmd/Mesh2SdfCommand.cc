@@ -27,6 +27,12 @@ Command addMesh2SdfCommand(CLI::App& parent)
     c->add_option("--role", o.role,
                   "scene role stored as grid metadata 'ghostfx_role': " + vdbio::meshRoles());
     c->add_option("--scale", o.scale, "uniform scale from mesh units to m")->capture_default_str();
+    CLI::Option* append =
+        c->add_flag("--append", o.append,
+                    "add the grid to the output .vdb, keeping the grids it holds (a scene of a "
+                    "solid and a liquid from two calls); a grid of the same name is refused");
+    c->add_flag("--replace", o.replace, "with --append: replace a grid of the same name")
+        ->needs(append);
     return {c, [args] {
                 const vdbio::MeshToSdfOptions& o = args->options;
                 const auto t0 = std::chrono::steady_clock::now();
@@ -49,7 +55,8 @@ Command addMesh2SdfCommand(CLI::App& parent)
                             o.voxelSize, o.halfWidth,
                             static_cast<unsigned long long>(grid->activeVoxelCount()), lo.x(),
                             lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
-                std::printf("  -> '%s' in %.2f s\n", args->output.c_str(), seconds);
+                std::printf("  -> '%s'%s in %.2f s\n", args->output.c_str(),
+                            o.append ? " (appended)" : "", seconds);
                 if (stats.boundaryEdges > 0 || stats.nonManifoldEdges > 0) {
                     std::fprintf(stderr,
                                  "ghostfx mesh2sdf: warning: the mesh is not closed (%zu open "

@@ -1,5 +1,6 @@
 /// @file   PreviewCommand.cc
-/// @brief  `ghostfx preview`: render a density (fog) or surface (level-set) grid to an EXR.
+/// @brief  `ghostfx preview`: render a surface (level-set) or density (fog) grid to an EXR or
+///         PNG image.
 #include "Command.h"
 
 #include <ghostfx/vdbio/Preview.h>
@@ -15,13 +16,16 @@ Command addPreviewCommand(CLI::App& parent)
 {
     auto args = std::make_shared<FileToFileArgs<vdbio::PreviewOptions>>();
     vdbio::PreviewOptions& o = args->options;
-    CLI::App* c = addFileToFileCommand(parent, "preview",
-                                       "Render a fog volume (density) or level set (surface) of "
-                                       "a .vdb to an EXR image, camera framed on the grid",
-                                       "file", "input .vdb file", "output .exr image", *args);
+    CLI::App* c = addFileToFileCommand(
+        parent, "preview",
+        "Render a level set (the liquid's surface) or fog volume (density) of a .vdb to an "
+        "image, camera framed on the grid. The output's extension chooses the format: .png "
+        "writes an 8-bit sRGB PNG, .exr (or any other name) a half-float RGBA OpenEXR",
+        "file", "input .vdb file", "output image: .exr (half-float RGBA) or .png (8-bit sRGB)",
+        *args);
     c->add_option("--grid", o.grid,
-                  "grid to render (default: 'density' if present, else 'surface', else the "
-                  "first float grid)");
+                  "grid to render (default: 'surface', the liquid's level set, if present, "
+                  "else 'density', else the first float grid)");
     c->add_option("--width", o.width, "image width (pixels)")->capture_default_str();
     c->add_option("--height", o.height, "image height (pixels)")->capture_default_str();
     c->add_option("--azimuth", o.azimuth,

@@ -14,6 +14,7 @@
 #include <ghostfx/vdbio/Stats.h>
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +35,8 @@ struct OutputMedium
     double spacing = 0, support = 0, restDensity = 0;
     sph::Vec3 gravity{0}; ///< the medium's gravity (m/s^2)
     bool liquid = true;   ///< liquids get a surface; gases get temperature
+    /// A gas's ambient temperature (K): its temperature grid's background; NaN: none.
+    double ambientTemperature = std::numeric_limits<double>::quiet_NaN();
 };
 
 class Simulation

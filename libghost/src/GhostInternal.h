@@ -22,20 +22,58 @@
 namespace ghostfx {
 namespace ghost {
 
-/// A continuous liquid source.
-struct GhostSolver::Emitter
+/// A continuous liquid source: its shape in its own frame and, for a moving emitter (a hose
+/// sweeping a floor), the rigid motion that places it (empty: the shape stays where it is
+/// given). Its velocity is the liquid's in its own frame; in the world the liquid leaves at
+/// that velocity rotated with the emitter plus the emitter's own velocity where it is.
+struct GhostSolver::Emitter : sph::MovingLevelSet
 {
-    sph::LevelSet shape;
-    sph::Vec3 velocity;
+    /// A static emitter (give a moving one its `motion`, then placeAt()).
+    Emitter(const sph::LevelSet& shape_, const sph::Vec3& velocity_, double start_, double end_)
+        : MovingLevelSet{shape_, {}}
+        , velocity(velocity_)
+        , start(start_)
+        , end(end_)
+        , box(shape_.bounds())
+    {}
+
+    sph::Vec3 velocity; ///< of the liquid leaving it (m/s), in the emitter's frame
     double start, end;
     /// The shape's shadow along the velocity (m^2; 0 without velocity): the emitted volume
-    /// per second is |velocity| crossSection.
+    /// per second is |velocity| crossSection, in the emitter's frame.
     double crossSection = 0;
     /// Mass (kg) the emitter owes: rho0 |velocity| crossSection per second of its steps,
     /// less the mass of the particles it added (GhostSolver::emit()).
     double credit = 0;
     /// The fills' Poisson radius, in the sampler's radii r (GhostSolver::limitToCredit).
     double fillScale = 1;
+    /// Where placeAt() put a moving emitter (local to world), at `placedTime` (s), and the
+    /// world box of its shape there (a static emitter's: its shape's bounds).
+    sph::RigidTransform placement;
+    double placedTime = 0;
+    sph::Aabb box;
+
+    bool moving() const { return bool(motion); }
+    /// Place a moving emitter at `time` (s); a static one stays as it is.
+    void placeAt(double time);
+    /// Level-set value (m) at the world point x where the emitter is placed.
+    sph::Real placedPhi(const sph::Vec3& x) const
+    {
+        return moving() ? shape.phi(placement.toLocal(x)) : shape.phi(x);
+    }
+    /// x (m, world) in the placed box and inside the placed shape.
+    bool contains(const sph::Vec3& x) const { return box.contains(x) && placedPhi(x) < 0; }
+    /// The world point of the emitter's local point (m).
+    sph::Vec3 placedPoint(const sph::Vec3& local) const
+    {
+        return moving() ? placement.toWorld(local) : local;
+    }
+    /// The velocity (m/s, world) the emitter gives liquid at the world point x: `velocity`
+    /// rotated with the emitter plus the emitter's velocity at x (translation rate plus
+    /// rotation rate times x in the emitter's frame); `velocity` itself for a static one.
+    sph::Vec3 liquidVelocity(const sph::Vec3& x) const;
+    /// Write liquidVelocity(x[k]) to velocities[k] for every new particle x[k].
+    void giveVelocities(const std::vector<sph::Vec3>& x, sph::Vec3* velocities) const;
 };
 
 /// A solid: its level set (in its local frame), its rigid motion, and whether it moves (a

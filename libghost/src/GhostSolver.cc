@@ -453,7 +453,7 @@ void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double
         throw ValueError(msg("emitter '", shape.name(), "': start ", startTime, " s, end ", endTime,
                              " s: expected 0 <= start < end"));
     }
-    auto emitter = std::make_unique<Emitter>(Emitter{shape, velocity, startTime, endTime});
+    auto emitter = std::make_unique<Emitter>(shape, velocity, startTime, endTime);
     if (velocity.lengthSqr() > Real(0)) {
         // Half the finer of the spacing and the voxel, but at most 512 cells across the shape
         // (a metre-wide emitter at 5 mm would otherwise trace 640k rays): the outline's cells
@@ -467,6 +467,15 @@ void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double
         std::tie(emitter->credit, emitter->fillScale) = mRestoredEmitterFills[mEmitters.size()];
     }
     mEmitters.push_back(std::move(emitter));
+}
+
+void GhostSolver::addMovingEmitter(const LevelSet& shape, const Vec3& velocity, RigidMotion motion,
+                                   double startTime, double endTime)
+{
+    if (!motion) throw ValueError(msg("moving emitter '", shape.name(), "': no motion given"));
+    addEmitter(shape, velocity, startTime, endTime);
+    mEmitters.back()->motion = std::move(motion);
+    mEmitters.back()->placeAt(mRun.time);
 }
 
 std::vector<GhostSolver::EmitterRate> GhostSolver::emitterRates() const
@@ -492,7 +501,8 @@ void GhostSolver::accrueEmission(double t0, double t1)
 void GhostSolver::emit()
 {
     for (std::size_t e = 0; e < mEmitters.size(); ++e) {
-        const Emitter& em = *mEmitters[e];
+        Emitter& em = *mEmitters[e];
+        em.placeAt(mRun.time);
         if (mRun.time >= em.start && mRun.time < em.end) emitFrom(e);
     }
 }
@@ -501,7 +511,7 @@ void GhostSolver::emitFrom(std::size_t e)
 {
     Emitter& em = *mEmitters[e];
     const Real R = mSettings.supportRadius();
-    const Aabb box = em.shape.bounds();
+    const Aabb& box = em.box;
     const Aabb near = box.padded(R);
 
     // Air inside the emitter gives way to the liquid at once.
@@ -509,7 +519,7 @@ void GhostSolver::emitFrom(std::size_t e)
     bool anyAir = false;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
         if (mParticles.kinds()[i] == ParticleKind::GhostAir
-            && em.shape.phi(mParticles.positions()[i]) < Real(0)) {
+            && em.placedPhi(mParticles.positions()[i]) < Real(0)) {
             remove[i] = anyAir = true;
         }
     }
@@ -525,9 +535,9 @@ void GhostSolver::emitFrom(std::size_t e)
     for (std::size_t i = 0; i < mParticles.size(); ++i) {
         const Vec3& x = mParticles.positions()[i];
         if (!near.contains(x)) continue;
-        if (mParticles.kinds()[i] == ParticleKind::Liquid && em.shape.phi(x) < Real(0)) {
+        if (mParticles.kinds()[i] == ParticleKind::Liquid && em.placedPhi(x) < Real(0)) {
             seeds.push_back(x);
-            v[i] = em.velocity;
+            v[i] = em.liquidVelocity(x);
         } else {
             obstacles.push_back(x);
         }
@@ -549,8 +559,7 @@ void GhostSolver::emitFrom(std::size_t e)
     }
     if (fresh.empty()) return;
     const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);
-    std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(),
-              em.velocity);
+    em.giveVelocities(fresh, mParticles.velocities().data() + first);
     mRun.emitted += fresh.size();
 }
 
@@ -564,7 +573,8 @@ std::vector<Vec3> GhostSolver::emitterFill(std::size_t e, const std::vector<Vec3
         // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
         const PoissonSettings ps =
             bodySampling(mSettings.seed + 31337ULL * (e + 1) + mRun.step);
-        for (const Vec3& x : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
+        for (const Vec3& local : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
+            const Vec3 x = em.placedPoint(local);
             bool clear = !blockedBySolid(x);
             for (const Vec3& o : obstacles) {
                 if (!clear) break;
@@ -578,7 +588,7 @@ std::vector<Vec3> GhostSolver::emitterFill(std::size_t e, const std::vector<Vec3
         ps.radius *= Real(em.fillScale);
         ps.seed = mSettings.seed ^ (0xc2b2ae3d27d4eb4fULL * (mRun.step + 1) + e);
         auto accept = [&](const Vec3& x) {
-            return em.shape.phi(x) < Real(0) && !blockedBySolid(x);
+            return em.placedPhi(x) < Real(0) && !blockedBySolid(x);
         };
         fresh = PoissonDiskSampler(ps).sampleFromSeeds(seeds, obstacles, accept, box);
     }

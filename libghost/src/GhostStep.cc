@@ -447,7 +447,7 @@ void GhostSolver::shiftParticles(Real dt, const std::vector<Vec3>& gradMass)
         // how the emitter fills its shape.
         if (kind[i] != ParticleKind::Liquid || rho[i] < completeDensity || !owned(i)) return;
         for (const auto& em : mEmitters) {
-            if (em->shape.bounds().contains(x[i]) && em->shape.phi(x[i]) < Real(0)) return;
+            if (em->contains(x[i])) return;
         }
         Vec3 d = -(scale * v[i].length()) * gradMass[i];
         const Real length = d.length();

@@ -20,7 +20,9 @@
 #include <openvdb/points/PointDataGrid.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -172,6 +174,44 @@ TEST_F(Cli, ResumedRunMatchesAnUninterruptedOneBitForBit)
     // The statistics continue where the checkpoint left off: 4 frames x 10 steps.
     const std::string csv = slurp(b / "stats.csv");
     EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 41);
+}
+
+TEST_F(Cli, MovingEmitterRunsAndResumesBitForBit)
+{
+    // A hose sweeping the tank's floor: the emitter's `motion` keys move it 0.12 m along x over
+    // the run while it pours 0.5 m/s down. The key is read (an unknown key is an error), the
+    // run pours, a resumed run continues it bit for bit (the keys are part of the scene), and a
+    // checkpoint of other keys is refused.
+    Json scene = smallScene();
+    scene["settings"]["frame_range"] = {1, 4};
+    scene.erase("liquids");
+    scene["emitters"] = Json::parse(
+        R"([{ "name": "hose", "velocity": [0, -0.5, 0],
+              "geometry": { "box": { "min": [0.03, 0.1, 0.12], "max": [0.09, 0.16, 0.18] } },
+              "motion": { "keys": [ { "time": 0, "translate": [0, 0, 0] },
+                                    { "time": 0.2, "translate": [0.12, 0, 0], "rotate": [0, 0, 10] } ] } }])");
+    const std::string path = write(scene);
+    const fs::path a = mDir / "a", b = mDir / "b";
+    const Result full = run("run " + path + " --out " + a.string() + " --progress log");
+    ASSERT_EQ(full.code, 0) << full.err;
+    EXPECT_CONTAINS(full.err, "emitter 'hose': 0.5 m/s through ");
+    const vdbio::CheckpointHeader header =
+        vdbio::readCheckpointHeader((a / "checkpoint.0004.h5").string());
+    // 0.133 s at 0.5 m/s through about 36 cm^2 is 2.4e-4 m^3, some 70 particles at 0.015 m:
+    // at least half of them must be there.
+    EXPECT_GT(header.countPerKind.at("liquid"), 35u);
+
+    ASSERT_EQ(run("run " + path + " --out " + b.string() + " -q --frames 1-2").code, 0);
+    const Result resumed = run("run " + path + " --out " + b.string() + " -q --resume "
+                               + (b / "checkpoint.0002.h5").string());
+    ASSERT_EQ(resumed.code, 0) << resumed.err;
+    EXPECT_EQ(checkpointDifference(path, a / "checkpoint.0004.h5", b / "checkpoint.0004.h5"), "");
+
+    // Other keys are another scene: its checkpoint does not resume this one.
+    const std::string line =
+        errorLine("run " + path + " -D emitters[0].motion.keys[1].translate=[0.1,0,0] --out "
+                  + b.string() + " --resume " + (b / "checkpoint.0002.h5").string());
+    EXPECT_CONTAINS(line, "checkpoint.0002.h5' was written with different settings");
 }
 
 TEST_F(Cli, CheckpointFromOtherSettingsIsRefused)
@@ -538,11 +578,131 @@ TEST_F(Cli, InfoPreviewAndSceneFromRoleTaggedVdb)
     EXPECT_CONTAINS(pointsText, "\n    density        ");
     EXPECT_EQ(run("info " + (out / "checkpoint.0001.h5").string()).code, 0);
     EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "schema_version");
+    // The frame holds density, surface and vel: by default the preview draws the liquid's
+    // surface, and the extension chooses the format.
     EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o "
                   + (mDir / "p.exr").string() + " --width 64 --height 48")
                   .code,
               0);
     EXPECT_TRUE(fs::exists(mDir / "p.exr"));
+    EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "grid 'surface' (level set");
+    EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o "
+                  + (mDir / "p.png").string() + " --width 64 --height 48 --grid density")
+                  .code,
+              0);
+    EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "grid 'density' (fog volume");
+    std::ifstream png(mDir / "p.png", std::ios::binary);
+    char magic[4] = {};
+    png.read(magic, 4);
+    EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "a .png output is a PNG file";
+    // The help says which formats it writes and how one is chosen.
+    ASSERT_EQ(run("preview --help").code, 0);
+    const std::string help = slurp(mDir / "stdout.txt");
+    EXPECT_CONTAINS(help, ".exr");
+    EXPECT_CONTAINS(help, ".png");
+    EXPECT_CONTAINS(help, "extension chooses the format");
+    EXPECT_CONTAINS(help, "default: 'surface'");
+}
+
+namespace {
+
+/// A closed box [lo, hi] (m) as OBJ text.
+std::string boxObj(const std::array<double, 3>& lo, const std::array<double, 3>& hi)
+{
+    std::ostringstream obj;
+    for (int c = 0; c < 8; ++c) {
+        obj << "v " << (c & 1 ? hi : lo)[0] << " " << (c & 2 ? hi : lo)[1] << " "
+            << (c & 4 ? hi : lo)[2] << "\n";
+    }
+    obj << "f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
+    return obj.str();
+}
+
+/// A closed UV sphere of `radius` (m) around `centre`: 12 rings of 24 vertices and the poles.
+std::string ballObj(const std::array<double, 3>& centre, double radius)
+{
+    constexpr int RINGS = 12, SLICES = 24;
+    std::ostringstream obj;
+    obj << "v " << centre[0] << " " << centre[1] + radius << " " << centre[2] << "\n";
+    for (int i = 1; i < RINGS; ++i) {
+        const double polar = M_PI * i / RINGS;
+        for (int j = 0; j < SLICES; ++j) {
+            const double azimuth = 2 * M_PI * j / SLICES;
+            obj << "v " << centre[0] + radius * std::sin(polar) * std::cos(azimuth) << " "
+                << centre[1] + radius * std::cos(polar) << " "
+                << centre[2] + radius * std::sin(polar) * std::sin(azimuth) << "\n";
+        }
+    }
+    obj << "v " << centre[0] << " " << centre[1] - radius << " " << centre[2] << "\n";
+    const int south = 2 + (RINGS - 1) * SLICES;
+    auto ring = [](int i, int j) { return 2 + (i - 1) * SLICES + j % SLICES; }; // 1-based
+    for (int j = 0; j < SLICES; ++j) {
+        obj << "f 1 " << ring(1, j + 1) << " " << ring(1, j) << "\n";
+        for (int i = 1; i + 1 < RINGS; ++i) {
+            obj << "f " << ring(i, j) << " " << ring(i, j + 1) << " " << ring(i + 1, j + 1) << " "
+                << ring(i + 1, j) << "\n";
+        }
+        obj << "f " << south << " " << ring(RINGS - 1, j) << " " << ring(RINGS - 1, j + 1)
+            << "\n";
+    }
+    return obj.str();
+}
+
+} // namespace
+
+TEST_F(Cli, Mesh2SdfAppendsASolidAndALiquidIntoOneVdbScene)
+{
+    // Two meshes, two calls: a floor slab (solid) and a ball of water above it (liquid), both
+    // into scene.vdb with --append; the .vdb is then a scene that runs with both.
+    std::ofstream(mDir / "floor.obj") << boxObj({0, 0, 0}, {0.3, 0.05, 0.3});
+    std::ofstream(mDir / "ball.obj") << ballObj({0.15, 0.12, 0.15}, 0.05);
+    const std::string vdb = (mDir / "scene.vdb").string();
+    const std::string common = " -o " + vdb + " --voxel-size 0.0075 --append";
+    ASSERT_EQ(run("mesh2sdf " + (mDir / "floor.obj").string() + common + " --role solid --name floor")
+                  .code,
+              0);
+    ASSERT_EQ(run("mesh2sdf " + (mDir / "ball.obj").string() + common + " --role liquid --name water")
+                  .code,
+              0);
+    EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "(appended)");
+    const auto grids = gridBytes(mDir / "scene.vdb");
+    ASSERT_EQ(grids.size(), 2u);
+    EXPECT_EQ(grids.count("floor"), 1u);
+    EXPECT_EQ(grids.count("water"), 1u);
+
+    // The same name again is one line and leaves the file as it was; --replace replaces it.
+    EXPECT_CONTAINS(errorLine("mesh2sdf " + (mDir / "floor.obj").string() + common
+                              + " --role liquid --name water"),
+                    "'" + vdb + "' already has a grid 'water': expected a new name (--name) or "
+                    "--replace");
+    EXPECT_EQ(gridBytes(mDir / "scene.vdb"), grids);
+    ASSERT_EQ(run("mesh2sdf " + (mDir / "ball.obj").string() + common
+                  + " --role liquid --name water --replace")
+                  .code,
+              0);
+    EXPECT_EQ(gridBytes(mDir / "scene.vdb").size(), 2u);
+
+    // The scene: spacing twice the voxel (0.015 m); the log's frame line counts the media.
+    const Result ran = run("run " + vdb + " --out " + (mDir / "out").string()
+                           + " --frames 1-1 --progress log");
+    ASSERT_EQ(ran.code, 0) << ran.err;
+    std::size_t liquid = 0, air = 0, solid = 0;
+    const std::size_t at = ran.err.find("frame 1/1: ");
+    ASSERT_NE(at, std::string::npos) << ran.err;
+    ASSERT_EQ(std::sscanf(ran.err.c_str() + ran.err.find("steps, ", at),
+                          "steps, %zu liquid, %zu air, %zu solid ghosts", &liquid, &air, &solid),
+              3)
+        << ran.err;
+    // The ball's volume (4/3 pi 0.05^3 = 5.24e-4 m^3, less the polygon's 2 %) over h^3 is 152
+    // particles; the sampler packs 1.1-1.2 per h^3 (the 0.1 m cube of smallScene: 346 for
+    // 296). Bounds 0.9-1.4 of it. The floor's ghosts: at least one layer under the ball.
+    const double perCube = 5.24e-4 / (0.015 * 0.015 * 0.015);
+    std::printf("[measured] .vdb scene from two appended meshes: %zu liquid (%.2f per h^3 of the "
+                "ball), %zu air, %zu solid ghosts\n",
+                liquid, liquid / perCube, air, solid);
+    EXPECT_GT(liquid, 0.9 * perCube);
+    EXPECT_LT(liquid, 1.4 * perCube);
+    EXPECT_GT(solid, 100u);
 }
 
 namespace {
@@ -585,6 +745,11 @@ TEST_F(Cli, GasPlumeRunsToDensityAndTemperatureVolumes)
     std::printf("[measured] hottest temperature voxel %.1f K\n", hottest);
     EXPECT_GT(hottest, 400.f);
     EXPECT_LE(hottest, 600.5f);
+    // Outside the plume the grid reads the scene's ambient temperature (the default 293.15 K),
+    // which its metadata also gives.
+    EXPECT_EQ(temperature->background(), 293.15f);
+    EXPECT_EQ(temperature->metaValue<float>("ghostfx_ambient_temperature"), 293.15f);
+    EXPECT_EQ(temperature->tree().getValue(openvdb::Coord(100000, 100000, 100000)), 293.15f);
     EXPECT_FALSE(fs::exists(out / "liquid.0001.vdb")) << "no liquid output in a gas scene";
     EXPECT_GT(pointCount(out / "gas_points.0003.vdb"), 0u);
 
@@ -647,6 +812,15 @@ TEST_F(Cli, BoilingPanRunsLiquidAndVapour)
     const std::size_t vapour = pointCount(out / "gas_points.0002.vdb");
     std::printf("[measured] %zu vapour particles after 2 frames\n", vapour);
     EXPECT_GT(vapour, 0u);
+    // The vapour's temperature grid reads the gas's ambient temperature outside the vapour.
+    openvdb::io::File gas((out / "gas.0002.vdb").string());
+    gas.open();
+    auto vapourTemperature =
+        openvdb::gridPtrCast<openvdb::FloatGrid>(gas.readGrid("temperature"));
+    gas.close();
+    ASSERT_TRUE(vapourTemperature);
+    EXPECT_EQ(vapourTemperature->background(), 293.15f);
+    EXPECT_EQ(vapourTemperature->metaValue<float>("ghostfx_ambient_temperature"), 293.15f);
     // Mass budget per step in the statistics: liquid + gas stays constant (float round-off).
     const std::string csv = slurp(out / "stats.csv");
     EXPECT_NE(csv.find("mass_liquid"), std::string::npos);

@@ -780,6 +780,59 @@ TEST(FrameFiles, EmptySelectionWritesValidEmptyGrids)
     EXPECT_EQ(points->at(0)->activeVoxelCount(), 0u);
 }
 
+TEST(FrameFiles, TemperatureOutsideTheGasIsTheAmbient)
+{
+    // A gas's temperature grid: outside the particles (the background, and the inactive voxels
+    // of its leaves) it reads the ambient temperature, not 0 K; inside, the Shepard values are
+    // the same bit for bit as without an ambient.
+    const Scene& sc = scene();
+    vdbio::VolumeOptions o = volumeOptions();
+    o.surface = false;
+    o.scalarChannels = {"temperature"};
+    const auto temperatureOf = [&](const vdbio::VolumeOptions& options) {
+        for (const auto& g : vdbio::makeVolumeGrids(sc.particles, options)) {
+            if (g->getName() == "temperature") return openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+        }
+        return openvdb::FloatGrid::Ptr();
+    };
+    const openvdb::FloatGrid::Ptr plain = temperatureOf(o);
+    o.ambientTemperature = 293.15;
+    const openvdb::FloatGrid::Ptr ambient = temperatureOf(o);
+    ASSERT_TRUE(plain && ambient);
+    EXPECT_EQ(plain->background(), 0.0f);
+    EXPECT_FALSE((*plain)[vdbio::AMBIENT_TEMPERATURE_METADATA]);
+    EXPECT_EQ(ambient->background(), 293.15f);
+    EXPECT_EQ(ambient->metaValue<float>(vdbio::AMBIENT_TEMPERATURE_METADATA), 293.15f);
+    // Far from the liquid sphere (a metre away), and every inactive voxel of every leaf.
+    EXPECT_EQ(ambient->tree().getValue(ambient->transform().worldToIndexCellCentered(
+                  openvdb::Vec3d(1.0, 1.0, 1.0))),
+              293.15f);
+    std::size_t inactive = 0, wrong = 0;
+    for (auto leaf = ambient->tree().cbeginLeaf(); leaf; ++leaf) {
+        for (auto v = leaf->cbeginValueOff(); v; ++v, ++inactive) wrong += *v != 293.15f;
+    }
+    EXPECT_GT(inactive, 0u) << "the liquid sphere's fringe leaves have inactive voxels";
+    EXPECT_EQ(wrong, 0u);
+    ASSERT_TRUE(ambient->tree().hasSameTopology(plain->tree()));
+    std::size_t differ = 0;
+    for (auto it = plain->cbeginValueOn(); it; ++it) {
+        differ += *it != ambient->tree().getValue(it.getCoord());
+    }
+    EXPECT_EQ(differ, 0u);
+    std::printf("[measured] temperature grid: %llu active voxels identical, %zu inactive leaf "
+                "voxels at the ambient 293.15 K\n",
+                (unsigned long long)ambient->activeVoxelCount(), inactive);
+
+    o.ambientTemperature = -1;
+    try {
+        o.validate();
+        FAIL() << "a negative ambient temperature must be refused";
+    } catch (const ValueError& e) {
+        EXPECT_EQ(std::string(e.what()), "volume output: ambient temperature = -1: expected a "
+                                         "temperature > 0 (K), or none");
+    }
+}
+
 TEST(FrameFiles, GridsAreIdenticalAtAnyThreadCount)
 {
     const Scene& sc = scene();

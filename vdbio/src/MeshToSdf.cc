@@ -143,6 +143,38 @@ void checkOutputFolder(const std::string& vdbPath)
     }
 }
 
+/// What an appended grid joins: the grids of the .vdb `vdbPath` (none when it does not exist)
+/// and its file metadata; `replaced` is the index of the grid named `options.gridName` that
+/// `options.replace` replaces (-1 for none). Such a grid without `replace` is refused.
+openvdb::GridPtrVec gridsToKeep(const std::string& vdbPath, const MeshToSdfOptions& options,
+                                openvdb::MetaMap& fileMeta, int& replaced)
+{
+    replaced = -1;
+    std::error_code ec;
+    if (!fs::exists(vdbPath, ec)) return {};
+    openvdb::io::File file(vdbPath);
+    openvdb::GridPtrVecPtr grids;
+    try {
+        file.open(/*delayLoad=*/false);
+        grids = file.getGrids();
+        fileMeta = *file.getMetadata();
+        file.close();
+    } catch (const openvdb::Exception& e) {
+        throw IoError(msg("mesh2sdf --append: '", vdbPath, "' is not a readable .vdb file (",
+                          e.what(), ")"));
+    }
+    for (std::size_t k = 0; k < grids->size(); ++k) {
+        if ((*grids)[k]->getName() != options.gridName) continue;
+        if (!options.replace) {
+            throw ValueError(msg("mesh2sdf --append: '", vdbPath, "' already has a grid '",
+                                 options.gridName,
+                                 "': expected a new name (--name) or --replace to overwrite it"));
+        }
+        replaced = int(k);
+    }
+    return *grids;
+}
+
 } // namespace
 
 std::string meshRoles()
@@ -164,6 +196,10 @@ void MeshToSdfOptions::validate() const
         throw ValueError(msg("scale = ", scale, ": expected > 0"));
     }
     if (gridName.empty()) throw ValueError("gridName is empty: expected a grid name");
+    if (replace && !append) {
+        throw ValueError("replace without append: --replace replaces a grid of the file "
+                         "--append adds to");
+    }
     const auto isRole = [&](const char* r) { return role == r; };
     if (!role.empty() && std::none_of(std::begin(ROLES), std::end(ROLES), isRole)) {
         throw ValueError(msg("role = '", role, "': expected one of ", meshRoles(), " (or none)"));
@@ -227,10 +263,16 @@ openvdb::FloatGrid::Ptr convertMeshFile(const std::string& meshPath, const std::
 {
     options.validate();
     checkOutputFolder(vdbPath);
-    openvdb::FloatGrid::Ptr grid = meshToLevelSet(meshPath, options, stats);
     openvdb::MetaMap fileMeta;
+    int replaced = -1;
+    const openvdb::GridPtrVec kept =
+        options.append ? gridsToKeep(vdbPath, options, fileMeta, replaced) : openvdb::GridPtrVec{};
+    openvdb::FloatGrid::Ptr grid = meshToLevelSet(meshPath, options, stats);
+    openvdb::GridCPtrVec grids(kept.begin(), kept.end());
+    if (replaced >= 0) grids[std::size_t(replaced)] = grid;
+    else grids.push_back(grid);
     fileMeta.insertMeta("creator", openvdb::StringMetadata("ghostfx mesh2sdf"));
-    detail::writeVdbFile(vdbPath, "level set", openvdb::GridCPtrVec{grid}, fileMeta);
+    detail::writeVdbFile(vdbPath, "level set", grids, fileMeta);
     return grid;
 }
 

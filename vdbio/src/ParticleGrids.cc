@@ -155,6 +155,23 @@ void placeGrid(openvdb::GridBase& grid, const openvdb::math::Transform& xform, d
     grid.insertMeta("kernel_support", openvdb::FloatMetadata(float(R)));
 }
 
+/// The background of channel `name`'s grid, which its voxels outside the particles keep: the
+/// ambient temperature for "temperature" where `options` gives one, else 0.
+float channelBackground(const VolumeOptions& options, const std::string& name)
+{
+    const bool ambient = name == "temperature" && !std::isnan(options.ambientTemperature);
+    return ambient ? float(options.ambientTemperature) : 0.0f;
+}
+
+/// channelBackground() of every channel, in the order asked.
+std::vector<float> channelBackgrounds(const VolumeOptions& options)
+{
+    std::vector<float> backgrounds;
+    for (const std::string& name : options.scalarChannels)
+        backgrounds.push_back(channelBackground(options, name));
+    return backgrounds;
+}
+
 /// The empty output grids, named, described and placed (fog voxel size) as `options` asks.
 OutputGrids makeOutputGrids(const VolumeOptions& options)
 {
@@ -176,8 +193,12 @@ OutputGrids makeOutputGrids(const VolumeOptions& options)
     placeGrid(density, *xform, R);
     placeGrid(*grids.vel, *xform, R);
     for (const std::string& name : options.scalarChannels) {
-        openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.0f);
+        openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(channelBackground(options, name));
         g->setName(name);
+        if (name == "temperature" && !std::isnan(options.ambientTemperature)) {
+            g->insertMeta(AMBIENT_TEMPERATURE_METADATA,
+                          openvdb::FloatMetadata(float(options.ambientTemperature)));
+        }
         g->setGridClass(openvdb::GRID_FOG_VOLUME);
         g->insertMeta(
             "normalisation",
@@ -247,6 +268,7 @@ public:
         , mCutoff(options.densityCutoff)
         , mWantVel(options.velocity)
         , mChannels(options.scalarChannels.size())
+        , mChannelBackgrounds(channelBackgrounds(options))
         , mSearchRadius(sph::Real(mR + leafHalfDiagonal(mDx)))
     {}
 
@@ -327,8 +349,9 @@ private:
                     res.vel = std::make_unique<VecLeaf>(origin, openvdb::Vec3s(0.0f), false);
                 }
                 res.channels.resize(mChannels);
-                for (auto& leaf : res.channels) {
-                    leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                for (std::size_t ch = 0; ch < mChannels; ++ch) {
+                    res.channels[ch] =
+                        std::make_unique<FloatLeaf>(origin, mChannelBackgrounds[ch], false);
                 }
             }
             const openvdb::Index offset = openvdb::Index(voxel);
@@ -351,6 +374,7 @@ private:
     const double mRho0, mCutoff;
     const bool mWantVel;
     const std::size_t mChannels;
+    const std::vector<float> mChannelBackgrounds; ///< each channel's inactive value
     /// The kernel support plus a leaf's half-diagonal: the particles that may reach a leaf (m).
     const sph::Real mSearchRadius;
 };

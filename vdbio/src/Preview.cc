@@ -378,6 +378,37 @@ PreviewSummary renderPreview(const openvdb::GridBase& grid, const PreviewOptions
     return render(grid, options, exrPath, msg("grid '", grid.getName(), "'"));
 }
 
+namespace {
+
+/// The grid of `vdbPath` (grid headers `headers`) a preview draws: `asked`, or by default the
+/// liquid's "surface", else "density", else the first float grid. GridError when there is none
+/// or `asked` is not in the file.
+std::string previewGridName(const std::string& vdbPath, const openvdb::GridPtrVec& headers,
+                            const std::string& asked)
+{
+    if (!asked.empty()) {
+        const bool found = std::any_of(headers.begin(), headers.end(),
+                                       [&](const auto& g) { return g->getName() == asked; });
+        if (!found) {
+            throw GridError(msg("grid '", asked, "' not found in '", vdbPath,
+                                "' (grids: ", listNames(headers), ")"));
+        }
+        return asked;
+    }
+    for (const char* preferred : {"surface", "density"}) {
+        for (const auto& g : headers) {
+            if (g->getName() == preferred) return preferred;
+        }
+    }
+    for (const auto& g : headers) {
+        if (g->isType<openvdb::FloatGrid>()) return g->getName();
+    }
+    throw GridError(
+        msg("'", vdbPath, "' holds no float grid to preview (grids: ", listNames(headers), ")"));
+}
+
+} // namespace
+
 PreviewSummary renderPreviewFromFile(const std::string& vdbPath, const PreviewOptions& options,
                                      const std::string& exrPath)
 {
@@ -394,29 +425,7 @@ PreviewSummary renderPreviewFromFile(const std::string& vdbPath, const PreviewOp
         throw IoError(msg("'", vdbPath, "': cannot read as a .vdb file (", e.what(), ")"));
     }
 
-    std::string name = options.grid;
-    if (name.empty()) {
-        for (const char* preferred : {"density", "surface"}) {
-            for (const auto& g : *headers) {
-                if (name.empty() && g->getName() == preferred) name = preferred;
-            }
-        }
-        for (const auto& g : *headers) {
-            if (name.empty() && g->isType<openvdb::FloatGrid>()) name = g->getName();
-        }
-        if (name.empty()) {
-            throw GridError(msg("'", vdbPath, "' holds no float grid to preview (grids: ",
-                                listNames(*headers), ")"));
-        }
-    } else {
-        const bool found = std::any_of(headers->begin(), headers->end(),
-                                       [&](const auto& g) { return g->getName() == name; });
-        if (!found) {
-            throw GridError(msg("grid '", name, "' not found in '", vdbPath,
-                                "' (grids: ", listNames(*headers), ")"));
-        }
-    }
-
+    const std::string name = previewGridName(vdbPath, *headers, options.grid);
     openvdb::GridBase::Ptr grid;
     try {
         grid = file.readGrid(name);

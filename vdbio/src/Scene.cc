@@ -685,6 +685,7 @@ void readLiquidEntries(const JsonObject& root, Scene& scene)
         SceneEmitter emitter = readShaped<SceneEmitter>(o, scene, Sampled::Volume);
         emitter.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         readInterval(o, emitter.start, emitter.end);
+        if (auto motion = o.optionalObject("motion")) emitter.motion = readMotion(*motion);
         o.finish();
         scene.emitters.push_back(std::move(emitter));
     }

@@ -280,6 +280,10 @@ void VolumeOptions::validate() const
     if (density || velocity || !scalarChannels.empty()) validateGathered(*this, where);
     if (surface) validateSurface(*this, where);
     validateChannelNames(scalarChannels, where);
+    if (!std::isnan(ambientTemperature) && !isPositiveFinite(ambientTemperature)) {
+        throw ValueError(msg(where, "ambient temperature = ", ambientTemperature,
+                             ": expected a temperature > 0 (K), or none"));
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -138,6 +138,14 @@ public:
     /// its shape full.
     void addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime = 0,
                     double endTime = std::numeric_limits<double>::infinity());
+    /// An emitter moving rigidly (a hose sweeping a floor): at time t its level set (given in
+    /// its own frame) sits at `motion(t)`, and `velocity` is the liquid's in that frame. The
+    /// liquid in it, and the new liquid, move at `velocity` rotated with the emitter plus the
+    /// emitter's own velocity at the particle; the rate is addEmitter's, in the emitter's
+    /// frame. Motions are not part of saveState(): a restored run uses what its caller adds.
+    void addMovingEmitter(const LevelSet& shape, const Vec3& velocity, RigidMotion motion,
+                          double startTime = 0,
+                          double endTime = std::numeric_limits<double>::infinity());
     /// Each emitter's cross-section (m^2, the shadow of its shape along its velocity; 0 without
     /// velocity) and the mass it pours per second (kg/s, rho0 |velocity| times that), in the
     /// order added.

@@ -28,6 +28,18 @@ struct RigidTransform
 
     Vec3 toWorld(const Vec3& local) const { return rotation * local + translation; }
     Vec3 toLocal(const Vec3& world) const { return rotation.transpose() * (world - translation); }
+    /// The world box around the placed corners of the local box `local` (empty stays empty).
+    Aabb toWorld(const Aabb& local) const
+    {
+        Aabb box;
+        if (local.empty()) return box;
+        for (int c = 0; c < 8; ++c) {
+            box.expand(toWorld(Vec3(c & 1 ? local.max[0] : local.min[0],
+                                    c & 2 ? local.max[1] : local.min[1],
+                                    c & 4 ? local.max[2] : local.min[2])));
+        }
+        return box;
+    }
 };
 
 /// A body's placement as a function of time (s). It must be defined for every t >= 0. A motion

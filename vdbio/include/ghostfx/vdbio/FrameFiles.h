@@ -30,11 +30,16 @@
 
 #include <openvdb/openvdb.h>
 
+#include <limits>
 #include <string>
 #include <vector>
 
 namespace ghostfx {
 namespace vdbio {
+
+/// Float metadata of a gas "temperature" grid: the ambient temperature (K), which is also the
+/// grid's background (VolumeOptions::ambientTemperature).
+constexpr const char* AMBIENT_TEMPERATURE_METADATA = "ghostfx_ambient_temperature";
 
 // ---------------------------------------------------------------------------------------------
 // Points
@@ -171,6 +176,10 @@ struct VolumeOptions
     /// Named scalar channels of the ParticleSet (or the built-in "pressure"), each rasterised
     /// as a Shepard-normalised fog grid named after the channel, e.g. {"temperature"}.
     std::vector<std::string> scalarChannels;
+    /// The gas's ambient temperature (K), > 0: the "temperature" channel grid's background and
+    /// the value of its voxels outside the gas (inactive), stored as the grid's float metadata
+    /// AMBIENT_TEMPERATURE_METADATA. NaN (the default): background 0 and no metadata.
+    double ambientTemperature = std::numeric_limits<double>::quiet_NaN();
 
     // Rasterisation -----------------------------------------------------------------------
     /// Voxels whose rho / rho0 falls below this stay inactive, so the grids stay sparse. With

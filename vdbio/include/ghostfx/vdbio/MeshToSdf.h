@@ -25,6 +25,13 @@ struct MeshToSdfOptions
     /// source (the roles a scene .vdb understands, DESIGN.md "Scene files").
     std::string role;
     double scale = 1; ///< uniform scale applied to the mesh (mesh units -> m), > 0
+    /// convertMeshFile(): add the grid to an existing .vdb (a role-tagged scene holding a solid
+    /// and a liquid) instead of writing a file of that one grid; a file that does not exist yet
+    /// is created.
+    bool append = false;
+    /// With `append`: a grid of the same name already in the file is replaced (in its place);
+    /// without it, such a grid is refused.
+    bool replace = false;
 
     void validate() const;
 };
@@ -51,8 +58,11 @@ std::string meshRoles();
 openvdb::FloatGrid::Ptr meshToLevelSet(const std::string& meshPath, const MeshToSdfOptions& options,
                                        MeshStats* stats = nullptr);
 
-/// meshToLevelSet() then write the grid to `vdbPath` atomically (the file holds that one grid).
-/// Returns the grid that was written.
+/// meshToLevelSet() then write the grid to `vdbPath` atomically: the file holds that one grid,
+/// or, with `options.append`, the grids it already held and this one (the file's metadata
+/// kept). Throws ValueError, before converting anything, for an appended grid whose name is in
+/// the file already (unless `options.replace`), IoError for an existing file that cannot be
+/// read. Returns the grid that was written.
 openvdb::FloatGrid::Ptr convertMeshFile(const std::string& meshPath, const std::string& vdbPath,
                                         const MeshToSdfOptions& options,
                                         MeshStats* stats = nullptr);

@@ -1,5 +1,5 @@
 /// @file   Preview.h
-/// @brief  Quick EXR previews of a density (fog volume) or surface (level set) grid.
+/// @brief  Quick EXR or PNG previews of a surface (level set) or density (fog volume) grid.
 /// @details A look-dev aid, not a renderer: one directional key light, no global illumination.
 ///          Fog volumes go through OpenVDB's tools::VolumeRender (single scattering with shadow
 ///          rays), level sets through tools::LevelSetRayTracer with a Lambertian shader. The
@@ -7,7 +7,8 @@
 ///          box from the direction given by azimuth and elevation, far enough away that the
 ///          box's bounding sphere fills the frame. The background is transparent (RGBA = 0), so
 ///          the alpha channel is the coverage of the grid. Images are written atomically as
-///          half-float RGBA OpenEXR (premultiplied alpha, the EXR convention).
+///          half-float RGBA OpenEXR (premultiplied alpha, the EXR convention), or as an 8-bit
+///          sRGB PNG for a path ending in .png.
 #pragma once
 
 #include <openvdb/openvdb.h>
@@ -22,7 +23,8 @@ namespace vdbio {
 /// What to render and from where. Every field is checked by validate().
 struct PreviewOptions
 {
-    /// Grid to render; "" picks "density" if present, else "surface", else the first float grid.
+    /// Grid to render; "" picks the liquid's "surface" if present, else "density", else the
+    /// first float grid.
     std::string grid;
     /// Image size (pixels), each in [1, 16384].
     int width = 640, height = 360;

@@ -95,8 +95,9 @@ struct SceneEmitter : SceneShape
 {
     using SceneShape::SceneShape;
 
-    sph::Vec3d velocity{0};
+    sph::Vec3d velocity{0}; ///< of the liquid leaving it, in its own frame (m/s)
     double start = 0, end = std::numeric_limits<double>::infinity();
+    sph::KeyedMotion motion; ///< a moving emitter (a hose sweeping a floor); empty: static
 };
 
 /// A gas source ([RYY15]): keeps its volume filled with gas at `temperature` (K) moving at
