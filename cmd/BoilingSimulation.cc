@@ -173,6 +173,16 @@ public:
         return {{"liquid", mLiquid->count(ParticleKind::Liquid)}, {"gas", mGas->visibleGasCount()}};
     }
 
+    void addGasSource(const vdbio::SceneGasSource& source) override
+    {
+        addSceneGasSource(*mGas, source);
+    }
+    WritableParticles writableParticles(ParticleKind kind) override
+    {
+        if (kind == ParticleKind::Liquid) return {&mLiquid->particles(), nullptr};
+        return writableGas(*mGas, kind);
+    }
+
     std::vector<sph::SolverState> saveStates() const override
     {
         sph::SolverState liquid = mLiquid->saveState();
