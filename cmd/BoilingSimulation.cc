@@ -179,7 +179,9 @@ public:
     }
     WritableParticles writableParticles(ParticleKind kind) override
     {
-        if (kind == ParticleKind::Liquid) return {&mLiquid->particles(), nullptr};
+        GhostSolver* liquid = mLiquid.get();
+        if (kind == ParticleKind::Liquid)
+            return {&liquid->particles(), nullptr, [liquid] { liquid->liquidMoved(); }};
         return writableGas(*mGas, kind);
     }
 

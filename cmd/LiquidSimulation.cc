@@ -107,7 +107,8 @@ public:
     WritableParticles writableParticles(ParticleKind kind) override
     {
         if (kind != ParticleKind::Liquid) return {};
-        return {&mSolver->particles(), nullptr};
+        GhostSolver* solver = mSolver.get();
+        return {&solver->particles(), nullptr, [solver] { solver->liquidMoved(); }};
     }
     std::size_t addLiquid(const sph::LevelSet& shape, const Vec3& velocity) override
     {

@@ -46,6 +46,9 @@ struct WritableParticles
 {
     sph::ParticleSet* set = nullptr; ///< null: no such particles can be set
     const std::vector<sph::Real>* skip = nullptr;
+    /// To call after positions were set: the solver renews what it derives from them between
+    /// steps (the liquid's ghost air); empty where nothing is.
+    std::function<void()> moved;
 };
 
 class Simulation

@@ -386,6 +386,10 @@ public:
         }
         for (std::size_t n = 0; n < index.size(); ++n)
             out[index[n]] = sph::Vec3(sph::Real(a(n, 0)), sph::Real(a(n, 1)), sph::Real(a(n, 2)));
+        if (positions && w.moved) {
+            py::gil_scoped_release release;
+            w.moved();
+        }
     }
 
     void onStep(const py::object& callback)

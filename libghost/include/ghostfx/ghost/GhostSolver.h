@@ -230,6 +230,11 @@ public:
     Real startParticleMass() const;
     /// The first step's set-up (air layer, mass scaling, relaxation) is done.
     bool initialized() const { return mRun.initialized; }
+    /// After the liquid's positions were set from outside (a script moving it): a Ghost SPH
+    /// solver samples its ghost air anew, a full layer at once as at the first step (the
+    /// resampling renews a phase of it per step, and the old layer would stay where the liquid
+    /// was). Nothing to redo before the first step or for Basic SPH.
+    void liquidMoved();
 
     /// The moving particles: liquid and ghost air.
     ParticleSet& particles() { return mParticles; }
