@@ -73,8 +73,9 @@ Json inputsJson(const ScriptInputs& in, ShapeWriter& shapes)
         e["velocity"] = vec(s.velocity);
         e["keys"] = Json::array();
         for (const sph::RigidKey& k : s.motion.keys) {
-            e["keys"].push_back(
-                {{"time", k.time}, {"translate", vec(k.translate)}, {"rotate", vec(k.rotateDegrees)}});
+            e["keys"].push_back({{"time", k.time},
+                                 {"translate", vec(k.translate)},
+                                 {"rotate", vec(k.rotateDegrees)}});
         }
         doc["solids"].push_back(e);
     }
@@ -92,7 +93,8 @@ Json inputsJson(const ScriptInputs& in, ShapeWriter& shapes)
                   {"end", endTime(s.end)}});
         doc["gas_sources"].push_back(e);
     }
-    for (const auto& [index, v] : in.velocities) doc["solid_velocities"].push_back(solidVelocity(index, v));
+    for (const auto& [index, v] : in.velocities)
+        doc["solid_velocities"].push_back(solidVelocity(index, v));
     return doc;
 }
 
@@ -124,7 +126,8 @@ SolidVelocity readSolidVelocity(const Json& e)
     SolidVelocity v;
     v.time = e.at("time");
     for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) v.start.rotation(r, c) = Real(e.at("rotation").at(3 * r + c).get<double>());
+        for (int c = 0; c < 3; ++c)
+            v.start.rotation(r, c) = Real(e.at("rotation").at(3 * r + c).get<double>());
     }
     v.start.translation = sph::Vec3(vec(e.at("translation")));
     v.velocity = vec(e.at("velocity"));
@@ -138,8 +141,8 @@ ScriptInputs readInputs(const Json& doc, const std::vector<openvdb::FloatGrid::P
         vdbio::SceneSolid s = shapedEntry<vdbio::SceneSolid>(e, shapes);
         s.velocity = vec(e.at("velocity"));
         for (const Json& k : e.at("keys")) {
-            s.motion.keys.push_back({k.at("time").get<double>(), vec(k.at("translate")),
-                                     vec(k.at("rotate"))});
+            s.motion.keys.push_back(
+                {k.at("time").get<double>(), vec(k.at("translate")), vec(k.at("rotate"))});
         }
         in.solids.push_back(s);
     }
