@@ -239,7 +239,8 @@ void refuseDuplicate(const Entries& entries, const std::string& name, const char
 {
     for (const auto& e : entries) {
         if (e.name == name) {
-            throw ValueError(msg(what, " '", name, "': the simulation has one of that name already (",
+            throw ValueError(msg(what, " '", name,
+                                 "': the simulation has one of that name already (",
                                  namesOf(entries), "); give another name=..."));
         }
     }
@@ -283,8 +284,8 @@ public:
             if (solids[i].name == name) index = i;
         }
         if (index == solids.size()) {
-            throw ValueError("solid '" + name + "': the scene has no such solid (solids: "
-                             + namesOf(solids) + ")");
+            throw ValueError("solid '" + name
+                             + "': the scene has no such solid (solids: " + namesOf(solids) + ")");
         }
         python::SolidVelocity v;
         v.time = mSim->time();
@@ -316,8 +317,8 @@ public:
         mInputs.solids.push_back(solid);
     }
 
-    void addEmitter(const sph::LevelSet& shape, const std::array<double, 3>& velocity,
-                    double start, double end, const py::object& name)
+    void addEmitter(const sph::LevelSet& shape, const std::array<double, 3>& velocity, double start,
+                    double end, const py::object& name)
     {
         vdbio::SceneEmitter e(name.is_none() ? shape.name() : name.cast<std::string>(),
                               "add_emitter", shape);
@@ -373,16 +374,19 @@ public:
             if (w.set->kinds()[i] == k && (!w.skip || (*w.skip)[i] == sph::Real(0)))
                 index.push_back(i);
         }
-        if (values.ndim() != 2 || values.shape(1) != 3 || std::size_t(values.shape(0)) != index.size()) {
-            throw ValueError(msg(what, "('", kind, "'): expected an (N, 3) array with N = ",
-                                 index.size(), " (the ", kind, " particles now), got shape (",
-                                 values.ndim() > 0 ? values.shape(0) : 0, values.ndim() > 1 ? msg(", ", values.shape(1)) : "", ")"));
+        if (values.ndim() != 2 || values.shape(1) != 3
+            || std::size_t(values.shape(0)) != index.size()) {
+            throw ValueError(msg(
+                what, "('", kind, "'): expected an (N, 3) array with N = ", index.size(), " (the ",
+                kind, " particles now), got shape (", values.ndim() > 0 ? values.shape(0) : 0,
+                values.ndim() > 1 ? msg(", ", values.shape(1)) : "", ")"));
         }
         auto a = values.unchecked<2>();
         std::vector<sph::Vec3>& out = positions ? w.set->positions() : w.set->velocities();
         for (std::size_t n = 0; n < index.size(); ++n) {
             const sph::Vec3 v(sph::Real(a(n, 0)), sph::Real(a(n, 1)), sph::Real(a(n, 2)));
-            if (!sph::isFinite(v)) throw ValueError(msg(what, "('", kind, "'): row ", n, " is not finite"));
+            if (!sph::isFinite(v))
+                throw ValueError(msg(what, "('", kind, "'): row ", n, " is not finite"));
         }
         for (std::size_t n = 0; n < index.size(); ++n)
             out[index[n]] = sph::Vec3(sph::Real(a(n, 0)), sph::Real(a(n, 1)), sph::Real(a(n, 2)));
@@ -394,7 +398,8 @@ public:
 
     void onStep(const py::object& callback)
     {
-        if (!PyCallable_Check(callback.ptr())) throw ValueError("on_step: expected a callable (sim, dt)");
+        if (!PyCallable_Check(callback.ptr()))
+            throw ValueError("on_step: expected a callable (sim, dt)");
         mHooks->callbacks.push_back(callback);
     }
 
@@ -520,7 +525,9 @@ private:
         : mScene(std::make_shared<vdbio::Scene>(*scene))
         , mInputs(std::move(inputs))
     {
-        auto append = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+        auto append = [](auto& to, const auto& from) {
+            to.insert(to.end(), from.begin(), from.end());
+        };
         append(mScene->solids, mInputs.solids);
         append(mScene->emitters, mInputs.emitters);
         append(mScene->gasSources, mInputs.gasSources);
@@ -536,7 +543,8 @@ private:
         const auto set = mInputs.velocities.find(index);
         if (set != mInputs.velocities.end()) return set->second.motion();
         const vdbio::SceneSolid& s = mScene->solids[index];
-        return s.motion.keys.empty() ? sph::constantVelocity(sph::Vec3(s.velocity)) : s.motion.motion();
+        return s.motion.keys.empty() ? sph::constantVelocity(sph::Vec3(s.velocity))
+                                     : s.motion.motion();
     }
 
     /// The per-step statistics rows (the columns of `ghostfx run`'s stats file), collected by a
@@ -627,9 +635,8 @@ void bindScripting(PySimulationClass& c)
           "From now on the solid `name` (the scene's or an added one) moves at `velocity` (m/s) "
           "from where it is, without turning. It must be a moving solid (a velocity or motion "
           "keys); saved in checkpoints")
-        .def("add_solid", &PySimulation::addSolid, py::arg("level_set"),
-             py::arg("velocity") = zero, py::arg("name") = py::none(),
-             py::arg("motion") = py::none(),
+        .def("add_solid", &PySimulation::addSolid, py::arg("level_set"), py::arg("velocity") = zero,
+             py::arg("name") = py::none(), py::arg("motion") = py::none(),
              "Add a solid beside the scene's, as a scene solid: static, or placed at level set + "
              "velocity t (t from 0 s), or by `motion`, the keys of a scene solid's motion "
              "([{'time': 0, 'translate': [x, y, z], 'rotate': [rx, ry, rz]}, ...]). `name` "
@@ -653,14 +660,18 @@ void bindScripting(PySimulationClass& c)
              "vapour of boiling ones")
         .def(
             "set_positions",
-            [](PySimulation& s, const std::string& kind, const FloatArray& v) { s.setVectors(kind, v, true); },
+            [](PySimulation& s, const std::string& kind, const FloatArray& v) {
+        s.setVectors(kind, v, true);
+            },
             py::arg("kind"), py::arg("positions"),
             "Replace the positions (m) of the particles of `kind` ('liquid' or 'gas'), an (N, 3) "
             "array in the order of positions(kind); the next step searches neighbours anew. "
             "Ghosts ('air', 'solid', 'boundary') are made from the rest and cannot be set")
         .def(
             "set_velocities",
-            [](PySimulation& s, const std::string& kind, const FloatArray& v) { s.setVectors(kind, v, false); },
+            [](PySimulation& s, const std::string& kind, const FloatArray& v) {
+        s.setVectors(kind, v, false);
+            },
             py::arg("kind"), py::arg("velocities"),
             "Replace the velocities (m/s) of the particles of `kind` ('liquid' or 'gas'), an "
             "(N, 3) array in the order of positions(kind)");
@@ -724,11 +735,14 @@ PYBIND11_MODULE(_ghostfx, m)
         .def_property_readonly("method", [](const PyScene& s) { return s.scene->method; })
         .def_property_readonly("spacing", [](const PyScene& s) { return s.scene->spacing; })
         .def_property_readonly("frame_rate", [](const PyScene& s) { return s.scene->frameRate; })
-        .def_property_readonly("frame_range", [](const PyScene& s) {
-            return std::make_pair(s.scene->firstFrame, s.scene->lastFrame);
-        })
-        .def_property_readonly("settings", [](const PyScene& s) { return settingsOf(*s.scene); },
-                               "the `settings` object (after overrides) as a dict, a copy");
+        .def_property_readonly(
+            "frame_range",
+            [](const PyScene& s) {
+        return std::make_pair(s.scene->firstFrame, s.scene->lastFrame);
+            })
+        .def_property_readonly(
+            "settings", [](const PyScene& s) { return settingsOf(*s.scene); },
+            "the `settings` object (after overrides) as a dict, a copy");
 
     m.def(
         "load_scene",

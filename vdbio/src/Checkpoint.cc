@@ -570,10 +570,11 @@ CheckpointAttachments readCheckpointAttachments(const std::string& path)
             const std::string name = group.getObjnameByIdx(k);
             H5::DataSet set = group.openDataSet(name);
             hsize_t rows = 0;
-            if (set.getSpace().getSimpleExtentNdims() == 1) set.getSpace().getSimpleExtentDims(&rows);
+            if (set.getSpace().getSimpleExtentNdims() == 1)
+                set.getSpace().getSimpleExtentDims(&rows);
             std::string bytes(std::size_t(rows), '\0');
-            r.readDataset(group, "/" + std::string(ATTACHMENTS), name,
-                          H5::PredType::NATIVE_UINT8, H5T_INTEGER, bytes.data(), bytes.size(), 1);
+            r.readDataset(group, "/" + std::string(ATTACHMENTS), name, H5::PredType::NATIVE_UINT8,
+                          H5T_INTEGER, bytes.data(), bytes.size(), 1);
             out[name] = std::move(bytes);
         }
         return out;
