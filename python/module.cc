@@ -483,6 +483,18 @@ public:
     std::uint64_t steps() const { return mSim->stepCount(); }
     std::string counts() const { return mSim->counts(); }
     py::object settings() const { return settingsOf(*mScene); }
+    /// Each liquid emitter's name, cross-section (m^2) and mass rate (kg/s), scene's first.
+    py::list emitterRates() const
+    {
+        py::list out;
+        const std::vector<cmd::Simulation::EmitterRate> rates = mSim->emitterRates();
+        for (std::size_t i = 0; i < rates.size() && i < mScene->emitters.size(); ++i) {
+            out.append(py::dict(py::arg("name") = mScene->emitters[i].name,
+                                py::arg("cross_section") = rates[i].crossSection,
+                                py::arg("mass_rate") = rates[i].massRate));
+        }
+        return out;
+    }
 
     py::array_t<double> positions(const std::string& kind) const
     {
@@ -687,6 +699,10 @@ void bindReading(PySimulationClass& c)
                                "particle counts, as the log prints")
         .def_property_readonly("settings", &PySimulation::settings,
                                "the scene's `settings` object (after overrides) as a dict, a copy")
+        .def("emitter_rates", &PySimulation::emitterRates,
+             "Each liquid emitter (the scene's, then the added ones) as a dict: name, "
+             "cross_section (m^2, its shadow along its velocity) and mass_rate (kg/s, rho0 "
+             "|velocity| cross_section); empty where the scene's solver has none")
         .def("positions", &PySimulation::positions, py::arg("kind") = "liquid",
              "Positions (m) of the particles of `kind` ('liquid', 'air', 'solid', 'gas', "
              "'boundary'), an (N, 3) float64 copy")
