@@ -80,6 +80,13 @@ public:
             BuiltGrids built =
                 buildFrameGrids(*mExchange, *m.particles, m.kinds, points ? &po : nullptr,
                                 volumes ? &vo : nullptr, &mPieceCounts);
+            // The mesh's surface and velocity, where the volume file does not hold them.
+            if (m.liquid && !outputs.meshFile.empty()
+                && !(volumes && volumeHoldsMeshGrids(vo))) {
+                const vdbio::VolumeOptions mo = meshVolumeOptions(m, outputs);
+                built.mesh =
+                    buildFrameGrids(*mExchange, *m.particles, m.kinds, nullptr, &mo).volumes;
+            }
             if (!root()) continue;
             // The writer reads the grids; the particles stay with their processes.
             auto none = std::make_shared<const sph::ParticleSet>();

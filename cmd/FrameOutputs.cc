@@ -1,6 +1,7 @@
 /// @file   FrameOutputs.cc
 /// @brief  A frame's files from its snapshot (FrameWriter.h, writeFrameOutputs): each medium's
-///         points and volume files, and the preview of the scene with its solids where they are.
+///         points and volume files, the liquid's mesh, and the preview of the scene with its
+///         solids where they are.
 #include "FrameWriter.h"
 
 
@@ -8,6 +9,7 @@
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/FrameFiles.h>
+#include <ghostfx/vdbio/MeshFile.h>
 #include <ghostfx/vdbio/Preview.h>
 #include <ghostfx/vdbio/Scene.h>
 #include <ghostfx/vdbio/ScenePreview.h>
@@ -15,6 +17,8 @@
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -104,6 +108,52 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
     return grids;
 }
 
+/// The grid of `grids` named `name` as a `GridT`, or null.
+template <typename GridT>
+typename GridT::Ptr gridNamed(const openvdb::GridPtrVec& grids, const std::string& name)
+{
+    for (const openvdb::GridBase::Ptr& g : grids) {
+        if (g->getName() == name) return openvdb::gridPtrCast<GridT>(g);
+    }
+    return nullptr;
+}
+
+/// Write the liquid's mesh file `path` of `frame` from the "surface" and "vel" grids of the
+/// volume file (`volumeGrids`) when it holds both, else from grids made for the mesh
+/// (meshVolumeOptions: the same surface and velocity); returns the log line (its counts, the
+/// volume it encloses, and the seconds meshing and writing took).
+std::string writeMesh(const OutputMedium& m, const vdbio::SceneOutputs& out,
+                      const openvdb::GridPtrVec& volumeGrids, const std::string& path, int frame,
+                      const openvdb::MetaMap& fileMeta, const BuiltGrids* built)
+{
+    openvdb::GridPtrVec grids;
+    if (!out.volumeFile.empty() && volumeHoldsMeshGrids(volumeOptions(m, out))) {
+        grids = volumeGrids;
+    } else if (built) {
+        grids = built->mesh;
+    } else {
+        grids = vdbio::makeVolumeGrids(*m.particles, meshVolumeOptions(m, out));
+    }
+    const openvdb::FloatGrid::Ptr surface = gridNamed<openvdb::FloatGrid>(grids, "surface");
+    const openvdb::Vec3SGrid::Ptr vel = gridNamed<openvdb::Vec3SGrid>(grids, "vel");
+    if (!surface || !vel) {
+        throw SceneError(msg("outputs.mesh: frame ", frame, " has no liquid surface and velocity "
+                             "grids to mesh"));
+    }
+    vdbio::MeshOptions options;
+    options.adaptivity = out.meshAdaptivity;
+    const auto start = std::chrono::steady_clock::now();
+    const vdbio::SurfaceMesh mesh = vdbio::makeSurfaceMesh(*surface, vel.get(), options);
+    vdbio::writeMeshFile(path, mesh, vdbio::meshComments(fileMeta));
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    char took[32];
+    std::snprintf(took, sizeof(took), "%.2f s", seconds);
+    return msg("mesh of frame ", frame, " '", path, "': ", mesh.points.size(), " vertices, ",
+               mesh.triangles.size(), " triangles, ", mesh.enclosedVolume(), " m^3 enclosed, ",
+               took);
+}
+
 /// The file metadata every frame file carries: the scene, its method, the frame and its time.
 openvdb::MetaMap frameMetadata(const vdbio::Scene& scene, const FrameSnapshot& snapshot)
 {
@@ -178,8 +228,10 @@ void writePreview(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
 
 } // namespace
 
-void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
-                       const std::string& folder, vdbio::PreviewCache* previewCache)
+std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,
+                                           const FrameSnapshot& snapshot,
+                                           const std::string& folder,
+                                           vdbio::PreviewCache* previewCache)
 {
     const vdbio::SceneOutputs& out = scene.outputs;
     auto inFolder = [&](const std::string& pattern) {
@@ -189,18 +241,23 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
     };
     const openvdb::MetaMap fileMeta = frameMetadata(scene, snapshot);
     std::vector<vdbio::PreviewLayer> media;
+    std::vector<std::string> notes;
     bool namedGridFound = false;
     for (std::size_t index = 0; index < snapshot.media.size(); ++index) {
         const OutputMedium& m = snapshot.media[index];
+        const BuiltGrids* built = index < snapshot.built.size() ? &snapshot.built[index] : nullptr;
         const openvdb::GridPtrVec grids =
             writeMedium(m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
-                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
-                        index < snapshot.built.size() ? &snapshot.built[index] : nullptr);
+                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta, built);
+        if (m.liquid && !out.meshFile.empty()) {
+            notes.push_back(writeMesh(m, out, grids, inFolder(out.meshFile), snapshot.frame,
+                                      fileMeta, built));
+        }
         if (out.previewFile.empty()) continue;
         if (auto layer = mediumLayer(m, grids, out.previewGrid, namedGridFound))
             media.push_back(*layer);
     }
-    if (out.previewFile.empty()) return;
+    if (out.previewFile.empty()) return notes;
     // checkOutputs() refused this before the first step; a medium's grids can still be missing
     // (a frame written by a script).
     if (media.empty() || (!out.previewGrid.empty() && !namedGridFound)) {
@@ -209,6 +266,7 @@ void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
                              "': the volume output has no such grid"));
     }
     writePreview(scene, snapshot, media, inFolder(out.previewFile), previewCache);
+    return notes;
 }
 
 } // namespace cmd

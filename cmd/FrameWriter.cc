@@ -55,6 +55,21 @@ vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutp
     return vo;
 }
 
+vdbio::VolumeOptions meshVolumeOptions(const OutputMedium& m, const vdbio::SceneOutputs& out)
+{
+    vdbio::VolumeOptions vo = volumeOptions(m, out);
+    // The volume's own surface settings where its file is written (the scene reader holds the
+    // mesh's to them), else the mesh section's.
+    vo.surfaceMethod = out.meshSurfaceMethod;
+    vo.voxelSize = out.meshVoxelSize > 0 ? out.meshVoxelSize : 0.5 * m.spacing;
+    vo.surface = vo.velocity = true;
+    vo.density = false;
+    vo.scalarChannels.clear();
+    return vo;
+}
+
+bool volumeHoldsMeshGrids(const vdbio::VolumeOptions& vo) { return vo.surface && vo.velocity; }
+
 FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation& sim, int frame)
 {
     FrameSnapshot s;
@@ -104,7 +119,9 @@ void FrameWriter::rethrow()
 void FrameWriter::submit(FrameSnapshot snapshot)
 {
     if (!mThread.joinable()) {
-        writeFrameOutputs(mScene, snapshot, mFolder, &mPreviewCache);
+        std::vector<std::string> notes =
+            writeFrameOutputs(mScene, snapshot, mFolder, &mPreviewCache);
+        mNotes.insert(mNotes.end(), notes.begin(), notes.end());
         return;
     }
     std::unique_lock<std::mutex> lock(mMutex);
@@ -123,6 +140,14 @@ void FrameWriter::finish()
     rethrow();
 }
 
+std::vector<std::string> FrameWriter::takeNotes()
+{
+    std::lock_guard<std::mutex> lock(mMutex);
+    std::vector<std::string> notes;
+    notes.swap(mNotes);
+    return notes;
+}
+
 void FrameWriter::work()
 {
     std::unique_lock<std::mutex> lock(mMutex);
@@ -136,14 +161,16 @@ void FrameWriter::work()
         lock.unlock();
         mChanged.notify_all(); // the queue has room again
         std::exception_ptr error;
+        std::vector<std::string> notes;
         if (!failed) { // after a failure, later frames are dropped: the run is stopping
             try {
-                writeFrameOutputs(mScene, snapshot, mFolder, &mPreviewCache);
+                notes = writeFrameOutputs(mScene, snapshot, mFolder, &mPreviewCache);
             } catch (...) {
                 error = std::current_exception();
             }
         }
         lock.lock();
+        mNotes.insert(mNotes.end(), notes.begin(), notes.end());
         mWriting = false;
         if (error && !mError) mError = error;
         mChanged.notify_all();

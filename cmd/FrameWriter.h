@@ -33,6 +33,9 @@ struct BuiltGrids
 {
     openvdb::GridBase::Ptr points; ///< the "particles" PointDataGrid, or null: none written
     openvdb::GridPtrVec volumes;   ///< the volume file's grids (the preview draws them)
+    /// The liquid's "surface" and "vel" grids the mesh output is made from (meshVolumeOptions)
+    /// when the volume file does not hold both; empty otherwise.
+    openvdb::GridPtrVec mesh;
 };
 
 /// What one frame's outputs need, owned: the media with copies of their particles, or their
@@ -52,16 +55,25 @@ struct FrameSnapshot
 /// (the liquid's surface at h / 2 unless the scene says otherwise, its gathered grids at h).
 vdbio::PointsOptions pointsOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
 vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
+/// The grids the liquid's mesh output is made from: the volume output's options with only
+/// "surface" and "vel" asked for, the surface method and voxel size of outputs.mesh (the
+/// volume's where its file is written: the same surface and velocity as the volume file's).
+vdbio::VolumeOptions meshVolumeOptions(const OutputMedium& m, const vdbio::SceneOutputs& out);
+/// Whether the volume grids `vo` already hold what the mesh output needs ("surface", "vel").
+bool volumeHoldsMeshGrids(const vdbio::VolumeOptions& vo);
 
 /// Copy what the scene's outputs of `frame` read from `sim` (with the ghosts only where the
 /// points output asks for them).
 FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation& sim, int frame);
 
-/// Write the scene's outputs of a snapshot into `folder` (points, volume and preview files, as
-/// the scene's `outputs` name them); every file atomically. `previewCache` keeps the static
-/// solids' preview hits from one frame to the next (the pictures are the same without it).
-void writeFrameOutputs(const vdbio::Scene& scene, const FrameSnapshot& snapshot,
-                       const std::string& folder, vdbio::PreviewCache* previewCache = nullptr);
+/// Write the scene's outputs of a snapshot into `folder` (points, volume, mesh and preview
+/// files, as the scene's `outputs` name them); every file atomically. `previewCache` keeps the
+/// static solids' preview hits from one frame to the next (the pictures are the same without
+/// it). Returns lines for the run's log: what each mesh file holds.
+std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,
+                                           const FrameSnapshot& snapshot,
+                                           const std::string& folder,
+                                           vdbio::PreviewCache* previewCache = nullptr);
 
 class FrameWriter
 {
@@ -79,6 +91,9 @@ public:
     void submit(FrameSnapshot snapshot);
     /// Wait until every submitted frame is on disk; throws the first write error.
     void finish();
+    /// The log lines of the frames written since the last call (writeFrameOutputs' lines), in
+    /// frame order.
+    std::vector<std::string> takeNotes();
 
 private:
     void work();
@@ -92,6 +107,7 @@ private:
     std::optional<FrameSnapshot> mQueued;
     bool mWriting = false, mStop = false;
     std::exception_ptr mError;
+    std::vector<std::string> mNotes; ///< guarded by mMutex
     std::thread mThread;
 };
 

@@ -5,12 +5,18 @@
 #include "FrameWriter.h"
 
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/FrameFiles.h>
+#include <ghostfx/vdbio/MeshFile.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <unistd.h>
 
 namespace ghostfx {
 namespace cmd {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -54,7 +60,46 @@ void checkPreviewGrid(const vdbio::Scene& scene, const std::vector<OutputMedium>
                          "': the volume output has no such grid"));
 }
 
+/// outputs.mesh: the liquid's surface, so a scene with no liquid (a gas scene) has none to
+/// mesh; the liquid's surface and velocity options as the volume output checks them.
+void checkMesh(const vdbio::Scene& scene, const std::vector<OutputMedium>& media)
+{
+    const vdbio::SceneOutputs& out = scene.outputs;
+    if (out.meshFile.empty()) return;
+    const std::string key = msg("scene '", scene.file, "': outputs.mesh");
+    bool liquid = false;
+    for (const OutputMedium& m : media) {
+        if (!m.liquid) continue;
+        liquid = true;
+        vdbio::checkVolumeOutput(*m.particles, meshVolumeOptions(m, out), key);
+    }
+    if (!liquid) {
+        throw SceneError(msg(key, ": a mesh is made of the liquid's surface, and this ",
+                             scene.method, " scene has no liquid (switch outputs.mesh off; "
+                             "outputs.gas_volume writes the gas density)"));
+    }
+    vdbio::MeshOptions options;
+    options.adaptivity = out.meshAdaptivity;
+    options.validate();
+}
+
 } // namespace
+
+void checkOutputFolders(const vdbio::Scene& scene, const std::string& folder)
+{
+    const vdbio::SceneOutputs& out = scene.outputs;
+    if (out.meshFile.empty()) return;
+    const fs::path dir =
+        (fs::path(folder) / vdbio::expandFramePattern(out.meshFile, scene.firstFrame))
+            .parent_path();
+    std::error_code ec;
+    const char* why = !fs::is_directory(dir, ec)        ? "does not exist or is not a folder"
+                      : ::access(dir.c_str(), W_OK) != 0 ? "cannot be written"
+                                                         : nullptr;
+    if (!why) return;
+    throw IoError(msg("scene '", scene.file, "': outputs.mesh.file = '", out.meshFile,
+                      "': folder '", dir.string(), "' ", why));
+}
 
 void checkOutputs(const vdbio::Scene& scene, const Simulation& sim)
 {
@@ -71,6 +116,7 @@ void checkOutputs(const vdbio::Scene& scene, const Simulation& sim)
         }
     }
     checkPreviewGrid(scene, media);
+    checkMesh(scene, media);
 }
 
 } // namespace cmd

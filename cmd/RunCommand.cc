@@ -260,7 +260,10 @@ private:
         checkStepsPerFrame(mScene, *mSim);
         if (mDistributed)
             mDistributed->share(*mSim, mManifest ? &mManifest->decomposition : nullptr);
-        if (mWrites) vdbio::ensureWritableDirectory(mFolder);
+        if (mWrites) {
+            vdbio::ensureWritableDirectory(mFolder);
+            checkOutputFolders(mScene, mFolder);
+        }
     }
 
     void makeProgress()
@@ -364,6 +367,7 @@ private:
             if (stopSignal != 0) return StopSignals::exitCode(stopSignal);
         }
         writer.finish();
+        for (const std::string& note : writer.takeNotes()) mProgress->message(note);
         reportDone(mSim->stepCount() - stepsAtStart);
         return 0;
     }
@@ -401,6 +405,7 @@ private:
         mProgress->frame(*mSim, mDistributed ? mDistributed->counts(*mSim) : mSim->counts(),
                          mFrame, int(mSim->stepCount() - stepsBefore),
                          secondsBetween(frameStart, Clock::now()), write);
+        for (const std::string& note : writer.takeNotes()) mProgress->message(note);
         if (stopSignal != 0) reportStop(stopSignal, checkpoint);
         return stopSignal;
     }

@@ -8,6 +8,7 @@
 ///          raises ValueError with the message the command line prints after "ghostfx: error: ".
 #include "FrameWriter.h"
 #include "LiquidScene.h"
+#include "Readers.h"
 #include "ScriptInputs.h"
 #include "Simulation.h"
 #include "StopSignals.h"
@@ -846,5 +847,6 @@ PYBIND11_MODULE(_ghostfx, m)
         },
         "(shapes loaded, shapes sampled and kept) by this process's sample cache so far");
 
+    bindReaders(m);
     m.attr("__version__") = GHOSTFX_VERSION;
 }

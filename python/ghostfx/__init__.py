@@ -7,6 +7,8 @@
 
 The same code as the `ghostfx` command line: scene errors raise ValueError with its message.
 Particle arrays are float64 NumPy copies (the solver reorders its storage every step).
+The files a run writes read back as NumPy arrays: read_points (points .vdb), read_volume
+(volume grids), read_stats (stats.h5), read_checkpoint (checkpoint .h5).
 """
 import csv as _csv
 import json as _json
@@ -18,8 +20,10 @@ import tempfile as _tempfile
 from ._ghostfx import LevelSet, Scene, Simulation, sample, __version__
 from ._ghostfx import load_scene as _load_scene_file
 from ._ghostfx import sample_cache_counts, set_sample_cache
+from ._ghostfx import Volume, read_checkpoint, read_points, read_stats, read_volume
 
-__all__ = ["Interrupted", "LevelSet", "Scene", "Simulation", "load_scene", "sample",
+__all__ = ["Interrupted", "LevelSet", "Scene", "Simulation", "Volume", "load_scene",
+           "read_checkpoint", "read_points", "read_stats", "read_volume", "sample",
            "sample_cache_counts", "set_sample_cache", "study", "__version__"]
 
 

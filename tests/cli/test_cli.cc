@@ -529,6 +529,13 @@ TEST_F(Cli, InfoPreviewAndSceneFromRoleTaggedVdb)
     const std::string text = slurp(mDir / "stdout.txt");
     EXPECT_CONTAINS(text, "surface");
     EXPECT_CONTAINS(text, "density");
+    // Points: per-attribute ranges, as vdbio::readPoints gives them (P in world space).
+    EXPECT_EQ(run("info " + (out / "liquid_points.0001.vdb").string()).code, 0);
+    const std::string pointsText = slurp(mDir / "stdout.txt");
+    EXPECT_CONTAINS(pointsText, "  attribute ranges (min .. max, mean; P in world space, m):\n");
+    EXPECT_CONTAINS(pointsText, "\n    P              [");
+    EXPECT_CONTAINS(pointsText, "\n    id             "); // ids follow the solid ghosts'
+    EXPECT_CONTAINS(pointsText, "\n    density        ");
     EXPECT_EQ(run("info " + (out / "checkpoint.0001.h5").string()).code, 0);
     EXPECT_CONTAINS(slurp(mDir / "stdout.txt"), "schema_version");
     EXPECT_EQ(run("preview " + (out / "liquid.0001.vdb").string() + " -o "

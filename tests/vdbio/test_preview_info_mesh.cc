@@ -508,6 +508,16 @@ TEST(Info, DescribesTheGridsAndPointsOfAVdbFile)
           "id ", "bytes per point: 40 in attributes"}) {
         EXPECT_TRUE(contains(pointsText, part)) << "missing: " << part;
     }
+    // Ranges from vdbio::readPointsGrid, as Python's read_points returns the columns: x runs
+    // over 0 .. 0.99 m (float 0.99 prints as 0.99 at 6 digits), the mean of 0.01 i over
+    // i < 100 is 0.495 m; ids are 0 .. 99; the particles are at rest.
+    for (const char* part :
+         {"attribute ranges (min .. max, mean; P in world space, m):\n",
+          "    P              [0, 0, 0] .. [0.99, 0, 0], mean [0.495, 0, 0]\n",
+          "    v              [0, 0, 0] .. [0, 0, 0], mean [0, 0, 0]\n",
+          "    id             0 .. 99, mean 49.5\n"}) {
+        EXPECT_TRUE(contains(pointsText, part)) << "missing: " << part;
+    }
 
     // Points and volumes in one file: the points' lines must not change how the next grid's
     // numbers are printed (a regression: the level set's background read "0.01").

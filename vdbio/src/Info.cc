@@ -4,6 +4,7 @@
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
+#include <ghostfx/vdbio/Readers.h>
 
 #include <openvdb/io/File.h>
 #include <openvdb/points/PointCount.h>
@@ -95,6 +96,36 @@ void worldBounds(const openvdb::GridBase& grid, const openvdb::CoordBBox& ibox,
     }
 }
 
+/// One component list: "1.5" for a scalar, "[1, 2, 3]" for a vector.
+std::string components(const std::vector<double>& v)
+{
+    if (v.size() == 1) return msg(v[0]);
+    std::string out;
+    for (double x : v) out += (out.empty() ? "[" : ", ") + msg(x);
+    return out + "]";
+}
+
+/// Per attribute (as vdbio::readPointsGrid returns it, P in world space): min .. max and the
+/// mean of each component.
+void describeRanges(std::ostream& os, const openvdb::points::PointDataGrid& grid)
+{
+    PointsData data;
+    try {
+        data = readPointsGrid(grid, "ghostfx info");
+    } catch (const GridError& e) { // an attribute type the reader does not take
+        os << "  attribute ranges: not read (" << e.what() << ")\n";
+        return;
+    }
+    if (data.count == 0) return;
+    os << "  attribute ranges (min .. max, mean; P in world space, m):\n";
+    for (const Column& column : data.columns) {
+        const ColumnRange r = columnRange(column);
+        os << "    " << std::left << std::setw(14) << column.name << std::right << " "
+           << components(r.min) << " .. " << components(r.max) << ", mean " << components(r.mean)
+           << "\n";
+    }
+}
+
 void describePoints(std::ostream& os, const openvdb::points::PointDataGrid& grid)
 {
     const openvdb::Index64 count = openvdb::points::pointCount(grid.tree());
@@ -129,6 +160,7 @@ void describePoints(std::ostream& os, const openvdb::points::PointDataGrid& grid
         os << ", " << perPoint.str() << " in memory with the tree";
     }
     os << "\n";
+    describeRanges(os, grid);
 }
 
 void describeGrid(std::ostream& os, const openvdb::GridBase& grid)

@@ -372,6 +372,45 @@ void readVolume(const JsonObject& s, SceneOutputs& out)
     out.densityVoxelSize = s.nonNegative("density_voxel_size", out.densityVoxelSize);
 }
 
+/// outputs.mesh's surface: the volume output's method and voxel size, which the mesh section
+/// may set where the volume file is not written (else they must be the volume's).
+void readMeshSurface(const JsonObject& s, SceneOutputs& out)
+{
+    const std::string volumeMethod = sph::nameOf(SURFACE_METHOD_NAMES, out.surfaceMethod);
+    const std::string method = s.choice("surface_method", volumeMethod, surfaceMethodNames());
+    out.meshVoxelSize = s.nonNegative("voxel_size", out.voxelSize);
+    if (out.volumeFile.empty()) {
+        out.meshSurfaceMethod = sph::valueOf(SURFACE_METHOD_NAMES, method, "surface method");
+    } else if (method != volumeMethod) {
+        s.failValue("surface_method", msg("expected outputs.volume.surface_method (\"",
+                                          volumeMethod, "\"): the mesh is the volume's surface"));
+    } else if (out.meshVoxelSize != out.voxelSize) {
+        s.failValue("voxel_size", msg("expected outputs.volume.voxel_size (", out.voxelSize,
+                                      "): the mesh is the volume's surface"));
+    }
+}
+
+/// outputs.mesh: its file (a frame pattern, .ply or .obj), adaptivity and surface; `true` for
+/// the defaults.
+void readMesh(const JsonObject& o, SceneOutputs& out)
+{
+    const char* const fallback = "liquid.$F4.ply";
+    out.meshSurfaceMethod = out.surfaceMethod;
+    out.meshVoxelSize = out.voxelSize;
+    const Json* v = o.raw("mesh");
+    if (v && v->is_boolean() && v->get<bool>()) out.meshFile = fallback;
+    readSection(o, "mesh", out.meshFile, [&](const JsonObject& s) {
+        out.meshFile = outputFile(s, "file", fallback, {".ply", ".obj"},
+                                  "a PLY or OBJ triangle mesh");
+        if (!hasFrameToken(out.meshFile)) {
+            s.failValue("file", "expected a frame pattern with $F (e.g. liquid.$F4.ply): "
+                                "every frame writes its own mesh");
+        }
+        out.meshAdaptivity = s.inRange("adaptivity", out.meshAdaptivity, 0, 1);
+        readMeshSurface(s, out);
+    });
+}
+
 void readOutputs(const JsonObject& o, SceneOutputs& out)
 {
     const std::vector<std::string> vdb{".vdb"}, h5{".h5", ".hdf5"};
@@ -382,6 +421,7 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
         out.pointGhosts = s.get<bool>("ghosts", out.pointGhosts);
     });
     readSection(o, "volume", out.volumeFile, [&](const JsonObject& s) { readVolume(s, out); });
+    readMesh(o, out);
     readSection(o, "gas_points", out.gasPointsFile, [&](const JsonObject& s) {
         out.gasPointsFile = outputFile(s, "file", out.gasPointsFile, vdb, "OpenVDB points");
         out.gasPointChannels = s.get<std::vector<std::string>>("channels", out.gasPointChannels);

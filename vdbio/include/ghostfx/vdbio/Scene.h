@@ -154,6 +154,14 @@ struct SceneOutputs
     SurfaceMethod surfaceMethod = SurfaceMethod::Spheres; ///< of the liquid surface
     double voxelSize = 0;        ///< of the surface; 0: half the particle spacing
     double densityVoxelSize = 0; ///< of density, vel, temperature; 0: the particle spacing
+    // Liquid surface as a triangle mesh (MeshFile.h), .ply or .obj by the name's extension;
+    // the volume's surface, whether or not the volume file is written. Empty: off.
+    std::string meshFile;
+    double meshAdaptivity = 0; ///< tools::volumeToMesh's adaptivity, 0 to 1
+    /// The surface meshed: the volume's method and voxel size (0: h / 2), which a scene may set
+    /// in outputs.mesh only where no volume file is written (or to the same values).
+    SurfaceMethod meshSurfaceMethod = SurfaceMethod::Spheres;
+    double meshVoxelSize = 0;
     // Gas (gas scenes and boiling): points and volumes of the gas particles.
     std::string gasPointsFile = "gas_points.$F4.vdb";
     std::vector<std::string> gasPointChannels{"v", "id", "temperature"};
