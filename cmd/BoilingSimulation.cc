@@ -173,6 +173,18 @@ public:
         return {{"liquid", mLiquid->count(ParticleKind::Liquid)}, {"gas", mGas->visibleGasCount()}};
     }
 
+    void addGasSource(const vdbio::SceneGasSource& source) override
+    {
+        addSceneGasSource(*mGas, source);
+    }
+    WritableParticles writableParticles(ParticleKind kind) override
+    {
+        GhostSolver* liquid = mLiquid.get();
+        if (kind == ParticleKind::Liquid)
+            return {&liquid->particles(), nullptr, [liquid] { liquid->liquidMoved(); }};
+        return writableGas(*mGas, kind);
+    }
+
     std::vector<sph::SolverState> saveStates() const override
     {
         sph::SolverState liquid = mLiquid->saveState();

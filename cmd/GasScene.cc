@@ -76,17 +76,20 @@ std::unique_ptr<gas::GasSolver> makeGasSolver(const vdbio::Scene& scene,
         if (solid.motion.keys.empty()) solver->addSolid(solid.shape, Vec3(solid.velocity));
         else solver->addMovingSolid(solid.shape, solid.motion.motion());
     }
-    for (const vdbio::SceneGasSource& src : scene.gasSources) {
-        gas::GasSource s;
-        s.temperature = Real(src.temperature);
-        s.velocity = Vec3(src.velocity);
-        s.rate = Real(src.rate);
-        s.start = src.start;
-        s.end = src.end;
-        if (!src.motion.keys.empty()) s.motion = src.motion.motion();
-        solver->addSource(src.shape, s);
-    }
+    for (const vdbio::SceneGasSource& src : scene.gasSources) addSceneGasSource(*solver, src);
     return solver;
+}
+
+void addSceneGasSource(gas::GasSolver& solver, const vdbio::SceneGasSource& src)
+{
+    gas::GasSource s;
+    s.temperature = Real(src.temperature);
+    s.velocity = Vec3(src.velocity);
+    s.rate = Real(src.rate);
+    s.start = src.start;
+    s.end = src.end;
+    if (!src.motion.keys.empty()) s.motion = src.motion.motion();
+    solver.addSource(src.shape, s);
 }
 
 } // namespace cmd

@@ -33,5 +33,8 @@ std::unique_ptr<gas::GasSolver> makeGasSolver(const vdbio::Scene& scene,
                                               const gas::GasSettings& settings,
                                               const sph::SolverState* restored);
 
+/// Add one gas source to a gas solver, as makeGasSolver adds the scene's.
+void addSceneGasSource(gas::GasSolver& solver, const vdbio::SceneGasSource& source);
+
 } // namespace cmd
 } // namespace ghostfx

@@ -23,6 +23,14 @@ void copyVisibleGas(const sph::ParticleSet& from, sph::ParticleSet& to)
     to.removeIf(remove);
 }
 
+WritableParticles writableGas(gas::GasSolver& s, ParticleKind kind)
+{
+    if (kind != ParticleKind::Gas) return {};
+    sph::ParticleSet& p = s.particles();
+    return {&p, p.hasScalarChannel(gas::channel::AMBIENT) ? &p.scalarChannel(gas::channel::AMBIENT)
+                                                          : nullptr};
+}
+
 OutputMedium gasMedium(const gas::GasSolver& s, const sph::ParticleSet& visible)
 {
     OutputMedium m;
@@ -35,6 +43,7 @@ OutputMedium gasMedium(const gas::GasSolver& s, const sph::ParticleSet& visible)
     m.gravity = s.settings().gravity;
     m.liquid = false;
     m.ambientTemperature = double(s.settings().ambientTemperature);
+    m.pendingMass = [&s] { return s.stepCount() == 0 ? double(s.referenceParticleMass()) : 0.0; };
     return m;
 }
 
@@ -87,6 +96,14 @@ public:
     }
 
     void advanceFrame() override { mSolver->advanceFrame(); }
+    void addGasSource(const vdbio::SceneGasSource& source) override
+    {
+        addSceneGasSource(*mSolver, source);
+    }
+    WritableParticles writableParticles(ParticleKind kind) override
+    {
+        return writableGas(*mSolver, kind);
+    }
 
     vdbio::StatsRow statsRow(int frame, double dt) override
     {

@@ -171,12 +171,7 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
     auto solver = std::make_unique<GhostSolver>(settings);
     solver->setSampleStore(processSampleCache());
     if (restored) solver->restoreState(*restored);
-    for (const vdbio::SceneSolid& solid : scene.solids) {
-        // A solid without motion keys moves at its constant velocity, or stands still: then its
-        // particles are sorted once and never re-placed.
-        if (solid.motion.keys.empty()) solver->addSolid(solid.shape, Vec3(solid.velocity));
-        else solver->addMovingSolid(solid.shape, motionOf(solid));
-    }
+    for (const vdbio::SceneSolid& solid : scene.solids) addSceneSolid(*solver, solid);
     if (!restored) {
         for (const vdbio::SceneLiquid& liquid : scene.liquids) {
             const std::size_t n = solver->addLiquid(liquid.shape, Vec3(liquid.velocity));
@@ -188,11 +183,27 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
             }
         }
     }
-    for (const vdbio::SceneEmitter& e : scene.emitters) {
-        if (e.motion.keys.empty()) solver->addEmitter(e.shape, Vec3(e.velocity), e.start, e.end);
-        else solver->addMovingEmitter(e.shape, Vec3(e.velocity), e.motion.motion(), e.start, e.end);
-    }
+    for (const vdbio::SceneEmitter& e : scene.emitters) addSceneEmitter(*solver, e);
     return solver;
+}
+
+void addSceneSolid(GhostSolver& solver, const vdbio::SceneSolid& solid)
+{
+    // A solid without motion keys moves at its constant velocity, or stands still: then its
+    // particles are sorted once and never re-placed.
+    if (solid.motion.keys.empty()) solver.addSolid(solid.shape, Vec3(solid.velocity));
+    else solver.addMovingSolid(solid.shape, motionOf(solid));
+}
+
+void addSceneEmitter(GhostSolver& solver, const vdbio::SceneEmitter& emitter)
+{
+    const Vec3 velocity(emitter.velocity);
+    if (emitter.motion.keys.empty()) {
+        solver.addEmitter(emitter.shape, velocity, emitter.start, emitter.end);
+    } else {
+        solver.addMovingEmitter(emitter.shape, velocity, emitter.motion.motion(), emitter.start,
+                                emitter.end);
+    }
 }
 
 void updateSolidSequences(const vdbio::Scene& scene, GhostSolver& solver, int frame)

@@ -32,6 +32,11 @@ std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
                                                      const ghost::GhostSettings& settings,
                                                      const sph::SolverState* restored = nullptr);
 
+/// Add one solid (static, moving at its velocity, or keyed) or one emitter to a liquid solver,
+/// as makeLiquidSolver adds the scene's.
+void addSceneSolid(ghost::GhostSolver& solver, const vdbio::SceneSolid& solid);
+void addSceneEmitter(ghost::GhostSolver& solver, const vdbio::SceneEmitter& emitter);
+
 /// This process's sample cache (vdbio::SampleCache): the folder of `--sample-cache`, else of
 /// $GHOSTFX_SAMPLE_CACHE, else the per-user defaultSampleCacheFolder(); "off" (or empty) in
 /// either place: none (null). Liquid solvers made by makeLiquidSolver take their solids' and

@@ -35,6 +35,7 @@ OutputMedium liquidMedium(const GhostSolver& s)
     m.restDensity = s.settings().restDensity;
     m.gravity = s.settings().gravity;
     m.liquid = true;
+    m.pendingMass = [&s] { return s.initialized() ? 0.0 : double(s.startParticleMass()); };
     return m;
 }
 
@@ -98,9 +99,16 @@ public:
     {
         mSolver->setSolidMotion(index, std::move(motion));
     }
-    void addSolid(const sph::LevelSet& shape, const Vec3& velocity) override
+    void addSolid(const vdbio::SceneSolid& solid) override { addSceneSolid(*mSolver, solid); }
+    void addEmitter(const vdbio::SceneEmitter& emitter) override
     {
-        mSolver->addSolid(shape, velocity);
+        addSceneEmitter(*mSolver, emitter);
+    }
+    WritableParticles writableParticles(ParticleKind kind) override
+    {
+        if (kind != ParticleKind::Liquid) return {};
+        GhostSolver* solver = mSolver.get();
+        return {&solver->particles(), nullptr, [solver] { solver->liquidMoved(); }};
     }
     std::size_t addLiquid(const sph::LevelSet& shape, const Vec3& velocity) override
     {

@@ -52,11 +52,26 @@ void Simulation::setSolidMotion(std::size_t /*index*/, sph::RigidMotion /*motion
     throw ValueError("changing a solid's motion during a run is supported in liquid scenes only");
 }
 
-void Simulation::addSolid(const sph::LevelSet& shape, const Vec3& /*velocity*/)
+void Simulation::addSolid(const vdbio::SceneSolid& solid)
 {
-    throw ValueError("solid '" + shape.name()
+    throw ValueError("solid '" + solid.name
                      + "': adding solids from a script is supported in liquid scenes only");
 }
+
+void Simulation::addEmitter(const vdbio::SceneEmitter& emitter)
+{
+    throw ValueError("emitter '" + emitter.name
+                     + "': adding emitters from a script is supported in liquid scenes only");
+}
+
+void Simulation::addGasSource(const vdbio::SceneGasSource& source)
+{
+    throw ValueError("gas source '" + source.name
+                     + "': adding gas sources from a script is supported in gas and boiling "
+                       "scenes only");
+}
+
+WritableParticles Simulation::writableParticles(ParticleKind /*kind*/) { return {}; }
 
 std::size_t Simulation::addLiquid(const sph::LevelSet& shape, const Vec3& /*velocity*/)
 {

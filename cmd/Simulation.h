@@ -37,6 +37,21 @@ struct OutputMedium
     bool liquid = true;   ///< liquids get a surface; gases get temperature
     /// A gas's ambient temperature (K): its temperature grid's background; NaN: none.
     double ambientTemperature = std::numeric_limits<double>::quiet_NaN();
+    /// Before the medium's first step: the mass (kg) that step gives the particles whose mass is
+    /// still 0 (the solver scales it then); 0 once it has stepped.
+    std::function<double()> pendingMass;
+};
+
+/// A solver's own particle set that holds a medium's particles of one kind, for scripts that
+/// set positions or velocities: its particles of `kind` whose `skip` value (if any) is 0, in
+/// order, are the ones media() lists.
+struct WritableParticles
+{
+    sph::ParticleSet* set = nullptr; ///< null: no such particles can be set
+    const std::vector<sph::Real>* skip = nullptr;
+    /// To call after positions were set: the solver renews what it derives from them between
+    /// steps (the liquid's ghost air); empty where nothing is.
+    std::function<void()> moved;
 };
 
 class Simulation
@@ -95,10 +110,18 @@ public:
     /// Replace the motion of the scene's solid `index` (in scene order) from now on; refused
     /// for a static solid and where the scene's solver cannot (gas, boiling).
     virtual void setSolidMotion(std::size_t index, sph::RigidMotion motion);
-    /// Add a solid (static for a zero velocity) or a liquid body given as a level set, beside
-    /// the scene's (scripts); returns the liquid particles added. Liquid scenes only.
-    virtual void addSolid(const sph::LevelSet& shape, const sph::Vec3& velocity);
+    /// Add a solid (static without velocity or keys, as a scene solid), a liquid body, a liquid
+    /// emitter or a gas source beside the scene's (scripts), as the scene's own are added;
+    /// addLiquid returns the liquid particles added. Solids, liquid bodies and emitters: liquid
+    /// scenes only; gas sources: gas scenes and the vapour of boiling ones. The others refuse
+    /// with a ValueError naming the shape.
+    virtual void addSolid(const vdbio::SceneSolid& solid);
     virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity);
+    virtual void addEmitter(const vdbio::SceneEmitter& emitter);
+    virtual void addGasSource(const vdbio::SceneGasSource& source);
+    /// The particles of `kind` a script may set (liquid and gas particles; ghosts are derived
+    /// from them and cannot be set); the default: none.
+    virtual WritableParticles writableParticles(sph::ParticleKind kind);
     /// Before simulating towards `frame`: per-frame inputs (deforming solid sequences).
     virtual void beforeFrame(int /*frame*/) {}
 

@@ -57,6 +57,9 @@ void checkLiquidSimulation(const vdbio::Scene& scene, ghost::Method method);
 /// Visible gas (not ambient air) copied into a set of its own for the outputs.
 void copyVisibleGas(const sph::ParticleSet& from, sph::ParticleSet& to);
 OutputMedium gasMedium(const gas::GasSolver& s, const sph::ParticleSet& visible);
+/// The visible gas of `s` as a script sets it (kind Gas, ambient air skipped); none for
+/// another kind.
+WritableParticles writableGas(gas::GasSolver& s, sph::ParticleKind kind);
 /// The gas statistics columns, timings as differences from `before`.
 std::vector<std::pair<std::string, double>> gasStats(const gas::GasSolver& s,
                                                      const gas::GasTimings& before);

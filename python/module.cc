@@ -9,6 +9,7 @@
 #include "FrameWriter.h"
 #include "LiquidScene.h"
 #include "Readers.h"
+#include "ScriptInputs.h"
 #include "Simulation.h"
 #include "StopSignals.h"
 
@@ -26,8 +27,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,6 +60,15 @@ struct PyScene
     std::shared_ptr<const vdbio::Scene> scene;
 };
 
+/// The scene document's `settings` object (after the overrides) as a Python dict.
+py::object settingsOf(const vdbio::Scene& scene)
+{
+    const vdbio::Json& doc = *scene.document;
+    const auto s = doc.find("settings");
+    const std::string text = s == doc.end() ? "{}" : s->dump();
+    return py::module_::import("json").attr("loads")(text);
+}
+
 sph::ParticleKind kindFromName(const std::string& name)
 {
     if (name == "liquid") return sph::ParticleKind::Liquid;
@@ -68,8 +80,11 @@ sph::ParticleKind kindFromName(const std::string& name)
                      + "': expected 'liquid', 'air', 'solid', 'gas' or 'boundary'");
 }
 
-/// One medium's particles of `kind`, ghosts included (a copy; see the file comment).
-sph::ParticleSet particlesOf(const cmd::Simulation& sim, sph::ParticleKind kind)
+/// One medium's particles of `kind`, ghosts included (a copy; see the file comment). With
+/// `pendingMass`, before the medium's first step the particles whose mass is still 0 get the
+/// mass that step will give them (the solver's mass scaling, measured apart: costs a sampling).
+sph::ParticleSet particlesOf(const cmd::Simulation& sim, sph::ParticleKind kind,
+                             bool pendingMass = false)
 {
     for (const cmd::OutputMedium& m : sim.media()) {
         const bool listed =
@@ -79,7 +94,12 @@ sph::ParticleSet particlesOf(const cmd::Simulation& sim, sph::ParticleKind kind)
         sph::ParticleSet all = m.withGhosts ? m.withGhosts() : *m.particles;
         std::vector<std::uint8_t> keep(all.size());
         for (std::size_t i = 0; i < all.size(); ++i) keep[i] = all.kinds()[i] == kind;
-        return all.select(keep);
+        sph::ParticleSet out = all.select(keep);
+        std::vector<sph::Real>& mass = out.masses();
+        const bool unset = std::find(mass.begin(), mass.end(), sph::Real(0)) != mass.end();
+        const double pending = pendingMass && unset && m.pendingMass ? m.pendingMass() : 0.0;
+        if (pending > 0) std::replace(mass.begin(), mass.end(), sph::Real(0), sph::Real(pending));
+        return out;
     }
     return sph::ParticleSet();
 }
@@ -167,22 +187,81 @@ py::array_t<double> poissonSamples(const sph::LevelSet& shape, double spacing, s
     return vectors(samples.positions);
 }
 
+/// The Python list of motion keys [{"time", "translate", "rotate"}, ...] (or the scene's
+/// {"keys": [...]} object) as a keyed motion, read by the scene reader's own rules.
+sph::KeyedMotion motionFromPython(const py::object& motion, const std::string& what)
+{
+    const py::module_ json = py::module_::import("json");
+    py::object object = motion;
+    if (!py::isinstance<py::dict>(motion)) {
+        py::dict keys;
+        keys["keys"] = motion;
+        object = keys;
+    }
+    auto doc = std::make_shared<const vdbio::Json>(
+        vdbio::Json::parse(json.attr("dumps")(object).cast<std::string>()));
+    return vdbio::readMotion(vdbio::JsonObject(doc, doc.get(), "motion", what, "script"));
+}
+
+using FloatArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+sph::Vec3d vec3(const std::array<double, 3>& v) { return sph::Vec3d(v[0], v[1], v[2]); }
+
+/// What the step observer calls besides the statistics: on_step(sim, dt) callbacks, those of
+/// sim.on_step() and the one of the run() in progress; `self` is the Python object of the
+/// simulation stepping (set for the length of each advance).
+struct StepHooks
+{
+    std::vector<py::object> callbacks;
+    py::object runCallback;
+    PyObject* self = nullptr;
+
+    void call(double dt) const
+    {
+        if (callbacks.empty() && !runCallback) return;
+        py::gil_scoped_acquire gil;
+        const py::handle sim(self);
+        for (const py::object& cb : callbacks) cb(sim, dt);
+        if (runCallback) runCallback(sim, dt);
+    }
+};
+
+/// One name among entries that each have one (solids, emitters, gas sources): "'a', 'b'".
+template <typename Entries>
+std::string namesOf(const Entries& entries)
+{
+    std::string known;
+    for (const auto& e : entries) known += (known.empty() ? "'" : ", '") + e.name + "'";
+    return known.empty() ? "none" : known;
+}
+
+template <typename Entries>
+void refuseDuplicate(const Entries& entries, const std::string& name, const char* what)
+{
+    for (const auto& e : entries) {
+        if (e.name == name) {
+            throw ValueError(msg(what, " '", name,
+                                 "': the simulation has one of that name already (",
+                                 namesOf(entries), "); give another name=..."));
+        }
+    }
+}
+
 class PySimulation
 {
 public:
-    explicit PySimulation(const PyScene& scene) : mScene(scene.scene)
-    {
-        mSim = cmd::makeSimulation(*mScene);
-        observe();
-    }
+    explicit PySimulation(const PyScene& scene) : PySimulation(scene.scene, {}, nullptr) {}
 
     /// A simulation continuing from a checkpoint written for the same scene settings (the
-    /// checkpoint is refused otherwise, naming the first differing key).
+    /// checkpoint is refused otherwise, naming the first differing key), with the solids,
+    /// emitters, gas sources and solid velocities the script had added or set.
     static PySimulation resume(const PyScene& scene, const std::string& path)
     {
         const std::vector<sph::SolverState> states =
             vdbio::readCheckpointStates(path, cmd::checkpointFingerprint(*scene.scene));
-        return PySimulation(scene.scene, cmd::makeSimulation(*scene.scene, &states));
+        python::ScriptInputs inputs =
+            python::fromAttachments(vdbio::readCheckpointAttachments(path), path);
+        return PySimulation(scene.scene, std::move(inputs), &states);
     }
 
     /// The scene's outputs of the current frame (points, volume, preview), into `folder` or
@@ -206,45 +285,126 @@ public:
             if (solids[i].name == name) index = i;
         }
         if (index == solids.size()) {
-            std::string known;
-            for (const auto& s : solids) known += (known.empty() ? "'" : ", '") + s.name + "'";
-            throw ValueError("solid '" + name + "': the scene has no such solid (solids: "
-                             + (known.empty() ? "none" : known) + ")");
+            throw ValueError("solid '" + name
+                             + "': the scene has no such solid (solids: " + namesOf(solids) + ")");
         }
-        if (mMotions.empty()) {
-            for (const auto& s : solids) {
-                mMotions.push_back(s.motion.keys.empty()
-                                       ? sph::constantVelocity(sph::Vec3(s.velocity))
-                                       : s.motion.motion());
-            }
-        }
-        const double t0 = mSim->time();
-        const sph::RigidTransform start = mMotions[index](t0);
-        const sph::Vec3d v(velocity[0], velocity[1], velocity[2]);
-        const sph::Vec3d p0(start.translation);
-        sph::RigidMotion motion = [start, p0, v, t0](double t) {
-            sph::RigidTransform xf = start;
-            xf.translation = sph::Vec3(p0 + v * (t - t0));
-            xf.translationRate = sph::Vec3(v);
-            xf.rotationRate = openvdb::math::Mat3<sph::Real>::zero();
-            xf.hasRates = true;
-            return xf;
-        };
-        mSim->setSolidMotion(index, motion);
-        mMotions[index] = motion;
+        python::SolidVelocity v;
+        v.time = mSim->time();
+        v.start = motionOf(index)(v.time);
+        v.velocity = vec3(velocity);
+        mSim->setSolidMotion(index, v.motion());
+        mInputs.velocities[index] = v;
     }
 
-    void addSolid(const sph::LevelSet& shape, const std::array<double, 3>& velocity)
+    void addSolid(const sph::LevelSet& shape, const std::array<double, 3>& velocity,
+                  const py::object& name, const py::object& motion)
     {
-        py::gil_scoped_release release;
-        mSim->addSolid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]),
-                                        sph::Real(velocity[2])));
+        vdbio::SceneSolid solid(name.is_none() ? shape.name() : name.cast<std::string>(),
+                                "add_solid", shape);
+        refuseDuplicate(mScene->solids, solid.name, "solid");
+        solid.velocity = vec3(velocity);
+        if (!motion.is_none()) {
+            if (solid.velocity != sph::Vec3d(0.0)) {
+                throw ValueError("solid '" + solid.name
+                                 + "': give either a velocity or motion keys, not both");
+            }
+            solid.motion = motionFromPython(motion, "add_solid('" + solid.name + "')");
+        }
+        {
+            py::gil_scoped_release release;
+            mSim->addSolid(solid);
+        }
+        mScene->solids.push_back(solid);
+        mInputs.solids.push_back(solid);
     }
+
+    void addEmitter(const sph::LevelSet& shape, const std::array<double, 3>& velocity, double start,
+                    double end, const py::object& name, const py::object& motion)
+    {
+        vdbio::SceneEmitter e(name.is_none() ? shape.name() : name.cast<std::string>(),
+                              "add_emitter", shape);
+        refuseDuplicate(mScene->emitters, e.name, "emitter");
+        e.velocity = vec3(velocity);
+        e.start = start;
+        e.end = end;
+        if (!motion.is_none()) e.motion = motionFromPython(motion, "add_emitter('" + e.name + "')");
+        mSim->addEmitter(e);
+        mScene->emitters.push_back(e);
+        mInputs.emitters.push_back(e);
+    }
+
+    void addGasSource(const sph::LevelSet& shape, const std::array<double, 3>& velocity,
+                      double temperature, double rate, double start, double end,
+                      const py::object& name, const py::object& motion)
+    {
+        vdbio::SceneGasSource g(name.is_none() ? shape.name() : name.cast<std::string>(),
+                                "add_gas_source", shape);
+        refuseDuplicate(mScene->gasSources, g.name, "gas source");
+        g.velocity = vec3(velocity);
+        g.temperature = temperature;
+        g.rate = rate;
+        g.start = start;
+        g.end = end;
+        if (!motion.is_none())
+            g.motion = motionFromPython(motion, "add_gas_source('" + g.name + "')");
+        mSim->addGasSource(g);
+        mScene->gasSources.push_back(g);
+        mInputs.gasSources.push_back(g);
+    }
+
     std::size_t addLiquid(const sph::LevelSet& shape, const std::array<double, 3>& velocity)
     {
         py::gil_scoped_release release;
-        return mSim->addLiquid(shape, sph::Vec3(sph::Real(velocity[0]), sph::Real(velocity[1]),
-                                                sph::Real(velocity[2])));
+        return mSim->addLiquid(shape, sph::Vec3(vec3(velocity)));
+    }
+
+    /// Replace the positions or velocities of the particles of `kind`, in the order of
+    /// positions(kind).
+    void setVectors(const std::string& kind, const FloatArray& values, bool positions)
+    {
+        const char* what = positions ? "set_positions" : "set_velocities";
+        const sph::ParticleKind k = kindFromName(kind);
+        const cmd::WritableParticles w = mSim->writableParticles(k);
+        if (!w.set) {
+            throw ValueError(msg(what, "('", kind, "'): ",
+                                 k == sph::ParticleKind::Liquid || k == sph::ParticleKind::Gas
+                                     ? "this scene has no such particles"
+                                     : "ghost particles are made from the liquid, the gas and "
+                                       "the solids every step and cannot be set; set 'liquid' or "
+                                       "'gas'"));
+        }
+        std::vector<std::size_t> index;
+        for (std::size_t i = 0; i < w.set->size(); ++i) {
+            if (w.set->kinds()[i] == k && (!w.skip || (*w.skip)[i] == sph::Real(0)))
+                index.push_back(i);
+        }
+        if (values.ndim() != 2 || values.shape(1) != 3
+            || std::size_t(values.shape(0)) != index.size()) {
+            throw ValueError(msg(
+                what, "('", kind, "'): expected an (N, 3) array with N = ", index.size(), " (the ",
+                kind, " particles now), got shape (", values.ndim() > 0 ? values.shape(0) : 0,
+                values.ndim() > 1 ? msg(", ", values.shape(1)) : "", ")"));
+        }
+        auto a = values.unchecked<2>();
+        std::vector<sph::Vec3>& out = positions ? w.set->positions() : w.set->velocities();
+        for (std::size_t n = 0; n < index.size(); ++n) {
+            const sph::Vec3 v(sph::Real(a(n, 0)), sph::Real(a(n, 1)), sph::Real(a(n, 2)));
+            if (!sph::isFinite(v))
+                throw ValueError(msg(what, "('", kind, "'): row ", n, " is not finite"));
+        }
+        for (std::size_t n = 0; n < index.size(); ++n)
+            out[index[n]] = sph::Vec3(sph::Real(a(n, 0)), sph::Real(a(n, 1)), sph::Real(a(n, 2)));
+        if (positions && w.moved) {
+            py::gil_scoped_release release;
+            w.moved();
+        }
+    }
+
+    void onStep(const py::object& callback)
+    {
+        if (!PyCallable_Check(callback.ptr()))
+            throw ValueError("on_step: expected a callable (sim, dt)");
+        mHooks->callbacks.push_back(callback);
     }
 
     /// Statistics of every step since this object was made: column name -> float64 array.
@@ -260,30 +420,40 @@ public:
         return out;
     }
 
-    /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames.
+    /// Write the state to an HDF5 checkpoint, as `ghostfx run` does at its checkpoint frames,
+    /// with what the script added.
     void saveCheckpoint(const std::string& path) const
     {
         vdbio::writeCheckpoint(path, mSim->saveStates(), cmd::checkpointFingerprint(*mScene),
-                               mSim->frame());
+                               mSim->frame(), python::toAttachments(mInputs));
     }
 
-    void advanceFrame()
+    void advanceFrame(const py::object& self)
     {
+        mHooks->self = self.ptr();
         py::gil_scoped_release release;
         mSim->beforeFrame(mSim->frame() + 1);
         mSim->advanceFrame();
     }
 
     /// Advance `frames` frames (default: to the scene's last frame), calling on_frame(self)
-    /// after each. Ctrl-C (KeyboardInterrupt) is raised at the end of a frame; so is
-    /// ghostfx.Interrupted for SIGTERM and SIGUSR1 (where the script has not set handlers of
-    /// its own), after the frame's checkpoint is written to `checkpoint` (a $F4 pattern) if given.
-    void run(py::object frames, py::object onFrame, py::object checkpoint, py::object self)
+    /// after each and on_step(self, dt) after each step. Ctrl-C (KeyboardInterrupt) is raised at
+    /// the end of a frame; so is ghostfx.Interrupted for SIGTERM and SIGUSR1 (where the script
+    /// has not set handlers of its own), after the frame's checkpoint is written to `checkpoint`
+    /// (a $F4 pattern) if given.
+    void run(py::object frames, py::object onFrame, py::object checkpoint, py::object onStep,
+             py::object self)
     {
         const int last = frames.is_none() ? mScene->lastFrame : mSim->frame() + frames.cast<int>();
         const cmd::StopSignals stopSignals(/*leaveHandled=*/true);
+        struct RunCallback // the run's on_step, for the length of the run
+        {
+            StepHooks& hooks;
+            ~RunCallback() { hooks.runCallback = py::object(); }
+        } scoped{*mHooks};
+        if (!onStep.is_none()) mHooks->runCallback = onStep;
         while (mSim->frame() < last) {
-            advanceFrame();
+            advanceFrame(self);
             if (!onFrame.is_none()) onFrame(self);
             if (PyErr_CheckSignals() != 0) throw py::error_already_set();
             if (const int signal = cmd::StopSignals::received()) stop(signal, checkpoint);
@@ -316,6 +486,19 @@ public:
     double time() const { return mSim->time(); }
     std::uint64_t steps() const { return mSim->stepCount(); }
     std::string counts() const { return mSim->counts(); }
+    py::object settings() const { return settingsOf(*mScene); }
+    /// Each liquid emitter's name, cross-section (m^2) and mass rate (kg/s), scene's first.
+    py::list emitterRates() const
+    {
+        py::list out;
+        const std::vector<cmd::Simulation::EmitterRate> rates = mSim->emitterRates();
+        for (std::size_t i = 0; i < rates.size() && i < mScene->emitters.size(); ++i) {
+            out.append(py::dict(py::arg("name") = mScene->emitters[i].name,
+                                py::arg("cross_section") = rates[i].crossSection,
+                                py::arg("mass_rate") = rates[i].massRate));
+        }
+        return out;
+    }
 
     py::array_t<double> positions(const std::string& kind) const
     {
@@ -328,7 +511,7 @@ public:
     /// A per-particle quantity: "density", "pressure", "mass", "id" or a named channel.
     py::array channel(const std::string& kind, const std::string& name) const
     {
-        const sph::ParticleSet p = particlesOf(*mSim, kindFromName(kind));
+        const sph::ParticleSet p = particlesOf(*mSim, kindFromName(kind), name == "mass");
         auto scalars = [](const std::vector<sph::Real>& s) {
             py::array_t<double> a(py::ssize_t(s.size()));
             auto w = a.mutable_unchecked<1>();
@@ -352,15 +535,37 @@ public:
     }
 
 private:
-    PySimulation(std::shared_ptr<const vdbio::Scene> scene, std::unique_ptr<cmd::Simulation> sim)
-        : mScene(std::move(scene))
-        , mSim(std::move(sim))
+    /// A simulation of its own copy of `scene` with `inputs` added, fresh or from `states`.
+    PySimulation(std::shared_ptr<const vdbio::Scene> scene, python::ScriptInputs inputs,
+                 const std::vector<sph::SolverState>* states)
+        : mScene(std::make_shared<vdbio::Scene>(*scene))
+        , mInputs(std::move(inputs))
     {
+        auto append = [](auto& to, const auto& from) {
+            to.insert(to.end(), from.begin(), from.end());
+        };
+        append(mScene->solids, mInputs.solids);
+        append(mScene->emitters, mInputs.emitters);
+        append(mScene->gasSources, mInputs.gasSources);
+        mSim = cmd::makeSimulation(*mScene, states);
+        for (const auto& [index, v] : mInputs.velocities) mSim->setSolidMotion(index, v.motion());
         observe();
     }
 
+    /// The motion solid `index` follows now: the one set_solid_velocity gave it last, else its
+    /// scene motion (keys, or its constant velocity).
+    sph::RigidMotion motionOf(std::size_t index) const
+    {
+        const auto set = mInputs.velocities.find(index);
+        if (set != mInputs.velocities.end()) return set->second.motion();
+        const vdbio::SceneSolid& s = mScene->solids[index];
+        return s.motion.keys.empty() ? sph::constantVelocity(sph::Vec3(s.velocity))
+                                     : s.motion.motion();
+    }
+
     /// The per-step statistics rows (the columns of `ghostfx run`'s stats file), collected by a
-    /// step observer that holds the simulation and the table, not this object (which moves).
+    /// step observer that holds the simulation and the table, not this object (which moves);
+    /// then the script's on_step callbacks.
     struct StatsTable
     {
         std::vector<std::string> columns;
@@ -370,7 +575,8 @@ private:
     {
         cmd::Simulation* sim = mSim.get();
         std::shared_ptr<StatsTable> table = mStats;
-        mSim->setStepObserver([sim, table](double dt) {
+        std::shared_ptr<StepHooks> hooks = mHooks;
+        mSim->setStepObserver([sim, table, hooks](double dt) {
             const vdbio::StatsRow row = sim->statsRow(sim->frame() + 1, dt);
             if (table->columns.empty()) {
                 for (const auto& [name, value] : row.values) table->columns.push_back(name);
@@ -379,14 +585,153 @@ private:
             for (std::size_t c = 0; c < row.values.size() && c < table->values.size(); ++c) {
                 table->values[c].push_back(row.values[c].second);
             }
+            hooks->call(dt);
         });
     }
 
-    std::shared_ptr<const vdbio::Scene> mScene;
+    std::shared_ptr<vdbio::Scene> mScene; ///< the scene with what the script added
+    python::ScriptInputs mInputs;         ///< what the script added, for checkpoints
     std::unique_ptr<cmd::Simulation> mSim;
-    std::vector<sph::RigidMotion> mMotions; ///< each scene solid's motion as this object set it
     std::shared_ptr<StatsTable> mStats = std::make_shared<StatsTable>();
+    std::shared_ptr<StepHooks> mHooks = std::make_shared<StepHooks>();
 };
+
+using PySimulationClass = py::class_<PySimulation>;
+
+/// Simulation: making, advancing, running and checkpointing.
+void bindRunning(PySimulationClass& c)
+{
+    c.def(py::init<const PyScene&>(), py::arg("scene"))
+        .def(
+            "advance_frame", [](py::object self) { self.cast<PySimulation&>().advanceFrame(self); },
+            "Simulate one frame (the scene's substeps or CFL steps); releases the GIL")
+        .def(
+            "run",
+            [](py::object self, py::object frames, py::object onFrame, py::object checkpoint,
+               py::object onStep) {
+        self.cast<PySimulation&>().run(frames, onFrame, checkpoint, onStep, self);
+            },
+            py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
+            py::arg("checkpoint") = py::none(), py::arg("on_step") = py::none(),
+            "Advance `frames` frames (default: to the scene's last), calling on_frame(sim) after "
+            "each frame and on_step(sim, dt) after each step (besides the callbacks of "
+            "sim.on_step). An exception raised by a callback stops the run after the complete "
+            "step and propagates. Ctrl-C stops at the end of a frame with KeyboardInterrupt. "
+            "SIGTERM and SIGUSR1 (a render farm's stop) finish the frame, call on_frame, write "
+            "the frame's checkpoint to `checkpoint` (a path pattern such as "
+            "'out/checkpoint.$F4.h5') if given, and raise ghostfx.Interrupted, a SystemExit whose "
+            "code is 128 + the signal (143, 138)")
+        .def("on_step", &PySimulation::onStep, py::arg("callback"),
+             "Call callback(sim, dt) after every step from now on (dt in s), in advance_frame() "
+             "and run() alike; an exception it raises stops the frame after the complete step "
+             "and propagates")
+        .def("write_frame", &PySimulation::writeFrame, py::arg("folder") = py::none(),
+             "Write the scene's outputs for the current frame (files named by the scene's "
+             "`outputs`, as `ghostfx run` writes them) into `folder` (default: "
+             "outputs.directory); releases the GIL. Added solids are drawn in the preview")
+        .def("statistics", &PySimulation::statistics,
+             "Per-step statistics since this object was made, as `ghostfx run` writes them to "
+             "stats.h5: a dict of column name -> float64 array, one entry per step")
+        .def("save_checkpoint", &PySimulation::saveCheckpoint, py::arg("path"),
+             "Write the state to an HDF5 checkpoint (the format of `ghostfx run`), with the "
+             "solids, emitters and gas sources the script added and the solid velocities it set")
+        .def_static("resume", &PySimulation::resume, py::arg("scene"), py::arg("path"),
+                    "A simulation continuing from a checkpoint of the same scene settings, with "
+                    "what the script had added (nothing to add again); it continues bit for bit "
+                    "as the run that wrote it");
+}
+
+/// Simulation: what a script adds and sets.
+void bindScripting(PySimulationClass& c)
+{
+    const auto zero = std::array<double, 3>{0, 0, 0};
+    const double never = std::numeric_limits<double>::infinity();
+    c.def("set_solid_velocity", &PySimulation::setSolidVelocity, py::arg("name"),
+          py::arg("velocity"),
+          "From now on the solid `name` (the scene's or an added one) moves at `velocity` (m/s) "
+          "from where it is, without turning. It must be a moving solid (a velocity or motion "
+          "keys); saved in checkpoints")
+        .def("add_solid", &PySimulation::addSolid, py::arg("level_set"), py::arg("velocity") = zero,
+             py::arg("name") = py::none(), py::arg("motion") = py::none(),
+             "Add a solid beside the scene's, as a scene solid: static, or placed at level set + "
+             "velocity t (t from 0 s), or by `motion`, the keys of a scene solid's motion "
+             "([{'time': 0, 'translate': [x, y, z], 'rotate': [rx, ry, rz]}, ...]). `name` "
+             "(default: the level set's) must be new; set_solid_velocity finds it, previews draw "
+             "it, checkpoints keep it. Its ghosts are sampled now. Liquid scenes")
+        .def("add_liquid", &PySimulation::addLiquid, py::arg("level_set"),
+             py::arg("velocity") = zero,
+             "Sample a liquid body into the simulation before its first frame; returns the "
+             "particles added. Liquid scenes")
+        .def("add_emitter", &PySimulation::addEmitter, py::arg("level_set"), py::arg("velocity"),
+             py::arg("start") = 0.0, py::arg("end") = never, py::arg("name") = py::none(),
+             py::arg("motion") = py::none(),
+             "Add a liquid emitter, as a scene emitter: from `start` to `end` (s) its volume is "
+             "kept full of liquid moving at `velocity` (m/s, in the emitter's own frame), pouring "
+             "rho0 |velocity| times its cross-section in kg/s. `motion`: keys as add_solid's, "
+             "moving and turning the emitter (a sweeping hose); the liquid leaves at `velocity` "
+             "turned with it plus the emitter's own velocity. Kept in checkpoints. Liquid scenes")
+        .def("add_gas_source", &PySimulation::addGasSource, py::arg("level_set"),
+             py::arg("velocity") = zero, py::arg("temperature") = 373.15, py::arg("rate") = 0.0,
+             py::arg("start") = 0.0, py::arg("end") = never, py::arg("name") = py::none(),
+             py::arg("motion") = py::none(),
+             "Add a gas source, as a scene gas source (`motion`: keys as add_solid's, a moving "
+             "source): from `start` to `end` (s) its volume is "
+             "kept full of gas at `temperature` (K) moving at `velocity` (m/s), at most `rate` "
+             "particles per second (0: as many as fit). Kept in checkpoints. Gas scenes and the "
+             "vapour of boiling ones")
+        .def(
+            "set_positions",
+            [](PySimulation& s, const std::string& kind, const FloatArray& v) {
+        s.setVectors(kind, v, true);
+            },
+            py::arg("kind"), py::arg("positions"),
+            "Replace the positions (m) of the particles of `kind` ('liquid' or 'gas'), an (N, 3) "
+            "array in the order of positions(kind); the next step searches neighbours anew. "
+            "Ghosts ('air', 'solid', 'boundary') are made from the rest and cannot be set")
+        .def(
+            "set_velocities",
+            [](PySimulation& s, const std::string& kind, const FloatArray& v) {
+        s.setVectors(kind, v, false);
+            },
+            py::arg("kind"), py::arg("velocities"),
+            "Replace the velocities (m/s) of the particles of `kind` ('liquid' or 'gas'), an "
+            "(N, 3) array in the order of positions(kind)");
+}
+
+/// Simulation: what a script reads.
+void bindReading(PySimulationClass& c)
+{
+    c.def_property_readonly("frame", &PySimulation::frame, "frames advanced so far")
+        .def_property_readonly("time", &PySimulation::time, "simulated time (s)")
+        .def_property_readonly("steps", &PySimulation::steps, "steps taken so far")
+        .def_property_readonly("counts", &PySimulation::counts,
+                               "particle counts, as the log prints")
+        .def_property_readonly("settings", &PySimulation::settings,
+                               "the scene's `settings` object (after overrides) as a dict, a copy")
+        .def("emitter_rates", &PySimulation::emitterRates,
+             "Each liquid emitter (the scene's, then the added ones) as a dict: name, "
+             "cross_section (m^2, its shadow along its velocity) and mass_rate (kg/s, rho0 "
+             "|velocity| cross_section); empty where the scene's solver has none")
+        .def("positions", &PySimulation::positions, py::arg("kind") = "liquid",
+             "Positions (m) of the particles of `kind` ('liquid', 'air', 'solid', 'gas', "
+             "'boundary'), an (N, 3) float64 copy")
+        .def("velocities", &PySimulation::velocities, py::arg("kind") = "liquid",
+             "Velocities (m/s), an (N, 3) float64 copy")
+        .def("channel", &PySimulation::channel, py::arg("kind"), py::arg("name"),
+             "A per-particle quantity ('density', 'pressure', 'mass', 'id' or a solver channel), "
+             "a copy. Before the first step 'mass' is the mass the first step gives (the mass "
+             "scaling's, measured apart)");
+}
+
+void bindSimulation(py::module_& m)
+{
+    PySimulationClass c(m, "Simulation",
+                        "The solvers a scene needs (liquid, gas or boiling), as `ghostfx run` "
+                        "builds them");
+    bindRunning(c);
+    bindScripting(c);
+    bindReading(c);
+}
 
 } // namespace
 
@@ -415,9 +760,14 @@ PYBIND11_MODULE(_ghostfx, m)
         .def_property_readonly("method", [](const PyScene& s) { return s.scene->method; })
         .def_property_readonly("spacing", [](const PyScene& s) { return s.scene->spacing; })
         .def_property_readonly("frame_rate", [](const PyScene& s) { return s.scene->frameRate; })
-        .def_property_readonly("frame_range", [](const PyScene& s) {
-            return std::make_pair(s.scene->firstFrame, s.scene->lastFrame);
-        });
+        .def_property_readonly(
+            "frame_range",
+            [](const PyScene& s) {
+        return std::make_pair(s.scene->firstFrame, s.scene->lastFrame);
+            })
+        .def_property_readonly(
+            "settings", [](const PyScene& s) { return settingsOf(*s.scene); },
+            "the `settings` object (after overrides) as a dict, a copy");
 
     m.def(
         "load_scene",
@@ -433,62 +783,7 @@ PYBIND11_MODULE(_ghostfx, m)
         "{'settings.stiffness': 5000}. A bad scene raises ValueError with the command line's "
         "message; a file that cannot be read raises OSError.");
 
-    py::class_<PySimulation>(m, "Simulation",
-                             "The solvers a scene needs (liquid, gas or boiling), as `ghostfx run` "
-                             "builds them")
-        .def(py::init<const PyScene&>(), py::arg("scene"))
-        .def("advance_frame", &PySimulation::advanceFrame,
-             "Simulate one frame (the scene's substeps or CFL steps); releases the GIL")
-        .def(
-            "run",
-            [](py::object self, py::object frames, py::object onFrame, py::object checkpoint) {
-        self.cast<PySimulation&>().run(frames, onFrame, checkpoint, self);
-            },
-            py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
-            py::arg("checkpoint") = py::none(),
-            "Advance `frames` frames (default: to the scene's last), calling on_frame(sim) after "
-            "each. Ctrl-C stops at the end of a frame with KeyboardInterrupt. SIGTERM and SIGUSR1 "
-            "(a render farm's stop) finish the frame, call on_frame, write the frame's checkpoint "
-            "to `checkpoint` (a path pattern such as 'out/checkpoint.$F4.h5') if given, and raise "
-            "ghostfx.Interrupted, a SystemExit whose code is 128 + the signal (143, 138)")
-        .def("write_frame", &PySimulation::writeFrame, py::arg("folder") = py::none(),
-             "Write the scene's outputs for the current frame (files named by the scene's "
-             "`outputs`, as `ghostfx run` writes them) into `folder` (default: "
-             "outputs.directory); releases the GIL")
-        .def("set_solid_velocity", &PySimulation::setSolidVelocity, py::arg("name"),
-             py::arg("velocity"),
-             "From now on the scene's solid `name` moves at `velocity` (m/s) from where it is. It "
-             "must be a moving solid in the scene (a velocity or motion keys); not saved in "
-             "checkpoints")
-        .def("add_solid", &PySimulation::addSolid, py::arg("level_set"),
-             py::arg("velocity") = std::array<double, 3>{0, 0, 0},
-             "Add a solid beside the scene's (static at zero velocity, else moving at it); its "
-             "ghosts are sampled now. Liquid scenes")
-        .def("add_liquid", &PySimulation::addLiquid, py::arg("level_set"),
-             py::arg("velocity") = std::array<double, 3>{0, 0, 0},
-             "Sample a liquid body into the simulation before its first frame; returns the "
-             "particles added. Liquid scenes")
-        .def("statistics", &PySimulation::statistics,
-             "Per-step statistics since this object was made, as `ghostfx run` writes them to "
-             "stats.h5: a dict of column name -> float64 array, one entry per step")
-        .def("save_checkpoint", &PySimulation::saveCheckpoint, py::arg("path"),
-             "Write the state to an HDF5 checkpoint (the format of `ghostfx run`)")
-        .def_static("resume", &PySimulation::resume, py::arg("scene"), py::arg("path"),
-                    "A simulation continuing from a checkpoint of the same scene settings; it "
-                    "continues bit for bit as the run that wrote it")
-        .def_property_readonly("frame", &PySimulation::frame, "frames advanced so far")
-        .def_property_readonly("time", &PySimulation::time, "simulated time (s)")
-        .def_property_readonly("steps", &PySimulation::steps, "steps taken so far")
-        .def_property_readonly("counts", &PySimulation::counts,
-                               "particle counts, as the log prints")
-        .def("positions", &PySimulation::positions, py::arg("kind") = "liquid",
-             "Positions (m) of the particles of `kind` ('liquid', 'air', 'solid', 'gas', "
-             "'boundary'), an (N, 3) float64 copy")
-        .def("velocities", &PySimulation::velocities, py::arg("kind") = "liquid",
-             "Velocities (m/s), an (N, 3) float64 copy")
-        .def("channel", &PySimulation::channel, py::arg("kind"), py::arg("name"),
-             "A per-particle quantity ('density', 'pressure', 'mass', 'id' or a solver channel), "
-             "a copy");
+    bindSimulation(m);
 
     py::class_<sph::LevelSet>(m, "LevelSet",
                               "A narrow-band signed-distance grid (OpenVDB), negative inside")

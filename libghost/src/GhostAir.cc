@@ -33,6 +33,18 @@ void GhostSolver::resampleAir(int phase, int count)
     mTimings.airResampling += secondsSince(start);
 }
 
+void GhostSolver::liquidMoved()
+{
+    if (!mRun.initialized || mSettings.method != Method::Ghost) return;
+    dropAir();
+    searchNeighbors();
+    // The whole layer at full weight, as the first one (resampleAir fades in new air only
+    // once the solver is initialised).
+    mRun.initialized = false;
+    resampleAir(-1);
+    mRun.initialized = true;
+}
+
 void GhostSolver::fadeAir(Real span)
 {
     auto& weight = mParticles.scalarChannel(AIR_WEIGHT);

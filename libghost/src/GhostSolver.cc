@@ -703,11 +703,23 @@ void GhostSolver::scaleMass()
     // surface.
     std::unique_ptr<GhostSolver> probe;
     if (mSettings.method == Method::Basic) probe = massProbe();
-    const ParticleSet all = (probe ? *probe : *this).allParticles();
+    setParticleMass(restDensityMass(probe ? *probe : *this));
+}
+
+Real GhostSolver::restDensityMass(const GhostSolver& measured) const
+{
+    const ParticleSet all = measured.allParticles();
     std::vector<std::uint8_t> liquid(all.size());
     for (std::size_t i = 0; i < liquid.size(); ++i)
         liquid[i] = all.kinds()[i] == ParticleKind::Liquid;
-    setParticleMass(massForRestDensity(all.positions(), mKernel, mSettings.restDensity, liquid));
+    return massForRestDensity(all.positions(), mKernel, mSettings.restDensity, liquid);
+}
+
+Real GhostSolver::startParticleMass() const
+{
+    if (mRun.initialized || mMass != Real(0)) return mMass;
+    if (mParticles.count(ParticleKind::Liquid) == 0) return Real(0);
+    return restDensityMass(*massProbe());
 }
 
 std::unique_ptr<GhostSolver> GhostSolver::massProbe() const

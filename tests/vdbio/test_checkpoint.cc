@@ -198,6 +198,24 @@ TEST(Checkpoint, SeveralStatesRoundTripInOrder)
     fs::remove_all(dir);
 }
 
+TEST(Checkpoint, AttachmentsRoundTripBesideTheStates)
+{
+    // Byte strings a caller keeps beside the states (the Python module's added shapes): read
+    // back byte for byte, NULs and high bytes included; a checkpoint without them has none,
+    // and the states read as before.
+    const fs::path dir = freshDir("attachments");
+    const std::string with = (dir / "with.h5").string(), without = (dir / "without.h5").string();
+    const std::string bytes("\0\x01\xff vdb", 7);
+    const CheckpointAttachments attachments = {{"a.json", "{\"x\": 1}"}, {"b.vdb", bytes},
+                                               {"empty", ""}};
+    writeCheckpoint(with, {awkwardState()}, SETTINGS, 2, attachments);
+    writeCheckpoint(without, {awkwardState()}, SETTINGS, 2);
+    EXPECT_EQ(readCheckpointAttachments(with), attachments);
+    EXPECT_TRUE(readCheckpointAttachments(without).empty());
+    EXPECT_EQ(firstDifference(readCheckpoint(with, SETTINGS), awkwardState()), "");
+    fs::remove_all(dir);
+}
+
 TEST(Checkpoint, RefusesOtherSchemaAndPrecision)
 {
     const fs::path dir = freshDir("schema");

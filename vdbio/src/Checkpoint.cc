@@ -29,6 +29,7 @@ constexpr const char* SCALARS = "scalar";
 constexpr const char* VECTORS = "vector";
 constexpr const char* REALS = "reals";
 constexpr const char* INTEGERS = "integers";
+constexpr const char* ATTACHMENTS = "attachments";
 /// The particle kinds a file may hold (ParticleKind values 0 .. KIND_COUNT - 1).
 constexpr int KIND_COUNT = 5;
 
@@ -153,7 +154,8 @@ std::string stateGroupName(std::size_t k) { return msg("state_", k); }
 
 /// `count` states from `states` on into a new checkpoint at `path` (atomically).
 void writeStates(const std::string& path, const SolverState* states, std::size_t count,
-                 const std::string& settingsJson, int frame)
+                 const std::string& settingsJson, int frame,
+                 const CheckpointAttachments& attachments = {})
 {
     if (count == 0) throw ValueError(msg("checkpoint '", path, "': no solver state to write"));
     quietHdf5();
@@ -165,6 +167,13 @@ void writeStates(const std::string& path, const SolverState* states, std::size_t
             for (std::size_t k = 1; k < count; ++k) {
                 H5::Group group = h5.createGroup(stateGroupName(k));
                 writeStateGroup(group, states[k]);
+            }
+            if (!attachments.empty()) {
+                H5::Group group = h5.createGroup(ATTACHMENTS);
+                for (const auto& [name, bytes] : attachments) {
+                    writeDataset(group, name, H5::PredType::NATIVE_UINT8, bytes.data(),
+                                 bytes.size(), 1);
+                }
             }
         } catch (const H5::Exception& e) {
             throw IoError(msg("checkpoint '", path, "': cannot write it (", detailOf(e), ")"));
@@ -541,6 +550,35 @@ void writeCheckpoint(const std::string& path, const std::vector<SolverState>& st
                      const std::string& settingsJson, int frame)
 {
     writeStates(path, states.data(), states.size(), settingsJson, frame);
+}
+
+void writeCheckpoint(const std::string& path, const std::vector<SolverState>& states,
+                     const std::string& settingsJson, int frame,
+                     const CheckpointAttachments& attachments)
+{
+    writeStates(path, states.data(), states.size(), settingsJson, frame, attachments);
+}
+
+CheckpointAttachments readCheckpointAttachments(const std::string& path)
+{
+    const Reader r = openCheckpoint(path);
+    return guarded(path, [&] {
+        CheckpointAttachments out;
+        if (!r.file.nameExists(ATTACHMENTS)) return out;
+        const H5::Group group = r.file.openGroup(ATTACHMENTS);
+        for (hsize_t k = 0; k < group.getNumObjs(); ++k) {
+            const std::string name = group.getObjnameByIdx(k);
+            H5::DataSet set = group.openDataSet(name);
+            hsize_t rows = 0;
+            if (set.getSpace().getSimpleExtentNdims() == 1)
+                set.getSpace().getSimpleExtentDims(&rows);
+            std::string bytes(std::size_t(rows), '\0');
+            r.readDataset(group, "/" + std::string(ATTACHMENTS), name, H5::PredType::NATIVE_UINT8,
+                          H5T_INTEGER, bytes.data(), bytes.size(), 1);
+            out[name] = std::move(bytes);
+        }
+        return out;
+    });
 }
 
 void writeCheckpoint(const std::string& path, const SolverState& state,

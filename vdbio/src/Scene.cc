@@ -275,26 +275,6 @@ sph::LevelSet readGeometry(const JsonObject& g, const Scene& scene, std::string&
     }
 }
 
-/// Keys of a rigid motion: { "keys": [ { "time", "translate", "rotate" }, ... ] }.
-sph::KeyedMotion readMotion(const JsonObject& motion)
-{
-    sph::KeyedMotion m;
-    for (const JsonObject& k : motion.objects("keys")) {
-        sph::RigidKey key;
-        key.time = k.require<double>("time");
-        key.translate = vec(k.get<std::array<double, 3>>("translate", {0, 0, 0}));
-        key.rotateDegrees = vec(k.get<std::array<double, 3>>("rotate", {0, 0, 0}));
-        k.finish();
-        if (!m.keys.empty() && !(key.time > m.keys.back().time)) {
-            k.failValue("time", "expected key times in increasing order");
-        }
-        m.keys.push_back(key);
-    }
-    if (m.keys.empty()) motion.fail("keys", "expected at least one key");
-    motion.finish();
-    return m;
-}
-
 /// The `grids` of an output section: each one of `allowed`, or a one-line error with the
 /// closest name.
 std::vector<std::string> readGridNames(const JsonObject& s,
@@ -537,6 +517,25 @@ void readInterval(const JsonObject& o, double& start, double& end)
 }
 
 } // namespace
+
+sph::KeyedMotion readMotion(const JsonObject& motion)
+{
+    sph::KeyedMotion m;
+    for (const JsonObject& k : motion.objects("keys")) {
+        sph::RigidKey key;
+        key.time = k.require<double>("time");
+        key.translate = vec(k.get<std::array<double, 3>>("translate", {0, 0, 0}));
+        key.rotateDegrees = vec(k.get<std::array<double, 3>>("rotate", {0, 0, 0}));
+        k.finish();
+        if (!m.keys.empty() && !(key.time > m.keys.back().time)) {
+            k.failValue("time", "expected key times in increasing order");
+        }
+        m.keys.push_back(key);
+    }
+    if (m.keys.empty()) motion.fail("keys", "expected at least one key");
+    motion.finish();
+    return m;
+}
 
 std::string Scene::simulationFingerprint(const std::vector<std::string>& freeOnResume) const
 {

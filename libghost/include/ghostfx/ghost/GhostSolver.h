@@ -232,6 +232,17 @@ public:
     /// scaling of [SB12] Sec. 4.6 unless set explicitly.
     Real particleMass() const { return mMass; }
     void setParticleMass(Real mass);
+    /// The particle mass (kg) the first step gives the liquid added so far: particleMass() once
+    /// set; before that, what the mass scaling of [SB12] Sec. 4.6 gives it, measured on a probe
+    /// with its own air layer (this solver is not changed); 0 while there is no liquid.
+    Real startParticleMass() const;
+    /// The first step's set-up (air layer, mass scaling, relaxation) is done.
+    bool initialized() const { return mRun.initialized; }
+    /// After the liquid's positions were set from outside (a script moving it): a Ghost SPH
+    /// solver samples its ghost air anew, a full layer at once as at the first step (the
+    /// resampling renews a phase of it per step, and the old layer would stay where the liquid
+    /// was). Nothing to redo before the first step or for Basic SPH.
+    void liquidMoved();
 
     /// The moving particles: liquid and ghost air.
     ParticleSet& particles() { return mParticles; }
@@ -347,6 +358,9 @@ private:
     bool initialize();
     /// [SB12] Sec. 4.6's mass scaling (setParticleMass).
     void scaleMass();
+    /// The mass that gives the liquid of `measured` (this solver, or a probe with its air layer
+    /// sampled) a mean density of rho0.
+    Real restDensityMass(const GhostSolver& measured) const;
     /// For Basic SPH's mass scaling: a Ghost SPH solver over the same liquid and solids, with
     /// its air layer sampled.
     std::unique_ptr<GhostSolver> massProbe() const;

@@ -25,6 +25,9 @@
 ///              particles get);
 ///            - `reals` and `integers`: groups whose attributes are the state's scalar maps
 ///              (double and int64).
+///          - optionally a group `attachments`: named 1-D uint8 datasets, byte strings a
+///            caller keeps beside the states (the Python module's added solids, emitters and
+///            gas sources, CheckpointAttachments); a checkpoint without it has none.
 ///          Schema 1 is schema 2 with one state and no `state_count`: it is read as that, and a
 ///          liquid solver's state gets the keys that solver added since at the values its
 ///          schema-1 states were saved with (migrateSchema1 in Checkpoint.cc), so the solver
@@ -62,6 +65,18 @@ struct CheckpointHeader
 /// checkpoint). Parameters and errors as the one-state form below.
 void writeCheckpoint(const std::string& path, const std::vector<sph::SolverState>& states,
                      const std::string& settingsJson, int frame);
+
+/// Named byte strings stored beside the states (the group `attachments` of the layout above).
+using CheckpointAttachments = std::map<std::string, std::string>;
+
+/// The same, with `attachments` stored beside the states (none when empty).
+void writeCheckpoint(const std::string& path, const std::vector<sph::SolverState>& states,
+                     const std::string& settingsJson, int frame,
+                     const CheckpointAttachments& attachments);
+
+/// The attachments of a checkpoint (empty for one without); IoError naming the file and the
+/// dataset for one that is not a 1-D uint8 dataset. No state or settings check is made here.
+CheckpointAttachments readCheckpointAttachments(const std::string& path);
 
 /// Write `state` to `path` (HDF5, atomically: a killed run keeps the previous checkpoint).
 /// @param settingsJson  the effective scene settings as JSON text; a resume compares them

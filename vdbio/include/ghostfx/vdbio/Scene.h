@@ -229,6 +229,11 @@ struct Scene
 /// applied to the document before reading (`-D` on the command line).
 Scene readScene(const std::string& path, const std::vector<std::string>& overrides = {});
 
+/// A keyed rigid motion from its object `{ "keys": [ { "time", "translate", "rotate" }, ... ] }`
+/// (a solid's or a gas source's `motion`): keys in increasing time, at least one. Errors name the
+/// key by the object's path.
+sph::KeyedMotion readMotion(const JsonObject& motion);
+
 /// Read and validate one level-set grid from a .vdb file; `context` names the scene key in
 /// messages ("solids[0].geometry").
 sph::LevelSet loadLevelSet(const std::string& file, const std::string& grid,
