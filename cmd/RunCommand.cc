@@ -224,6 +224,19 @@ private:
         mSim = cmd::makeSimulation(mScene, &states);
     }
 
+    /// A checkpoint a Python script wrote with solids, emitters or gas sources it added holds
+    /// them as attachments the scene file does not have: refused, naming where it resumes.
+    static void refuseScriptAdditions(const std::string& path)
+    {
+        const vdbio::CheckpointAttachments attachments = vdbio::readCheckpointAttachments(path);
+        if (attachments.empty()) return;
+        std::string names;
+        for (const auto& [name, bytes] : attachments) names += (names.empty() ? "" : ", ") + name;
+        throw SceneError(msg("--resume '", path, "': the checkpoint holds what a Python script "
+                             "added to the scene (attachments ", names, "); resume it from the "
+                             "script with ghostfx.Simulation.resume(scene, '", path, "')"));
+    }
+
     /// A run over several processes resumes from its manifest: on as many processes, each from
     /// its own file, with the saved regions (bit for bit); on another count (one process
     /// included), every process reads every file and the domain is cut anew. A one-process
@@ -231,6 +244,7 @@ private:
     std::vector<sph::SolverState> readResumeStates()
     {
         if (!isDistributedManifest(mOptions.resume)) {
+            refuseScriptAdditions(mOptions.resume);
             return vdbio::readCheckpointStates(mOptions.resume, mFingerprint);
         }
         const int here = mDistributed ? mDistributed->ranks() : 1;

@@ -1,7 +1,9 @@
 """pytest suite of what a script adds to and sets in a simulation (ghostfx.Simulation):
 settings, named solids, emitters, gas sources, particle positions and velocities, per-step
 callbacks, and checkpoints that carry it all. Each test states where its bound comes from."""
+import json
 import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -10,6 +12,7 @@ import ghostfx
 
 SOURCE = os.environ.get("GHOSTFX_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 DAM = os.path.join(SOURCE, "examples", "dam_break", "scene.json")
+EXE = os.environ.get("GHOSTFX_EXE")
 
 
 def box(lo, hi, name, voxel=0.01):
@@ -22,14 +25,17 @@ def box(lo, hi, name, voxel=0.01):
     return ghostfx.LevelSet.from_array(sdf, voxel, tuple(origin), name)
 
 
-def tank_scene(tmp_path, **settings):
+def tank_document(**settings):
     """A 60 x 30 x 20 cm tank at 2 cm spacing, 10 cm of water in its right half."""
     s = {"method": "ghost", "spacing": 0.02, "substeps": 0, "frame_range": [1, 4], "seed": 3}
     s.update(settings)
-    scene = {"ghostfx_scene": 1, "settings": s,
-             "solids": [{"name": "tank", "geometry": {"container": {"min": [0, 0, 0], "max": [0.6, 0.3, 0.2]}}}],
-             "liquids": [{"name": "water", "geometry": {"box": {"min": [0.3, 0, 0], "max": [0.6, 0.1, 0.2]}}}]}
-    return ghostfx.load_scene(scene, folder=tmp_path)
+    return {"ghostfx_scene": 1, "settings": s,
+            "solids": [{"name": "tank", "geometry": {"container": {"min": [0, 0, 0], "max": [0.6, 0.3, 0.2]}}}],
+            "liquids": [{"name": "water", "geometry": {"box": {"min": [0.3, 0, 0], "max": [0.6, 0.1, 0.2]}}}]}
+
+
+def tank_scene(tmp_path, **settings):
+    return ghostfx.load_scene(tank_document(**settings), folder=tmp_path)
 
 
 def test_masses_are_set_before_the_first_step_and_change_nothing():
@@ -259,3 +265,26 @@ def test_resume_carries_added_solids_emitters_and_velocities_bit_for_bit(tmp_pat
         assert np.array_equal(resumed.velocities(kind), straight.velocities(kind)), kind
     # The added solid keeps its name in the resumed run.
     resumed.set_solid_velocity("paddle", (0, 0, 0))
+
+
+def test_the_command_line_refuses_a_checkpoint_with_a_scripts_additions(tmp_path):
+    # `ghostfx run --resume` knows only the scene file: a checkpoint holding an added solid is
+    # refused in one line that says where it resumes, and nothing is written.
+    if not EXE:
+        pytest.skip("GHOSTFX_EXE is not set")
+    path = tmp_path / "tank.json"
+    path.write_text(json.dumps(tank_document()))
+    sim = ghostfx.Simulation(ghostfx.load_scene(str(path)))
+    sim.add_solid(box([0.02, 0.0, 0.0], [0.06, 0.25, 0.2], "board"), name="paddle")
+    sim.advance_frame()
+    checkpoint = str(tmp_path / "c.h5")
+    sim.save_checkpoint(checkpoint)
+    out = tmp_path / "out"
+    run = subprocess.run([EXE, "run", str(path), "--resume", checkpoint, "--out", str(out)],
+                         capture_output=True, text=True)
+    assert run.returncode == 1
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1
+    assert f"--resume '{checkpoint}': the checkpoint holds what a Python script added" in lines[0]
+    assert "ghostfx.Simulation.resume(scene," in lines[0]
+    assert not out.exists() or not any(out.iterdir())
