@@ -65,7 +65,11 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
         layer.albedo = vdbio::SOLID_ALBEDO;
         // A solid that neither moves nor changes shape looks the same in every frame.
         layer.fixed = solid.isStatic();
-        if (solid.motion.keys.empty()) {
+        if (i < snapshot.solidPlacements.size()) {
+            const sph::RigidTransform& placed = snapshot.solidPlacements[i];
+            layer.rotation = openvdb::math::Mat3d(placed.rotation);
+            layer.translation = openvdb::Vec3d(placed.translation);
+        } else if (solid.motion.keys.empty()) {
             layer.translation = solid.velocity * snapshot.time;
         } else {
             const sph::RigidKey key = solid.motion.at(snapshot.time);

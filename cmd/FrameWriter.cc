@@ -80,6 +80,7 @@ FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation
     FrameSnapshot s;
     s.frame = frame;
     s.time = sim.time();
+    s.solidPlacements = sim.solidPlacements();
     for (OutputMedium m : sim.media()) {
         auto particles = std::make_shared<const sph::ParticleSet>(*m.particles);
         s.particles.push_back(particles);

@@ -49,6 +49,9 @@ struct FrameSnapshot
     /// Per medium where its grids were built before the snapshot, else empty: the writer
     /// builds them from the particles.
     std::vector<BuiltGrids> built;
+    /// Where each solid is at `time` (Simulation::solidPlacements), for the preview; empty:
+    /// where the scene's motion puts it.
+    std::vector<sph::RigidTransform> solidPlacements;
 };
 
 /// The options a medium's points and volume outputs are built with, from the scene's outputs

@@ -95,6 +95,13 @@ public:
         for (const auto& r : mSolver->emitterRates()) rates.push_back({r.crossSection, r.massRate});
         return rates;
     }
+    std::vector<sph::RigidTransform> solidPlacements() const override
+    {
+        std::vector<sph::RigidTransform> placements;
+        for (std::size_t i = 0; i < mSolver->solidCount(); ++i)
+            placements.push_back(mSolver->solidPlacement(i));
+        return placements;
+    }
     void setSolidMotion(std::size_t index, sph::RigidMotion motion) override
     {
         mSolver->setSolidMotion(index, std::move(motion));

@@ -84,6 +84,10 @@ public:
         double crossSection, massRate;
     };
     virtual std::vector<EmitterRate> emitterRates() const { return {}; }
+    /// Where each solid is now, in the order added (the scene's, then a script's): the
+    /// placement its motion gives at time(), wherever a script steered it; empty where the
+    /// solver does not place solids (then the scene's motion says where they are).
+    virtual std::vector<sph::RigidTransform> solidPlacements() const { return {}; }
 
     /// Called after every step with its dt (s).
     virtual void setStepObserver(std::function<void(double dt)> observer) = 0;

@@ -276,18 +276,40 @@ public:
                                dir);
     }
 
+    /// The index of the solid `name` (the scene's, then the script's), or a ValueError naming
+    /// the solids there are.
+    std::size_t solidIndex(const std::string& name) const
+    {
+        const auto& solids = mScene->solids;
+        for (std::size_t i = 0; i < solids.size(); ++i) {
+            if (solids[i].name == name) return i;
+        }
+        throw ValueError("solid '" + name
+                         + "': the scene has no such solid (solids: " + namesOf(solids) + ")");
+    }
+
+    /// (rotation 3x3, translation (m)): where the solid `name` is now, its level set's local
+    /// frame placed in the world as x_world = rotation x + translation.
+    py::tuple solidPlacement(const std::string& name) const
+    {
+        const std::size_t index = solidIndex(name);
+        const std::vector<sph::RigidTransform> placed = mSim->solidPlacements();
+        if (index >= placed.size()) {
+            throw ValueError("solid '" + name + "': this simulation does not place solids");
+        }
+        py::array_t<double> rotation({3, 3});
+        auto r = rotation.mutable_unchecked<2>();
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) r(i, j) = double(placed[index].rotation(i, j));
+        }
+        const sph::Vec3d t(placed[index].translation);
+        return py::make_tuple(rotation, std::array<double, 3>{t.x(), t.y(), t.z()});
+    }
+
     /// From now on, solid `name` moves at `velocity` (m/s) from where it is, without turning.
     void setSolidVelocity(const std::string& name, const std::array<double, 3>& velocity)
     {
-        const auto& solids = mScene->solids;
-        std::size_t index = solids.size();
-        for (std::size_t i = 0; i < solids.size(); ++i) {
-            if (solids[i].name == name) index = i;
-        }
-        if (index == solids.size()) {
-            throw ValueError("solid '" + name
-                             + "': the scene has no such solid (solids: " + namesOf(solids) + ")");
-        }
+        const std::size_t index = solidIndex(name);
         python::SolidVelocity v;
         v.time = mSim->time();
         v.start = motionOf(index)(v.time);
@@ -651,6 +673,10 @@ void bindScripting(PySimulationClass& c)
           "From now on the solid `name` (the scene's or an added one) moves at `velocity` (m/s) "
           "from where it is, without turning. It must be a moving solid (a velocity or motion "
           "keys); saved in checkpoints")
+        .def("solid_placement", &PySimulation::solidPlacement, py::arg("name"),
+             "(rotation, translation): where the solid `name` is now, its level set's frame "
+             "placed as x_world = rotation @ x + translation (m), as the preview draws it. "
+             "Liquid scenes")
         .def("add_solid", &PySimulation::addSolid, py::arg("level_set"), py::arg("velocity") = zero,
              py::arg("name") = py::none(), py::arg("motion") = py::none(),
              "Add a solid beside the scene's, as a scene solid: static, or placed at level set + "

@@ -207,6 +207,16 @@ void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
     sampleSolid(solidIndex);
 }
 
+RigidTransform GhostSolver::solidPlacement(std::size_t solidIndex) const
+{
+    if (solidIndex >= mSolids.size()) {
+        throw ValueError(msg("solidPlacement: solid ", solidIndex, " does not exist (",
+                             mSolids.size(), " solids)"));
+    }
+    const Solid& solid = *mSolids[solidIndex];
+    return solid.motion ? solid.at(time()) : RigidTransform();
+}
+
 void GhostSolver::setSolidMotion(std::size_t solidIndex, RigidMotion motion)
 {
     if (solidIndex >= mSolids.size()) {

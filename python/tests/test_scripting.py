@@ -116,6 +116,33 @@ def test_an_added_solid_is_drawn_in_the_preview(tmp_path):
     assert images[0] != images[1]
 
 
+def test_a_steered_solid_is_drawn_where_it_is(tmp_path):
+    # A paddle far from the water (the front does not reach it in 2 frames, so the liquid is the
+    # same in every run): steered at 0.5 m/s, it is drawn 33 mm on, as one added moving at that
+    # velocity is, and not where its scene velocity (1e-9 m/s) would have put it.
+    outputs = {"outputs.preview": {"file": "p.$F4.png", "width": 160, "height": 90},
+               "outputs.points": None, "outputs.volume.grids": ["surface"]}
+    runs = {}
+    for name, velocity, steer in (("steered", 1e-9, True), ("still", 1e-9, False),
+                                  ("moving", 0.5, False)):
+        sim = ghostfx.Simulation(ghostfx.load_scene(tank_document(), outputs, folder=tmp_path))
+        sim.add_solid(box([0.02, 0.0, 0.0], [0.06, 0.25, 0.2], "board"), (velocity, 0, 0),
+                      name="paddle")
+        if steer:
+            sim.set_solid_velocity("paddle", (0.5, 0, 0))
+        sim.run(frames=2)
+        sim.write_frame(tmp_path / name)
+        rotation, translation = sim.solid_placement("paddle")
+        runs[name] = (sim.positions("liquid"), (tmp_path / name / "p.0002.png").read_bytes(),
+                      translation)
+    assert np.array_equal(runs["steered"][0], runs["still"][0])
+    assert runs["steered"][2][0] == pytest.approx(0.5 / 15, abs=1e-6)
+    assert runs["steered"][1] != runs["still"][1]
+    assert runs["steered"][1] == runs["moving"][1]
+    with pytest.raises(ValueError, match="solid 'lid': the scene has no such solid"):
+        sim.solid_placement("lid")
+
+
 def liquid_mass(sim):
     return sim.channel("liquid", "mass").sum()
 

@@ -122,6 +122,9 @@ public:
     /// Motions are not part of saveState(): a restored run uses what its caller adds.
     void setSolidMotion(std::size_t solidIndex, RigidMotion motion);
     std::size_t solidCount() const { return mSolids.size(); }
+    /// Where solid `solidIndex` (in the order added) is now: its motion at time() (the
+    /// identity for a static solid).
+    RigidTransform solidPlacement(std::size_t solidIndex) const;
 
     /// Sample a liquid body from a level set ([SB12] Sec. 4.5 - 4.6) with initial velocity
     /// `velocity` (m/s). Returns the number of particles added. Throws ValueError after
