@@ -153,6 +153,18 @@ sph::KeyedMotion readKeys(const Json& entry)
     return motion;
 }
 
+/// An emitter or gas source entry: its shape, velocity, start and end times and motion keys.
+template <typename Entry>
+Entry timedEntry(const Json& e, const std::vector<openvdb::FloatGrid::Ptr>& shapes)
+{
+    Entry s = shapedEntry<Entry>(e, shapes);
+    s.velocity = vec(e.at("velocity"));
+    s.start = e.at("start");
+    s.end = endTime(e.at("end"));
+    s.motion = readKeys(e);
+    return s;
+}
+
 ScriptInputs readInputs(const Json& doc, const std::vector<openvdb::FloatGrid::Ptr>& shapes)
 {
     ScriptInputs in;
@@ -162,22 +174,12 @@ ScriptInputs readInputs(const Json& doc, const std::vector<openvdb::FloatGrid::P
         s.motion = readKeys(e);
         in.solids.push_back(s);
     }
-    for (const Json& e : doc.at("emitters")) {
-        vdbio::SceneEmitter s = shapedEntry<vdbio::SceneEmitter>(e, shapes);
-        s.velocity = vec(e.at("velocity"));
-        s.start = e.at("start");
-        s.end = endTime(e.at("end"));
-        s.motion = readKeys(e);
-        in.emitters.push_back(s);
-    }
+    for (const Json& e : doc.at("emitters"))
+        in.emitters.push_back(timedEntry<vdbio::SceneEmitter>(e, shapes));
     for (const Json& e : doc.at("gas_sources")) {
-        vdbio::SceneGasSource s = shapedEntry<vdbio::SceneGasSource>(e, shapes);
-        s.velocity = vec(e.at("velocity"));
+        auto s = timedEntry<vdbio::SceneGasSource>(e, shapes);
         s.temperature = e.at("temperature");
         s.rate = e.at("rate");
-        s.start = e.at("start");
-        s.end = endTime(e.at("end"));
-        s.motion = readKeys(e);
         in.gasSources.push_back(s);
     }
     for (const Json& e : doc.at("solid_velocities")) {

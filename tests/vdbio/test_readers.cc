@@ -155,15 +155,27 @@ TEST(Readers, PointsComeBackWithEveryAttributeInItsStoredType)
     EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), std::ptrdiff_t(particles.size()));
 }
 
-TEST(Readers, PointAttributesOfOtherTypesCodecsAndGroups)
+namespace {
+
+/// The lattice's points as writePointsFile writes them into `dir`, read back as a grid to
+/// change.
+PointDataGrid::Ptr writtenLatticeGrid(const fs::path& dir)
 {
-    const fs::path dir = freshDir("readers_foreign");
     const std::string written = (dir / "points.vdb").string();
     vdbio::writePointsFile(written, latticeParticles(), vdbio::PointsOptions());
     openvdb::io::File in(written);
     in.open();
     const PointDataGrid::Ptr grid = openvdb::gridPtrCast<PointDataGrid>(in.readGrid("particles"));
     in.close();
+    return grid;
+}
+
+} // namespace
+
+TEST(Readers, PointAttributesOfOtherTypesCodecsAndGroups)
+{
+    const fs::path dir = freshDir("readers_foreign");
+    const PointDataGrid::Ptr grid = writtenLatticeGrid(dir);
     addForeignAttributes(*grid);
     grid->setName("spray");
     const std::string file = (dir / "foreign.vdb").string();
@@ -328,12 +340,7 @@ TEST(Readers, ErrorsNameTheFileAndTheGrid)
 TEST(Readers, AnAttributeOfAnotherTypeIsNamedAndInfoStillDescribesTheFile)
 {
     const fs::path dir = freshDir("readers_unsupported");
-    const std::string written = (dir / "points.vdb").string();
-    vdbio::writePointsFile(written, latticeParticles(), vdbio::PointsOptions());
-    openvdb::io::File in(written);
-    in.open();
-    const PointDataGrid::Ptr grid = openvdb::gridPtrCast<PointDataGrid>(in.readGrid("particles"));
-    in.close();
+    const PointDataGrid::Ptr grid = writtenLatticeGrid(dir);
     openvdb::points::appendAttribute<openvdb::math::Mat4s>(grid->tree(), "xform");
     const std::string file = (dir / "matrices.vdb").string();
     openvdb::io::File(file).write({grid});
