@@ -213,7 +213,7 @@ def test_gas_points_read_back_with_their_temperature(tmp_path):
 def test_a_mesh_reads_back_as_the_level_set_meshes(dam_frame, tmp_path):
     """mesh_volume of the written surface equals the .ply outputs.mesh writes from the same
     frame bit for bit (the same volumeToMesh of the same grid), and the closed mesh encloses
-    the level set's liquid volume within 1 % (issue 56's bound; MeshFile's tests measure
+    the level set's liquid volume within 1 % (the pipeline's bound for a mesh; MeshFile's tests measure
     under 0.5 %). The level set's volume is the sum of a smeared Heaviside of -phi over the
     voxels (half-width one voxel), second-order in the voxel size where phi is a distance;
     counting the voxel centres with phi < 0 is only first-order (1.6 % low here)."""

@@ -166,7 +166,8 @@ def test_an_added_emitter_pours_its_rate(tmp_path):
     sim.run(frames=6)
     rate = (liquid_mass(sim) - m0) / (sim.time - t0)
     # The fills are paid from that rate (docs/scene-format.md, emitters): within 5 %, the
-    # issue's bound (bench/RESULTS.md measures 6.3 - 6.6 kg/s for this tap).
+    # emitters' bound in tests/ghost/test_emitter.cc (bench/RESULTS.md measures 6.3 - 6.6 kg/s
+    # for this tap).
     assert rate == pytest.approx(tap["mass_rate"], rel=0.05)
 
 

@@ -202,7 +202,7 @@ TEST(Checkpoint, AttachmentsRoundTripBesideTheStates)
 {
     // Byte strings a caller keeps beside the states (the Python module's added shapes): read
     // back byte for byte, NULs and high bytes included; a checkpoint without them has none,
-    // and the states read as before.
+    // and its states read the same.
     const fs::path dir = freshDir("attachments");
     const std::string with = (dir / "with.h5").string(), without = (dir / "without.h5").string();
     const std::string bytes("\0\x01\xff vdb", 7);
