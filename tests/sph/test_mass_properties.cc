@@ -39,7 +39,9 @@ TEST(MassProperties, ASphereHasItsVolumeCentreAndTwoFifthsMR2)
         EXPECT_NEAR(p.centre[a], double(c[a]), 1e-3 * dx);
         EXPECT_LT(relative(p.inertia(a, a), inertia), 5e-3);
         for (int b = 0; b < 3; ++b) {
-            if (a != b) EXPECT_LT(std::abs(p.inertia(a, b)), 1e-4 * inertia);
+            if (a != b) {
+                EXPECT_LT(std::abs(p.inertia(a, b)), 1e-4 * inertia);
+            }
         }
     }
 }
