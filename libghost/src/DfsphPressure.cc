@@ -623,6 +623,26 @@ void DfsphPressure::prepareFactors(LiquidStep& step)
     else std::vector<Vec3>().swap(f.wallHydrostatic);
 }
 
+void DfsphPressure::solidPairPressure(LiquidStep& step, SolidPairPressure& out) const
+{
+    // The step moved solved particle i by -dt G (k_density + k_divergence) and the walls'
+    // known part: per solid pair, m_i M (c k_i + [mirror] g_s . (x_s - x_i) / rho0) grad W_is.
+    const ParticleSet& set = step.particles();
+    const auto& density = set.scalarChannel(DENSITY_KAPPA);
+    const auto& divergence = set.scalarChannel(DIVERGENCE_KAPPA);
+    out.liquid.resize(set.size());
+    parallel::forEach(
+        0, set.size(),
+        [&](std::size_t i) {
+        out.liquid[i] = mFactors.alpha[i] > Real(0) ? density[i] + divergence[i] : Real(0);
+        },
+        4096);
+    out.share = mFactors.wall;
+    out.solid = mFactors.mirror ? SolidPairPressure::SolidTerm::Mirror
+                                : SolidPairPressure::SolidTerm::None;
+    out.wallGravity = mFactors.movingWallGravity.empty() ? nullptr : &mFactors.movingWallGravity;
+}
+
 void DfsphPressure::computeMovingWallGravity(LiquidStep& step, Real dt)
 {
     std::vector<Vec3>& gravity = mFactors.movingWallGravity;

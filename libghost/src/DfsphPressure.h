@@ -65,6 +65,9 @@ public:
     const PressureSolveStats* solveStats() const override { return &mStats; }
     void resetStats() override { mStats = PressureSolveStats(); }
     std::size_t memoryBytes() const override;
+    /// The solves' pressure terms k_density + k_divergence of the solved particles, with the
+    /// wall's share and the mirrored ghosts' hydrostatic part (DfsphPressure.cc).
+    void solidPairPressure(LiquidStep& step, SolidPairPressure& out) const override;
 
 private:
     /// The share of [SB12]'s air resampling period the step spans (DfsphSettings::

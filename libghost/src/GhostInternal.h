@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 namespace ghostfx {
@@ -81,6 +82,26 @@ struct GhostSolver::Emitter : sph::MovingLevelSet
 struct GhostSolver::Solid : sph::MovingLevelSet
 {
     bool moving;
+    /// A dynamic solid's body (its motion places the solid where the body is), else null.
+    std::unique_ptr<Body> body;
+};
+
+/// A dynamic solid's rigid body and what its coupling keeps (GhostBodies.cc).
+struct GhostSolver::Body
+{
+    explicit Body(const sph::RigidBody& rigid_) : rigid(rigid_) {}
+
+    sph::RigidBody rigid;
+    /// The liquid's force and torque as applied last step (the added-mass filter's memory).
+    sph::Vec3d liquidForce{0.0}, liquidTorque{0.0};
+    /// This step's, as gathered (before the filter).
+    sph::Vec3d gatheredForce{0.0}, gatheredTorque{0.0};
+    /// Share of its ghosts the liquid reached this step (the added mass's share).
+    double wetShare = 0;
+    sph::Vec3d externalForce{0.0}, externalTorque{0.0}; ///< addBodyForce's
+    std::vector<sph::Vec3d> contactPoints; ///< its surface ghosts, in its own frame
+    std::size_t ghosts = 0; ///< its ghost particles
+    double radius = 0;      ///< the farthest contact point from the centre of mass (m)
 };
 
 namespace detail {
@@ -176,6 +197,8 @@ inline Real taitPressure(Real rho, Real rho0, Real k)
 /// smallest key is the nearest liquid particle and, at equal distance, the lowest index. Taking
 /// the minimum is order-independent: any thread count gives the same answer.
 constexpr std::uint64_t NO_LIQUID = ~std::uint64_t(0);
+/// A liquid particle the collision projection pushed out of no dynamic solid this step.
+constexpr std::uint32_t NO_BODY_HIT = ~std::uint32_t(0);
 inline std::uint64_t nearestKey(Real r, Index liquid)
 {
     const float f = float(r);

@@ -87,6 +87,7 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange, bool ownPart)
     };
     if (mSettings.method != Method::Ghost) refuse("method basic");
     if (!mRun.initialized) refuse("sharing before prepare()");
+    if (hasBodies()) refuse("a dynamic solid");
     // A fresh run (or one restored whole): every process has the same particles here; keep
     // what this one owns. A run restored from this process's own part of a checkpoint keeps
     // all of it (the particles that left its region since the last exchange migrate at the
@@ -137,9 +138,11 @@ void GhostSolver::addMovingSolid(const LevelSet& solid, RigidMotion motion)
     addSolidBody(solid, std::move(motion), true);
 }
 
-void GhostSolver::addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving)
+void GhostSolver::addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving,
+                               std::unique_ptr<Body> body)
 {
-    mSolids.push_back(std::make_unique<Solid>(Solid{{solid, std::move(motion)}, moving}));
+    mSolids.push_back(
+        std::make_unique<Solid>(Solid{{solid, std::move(motion)}, moving, std::move(body)}));
     // A solid the restored state already holds keeps its restored particles: sampling it again
     // would duplicate them (and, with a seed that depends on the step, differ from them).
     const std::size_t index = mSolids.size() - 1;
@@ -196,6 +199,10 @@ void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
         throw ValueError(msg("setSolidShape: solid ", solidIndex, " does not exist (",
                              mSolids.size(), " solids)"));
     }
+    if (mSolids[solidIndex]->body) {
+        throw ValueError(msg("setSolidShape: solid '", mSolids[solidIndex]->shape.name(),
+                             "' is dynamic: its shape sets its mass and inertia, and cannot change"));
+    }
     // Drop the old particles of this solid, then sample the new shape.
     restSolidValues(blockOf(solidIndex)); // its indices are about to change
     ParticleSet& set = blockOf(solidIndex).block.particles();
@@ -225,6 +232,10 @@ void GhostSolver::setSolidMotion(std::size_t solidIndex, RigidMotion motion)
     }
     if (!motion) throw ValueError(msg("setSolidMotion: solid ", solidIndex, ": no motion given"));
     Solid& solid = *mSolids[solidIndex];
+    if (solid.body) {
+        throw ValueError(msg("solid '", solid.shape.name(),
+                             "' is dynamic: the liquid and its contacts move it, not a motion"));
+    }
     if (!solid.moving) {
         throw ValueError(
             msg("solid '", solid.shape.name(),
@@ -289,6 +300,15 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     const SampleSet samples = sph::sampleVolumeStored(ps, solid, mSampleStore);
 
     const std::vector<Vec3> localNormals = bandNormals(samples, solid, mSettings.supportRadius());
+    // A dynamic solid's ghosts sit half a spacing deeper: the liquid ends half a spacing beyond
+    // its particles' centres, so its boundary is then the body's surface and the volume it
+    // displaces is the body's own (on a static solid's surface layer the liquid would keep
+    // half a spacing off, and a floating box's draft would come out 1 cm short at 2 cm).
+    std::vector<Vec3> local(samples.positions);
+    if (body.body) {
+        for (std::size_t k = 0; k < local.size(); ++k)
+            local[k] -= (Real(0.5) * mSettings.spacing) * localNormals[k];
+    }
 
     SolidBlock& target = blockOf(solidIndex);
     ParticleSet& set = target.block.particles();
@@ -308,7 +328,7 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     ParticleId firstId = std::max(set.nextId(), mParticles.nextId());
     if (mExchange) firstId = ParticleId(mExchange->maxOf(double(firstId)));
     set.setNextId(firstId);
-    std::vector<Vec3> positions(samples.positions);
+    std::vector<Vec3> positions(local);
     for (Vec3& x : positions) x = xf.toWorld(x);
     const ParticleKind kind =
         mSettings.method == Method::Ghost ? ParticleKind::GhostSolid : ParticleKind::Boundary;
@@ -321,8 +341,8 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
         set.densities()[first + k] = mSettings.restDensity;
         if (body.moving) {
             (*localNormalChannel)[first + k] = localNormal;
-            (*locals)[first + k] = samples.positions[k];
-            (*solidV)[first + k] = body.velocity(samples.positions[k], mRun.time);
+            (*locals)[first + k] = local[k];
+            (*solidV)[first + k] = body.velocity(local[k], mRun.time);
             set.velocities()[first + k] = (*solidV)[first + k];
         }
     }
@@ -739,7 +759,11 @@ std::unique_ptr<GhostSolver> GhostSolver::massProbe() const
     auto probe = std::make_unique<GhostSolver>(probeSettings);
     // The probe shares the solids and takes this solver's boundary particles as its ghost
     // solids: sampling them again would cost as much as the first time.
-    for (const auto& solid : mSolids) probe->mSolids.push_back(std::make_unique<Solid>(*solid));
+    // (A dynamic solid's copy keeps its placement through the motion and owns no body.)
+    for (const auto& solid : mSolids) {
+        probe->mSolids.push_back(
+            std::make_unique<Solid>(Solid{{solid->shape, solid->motion}, solid->moving, nullptr}));
+    }
     for (const SolidBlock* b : {&mStatic, &mMoving}) {
         SolidBlock& to = b == &mStatic ? probe->mStatic : probe->mMoving;
         to.block.particles() = restingParticles(*b);
@@ -849,6 +873,7 @@ SolverState GhostSolver::saveState() const
         state.reals["emitter_credit_" + std::to_string(e)] = mEmitters[e]->credit;
         state.reals["emitter_fill_scale_" + std::to_string(e)] = mEmitters[e]->fillScale;
     }
+    saveBodies(state);
     return state;
 }
 
@@ -920,6 +945,7 @@ void GhostSolver::restoreState(const SolverState& state)
                                   state.real("emitter_fill_scale_" + std::to_string(e)));
     }
 
+    readRestoredBodies(state);
     const ParticleSet& p = state.particles;
     const std::vector<std::uint8_t> solid = solidParticlesOf(state, solids);
     if (mSettings.method == Method::Basic && p.count(ParticleKind::GhostAir) > 0) {
@@ -988,6 +1014,8 @@ Real GhostSolver::stableTimeStep() const
     // Every process takes the same step: the fastest liquid of them all (between steps a
     // process holds no halo copies).
     if (mExchange) vmax = Real(mExchange->maxOf(double(vmax)));
+    // A dynamic solid's fastest point moves no farther in a step than the liquid may.
+    if (hasBodies()) vmax = std::max(vmax, fastestBody());
     return mPressure->stableTimeStep(mSettings, vmax, mRun.maxAcceleration);
 }
 

@@ -310,6 +310,7 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
     const auto t0 = std::chrono::steady_clock::now();
     resizeStepArray(mScratch, mParticles.size());
     extrapolateSolidVelocity();
+    if (hasBodies()) gatherBodyForces(dt);
     applyXsph(dt);
     // Halo liquid's new velocities, for the air near the cut that takes one of them.
     if (mExchange) {
@@ -326,6 +327,19 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
         0, mParticles.size(), [&](std::size_t i) { x[i] += dt * v[i]; }, 4096);
     if (!gradMass.empty()) shiftParticles(dt, gradMass);
     mTimings.xsphAndBoundary += secondsSince(t0);
+}
+
+Real GhostSolver::fastestOwnedLiquid() const
+{
+    const auto& kind = mParticles.kinds();
+    const auto& v = mParticles.velocities();
+    const Real* halo = haloFlags();
+    Real vmax = 0;
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        if (kind[i] == ParticleKind::Liquid && (!halo || halo[i] == Real(0)))
+            vmax = std::max(vmax, v[i].length());
+    }
+    return mExchange ? Real(mExchange->maxOf(double(vmax))) : vmax;
 }
 
 void GhostSolver::applyXsph(Real dt)
@@ -345,13 +359,8 @@ void GhostSolver::applyXsph(Real dt)
     // against the reference step at the liquid's largest speed.
     const Real* halo = haloFlags();
     auto owned = [halo](std::size_t i) { return !halo || halo[i] == Real(0); };
-    Real vmax = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (kind[i] == ParticleKind::Liquid && owned(i)) vmax = std::max(vmax, v[i].length());
-    }
-    if (mExchange) vmax = Real(mExchange->maxOf(double(vmax)));
     const Real eps = mSettings.xsphEpsilonPerStep();
-    const Real epsSolid = mSettings.solidEpsilonForStep(dt, vmax);
+    const Real epsSolid = mSettings.solidEpsilonForStep(dt, fastestOwnedLiquid());
     parallel::forEach(
         0, n,
         [&](std::size_t j) {
@@ -495,6 +504,7 @@ void GhostSolver::step(Real dt, bool reportPressure)
 
     const double t1 = mRun.time + double(dt);
     accrueEmission(mRun.time, t1);
+    if (hasBodies()) advanceBodies(dt);
     moveSolids(t1);
     mRun.time = t1;
     ++mRun.step;
@@ -530,6 +540,7 @@ void GhostSolver::stepWithoutLiquid(Real dt, std::chrono::steady_clock::time_poi
 {
     const double t1 = mRun.time + double(dt);
     if (accrue) accrueEmission(mRun.time, t1);
+    if (hasBodies()) advanceBodies(dt);
     moveSolids(t1);
     mRun.time = t1;
     ++mRun.step;
@@ -569,6 +580,11 @@ void GhostSolver::projectOutOfSolids(Real dt)
     std::atomic<std::size_t> stuck{mParticles.size()};
     std::atomic<std::uint64_t> restored{0};
     const Real* halo = haloFlags();
+    // The momentum each particle loses to a dynamic solid, given to it after the loop.
+    const bool bodies = hasBodies();
+    std::vector<Vec3> impulse(bodies ? mParticles.size() : 0, Vec3(0));
+    std::vector<std::uint32_t> hit(bodies ? mParticles.size() : 0, NO_BODY_HIT);
+    const auto& m = mParticles.masses();
     parallel::forEach(0, mParticles.size(), [&](std::size_t i) {
         if (kind[i] != ParticleKind::Liquid || (halo && halo[i] != Real(0))) return;
         const bool near = all || i >= listed || !mStatic.lists[i].empty()
@@ -577,8 +593,13 @@ void GhostSolver::projectOutOfSolids(Real dt)
         if (!near) return;
         const Vec3 previous = x[i] - dt * v[i];
         for (std::size_t b = 0; b < mSolids.size(); ++b) {
+            const Vec3 before = v[i];
             const Collision c =
                 collideWithSolid(*mSolids[b], placement[b], time, previous, x[i], v[i]);
+            if (bodies && mSolids[b]->body && (c == Collision::Projected || c == Collision::Restored)) {
+                impulse[i] += m[i] * (v[i] - before);
+                hit[i] = std::uint32_t(b);
+            }
             if (c == Collision::Restored) ++restored;
             if (c == Collision::Stuck) {
                 std::size_t expected = stuck.load();
@@ -587,6 +608,7 @@ void GhostSolver::projectOutOfSolids(Real dt)
         }
     });
     mRestoredFromSolids += restored.load();
+    if (bodies) giveCollisionImpulses(impulse, hit);
     if (const std::size_t i = stuck.load(); i < mParticles.size()) {
         std::size_t b = 0;
         while (b + 1 < mSolids.size() && !(mSolids[b]->phi(x[i], time) < Real(0))) ++b;

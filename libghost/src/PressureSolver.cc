@@ -6,6 +6,9 @@
 #include "DfsphPressure.h"
 #include "TaitPressure.h"
 
+#include <ghostfx/ghost/LiquidStep.h>
+#include <ghostfx/sph/Parallel.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -23,6 +26,24 @@ Real PressureSolver::stableTimeStep(const GhostSettings& settings, Real fastest,
     const Real a = std::max(maxAcceleration, settings.gravity.length());
     if (a > Real(0)) dt = std::min(dt, settings.cflNumber * std::sqrt(h / a));
     return dt;
+}
+
+void PressureSolver::solidPairPressure(LiquidStep& step, SolidPairPressure& out) const
+{
+    const sph::ParticleSet& set = step.particles();
+    const auto& kind = set.kinds();
+    const auto& p = set.pressures();
+    const auto& rho = set.densities();
+    out.liquid.resize(set.size());
+    parallel::forEach(
+        0, set.size(),
+        [&](std::size_t i) {
+        out.liquid[i] = kind[i] == sph::ParticleKind::Liquid ? p[i] / (rho[i] * rho[i]) : Real(0);
+        },
+        4096);
+    out.share = 1;
+    out.solid = SolidPairPressure::SolidTerm::Own;
+    out.wallGravity = nullptr;
 }
 
 std::unique_ptr<PressureSolver> makePressureSolver(const GhostSettings& settings)

@@ -45,6 +45,7 @@
 #include <ghostfx/sph/NeighborLists.h>
 #include <ghostfx/sph/ParticleExchange.h>
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/RigidBody.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SampleStore.h>
 #include <ghostfx/sph/SolverState.h>
@@ -69,6 +70,17 @@ using sph::ParticleSet;
 
 using sph::RigidMotion;
 using sph::RigidTransform;
+
+/// A solid that the liquid moves and that moves the liquid (GhostSolver::addDynamicSolid): a
+/// uniform rigid body given by its density or its mass.
+struct DynamicSolid
+{
+    double density = 0; ///< kg/m^3; or 0 and a mass
+    double mass = 0;    ///< kg; or 0 and a density
+    sph::Vec3d velocity{0.0};        ///< initial, of the centre of mass (m/s)
+    sph::Vec3d angularVelocity{0.0}; ///< initial (rad/s)
+    sph::RigidBodyMaterial material; ///< restitution and friction of its contacts
+};
 
 /// Seconds spent in each phase of the step, accumulated since the last reset ([SB12] Sec. 5).
 struct PhaseTimings
@@ -122,6 +134,26 @@ public:
     /// Motions are not part of saveState(): a restored run uses what its caller adds.
     void setSolidMotion(std::size_t solidIndex, RigidMotion motion);
     std::size_t solidCount() const { return mSolids.size(); }
+
+    /// Add a rigid body the liquid pushes and that pushes it back (GhostBodies.cc): its mass,
+    /// centre and inertia from its level set (sph::massProperties), its ghost particles
+    /// sampled as a moving solid's. Each step the liquid's pressure and wall drag on its
+    /// ghosts, reversed, are its force and torque, with gravity and any force a caller adds;
+    /// it then touches the other solids and bodies (level-set contact with its restitution
+    /// and friction) and moves. Ghost SPH only (Tait or DFSPH), on one process. After
+    /// restoreState() it continues from the state's body. Returns the solid's index.
+    std::size_t addDynamicSolid(const LevelSet& solid, const DynamicSolid& body);
+    /// Whether solid `solidIndex` is a dynamic one.
+    bool isDynamic(std::size_t solidIndex) const;
+    /// The body of dynamic solid `solidIndex` (its state at time()). ValueError for another.
+    const sph::RigidBody& body(std::size_t solidIndex) const;
+    /// Add a force (N, at the centre of mass) and a torque (N m) to what acts on dynamic solid
+    /// `solidIndex` in every step until clearBodyForces().
+    void addBodyForce(std::size_t solidIndex, const sph::Vec3d& force, const sph::Vec3d& torque);
+    void clearBodyForces();
+    /// The force and torque (about the centre of mass) the liquid gave dynamic solid
+    /// `solidIndex` in the last step, as it acted (after the added-mass filter, GhostBodies.cc).
+    std::pair<sph::Vec3d, sph::Vec3d> liquidForceOn(std::size_t solidIndex) const;
     /// Where solid `solidIndex` (in the order added) is now: its motion at time() (the
     /// identity for a static solid).
     RigidTransform solidPlacement(std::size_t solidIndex) const;
@@ -312,6 +344,7 @@ private:
     friend class DensitySummation;
     struct Solid;
     struct Emitter;
+    struct Body;
     /// The nearest liquid particle of each particle of a solid block that some liquid reaches
     /// this step, as packed (distance, index) keys (GhostInternal.h, nearestKey) that the
     /// density pass lowers. Kept in pages of 2^PAGE_BITS particles, allocated only for the
@@ -375,7 +408,8 @@ private:
     /// 1 for each solid particle of `state`, checking that it names one of its `solids`.
     static std::vector<std::uint8_t> solidParticlesOf(const sph::SolverState& state,
                                                       std::int64_t solids);
-    void addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving);
+    void addSolidBody(const LevelSet& solid, RigidMotion motion, bool moving,
+                      std::unique_ptr<Body> body = nullptr);
     /// Sampler settings for a liquid body, an emitter or a solid's band ([SB12] Sec. 4.5):
     /// the spacing's Poisson radius, the settings' relaxation and tiling, and `seed`.
     sph::PoissonSettings bodySampling(std::uint64_t seed) const;
@@ -445,6 +479,29 @@ private:
     void pressureToSolids();
     void moveSolids(double time);
     void projectOutOfSolids(Real dt);
+    // Dynamic solids (GhostBodies.cc) ----------------------------------------------------------
+    Body& bodyOf(std::size_t solidIndex) const;
+    bool hasBodies() const;
+    /// Each solid's place among the dynamic solids (0, 1, ... in solid order), -1 for others.
+    std::vector<int> bodySlots() const;
+    /// The world box of a body's contact points where it is, grown by `margin` (m).
+    sph::Aabb bodyBox(const Body& b, double margin) const;
+    /// The fastest owned liquid particle (m/s), over every process.
+    Real fastestOwnedLiquid() const;
+    /// The body's contact points: its ghost particles on its surface, in its own frame.
+    void findContactPoints(std::size_t solidIndex);
+    /// The liquid's pressure and drag on each body this step (before the particles move).
+    void gatherBodyForces(Real dt);
+    /// Each body over the step: forces, contacts, then its motion.
+    void advanceBodies(Real dt);
+    void resolveBodyContacts(Real dt);
+    /// The momentum the collision projection took from liquid particles hitting each body.
+    void giveCollisionImpulses(const std::vector<Vec3>& impulse,
+                               const std::vector<std::uint32_t>& hit);
+    /// The fastest point of any body's box (m/s), for the time step.
+    Real fastestBody() const;
+    void saveBodies(sph::SolverState& state) const;
+    void readRestoredBodies(const sph::SolverState& state);
     void checkBlowUp() const;
     Index nearestLiquid(const Vec3& x, Real maxRadius) const;
     /// The halo flags of mParticles (HALO_CHANNEL) when shared with other processes, else null.
@@ -491,6 +548,8 @@ private:
     std::size_t mRestoredEmitters = 0; ///< emitters the restored run had
     /// Their Emitter::credit and fillScale, by index.
     std::vector<std::pair<double, double>> mRestoredEmitterFills;
+    /// The restored state's body of each dynamic solid, by solid index (empty for others).
+    std::vector<std::vector<double>> mRestoredBodies;
 };
 
 } // namespace ghost

@@ -55,6 +55,24 @@ struct PressureSolveStats
     double lastLargestDensityError = 0, lastLargestDivergenceError = 0; ///< the last step's
 };
 
+/// How a step's pressure force acted between a liquid particle i and a solid particle s: the
+/// pair pushed i by -m_i M (share k_i + k_s) grad W_is, and the solid by the reverse (what a
+/// dynamic body feels). k is a pressure term p / rho^2 (m^5 / (kg s^2)).
+struct SolidPairPressure
+{
+    /// k_i of each particle of the step's particles; 0 where the pressure pushed nothing.
+    std::vector<Real> liquid;
+    /// The share of k_i in the pair (DFSPH's wall share c; 1 for the Tait step).
+    Real share = 1;
+    /// What k_s is: the solid particle's own p / rho^2 (its nearest liquid particle's, [SB12]
+    /// Algorithm 3 lines 5-7); the mirrored hydrostatic part (g_s . (x_s - x_i)) / rho0 with g_s
+    /// the moving wall's gravity; or nothing.
+    enum class SolidTerm { Own, Mirror, None } solid = SolidTerm::Own;
+    /// With SolidTerm::Mirror: g_s of each moving solid particle, or null for the settings'
+    /// gravity everywhere.
+    const std::vector<Vec3>* wallGravity = nullptr;
+};
+
 class PressureSolver
 {
 public:
@@ -94,6 +112,10 @@ public:
     /// The implicit solves' statistics, or null for a model without solves.
     virtual const PressureSolveStats* solveStats() const { return nullptr; }
     virtual void resetStats() {}
+    /// How this step's pressure force acted on the solids (SolidPairPressure), asked after the
+    /// model's forces and before LiquidStep::finish moves the particles. The default is the
+    /// Tait step's symmetric force, k = p / rho^2 on both sides.
+    virtual void solidPairPressure(LiquidStep& step, SolidPairPressure& out) const;
     /// Bytes of the per-step arrays the model keeps between steps (their capacity).
     virtual std::size_t memoryBytes() const { return 0; }
 };

@@ -98,6 +98,31 @@ double sum(std::size_t begin, std::size_t end, Fn&& fn, std::size_t block = 1024
     return total;
 }
 
+/// Deterministic reduction into a value of type T: each block of `block` iterations starts
+/// from a copy of `zero` and fn(i, acc) adds iteration i's share to it; the blocks' values are
+/// then combined by add(total, blockValue) in index order, so the result does not depend on
+/// the thread count or the scheduling (as sum()). A block of 0 means 1.
+template <typename T, typename Fn, typename Add>
+T reduceInOrder(std::size_t begin, std::size_t end, const T& zero, Fn&& fn, Add&& add,
+                std::size_t block = 1024)
+{
+    T total = zero;
+    if (end <= begin) return total;
+    if (block == 0) block = 1;
+    const std::size_t nBlocks = (end - begin + block - 1) / block;
+    std::vector<T> partial(nBlocks, zero);
+    forEach(
+        0, nBlocks,
+        [&](std::size_t b) {
+        const std::size_t lo = begin + b * block;
+        const std::size_t hi = lo + block < end ? lo + block : end;
+        for (std::size_t i = lo; i < hi; ++i) fn(i, partial[b]);
+        },
+        1);
+    for (const T& value : partial) add(total, value);
+    return total;
+}
+
 /// Largest `fn(i)` (as double) over [begin, end), or `lowest` when the range is empty; a maximum
 /// does not depend on the order, so neither on the thread count.
 template <typename Fn>

@@ -104,6 +104,13 @@ struct Aabb
         }
         return b;
     }
+    /// The boxes share a point (an empty box meets none).
+    bool intersects(const Aabb& o) const
+    {
+        return !empty() && !o.empty() && min[0] <= o.max[0] && o.min[0] <= max[0]
+               && min[1] <= o.max[1] && o.min[1] <= max[1] && min[2] <= o.max[2]
+               && o.min[2] <= max[2];
+    }
 };
 
 } // namespace sph
