@@ -106,19 +106,24 @@ void GhostSolver::gatherBodyForces(Real dt)
         }
         },
         addWrenches, 512);
-    // The share of each body's ghosts the liquid reached: the added mass's share.
-    std::vector<std::size_t> wet(bodies, 0);
-    for (Index s : mMoving.touched) {
-        const int b = slot[std::size_t(index[s])];
-        if (b >= 0) ++wet[std::size_t(b)];
+    for (std::size_t e = 0; e < mSolids.size(); ++e) {
+        if (slot[e] < 0) continue;
+        mSolids[e]->body->gatheredForce = totals[std::size_t(slot[e])].force;
+        mSolids[e]->body->gatheredTorque = totals[std::size_t(slot[e])].torque;
     }
+    measureWetShares(slot);
+}
+
+void GhostSolver::measureWetShares(const std::vector<int>& slot)
+{
+    // The share of each body's ghosts the liquid reached: the added mass's share.
+    const auto& index = mMoving.block.particles().scalarChannel(SOLID_INDEX);
+    std::vector<std::size_t> wet(mSolids.size(), 0);
+    for (Index s : mMoving.touched) ++wet[std::size_t(index[s])];
     for (std::size_t e = 0; e < mSolids.size(); ++e) {
         if (slot[e] < 0) continue;
         Body& body = *mSolids[e]->body;
-        const std::size_t b = std::size_t(slot[e]);
-        body.gatheredForce = totals[b].force;
-        body.gatheredTorque = totals[b].torque;
-        body.wetShare = body.ghosts ? double(wet[b]) / double(body.ghosts) : 0.0;
+        body.wetShare = body.ghosts ? double(wet[e]) / double(body.ghosts) : 0.0;
     }
 }
 

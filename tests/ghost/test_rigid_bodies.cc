@@ -34,17 +34,6 @@ GhostSettings tankSettings(PressureModel pressure)
     return s;
 }
 
-/// The liquid's volume sum m / rho (m^3).
-double liquidVolume(const GhostSolver& solver)
-{
-    const ParticleSet& p = solver.particles();
-    double v = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] == ParticleKind::Liquid) v += double(p.masses()[i] / p.densities()[i]);
-    }
-    return v;
-}
-
 /// Least-squares sums of the liquid's pressure against height in the ring |x|, |z| > `ring`
 /// between heights lo and hi, pooled over snapshots.
 struct PressureFit
