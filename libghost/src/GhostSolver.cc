@@ -1040,6 +1040,11 @@ void GhostSolver::advanceFrame()
                               : !(frameEnd - (mRun.time + double(dt)) > tolerance);
         step(dt, last);
         });
+    // The frame's end snaps the clock to frameEnd; the bodies' clocks follow (their placement
+    // at time() must be their state, with no extrapolation over a rounding difference).
+    for (const auto& solid : mSolids) {
+        if (solid->body) solid->body->rigid.setTime(mRun.time);
+    }
 }
 
 } // namespace ghost
