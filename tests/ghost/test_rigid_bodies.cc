@@ -132,9 +132,9 @@ double runFrames(GhostSolver& solver, std::size_t body, int frames)
 // Archimedes: a 20 x 10 x 20 cm box floats with its draft the fraction rho_b / rho0 of its
 // height, 5 cm at 500 kg/m^3 and 2.5 cm at 250, for both pressure models. Bound: the issue's
 // 3 % of the box's height (3 mm) at 500. At 250 the draft is 1.25 spacings and the liquid
-// under and beside it barely a layer deep: measured +4.5 mm (DFSPH) and +5.0 mm (Tait) at 2 cm,
-// so the 3 % is not met there; bound 6 %, to catch a regression.
-// Measured at 500: 5.02 cm (DFSPH), 5.15 cm (Tait).
+// beside it barely a layer deep: measured +3.5 mm (DFSPH) and +2.0 mm (Tait) at 2 cm, so the
+// issue's 3 % is not met there with DFSPH; bound 5 %, to catch a regression.
+// Measured at 500: 5.04 cm (DFSPH), 4.84 cm (Tait).
 TEST(RigidBodies, ABoxFloatsAtItsArchimedesDraftWithEitherPressure)
 {
     for (PressureModel pm : {PressureModel::Dfsph, PressureModel::Tait}) {
@@ -145,7 +145,7 @@ TEST(RigidBodies, ABoxFloatsAtItsArchimedesDraftWithEitherPressure)
             std::printf("[measured] %s, box of %.0f kg/m^3: draft %.4f m (Archimedes %.4f), "
                         "surface %.4f m\n",
                         name, rho, d.draft, expected, d.surface);
-            EXPECT_NEAR(d.draft, expected, (rho == 500.0 ? 0.03 : 0.06) * 0.1) << name << rho;
+            EXPECT_NEAR(d.draft, expected, (rho == 500.0 ? 0.03 : 0.05) * 0.1) << name << rho;
         }
     }
 }
@@ -206,13 +206,12 @@ TEST(RigidBodies, AFlatBoxRightsItselfAndATallOneCapsizesAsTheMetacentricHeightS
     }
 }
 
-// A light box (100 kg/m^3) released under the surface rises and floats without blowing up at
-// the CFL step and at half of it: it ends afloat (its bottom above 25 cm in water about 29 cm
-// deep, the Archimedes draft being 1 cm) and finite. The terminal-velocity estimate of a box
-// rising broadside, v = sqrt(2 (rho0 - rho_b) g t / (rho0 C_d)) = 1.33 m/s with C_d = 1 and
-// t = 0.1 m, is NOT met: the fastest speed measured is 3.1 m/s at CFL 0.4 and 6.8 m/s at 0.2
-// (the explicit coupling with the added-mass filter lets the body overshoot as it breaks the
-// surface); bound here 10 m/s, to catch a blow-up.
+// A light box (100 kg/m^3, density ratio 0.1) released under the surface rises and floats
+// without blowing up, at the CFL step and at half of it: its speed stays below the terminal
+// velocity of a box rising broadside, v = sqrt(2 (rho0 - rho_b) g t / (rho0 C_d)) = 1.33 m/s
+// with C_d = 1 and t = 0.1 m (a flat plate's C_d is about 1.2, so the estimate bounds it), and
+// it ends afloat, its bottom above 25 cm in water about 29 cm deep (the Archimedes draft is
+// 1 cm).
 TEST(RigidBodies, ALightBoxRisesAndFloatsAtEveryStepSize)
 {
     for (const Real cfl : {Real(0.4), Real(0.2)}) {
@@ -228,8 +227,7 @@ TEST(RigidBodies, ALightBoxRisesAndFloatsAtEveryStepSize)
         const double bottom = solver->body(1).state().position[1] - 0.05;
         std::printf("[measured] light box at CFL %.1f: fastest %.3f m/s, bottom %.4f m\n",
                     double(cfl), fastest, bottom);
-        EXPECT_TRUE(std::isfinite(fastest));
-        EXPECT_LT(fastest, 10.0);
+        EXPECT_LT(fastest, std::sqrt(2 * 0.9 * 9.81 * 0.1));
         EXPECT_GT(bottom, 0.25);
     }
 }
