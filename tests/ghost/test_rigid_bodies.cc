@@ -152,8 +152,8 @@ TEST(RigidBodies, ABoxFloatsAtItsArchimedesDraftWithEitherPressure)
 
 // A box of 2,000 kg/m^3 sinks and comes to rest on the floor (y = 0): its bottom within half
 // a spacing of the floor (contact keeps it out; the ghost layer sits h / 2 inside it), level
-// within 1 degree, and its speed below 3 cm/s after 2 s. A body falling freely for one step of
-// this run would pick up g dt = 5 cm/s; measured 1.9 cm/s, the liquid still moving around it.
+// within 1 degree, and its speed below 1 cm/s after 2 s (a body falling freely for one step of
+// this run picks up g dt = 5 cm/s, so a jittering one would keep about that; measured 2 mm/s).
 TEST(RigidBodies, AHeavyBoxSinksAndRestsOnTheFloor)
 {
     FloatingBodyScene scene;
@@ -168,7 +168,7 @@ TEST(RigidBodies, AHeavyBoxSinksAndRestsOnTheFloor)
                 b.state().velocity.length(), tiltOf(b));
     EXPECT_NEAR(bottom, 0.0, 0.5 * double(H));
     EXPECT_LT(tiltOf(b), M_PI / 180);
-    EXPECT_LT(b.state().velocity.length(), 0.03);
+    EXPECT_LT(b.state().velocity.length(), 0.01);
 }
 
 // Stability by the sign of the metacentric height: a flat box (20 x 10 x 20 cm, 500 kg/m^3,
