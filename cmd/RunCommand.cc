@@ -237,14 +237,13 @@ private:
     }
 
     /// Dynamic solids run on one process: over several, refused before any simulation, said
-    /// once, by the first process (the others wait in a reduction it never joins; its error
-    /// stops them all, runScene).
+    /// once, by the first process (the others wait for its error to stop them, runScene).
     void refuseDistributedBodies()
     {
         if (!mDistributed) return;
         for (std::size_t i = 0; i < mScene.solids.size(); ++i) {
             if (!mScene.solids[i].dynamic) continue;
-            if (!mDistributed->root()) mDistributed->maxOf(0.0);
+            if (!mDistributed->root()) awaitDistributedAbort();
             throw SceneError(msg("scene '", mScene.file, "': solids[", i, "].dynamic: solid '",
                                  mScene.solids[i].name, "' is dynamic, and dynamic solids run on "
                                  "one process: run this scene without mpirun"));
