@@ -241,13 +241,12 @@ std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,
     for (std::size_t index = 0; index < snapshot.media.size(); ++index) {
         const OutputMedium& m = snapshot.media[index];
         const BuiltGrids* built = index < snapshot.built.size() ? &snapshot.built[index] : nullptr;
-        const openvdb::GridPtrVec grids =
-            writeMedium(m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
-                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
-                        snapshot.time, built,
-                        m.liquid && out.volumeSolids && !out.volumeFile.empty()
-                            ? placedSolidGrids(scene, snapshot)
-                            : openvdb::GridPtrVec());
+        const openvdb::GridPtrVec grids = writeMedium(
+            m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
+            inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta, snapshot.time, built,
+            m.liquid && out.volumeSolids && !out.volumeFile.empty()
+                ? placedSolidGrids(scene, snapshot)
+                : openvdb::GridPtrVec());
         if (m.liquid && !out.meshFile.empty()) {
             notes.push_back(writeMesh(m, out, grids, inFolder(out.meshFile), snapshot.frame,
                                       fileMeta, built));

@@ -179,8 +179,8 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
         try {
             addSceneSolid(*solver, solid);
         } catch (const ValueError& e) {
-            throw SceneError(msg("scene '", scene.file, "': solids[", i, "] '", solid.name,
-                                 "': ", e.what()));
+            throw SceneError(
+                msg("scene '", scene.file, "': solids[", i, "] '", solid.name, "': ", e.what()));
         }
     }
     if (!restored) {

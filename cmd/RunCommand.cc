@@ -140,9 +140,19 @@ std::vector<vdbio::BodyRow> bodyRows(const vdbio::Scene& scene, const Simulation
                                                  : msg("solids[", b.solid, "]");
         const sph::RigidBodyState& s = b.state;
         const sph::Quatd& q = s.orientation;
-        row.values = {s.position[0], s.position[1], s.position[2], q.w(), q.x(), q.y(), q.z(),
-                      s.velocity[0], s.velocity[1], s.velocity[2], b.angularVelocity[0],
-                      b.angularVelocity[1], b.angularVelocity[2]};
+        row.values = {s.position[0],
+                      s.position[1],
+                      s.position[2],
+                      q.w(),
+                      q.x(),
+                      q.y(),
+                      q.z(),
+                      s.velocity[0],
+                      s.velocity[1],
+                      s.velocity[2],
+                      b.angularVelocity[0],
+                      b.angularVelocity[1],
+                      b.angularVelocity[2]};
         rows.push_back(std::move(row));
     }
     return rows;
@@ -245,7 +255,8 @@ private:
             if (!mScene.solids[i].dynamic) continue;
             if (!mDistributed->root()) awaitDistributedAbort();
             throw SceneError(msg("scene '", mScene.file, "': solids[", i, "].dynamic: solid '",
-                                 mScene.solids[i].name, "' is dynamic, and dynamic solids run on "
+                                 mScene.solids[i].name,
+                                 "' is dynamic, and dynamic solids run on "
                                  "one process: run this scene without mpirun"));
         }
     }

@@ -1,8 +1,8 @@
 /// @file   SolidGrids.cc
 #include "SolidGrids.h"
 
-#include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 #include <ghostfx/vdbio/FrameFiles.h>
 
@@ -39,7 +39,8 @@ namespace {
 
 /// `grid` (a level set in its solid's frame) resampled where `placed` puts that frame: a level
 /// set of the same voxel size and band, its values the given distances moved.
-openvdb::FloatGrid::Ptr resampled(const openvdb::FloatGrid::ConstPtr& grid, const PlacedSolid& placed)
+openvdb::FloatGrid::Ptr resampled(const openvdb::FloatGrid::ConstPtr& grid,
+                                  const PlacedSolid& placed)
 {
     // OpenVDB's matrices act on row vectors (world = index * M): the placement x -> R x + t is
     // R transposed in the upper block and t in the last row, applied after the grid's own map.
@@ -73,8 +74,9 @@ openvdb::GridPtrVec placedSolidGrids(const vdbio::Scene& scene, const FrameSnaps
         const openvdb::FloatGrid::ConstPtr grid = sph::gridOf(placed.shape);
         const bool inPlace = placed.rotation == openvdb::math::Mat3d::identity()
                              && placed.translation == openvdb::Vec3d(0.0);
-        openvdb::FloatGrid::Ptr out =
-            inPlace ? openvdb::ConstPtrCast<openvdb::FloatGrid>(grid)->copy() : resampled(grid, placed);
+        openvdb::FloatGrid::Ptr out = inPlace
+                                          ? openvdb::ConstPtrCast<openvdb::FloatGrid>(grid)->copy()
+                                          : resampled(grid, placed);
         out->setName(scene.solids[i].name);
         grids.push_back(out);
     }

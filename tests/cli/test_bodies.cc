@@ -67,7 +67,8 @@ TEST_F(Bodies, CsvHasARowPerBodyPerFrameAndTheStatisticsTheSame)
     const std::string text = slurp(mDir / "out" / "bodies.csv");
     EXPECT_EQ(text.substr(0, text.find('\n')),
               "frame,time,name,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz");
-    const std::vector<BodyRow> rows = ghostfx::vdbio::readBodiesCsv((mDir / "out" / "bodies.csv").string());
+    const std::vector<BodyRow> rows =
+        ghostfx::vdbio::readBodiesCsv((mDir / "out" / "bodies.csv").string());
     ASSERT_EQ(rows.size(), 8u) << "8 frames x 1 body";
     for (std::size_t f = 0; f < rows.size(); ++f) {
         const BodyRow& row = rows[f];
@@ -95,7 +96,8 @@ TEST_F(Bodies, CsvHasARowPerBodyPerFrameAndTheStatisticsTheSame)
     EXPECT_LT(rows.back().values[1], 0.17 - 0.01) << "it fell into the water";
 
     // stats.h5 holds the same rows, bit for bit (both are written from the same numbers).
-    const std::vector<BodyRow> h5 = ghostfx::vdbio::readStatsBodies((mDir / "out" / "stats.h5").string());
+    const std::vector<BodyRow> h5 =
+        ghostfx::vdbio::readStatsBodies((mDir / "out" / "stats.h5").string());
     ASSERT_EQ(h5.size(), rows.size());
     for (std::size_t i = 0; i < rows.size(); ++i) {
         EXPECT_EQ(h5[i].frame, rows[i].frame);
@@ -112,13 +114,15 @@ TEST_F(Bodies, ResumedRunContinuesTheRows)
     const fs::path a = mDir / "a", b = mDir / "b";
     ASSERT_EQ(run("run " + path + " --out " + a.string() + " -q").code, 0);
     ASSERT_EQ(run("run " + path + " --out " + b.string() + " -q --frames 1-2").code, 0);
-    const Result resumed =
-        run("run " + path + " --out " + b.string() + " -q --resume " + (b / "checkpoint.0002.h5").string());
+    const Result resumed = run("run " + path + " --out " + b.string() + " -q --resume "
+                               + (b / "checkpoint.0002.h5").string());
     ASSERT_EQ(resumed.code, 0) << resumed.err;
     // The rows of frames 1-2 are kept as written, bit for bit (the shortest text that reads
     // back as the same double), and 3-4 added once.
-    const std::vector<BodyRow> resumedRows = ghostfx::vdbio::readBodiesCsv((b / "bodies.csv").string());
-    const std::vector<BodyRow> straightRows = ghostfx::vdbio::readBodiesCsv((a / "bodies.csv").string());
+    const std::vector<BodyRow> resumedRows =
+        ghostfx::vdbio::readBodiesCsv((b / "bodies.csv").string());
+    const std::vector<BodyRow> straightRows =
+        ghostfx::vdbio::readBodiesCsv((a / "bodies.csv").string());
     ASSERT_EQ(resumedRows.size(), 4u) << "4 rows, none repeated";
     for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(resumedRows[i].frame, int(i) + 1);
     for (std::size_t i = 0; i < 2; ++i)
@@ -136,9 +140,11 @@ TEST_F(Bodies, ResumedRunContinuesTheRows)
         }
     }
     const std::string fingerprint = ghostfx::vdbio::readScene(path).simulationFingerprint();
-    const auto saved = ghostfx::vdbio::readCheckpointStates((b / "checkpoint.0002.h5").string(), fingerprint);
+    const auto saved =
+        ghostfx::vdbio::readCheckpointStates((b / "checkpoint.0002.h5").string(), fingerprint);
     ASSERT_EQ(saved.size(), 1u);
-    EXPECT_EQ(saved[0].real("body_1_y"), straightRows[1].values[1]) << "frame 2's centre, as written";
+    EXPECT_EQ(saved[0].real("body_1_y"), straightRows[1].values[1])
+        << "frame 2's centre, as written";
 }
 
 TEST_F(Bodies, VolumeFileHoldsEachSolidWhereItIs)
@@ -159,7 +165,10 @@ TEST_F(Bodies, VolumeFileHoldsEachSolidWhereItIs)
     Json still = scene;
     still["solids"][1].erase("dynamic");
     still["settings"]["frame_range"] = {1, 1};
-    ASSERT_EQ(run("run " + write(still, "still.json") + " --out " + (mDir / "still").string() + " -q").code, 0);
+    ASSERT_EQ(
+        run("run " + write(still, "still.json") + " --out " + (mDir / "still").string() + " -q")
+            .code,
+        0);
     const openvdb::FloatGrid::Ptr given = readGrid(mDir / "still" / "liquid.0001.vdb", "crate");
     ASSERT_TRUE(given);
     // The given level set holds the box's 0.1 x 0.06 x 0.1 m = 6e-4 m^3 less what its 1 cm
@@ -196,9 +205,10 @@ TEST_F(Bodies, BadKeysAreOneLineErrors)
         return errorLine("run " + write(scene) + " --out " + (mDir / "out").string());
     };
     const std::string file = (mDir / "scene.json").string();
-    EXPECT_EQ(errorFor([](Json& s) { s["solids"][1]["dynamic"]["mass"] = 12.5; }),
-              "ghostfx: error: scene '" + file
-                  + "': solids[1].dynamic: expected exactly one of 'density' (kg/m^3) or 'mass' (kg)\n");
+    EXPECT_EQ(
+        errorFor([](Json& s) { s["solids"][1]["dynamic"]["mass"] = 12.5; }),
+        "ghostfx: error: scene '" + file
+            + "': solids[1].dynamic: expected exactly one of 'density' (kg/m^3) or 'mass' (kg)\n");
     EXPECT_EQ(errorFor([](Json& s) { s["solids"][1]["dynamic"]["restitution"] = 2; }),
               "ghostfx: error: scene '" + file
                   + "': solids[1].dynamic.restitution = 2: expected a number in [0, 1]\n");
@@ -208,7 +218,9 @@ TEST_F(Bodies, BadKeysAreOneLineErrors)
     EXPECT_EQ(errorFor([](Json& s) { s["solids"][1]["dynamic"]["density"] = 0; }),
               "ghostfx: error: scene '" + file
                   + "': solids[1].dynamic.density = 0: expected a number > 0\n");
-    EXPECT_EQ(errorFor([](Json& s) { s["solids"][1]["velocity"] = {0, 1, 0}; }),
+    EXPECT_EQ(errorFor([](Json& s) {
+                  s["solids"][1]["velocity"] = {0, 1, 0};
+              }),
               "ghostfx: error: scene '" + file
                   + "': solids[1].velocity: a dynamic solid is moved by the liquid and its "
                     "contacts: expected no 'velocity' beside 'dynamic' (its start velocity is "
@@ -219,12 +231,13 @@ TEST_F(Bodies, BadKeysAreOneLineErrors)
               "ghostfx: error: scene '" + file
                   + "': solids[1].motion: a dynamic solid is moved by the liquid and its "
                     "contacts: expected no 'motion' beside 'dynamic'\n");
-    EXPECT_EQ(errorFor([](Json& s) {
-                  s["solids"][1]["sequence"] = Json::parse(R"({ "file": "c.$F4.vdb", "grid": "c" })");
-              }),
-              "ghostfx: error: scene '" + file
-                  + "': solids[1].sequence: a dynamic solid is moved by the liquid and its "
-                    "contacts: expected no 'sequence' beside 'dynamic' (its shape sets its mass)\n");
+    EXPECT_EQ(
+        errorFor([](Json& s) {
+            s["solids"][1]["sequence"] = Json::parse(R"({ "file": "c.$F4.vdb", "grid": "c" })");
+        }),
+        "ghostfx: error: scene '" + file
+            + "': solids[1].sequence: a dynamic solid is moved by the liquid and its "
+              "contacts: expected no 'sequence' beside 'dynamic' (its shape sets its mass)\n");
     EXPECT_EQ(errorFor([](Json& s) { s["solids"][1]["dynamic"]["densty"] = 500; }),
               "ghostfx: error: scene '" + file
                   + "': solids[1].dynamic.densty: unknown key (did you mean 'density'?)\n");
@@ -232,14 +245,16 @@ TEST_F(Bodies, BadKeysAreOneLineErrors)
               "ghostfx: error: scene '" + file
                   + "': solids[1].dynamic: solid 'crate' is dynamic, which settings.method "
                     "'basic' cannot simulate: expected a solid without 'dynamic'\n");
-    EXPECT_EQ(errorFor([](Json& s) {
-                  s["settings"]["method"] = "gas";
-                  s.erase("liquids");
-                  s["gas_sources"] = Json::parse(
-                      R"([ { "geometry": { "box": { "min": [0.1, 0, 0.1], "max": [0.2, 0.04, 0.2] } } } ])");
-              }),
-              "ghostfx: error: scene '" + file
-                  + "': solids[1].dynamic: solid 'crate' is dynamic, which a gas scene cannot "
-                    "simulate: expected a solid without 'dynamic'\n");
+    EXPECT_EQ(
+        errorFor(
+            [](Json& s) {
+        s["settings"]["method"] = "gas";
+        s.erase("liquids");
+        s["gas_sources"] = Json::parse(
+            R"([ { "geometry": { "box": { "min": [0.1, 0, 0.1], "max": [0.2, 0.04, 0.2] } } } ])");
+        }),
+        "ghostfx: error: scene '" + file
+            + "': solids[1].dynamic: solid 'crate' is dynamic, which a gas scene cannot "
+              "simulate: expected a solid without 'dynamic'\n");
     EXPECT_FALSE(fs::exists(mDir / "out" / "bodies.csv")) << "nothing written before the error";
 }

@@ -76,9 +76,11 @@ BodyRow parseRow(const std::string& path, int lineNumber, const std::string& lin
     bool ok = parseNumber(fields[0], frame) && parseNumber(fields[1], row.time);
     row.frame = int(frame);
     row.name = fields[2];
-    for (std::size_t v = 0; v < BODY_VALUES; ++v) ok = ok && parseNumber(fields[3 + v], row.values[v]);
+    for (std::size_t v = 0; v < BODY_VALUES; ++v)
+        ok = ok && parseNumber(fields[3 + v], row.values[v]);
     if (!ok || double(row.frame) != frame) {
-        throw IoError(msg("bodies '", path, "': line ", lineNumber, ": expected numbers in every "
+        throw IoError(msg("bodies '", path, "': line ", lineNumber,
+                          ": expected numbers in every "
                           "column but 'name'"));
     }
     return row;
@@ -142,8 +144,8 @@ std::vector<BodyRow> readBodiesCsv(const std::string& path)
     std::string expected;
     for (const std::string& c : bodyColumns()) expected += (expected.empty() ? "" : ",") + c;
     if (header != expected) {
-        throw IoError(msg("bodies '", path, "': line 1 is '", header, "', expected '", expected,
-                          "'"));
+        throw IoError(
+            msg("bodies '", path, "': line 1 is '", header, "', expected '", expected, "'"));
     }
     std::vector<BodyRow> rows;
     for (int n = 2; std::getline(in, line); ++n) {
@@ -165,8 +167,8 @@ void writeBodiesGroup(H5::H5File& file, const std::vector<BodyRow>& rows)
         .write(stringType, names.data());
     for (std::size_t c = 0; c < columns.size(); ++c) {
         if (columns[c] == "name") continue;
-        H5::DataSet set = group.createDataSet(columns[c], H5::PredType::NATIVE_DOUBLE,
-                                              H5::DataSpace(1, &count));
+        H5::DataSet set =
+            group.createDataSet(columns[c], H5::PredType::NATIVE_DOUBLE, H5::DataSpace(1, &count));
         set.write(columnValues(rows, c).data(), H5::PredType::NATIVE_DOUBLE);
         writeStringAttribute(set, "unit", bodyUnit(columns[c]));
     }
@@ -213,8 +215,8 @@ std::vector<BodyRow> readStatsBodies(const std::string& h5Path)
         }
         return rows;
     } catch (const H5::Exception& e) {
-        throw IoError(msg("statistics '", h5Path, "': cannot read '/bodies' (", e.getDetailMsg(),
-                          ")"));
+        throw IoError(
+            msg("statistics '", h5Path, "': cannot read '/bodies' (", e.getDetailMsg(), ")"));
     }
 }
 

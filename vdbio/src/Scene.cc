@@ -382,7 +382,8 @@ void checkSolidGridNames(const Scene& scene)
     for (const SceneSolid& solid : scene.solids) {
         if (std::find(taken.begin(), taken.end(), solid.name) != taken.end()) {
             throw SceneError(msg("scene '", scene.file, "': outputs.volume.solids: solid name '",
-                                 solid.name, "' is taken by another grid of the volume file: "
+                                 solid.name,
+                                 "' is taken by another grid of the volume file: "
                                  "expected solid names unlike each other and surface, density, "
                                  "vel, temperature"));
         }

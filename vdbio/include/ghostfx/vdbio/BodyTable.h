@@ -54,9 +54,7 @@ std::vector<BodyRow> readStatsBodies(const std::string& h5Path);
 class BodyLog
 {
 public:
-    explicit BodyLog(std::string csvPath)
-        : mCsvPath(std::move(csvPath))
-    {}
+    explicit BodyLog(std::string csvPath) : mCsvPath(std::move(csvPath)) {}
 
     void append(BodyRow row) { mRows.push_back(std::move(row)); }
     /// Rewrite the CSV file with every row so far (nothing before the first row).
