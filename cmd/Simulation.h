@@ -8,6 +8,7 @@
 
 #include <ghostfx/sph/ParticleExchange.h>
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/RigidBody.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
 #include <ghostfx/vdbio/Scene.h>
@@ -88,6 +89,17 @@ public:
     /// placement its motion gives at time(), wherever a script steered it; empty where the
     /// solver does not place solids (then the scene's motion says where they are).
     virtual std::vector<sph::RigidTransform> solidPlacements() const { return {}; }
+
+    /// One dynamic solid now: its index among the solids (the scene's order, then a
+    /// script's), its body's state and angular velocity (rad/s, world).
+    struct BodySample
+    {
+        std::size_t solid = 0;
+        sph::RigidBodyState state;
+        sph::Vec3d angularVelocity{0.0};
+    };
+    /// Every dynamic solid, in the order added; empty where there are none.
+    virtual std::vector<BodySample> bodies() const { return {}; }
 
     /// Called after every step with its dt (s).
     virtual void setStepObserver(std::function<void(double dt)> observer) = 0;
