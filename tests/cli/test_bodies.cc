@@ -1,7 +1,7 @@
 /// @file   test_bodies.cc
 /// @brief  Dynamic solids through `ghostfx run`: the `dynamic` scene key and its errors,
-///         bodies.csv and the statistics' `/bodies` group, a resumed run continuing them (its
-///         rows kept bit for bit, the solver's new ones within 1e-4), and outputs.volume.solids
+///         bodies.csv and the statistics' `/bodies` group, a resumed run continuing them bit
+///         for bit, and outputs.volume.solids
 ///         writing each body's level set where it is.
 #include "CliHarness.h"
 
@@ -127,18 +127,10 @@ TEST_F(Bodies, ResumedRunContinuesTheRows)
     for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(resumedRows[i].frame, int(i) + 1);
     for (std::size_t i = 0; i < 2; ++i)
         EXPECT_EQ(resumedRows[i].values, straightRows[i].values) << "frame " << i + 1;
-    // Frames 3-4 simulated from the checkpoint: the solver's resumed body follows the
-    // uninterrupted one within 1e-4 relative, not bit for bit (the bound and the gap of
-    // tests/ghost/test_rigid_bodies.cc, AResumedRunAndEitherThreadCountGiveTheSameBody; here
-    // the 9th digit differs). The checkpoint carries the body's state (body_1_* reals).
-    for (std::size_t i = 2; i < 4; ++i) {
-        for (std::size_t v = 0; v < ghostfx::vdbio::BODY_VALUES; ++v) {
-            const double straight = straightRows[i].values[v];
-            const double scale = std::max(std::abs(straight), 1e-2);
-            EXPECT_NEAR(resumedRows[i].values[v], straight, 1e-4 * scale)
-                << "frame " << i + 1 << ", column " << ghostfx::vdbio::bodyColumns()[3 + v];
-        }
-    }
+    // Frames 3-4 simulated from the checkpoint: the same as the uninterrupted run's, bit for bit
+    // (the checkpoint carries the body's state, the body_1_* reals).
+    for (std::size_t i = 2; i < 4; ++i)
+        EXPECT_EQ(resumedRows[i].values, straightRows[i].values) << "frame " << i + 1;
     const std::string fingerprint = ghostfx::vdbio::readScene(path).simulationFingerprint();
     const auto saved =
         ghostfx::vdbio::readCheckpointStates((b / "checkpoint.0002.h5").string(), fingerprint);
