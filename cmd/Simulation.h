@@ -8,6 +8,7 @@
 
 #include <ghostfx/sph/ParticleExchange.h>
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/RigidBody.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SolverState.h>
 #include <ghostfx/vdbio/Scene.h>
@@ -17,9 +18,13 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ghostfx {
+namespace ghost {
+struct DynamicSolid;
+}
 namespace cmd {
 
 /// Particles of one medium and how to turn them into output files.
@@ -123,6 +128,18 @@ public:
     virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity);
     virtual void addEmitter(const vdbio::SceneEmitter& emitter);
     virtual void addGasSource(const vdbio::SceneGasSource& source);
+    /// Dynamic solids (rigid bodies the liquid moves, ghost::GhostSolver::addDynamicSolid), for
+    /// scripts: add one beside the scene's solids (returns its solid index), read its body and
+    /// the liquid's force and torque on it in the last step, push it (force N at the centre of
+    /// mass, torque N m, world axes) in every step until clearBodyForces(). Liquid scenes only:
+    /// the others refuse adding one with a ValueError naming the shape and have none.
+    virtual std::size_t addDynamicSolid(const vdbio::SceneSolid& solid,
+                                        const ghost::DynamicSolid& body);
+    /// The body of solid `index`, or null where it is not a dynamic solid.
+    virtual const sph::RigidBody* body(std::size_t /*index*/) const { return nullptr; }
+    virtual std::pair<sph::Vec3d, sph::Vec3d> liquidForceOn(std::size_t index) const;
+    virtual void addBodyForce(std::size_t index, const sph::Vec3d& force, const sph::Vec3d& torque);
+    virtual void clearBodyForces() {}
     /// The particles of `kind` a script may set (liquid and gas particles; ghosts are derived
     /// from them and cannot be set); the default: none.
     virtual WritableParticles writableParticles(sph::ParticleKind kind);
