@@ -20,16 +20,19 @@ def box(lo, hi, name, voxel=0.005):
     return ghostfx.LevelSet.from_array(sdf, voxel, tuple(origin), name)
 
 
-def tank_scene(tmp_path, frames=10, height=0.6):
-    """An open tank 30 x `height` x 30 cm (y up), 15 cm of water, 2 cm spacing, fixed steps."""
-    doc = {"ghostfx_scene": 1,
+def tank_document(frames=10, height=0.6):
+    """An open tank 30 x `height` x 30 cm (y up), 15 cm of water, 2 cm spacing, CFL steps."""
+    return {"ghostfx_scene": 1,
            "settings": {"method": "ghost", "spacing": 0.02, "frame_rate": FPS, "substeps": 0,
                         "frame_range": [1, frames], "seed": 3},
            "solids": [{"name": "tank",
                        "geometry": {"container": {"min": [0, 0, 0], "max": [0.3, height, 0.3]}}}],
            "liquids": [{"name": "water",
                         "geometry": {"box": {"min": [0, 0, 0], "max": [0.3, 0.15, 0.3]}}}]}
-    return ghostfx.load_scene(doc, folder=tmp_path)
+
+
+def tank_scene(tmp_path, frames=10, height=0.6):
+    return ghostfx.load_scene(tank_document(frames, height), folder=tmp_path)
 
 
 # The 10 x 6 x 10 cm box: 4 cm above the water (it falls onto it), or high in the air.
@@ -42,8 +45,8 @@ def test_a_body_reads_its_mass_properties_and_state(tmp_path):
     sim = ghostfx.Simulation(tank_scene(tmp_path))
     sim.add_body(box(*FLOATING, "crate"), density=500)
     b = sim.body("crate")
-    # The box's volume is exact to the voxel (its faces on voxel centres' midpoints are
-    # resolved by the level-set integration to well under 1 %, the issue's tolerance).
+    # The level set's volume integral of the box (5 mm voxels) is 0.4 % under the exact
+    # 10 x 6 x 10 cm; the issue asks for 1 %.
     assert b["volume"] == pytest.approx(VOLUME, rel=0.01)
     assert b["mass"] == pytest.approx(500 * VOLUME, rel=0.01)
     assert b["mass"] == pytest.approx(500 * b["volume"], rel=1e-12)
@@ -197,3 +200,27 @@ def test_resume_continues_an_added_body_bit_for_bit(tmp_path):
     # The solids keep their names and order: the second post is still a static solid.
     with pytest.raises(ValueError):
         resumed.body("post2")
+
+
+def test_bodies_need_a_ghost_sph_liquid(tmp_path):
+    gas = ghostfx.load_scene({
+        "ghostfx_scene": 1,
+        "settings": {"method": "gas", "spacing": 0.03, "frame_range": [1, 2], "gas": {"seed": 1}},
+        "domain": {"kill_box": {"min": [-0.4, -0.05, -0.4], "max": [0.4, 1.0, 0.4]}},
+        "gas_sources": [{"name": "later", "start": 100,
+                         "geometry": {"sphere": {"center": [0.3, 0.1, 0.3], "radius": 0.05}}}],
+    }, folder=tmp_path)
+    sim = ghostfx.Simulation(gas)
+    with pytest.raises(ValueError) as e:
+        sim.add_body(box(*IN_AIR, "crate"), density=500)
+    assert str(e.value) == ("body 'crate': dynamic solids are supported in liquid scenes "
+                            "(method ghost) only")
+    with pytest.raises(ValueError) as e:
+        sim.body("crate")
+    assert str(e.value) == "body 'crate': the simulation has no body of that name (bodies: none)"
+    basic = ghostfx.Simulation(ghostfx.load_scene(
+        {**tank_document(), "settings": {**tank_document()["settings"], "method": "basic"}},
+        folder=tmp_path))
+    with pytest.raises(ValueError) as e:
+        basic.add_body(box(*IN_AIR, "crate"), density=500)
+    assert str(e.value) == "dynamic solid 'crate': dynamic solids need method 'ghost', not 'basic'"
