@@ -435,15 +435,12 @@ public:
     /// The solid index of the body `name`, or a ValueError naming the bodies there are.
     std::size_t bodyIndex(const std::string& name) const
     {
-        std::vector<const vdbio::SceneSolid*> bodies;
+        std::string known;
         for (std::size_t i = 0; i < mScene->solids.size(); ++i) {
             if (!mSim->body(i)) continue;
             if (mScene->solids[i].name == name) return i;
-            bodies.push_back(&mScene->solids[i]);
+            known += (known.empty() ? "'" : ", '") + mScene->solids[i].name + "'";
         }
-        std::string known;
-        for (const vdbio::SceneSolid* b : bodies)
-            known += (known.empty() ? "'" : ", '") + b->name + "'";
         throw ValueError("body '" + name + "': the simulation has no body of that name (bodies: "
                          + (known.empty() ? "none" : known) + ")");
     }
@@ -871,7 +868,7 @@ void bindBodies(PySimulationClass& c)
             "apply_force(name, (0, 0, 0), torque): a torque (N m, world axes) over the next "
             "frame")
         .def("body", &PySimulation::body, py::arg("name"),
-             "The rigid body `name` (added by add_body) now, a dict: position (its centre of "
+             "The rigid body (dynamic solid) `name` now, a dict: position (its centre of "
              "mass, m), orientation (unit quaternion w, x, y, z turning its level set's frame "
              "into the world), rotation (the same as a 3x3 array), velocity (m/s), "
              "angular_velocity (rad/s), mass (kg), volume (m^3), inertia (3x3, kg m^2, world "
