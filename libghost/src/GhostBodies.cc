@@ -216,6 +216,11 @@ void GhostSolver::findContactPoints(std::size_t solidIndex)
         b.contactPoints.push_back(Vec3d(onSurface));
         b.radius = std::max(b.radius, (Vec3d(onSurface) - b.rigid.localCentre()).length());
     }
+    // In an order of their own (the contact impulses are sequential): the block's order differs
+    // between a fresh run and a restored one.
+    std::sort(b.contactPoints.begin(), b.contactPoints.end(), [](const Vec3d& p, const Vec3d& q) {
+        return p[0] != q[0] ? p[0] < q[0] : p[1] != q[1] ? p[1] < q[1] : p[2] < q[2];
+    });
 }
 
 void GhostSolver::saveBodies(SolverState& state) const

@@ -280,6 +280,12 @@ std::vector<Vec3> bandNormals(const SampleSet& samples, const LevelSet& solid, R
     return normals;
 }
 
+/// Move each point `depth` (m) against its normal.
+void sinkAlong(std::vector<Vec3>& points, const std::vector<Vec3>& normals, Real depth)
+{
+    for (std::size_t k = 0; k < points.size(); ++k) points[k] -= depth * normals[k];
+}
+
 } // namespace
 
 void GhostSolver::sampleSolid(std::size_t solidIndex)
@@ -305,10 +311,7 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     // displaces is the body's own (on a static solid's surface layer the liquid would keep
     // half a spacing off, and a floating box's draft would come out 1 cm short at 2 cm).
     std::vector<Vec3> local(samples.positions);
-    if (body.body) {
-        for (std::size_t k = 0; k < local.size(); ++k)
-            local[k] -= (Real(0.5) * mSettings.spacing) * localNormals[k];
-    }
+    if (body.body) sinkAlong(local, localNormals, Real(0.5) * mSettings.spacing);
 
     SolidBlock& target = blockOf(solidIndex);
     ParticleSet& set = target.block.particles();
@@ -1037,6 +1040,11 @@ void GhostSolver::advanceFrame()
                               : !(frameEnd - (mRun.time + double(dt)) > tolerance);
         step(dt, last);
         });
+    // The frame's end snaps the clock to frameEnd; the bodies' clocks follow (their placement
+    // at time() must be their state, with no extrapolation over a rounding difference).
+    for (const auto& solid : mSolids) {
+        if (solid->body) solid->body->rigid.setTime(mRun.time);
+    }
 }
 
 } // namespace ghost

@@ -609,22 +609,27 @@ void GhostSolver::projectOutOfSolids(Real dt)
     });
     mRestoredFromSolids += restored.load();
     if (bodies) giveCollisionImpulses(impulse, hit);
-    if (const std::size_t i = stuck.load(); i < mParticles.size()) {
-        std::size_t b = 0;
-        while (b + 1 < mSolids.size() && !(mSolids[b]->phi(x[i], time) < Real(0))) ++b;
-        std::ostringstream where;
-        where << "(" << x[i][0] << ", " << x[i][1] << ", " << x[i][2] << ")";
-        const LevelSet& shape = mSolids[b]->shape;
-        throw NumericalError(msg("liquid solver at frame ", mRun.frame, ", step ", mRun.step,
-                                 " (t = ", mRun.time, " s): liquid particle id ",
-                                 mParticles.ids()[i], " at ", where.str(), " is inside solid '",
-                                 shape.name(), "' deeper than its level set's band (",
-                                 shape.bandWidth(),
-                                 " m), and so was its position before the step: it cannot "
-                                 "be put back; reduce the time step (substeps / cflNumber)"));
-    }
+    if (const std::size_t i = stuck.load(); i < mParticles.size()) throwStuckInSolid(i);
     mProjectAll = false;
     mTimings.xsphAndBoundary += secondsSince(start);
+}
+
+void GhostSolver::throwStuckInSolid(std::size_t i) const
+{
+    const auto& x = mParticles.positions();
+    const double time = mRun.time;
+    std::size_t b = 0;
+    while (b + 1 < mSolids.size() && !(mSolids[b]->phi(x[i], time) < Real(0))) ++b;
+    std::ostringstream where;
+    where << "(" << x[i][0] << ", " << x[i][1] << ", " << x[i][2] << ")";
+    const LevelSet& shape = mSolids[b]->shape;
+    throw NumericalError(msg("liquid solver at frame ", mRun.frame, ", step ", mRun.step,
+                             " (t = ", mRun.time, " s): liquid particle id ",
+                             mParticles.ids()[i], " at ", where.str(), " is inside solid '",
+                             shape.name(), "' deeper than its level set's band (",
+                             shape.bandWidth(),
+                             " m), and so was its position before the step: it cannot "
+                             "be put back; reduce the time step (substeps / cflNumber)"));
 }
 
 void GhostSolver::checkBlowUp() const

@@ -54,8 +54,11 @@ RigidBody::RigidBody(const MassProperties& mass, const RigidBodyMaterial& materi
 
 void RigidBody::setState(const RigidBodyState& state)
 {
+    // A saved state is taken bit for bit (normalising a unit quaternion again can change its
+    // last bits, and a resumed run would part from the original).
     mState = state;
-    mState.orientation = mState.orientation.unit();
+    const double norm = mState.orientation.dot(mState.orientation);
+    if (std::abs(norm - 1) > 1e-12) mState.orientation = mState.orientation.unit();
 }
 
 void RigidBody::setAngularVelocity(const Vec3d& omega)

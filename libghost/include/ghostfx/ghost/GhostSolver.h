@@ -479,6 +479,8 @@ private:
     void pressureToSolids();
     void moveSolids(double time);
     void projectOutOfSolids(Real dt);
+    /// The error of liquid particle i left inside a solid deeper than its band.
+    [[noreturn]] void throwStuckInSolid(std::size_t i) const;
     // Dynamic solids (GhostBodies.cc) ----------------------------------------------------------
     Body& bodyOf(std::size_t solidIndex) const;
     bool hasBodies() const;
@@ -492,6 +494,8 @@ private:
     void findContactPoints(std::size_t solidIndex);
     /// The liquid's pressure and drag on each body this step (before the particles move).
     void gatherBodyForces(Real dt);
+    /// Each body's wetShare: the share of its ghosts the liquid reached this step.
+    void measureWetShares(const std::vector<int>& slot);
     /// Each body over the step: forces, contacts, then its motion.
     void advanceBodies(Real dt);
     void resolveBodyContacts(Real dt);

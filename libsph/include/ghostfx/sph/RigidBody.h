@@ -61,10 +61,12 @@ public:
     const Vec3d& localCentre() const { return mMass.centre; }
 
     const RigidBodyState& state() const { return mState; }
-    /// Replace the state (a restored checkpoint, a script placing the body); the orientation is
-    /// normalised.
+    /// Replace the state (a restored checkpoint, a script placing the body): taken as it is,
+    /// except an orientation more than 1e-12 from unit length, which is normalised.
     void setState(const RigidBodyState& state);
     void setVelocity(const Vec3d& v) { mState.velocity = v; }
+    /// Relabel the state's time (s), as a solver's clock snaps to a frame's end.
+    void setTime(double time) { mState.time = time; }
     /// Set the angular velocity (rad/s, world): L = I_world omega.
     void setAngularVelocity(const Vec3d& omega);
 
