@@ -91,5 +91,11 @@ public:
 /// none waits for this one forever. Does nothing for a single process.
 void abortDistributedRun(int code);
 
+/// Wait for an error of another process that this one knows is coming (every process found
+/// the same fault, and one of them reports it): a barrier of all the processes that the
+/// reporting one never joins, left when its abortDistributedRun stops this one. Does nothing
+/// for a single process.
+void awaitDistributedAbort();
+
 } // namespace cmd
 } // namespace ghostfx

@@ -151,5 +151,10 @@ void abortDistributedRun(int code)
     if (gActive) MPI_Abort(MPI_COMM_WORLD, code);
 }
 
+void awaitDistributedAbort()
+{
+    if (gActive) MPI_Barrier(MPI_COMM_WORLD);
+}
+
 } // namespace cmd
 } // namespace ghostfx

@@ -26,5 +26,7 @@ std::unique_ptr<DistributedRun> DistributedRun::startIfLaunched()
 
 void abortDistributedRun(int /*code*/) {}
 
+void awaitDistributedAbort() {}
+
 } // namespace cmd
 } // namespace ghostfx

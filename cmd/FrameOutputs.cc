@@ -3,7 +3,7 @@
 ///         points and volume files, the liquid's mesh, and the preview of the scene with its
 ///         solids where they are.
 #include "FrameWriter.h"
-
+#include "SolidGrids.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/LevelSetGrid.h>
@@ -53,29 +53,16 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
     std::vector<vdbio::PreviewLayer> layers;
     for (std::size_t i = 0; i < scene.solids.size(); ++i) {
         const vdbio::SceneSolid& solid = scene.solids[i];
-        sph::LevelSet shape = solid.shape;
-        if (!solid.sequenceFile.empty()) {
-            shape = vdbio::loadLevelSet(
-                vdbio::expandFramePattern(solid.sequenceFile, snapshot.frame), solid.sequenceGrid,
-                msg("scene '", scene.file, "': solids[", i, "].sequence"));
-        }
+        const PlacedSolid placed = placedSolid(scene, snapshot, i);
+        const sph::LevelSet& shape = placed.shape;
         vdbio::PreviewLayer layer;
         layer.name = solid.name;
         layer.grid = sph::gridOf(shape);
         layer.albedo = vdbio::SOLID_ALBEDO;
         // A solid that neither moves nor changes shape looks the same in every frame.
         layer.fixed = solid.isStatic();
-        if (i < snapshot.solidPlacements.size()) {
-            const sph::RigidTransform& placed = snapshot.solidPlacements[i];
-            layer.rotation = openvdb::math::Mat3d(placed.rotation);
-            layer.translation = openvdb::Vec3d(placed.translation);
-        } else if (solid.motion.keys.empty()) {
-            layer.translation = solid.velocity * snapshot.time;
-        } else {
-            const sph::RigidKey key = solid.motion.at(snapshot.time);
-            layer.rotation = sph::KeyedMotion::rotation(key.rotateDegrees);
-            layer.translation = key.translate;
-        }
+        layer.rotation = placed.rotation;
+        layer.translation = placed.translation;
         if (media.max().x() >= media.min().x()) {
             const openvdb::Vec3d centre = media.getCenter();
             const openvdb::Vec3d local = layer.rotation.transpose() * (centre - layer.translation);
@@ -96,7 +83,7 @@ std::vector<vdbio::PreviewLayer> solidLayers(const vdbio::Scene& scene,
 openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs& out,
                                 const std::string& pointsPath, const std::string& volumePath,
                                 const openvdb::MetaMap& fileMeta, double time,
-                                const BuiltGrids* built)
+                                const BuiltGrids* built, const openvdb::GridPtrVec& solids)
 {
     if (!pointsPath.empty()) {
         if (built) {
@@ -110,7 +97,9 @@ openvdb::GridPtrVec writeMedium(const OutputMedium& m, const vdbio::SceneOutputs
     if (volumePath.empty()) return {};
     const openvdb::GridPtrVec grids =
         built ? built->volumes : vdbio::makeVolumeGrids(*m.particles, volumeOptions(m, out));
-    vdbio::writeVolumeFile(volumePath, grids, fileMeta);
+    openvdb::GridPtrVec written = grids;
+    written.insert(written.end(), solids.begin(), solids.end());
+    vdbio::writeVolumeFile(volumePath, written, fileMeta);
     return grids;
 }
 
@@ -252,10 +241,12 @@ std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,
     for (std::size_t index = 0; index < snapshot.media.size(); ++index) {
         const OutputMedium& m = snapshot.media[index];
         const BuiltGrids* built = index < snapshot.built.size() ? &snapshot.built[index] : nullptr;
-        const openvdb::GridPtrVec grids =
-            writeMedium(m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
-                        inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta,
-                        snapshot.time, built);
+        const openvdb::GridPtrVec grids = writeMedium(
+            m, out, inFolder(m.liquid ? out.pointsFile : out.gasPointsFile),
+            inFolder(m.liquid ? out.volumeFile : out.gasVolumeFile), fileMeta, snapshot.time, built,
+            m.liquid && out.volumeSolids && !out.volumeFile.empty()
+                ? placedSolidGrids(scene, snapshot)
+                : openvdb::GridPtrVec());
         if (m.liquid && !out.meshFile.empty()) {
             notes.push_back(writeMesh(m, out, grids, inFolder(out.meshFile), snapshot.frame,
                                       fileMeta, built));

@@ -34,6 +34,8 @@ gas::Method gasMethod(const std::string& name)
 gas::GasSettings gasSettings(const vdbio::Scene& scene, const vdbio::JsonObject& g,
                              double defaultSpacing, gas::Method method)
 {
+    refuseDynamicSolids(scene, scene.heaters.empty() ? "a gas scene"
+                                                     : "a boiling scene (its vapour's gas solver)");
     gas::GasSettings s;
     if (g.has("variant")) {
         // The gas baselines are methods now, chosen like the liquid's (settings.method).

@@ -37,6 +37,9 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
     g.killBox = scene.killBox;
     s.finish();
     validateSceneSettings(scene.file, g);
+    if (g.method != ghost::Method::Ghost) {
+        refuseDynamicSolids(scene, msg("settings.method '", ghost::methodName(g.method), "'"));
+    }
     return g;
 }
 
@@ -171,7 +174,15 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
     auto solver = std::make_unique<GhostSolver>(settings);
     solver->setSampleStore(processSampleCache());
     if (restored) solver->restoreState(*restored);
-    for (const vdbio::SceneSolid& solid : scene.solids) addSceneSolid(*solver, solid);
+    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+        const vdbio::SceneSolid& solid = scene.solids[i];
+        try {
+            addSceneSolid(*solver, solid);
+        } catch (const ValueError& e) {
+            throw SceneError(
+                msg("scene '", scene.file, "': solids[", i, "] '", solid.name, "': ", e.what()));
+        }
+    }
     if (!restored) {
         for (const vdbio::SceneLiquid& liquid : scene.liquids) {
             const std::size_t n = solver->addLiquid(liquid.shape, Vec3(liquid.velocity));
@@ -189,6 +200,18 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
 
 void addSceneSolid(GhostSolver& solver, const vdbio::SceneSolid& solid)
 {
+    if (solid.dynamic) {
+        const vdbio::SceneDynamic& d = *solid.dynamic;
+        ghost::DynamicSolid body;
+        body.density = d.density;
+        body.mass = d.mass;
+        body.velocity = d.velocity;
+        body.angularVelocity = d.angularVelocity;
+        body.material.restitution = d.restitution;
+        body.material.friction = d.friction;
+        solver.addDynamicSolid(solid.shape, body);
+        return;
+    }
     // A solid without motion keys moves at its constant velocity, or stands still: then its
     // particles are sorted once and never re-placed.
     if (solid.motion.keys.empty()) solver.addSolid(solid.shape, Vec3(solid.velocity));
@@ -203,6 +226,16 @@ void addSceneEmitter(GhostSolver& solver, const vdbio::SceneEmitter& emitter)
     } else {
         solver.addMovingEmitter(emitter.shape, velocity, emitter.motion.motion(), emitter.start,
                                 emitter.end);
+    }
+}
+
+void refuseDynamicSolids(const vdbio::Scene& scene, const std::string& why)
+{
+    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+        if (!scene.solids[i].dynamic) continue;
+        throw SceneError(msg("scene '", scene.file, "': solids[", i, "].dynamic: solid '",
+                             scene.solids[i].name, "' is dynamic, which ", why,
+                             " cannot simulate: expected a solid without 'dynamic'"));
     }
 }
 

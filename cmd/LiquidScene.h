@@ -32,10 +32,14 @@ std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
                                                      const ghost::GhostSettings& settings,
                                                      const sph::SolverState* restored = nullptr);
 
-/// Add one solid (static, moving at its velocity, or keyed) or one emitter to a liquid solver,
+/// Add one solid (static, moving at its velocity, keyed, or dynamic) or one emitter to a liquid solver,
 /// as makeLiquidSolver adds the scene's.
 void addSceneSolid(ghost::GhostSolver& solver, const vdbio::SceneSolid& solid);
 void addSceneEmitter(ghost::GhostSolver& solver, const vdbio::SceneEmitter& emitter);
+
+/// Refuse a scene with a dynamic solid where the solvers cannot move one (`why` names them:
+/// "a gas scene"): a SceneError naming the solid's key.
+void refuseDynamicSolids(const vdbio::Scene& scene, const std::string& why);
 
 /// This process's sample cache (vdbio::SampleCache): the folder of `--sample-cache`, else of
 /// $GHOSTFX_SAMPLE_CACHE, else the per-user defaultSampleCacheFolder(); "off" (or empty) in

@@ -102,6 +102,16 @@ public:
             placements.push_back(mSolver->solidPlacement(i));
         return placements;
     }
+    std::vector<BodySample> bodies() const override
+    {
+        std::vector<BodySample> bodies;
+        for (std::size_t i = 0; i < mSolver->solidCount(); ++i) {
+            if (!mSolver->isDynamic(i)) continue;
+            const sph::RigidBody& b = mSolver->body(i);
+            bodies.push_back({i, b.state(), b.angularVelocity()});
+        }
+        return bodies;
+    }
     void setSolidMotion(std::size_t index, sph::RigidMotion motion) override
     {
         mSolver->setSolidMotion(index, std::move(motion));

@@ -15,6 +15,7 @@
 #include <ghostfx/sph/LevelSetGrid.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/vdbio/AtomicFile.h>
+#include <ghostfx/vdbio/BodyTable.h>
 #include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/FrameFiles.h>
 #include <ghostfx/vdbio/Preview.h>
@@ -126,6 +127,37 @@ std::vector<Simulation::MediumCount> mediumCounts(const Simulation& sim,
     return counts;
 }
 
+/// The rows of bodies.csv for `frame`: every dynamic solid of `sim` at its time, named as the
+/// scene names it (a solid a script added: solids[i]).
+std::vector<vdbio::BodyRow> bodyRows(const vdbio::Scene& scene, const Simulation& sim, int frame)
+{
+    std::vector<vdbio::BodyRow> rows;
+    for (const Simulation::BodySample& b : sim.bodies()) {
+        vdbio::BodyRow row;
+        row.frame = frame;
+        row.time = sim.time();
+        row.name = b.solid < scene.solids.size() ? scene.solids[b.solid].name
+                                                 : msg("solids[", b.solid, "]");
+        const sph::RigidBodyState& s = b.state;
+        const sph::Quatd& q = s.orientation;
+        row.values = {s.position[0],
+                      s.position[1],
+                      s.position[2],
+                      q.w(),
+                      q.x(),
+                      q.y(),
+                      q.z(),
+                      s.velocity[0],
+                      s.velocity[1],
+                      s.velocity[2],
+                      b.angularVelocity[0],
+                      b.angularVelocity[1],
+                      b.angularVelocity[2]};
+        rows.push_back(std::move(row));
+    }
+    return rows;
+}
+
 /// Says once, when it happens, that a medium has no particles left (all through the kill box,
 /// boiled away or at the end of their life): the run goes on and writes empty frames.
 class EmptyMediaWatch
@@ -188,6 +220,7 @@ public:
     int run()
     {
         readScene();
+        refuseDistributedBodies();
         makeSimulation();
         checkBeforeOutput();
         makeProgress();
@@ -211,6 +244,21 @@ private:
         if (!mOptions.frames.empty()) parseFrames(mOptions.frames, mFirst, mLast);
         mFolder = mOptions.out.empty() ? mScene.outputs.directory : mOptions.out;
         mFingerprint = checkpointFingerprint(mScene);
+    }
+
+    /// Dynamic solids run on one process: over several, refused before any simulation, said
+    /// once, by the first process (the others wait for its error to stop them, runScene).
+    void refuseDistributedBodies()
+    {
+        if (!mDistributed) return;
+        for (std::size_t i = 0; i < mScene.solids.size(); ++i) {
+            if (!mScene.solids[i].dynamic) continue;
+            if (!mDistributed->root()) awaitDistributedAbort();
+            throw SceneError(msg("scene '", mScene.file, "': solids[", i, "].dynamic: solid '",
+                                 mScene.solids[i].name,
+                                 "' is dynamic, and dynamic solids run on "
+                                 "one process: run this scene without mpirun"));
+        }
     }
 
     /// The solvers the scene needs, fresh or from a checkpoint.
@@ -353,6 +401,10 @@ private:
             mStats = std::make_unique<vdbio::StatsWriter>(h5, csv);
             if (!mOptions.resume.empty()) mStats->resumeFrom(std::int64_t(mSim->stepCount()));
         }
+        if (mWrites && !mSim->bodies().empty()) {
+            mBodies = std::make_unique<vdbio::BodyLog>(inFolder("bodies.csv", 0));
+            if (!mOptions.resume.empty()) mBodies->resumeFrom(mSim->frame());
+        }
         const bool combine = !out.statsFile.empty() && mDistributed;
         mSim->setStepObserver([this, combine](double dt) {
             ++mSubstep;
@@ -402,6 +454,7 @@ private:
         } else if (write) {
             writer.submit(snapshotFrame(mScene.outputs, *mSim, mFrame));
         }
+        recordBodies();
         if (mStats) mStats->flush();
         // Every process stops at the same frame, whichever saw the signal, and all report the
         // same one.
@@ -422,6 +475,15 @@ private:
         for (const std::string& note : writer.takeNotes()) mProgress->message(note);
         if (stopSignal != 0) reportStop(stopSignal, checkpoint);
         return stopSignal;
+    }
+
+    /// The dynamic solids' rows of mFrame, into bodies.csv and the statistics' `/bodies`.
+    void recordBodies()
+    {
+        if (!mBodies) return;
+        for (vdbio::BodyRow& row : bodyRows(mScene, *mSim, mFrame)) mBodies->append(std::move(row));
+        mBodies->flush();
+        if (mStats) mStats->setBodies(mBodies->rows());
     }
 
     /// The checkpoint of mFrame, if the scene asks for checkpoints; returns the path to resume
@@ -482,6 +544,7 @@ private:
     std::unique_ptr<Simulation> mSim;
     std::unique_ptr<Progress> mProgress;
     std::unique_ptr<vdbio::StatsWriter> mStats;
+    std::unique_ptr<vdbio::BodyLog> mBodies; ///< with dynamic solids: bodies.csv
     int mFrame = 0, mSubstep = 0; ///< what the step observer reports
 };
 

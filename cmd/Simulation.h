@@ -94,6 +94,17 @@ public:
     /// solver does not place solids (then the scene's motion says where they are).
     virtual std::vector<sph::RigidTransform> solidPlacements() const { return {}; }
 
+    /// One dynamic solid now: its index among the solids (the scene's order, then a
+    /// script's), its body's state and angular velocity (rad/s, world).
+    struct BodySample
+    {
+        std::size_t solid = 0;
+        sph::RigidBodyState state;
+        sph::Vec3d angularVelocity{0.0};
+    };
+    /// Every dynamic solid, in the order added; empty where there are none.
+    virtual std::vector<BodySample> bodies() const { return {}; }
+
     /// Called after every step with its dt (s).
     virtual void setStepObserver(std::function<void(double dt)> observer) = 0;
     /// The statistics row of the step just taken.

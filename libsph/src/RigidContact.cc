@@ -43,11 +43,12 @@ struct PlacedObstacle
 };
 
 /// The normal velocity a contact point should leave with (RigidContact.h): to the surface
-/// from outside, out at the capped rate from inside, bouncing above the rest speed.
-double targetNormalSpeed(double phiNow, double vn, double dt, const ContactSettings& s)
+/// from outside, no nearer from inside, bouncing above the rest speed.
+double targetNormalSpeed(double phiNow, double vn, double dt, double restitution,
+                         const ContactSettings& s)
 {
-    double target = phiNow >= 0 ? -phiNow / dt : std::min(-phiNow, s.maxPushOut) / dt;
-    if (vn < -s.restSpeed) target = std::max(target, -s.restitution * vn);
+    double target = phiNow >= 0 ? -phiNow / dt : 0.0;
+    if (vn < -s.restSpeed) target = std::max(target, -restitution * vn);
     return target;
 }
 
@@ -69,33 +70,103 @@ Vec3d contactImpulse(const RigidBody& body, const PlacedObstacle& other, const V
     return J;
 }
 
+/// The body's surface points in the world, where its state places them.
+std::vector<Vec3d> placedPoints(const RigidBody& body, const std::vector<Vec3d>& points)
+{
+    const Mat3d R = body.rotation();
+    const Vec3d com = body.state().position, centre = body.localCentre();
+    std::vector<Vec3d> world;
+    world.reserve(points.size());
+    for (const Vec3d& p : points) world.push_back(R * (p - centre) + com);
+    return world;
+}
+
+/// A contact of the body's points with the obstacle: the points that end the coming drift
+/// inside it, their mean (x) and mean normal (n).
+struct Manifold
+{
+    int points = 0;
+    Vec3d x{0.0}, n{0.0};
+};
+
+Manifold findManifold(const RigidBody& body, const std::vector<Vec3d>& world,
+                      const PlacedObstacle& other, double dt)
+{
+    Manifold m;
+    for (const Vec3d& x : world) {
+        Vec3d n;
+        if (!(other.phi(x + body.pointVelocity(x) * dt, &n) < 0) || n.lengthSqr() < 0.25) continue;
+        ++m.points;
+        m.x += x;
+        m.n += n;
+    }
+    if (m.points == 0 || m.n.lengthSqr() == 0) return Manifold();
+    m.x /= double(m.points);
+    m.n = m.n.unit();
+    return m;
+}
+
+/// Push the body out of the obstacle along the deepest point's normal, by at most maxPushOut:
+/// a correction of position, so an overlap separates without the body gaining speed.
+void pushOut(RigidBody& body, const std::vector<Vec3d>& points, const PlacedObstacle& other,
+             double maxPushOut)
+{
+    double deepest = 0;
+    Vec3d normal(0.0);
+    for (const Vec3d& x : placedPoints(body, points)) {
+        Vec3d n;
+        const double phi = double(other.phi(x, &n));
+        if (phi < deepest && n.lengthSqr() >= 0.25) {
+            deepest = phi;
+            normal = n;
+        }
+    }
+    if (deepest == 0) return;
+    RigidBodyState s = body.state();
+    s.position += normal * std::min(-deepest, maxPushOut);
+    body.setState(s);
+}
+
 } // namespace
 
 int resolveContact(RigidBody& body, const std::vector<Vec3d>& points,
                    const ContactObstacle& obstacle, double dt, const ContactSettings& settings)
 {
-    int touching = 0;
+    // First the contact as a whole: one impulse at the mean of the touching points with their
+    // mean normal, with the restitution (a face landing flat bounces without spinning); then
+    // the points one by one without restitution, for what the whole left (a tilt, a corner).
+    const std::vector<Vec3d> world = placedPoints(body, points);
+    const Manifold m = findManifold(body, world, PlacedObstacle(obstacle, dt), dt);
+    if (m.points == 0) return 0;
+    {
+        const PlacedObstacle other(obstacle, dt);
+        const Vec3d relative = body.pointVelocity(m.x) - other.velocity(m.x);
+        const double vn = relative.dot(m.n);
+        const double target =
+            targetNormalSpeed(double(other.phi(m.x, nullptr)), vn, dt, settings.restitution, settings);
+        if (target > vn) {
+            const Vec3d J = contactImpulse(body, other, m.x, m.n, relative, target, settings.friction);
+            body.applyImpulse(m.x, J);
+            if (obstacle.body) obstacle.body->applyImpulse(m.x, -J);
+        }
+    }
     for (int sweep = 0; sweep < settings.sweeps; ++sweep) {
         const PlacedObstacle other(obstacle, dt);
-        const Mat3d R = body.rotation();
-        const Vec3d com = body.state().position, centre = body.localCentre();
-        touching = 0;
-        for (const Vec3d& p : points) {
-            const Vec3d x = R * (p - centre) + com;
+        for (const Vec3d& x : placedPoints(body, points)) {
             const Vec3d v = body.pointVelocity(x);
             Vec3d n;
             if (!(other.phi(x + v * dt, &n) < 0) || n.lengthSqr() < 0.25) continue;
-            ++touching;
             const Vec3d relative = v - other.velocity(x);
             const double vn = relative.dot(n);
-            const double target = targetNormalSpeed(double(other.phi(x, nullptr)), vn, dt, settings);
+            const double target = targetNormalSpeed(double(other.phi(x, nullptr)), vn, dt, 0.0, settings);
             if (!(target > vn)) continue;
             const Vec3d J = contactImpulse(body, other, x, n, relative, target, settings.friction);
             body.applyImpulse(x, J);
             if (obstacle.body) obstacle.body->applyImpulse(x, -J);
         }
     }
-    return touching;
+    pushOut(body, points, PlacedObstacle(obstacle, dt), settings.maxPushOut);
+    return m.points;
 }
 
 } // namespace sph

@@ -152,8 +152,8 @@ TEST(RigidBodies, ABoxFloatsAtItsArchimedesDraftWithEitherPressure)
 
 // A box of 2,000 kg/m^3 sinks and comes to rest on the floor (y = 0): its bottom within half
 // a spacing of the floor (contact keeps it out; the ghost layer sits h / 2 inside it), level
-// within 1 degree, and its speed below 3 cm/s after 2 s. A body falling freely for one step of
-// this run would pick up g dt = 5 cm/s; measured 1.9 cm/s, the liquid still moving around it.
+// within 1 degree, and its speed below 1 cm/s after 2 s (a body falling freely for one step of
+// this run picks up g dt = 5 cm/s, so a jittering one would keep about that; measured 2 mm/s).
 TEST(RigidBodies, AHeavyBoxSinksAndRestsOnTheFloor)
 {
     FloatingBodyScene scene;
@@ -168,7 +168,7 @@ TEST(RigidBodies, AHeavyBoxSinksAndRestsOnTheFloor)
                 b.state().velocity.length(), tiltOf(b));
     EXPECT_NEAR(bottom, 0.0, 0.5 * double(H));
     EXPECT_LT(tiltOf(b), M_PI / 180);
-    EXPECT_LT(b.state().velocity.length(), 0.03);
+    EXPECT_LT(b.state().velocity.length(), 0.01);
 }
 
 // Stability by the sign of the metacentric height: a flat box (20 x 10 x 20 cm, 500 kg/m^3,
@@ -286,4 +286,81 @@ TEST(RigidBodies, BadBodiesAreRefusedInOneLine)
     ok.density = 500;
     EXPECT_THROW(basic.addDynamicSolid(scene.body(H), ok), ValueError);
     EXPECT_THROW(solver.body(0), ValueError);
+}
+
+// A body of the liquid's density placed under the surface is neutral: the liquid's mean force
+// on it over its first half second, from its momentum, F = m dv / t + m g, is its weight within
+// 5 %. The sharper test, that it stays within one spacing of its start over 2 s, is NOT
+// met at 2 cm: the buoyancy comes out 2-3 % above the weight (the liquid's boundary about
+// 0.75 mm outside the body over its 0.16 m^2), and the box rises 12 cm to the surface in 1.3 s.
+TEST(RigidBodies, ANeutralBoxUnderTheSurfaceFeelsItsWeightInBuoyancy)
+{
+    FloatingBodyScene scene;
+    scene.depth = Real(0.3);
+    scene.centre = Vec3(0, Real(0.14), 0);
+    DynamicSolid spec;
+    spec.density = 1000;
+    auto solver = scene.solver(tankSettings(PressureModel::Dfsph), spec);
+    for (int f = 0; f < 15; ++f) solver->advanceFrame();
+    const RigidBody& b = solver->body(1);
+    const double weight = b.mass() * 9.81;
+    const double force = b.mass() * b.state().velocity[1] / solver->time() + weight;
+    std::printf("[measured] neutral box: mean liquid force %.3f N against its weight %.3f N "
+                "(%+.2f %%), risen %.4f m in %.2f s\n",
+                force, weight, 100 * (force / weight - 1), b.state().position[1] - 0.14,
+                solver->time());
+    EXPECT_NEAR(force / weight, 1.0, 0.05);
+}
+
+// Momentum: in zero gravity, with no walls, a liquid ball thrown at 1 m/s hits a free box of
+// the liquid's density. The pair forces, the wall drag and the collision projection act on
+// liquid and body in opposite senses, so the total momentum of the liquid and the body is kept:
+// with DFSPH within 1 % of the ball's at the end (the bound) and within 2 % while they
+// touch (the added-mass filter holds r dt F of the liquid's push back from the body while the
+// force changes; measured 1.1 %). With the Tait pressure the ghost air's own pressure pushes
+// the liquid with no reaction: two such balls colliding with no body change their total by
+// 13 % of one ball's, so the Tait step is not the test of the coupling's momentum.
+TEST(RigidBodies, AThrownBallAndAFreeBodyKeepTheirTotalMomentum)
+{
+    {
+        const PressureModel pm = PressureModel::Dfsph;
+        GhostSettings s = tankSettings(pm);
+        s.gravity = Vec3(0);
+        GhostSolver solver(s);
+        DynamicSolid spec;
+        spec.density = 1000;
+        solver.addDynamicSolid(
+            makeLevelSet(makeBoxLevelSet(Vec3(-0.05f, -0.05f, -0.05f), Vec3(0.05f, 0.05f, 0.05f),
+                                         H / 2),
+                         "box"),
+            spec);
+        solver.addLiquid(
+            makeLevelSet(makeSphereLevelSet(Vec3(-0.16f, 0, 0), Real(0.06), H / 2), "ball"),
+            Vec3(1, 0, 0));
+        auto momentum = [&] {
+            const ParticleSet& p = solver.particles();
+            Vec3d total = solver.body(0).state().velocity * solver.body(0).mass();
+            for (std::size_t i = 0; i < p.size(); ++i) {
+                if (p.kinds()[i] == ParticleKind::Liquid)
+                    total += Vec3d(p.velocities()[i]) * double(p.masses()[i]);
+            }
+            return total;
+        };
+        solver.prepare();
+        const Vec3d start = momentum();
+        double worst = 0;
+        for (int f = 0; f < 12; ++f) {
+            solver.advanceFrame();
+            worst = std::max(worst, (momentum() - start).length());
+        }
+        const double bodyShare = solver.body(0).state().velocity[0] * solver.body(0).mass() / start[0];
+        const double end = (momentum() - start).length();
+        std::printf("[measured] %s: ball momentum %.4f kg m/s, body took %.1f %%, total changed "
+                    "by %.3f %% at the end, at most %.3f %%\n",
+                    pm == PressureModel::Tait ? "tait" : "dfsph", start[0], 100 * bodyShare,
+                    100 * end / start.length(), 100 * worst / start.length());
+        EXPECT_GT(bodyShare, 0.1); // the ball hit the body
+        EXPECT_LT(end, 0.01 * start.length());
+        EXPECT_LT(worst, 0.02 * start.length());
+    }
 }

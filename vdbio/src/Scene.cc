@@ -370,6 +370,25 @@ void readVolume(const JsonObject& s, SceneOutputs& out)
     out.surfaceMethod = sph::valueOf(SURFACE_METHOD_NAMES, method, "surface method");
     out.voxelSize = s.nonNegative("voxel_size", out.voxelSize);
     out.densityVoxelSize = s.nonNegative("density_voxel_size", out.densityVoxelSize);
+    out.volumeSolids = s.get<bool>("solids", out.volumeSolids);
+}
+
+/// With outputs.volume.solids, every solid's grid is named after it: the names must differ
+/// from each other and from the volume's own grids.
+void checkSolidGridNames(const Scene& scene)
+{
+    if (!scene.outputs.volumeSolids || scene.outputs.volumeFile.empty()) return;
+    std::vector<std::string> taken = {"surface", "density", "vel", "temperature"};
+    for (const SceneSolid& solid : scene.solids) {
+        if (std::find(taken.begin(), taken.end(), solid.name) != taken.end()) {
+            throw SceneError(msg("scene '", scene.file, "': outputs.volume.solids: solid name '",
+                                 solid.name,
+                                 "' is taken by another grid of the volume file: "
+                                 "expected solid names unlike each other and surface, density, "
+                                 "vel, temperature"));
+        }
+        taken.push_back(solid.name);
+    }
 }
 
 /// outputs.mesh's surface: the volume output's method and voxel size, which the mesh section
@@ -613,8 +632,53 @@ void readDomain(const JsonObject& root, Scene& scene)
     domain->finish();
 }
 
+/// A solid's `dynamic` object: exactly one of `density` and `mass` (> 0), the initial
+/// `velocity` and `angular_velocity`, `restitution` (0 to 1) and `friction` (>= 0).
+SceneDynamic readDynamic(const JsonObject& d)
+{
+    SceneDynamic body;
+    if (d.has("density") == d.has("mass")) {
+        d.finish(); // a misspelt key is reported as an unknown key with the closest one
+        d.fail("", "expected exactly one of 'density' (kg/m^3) or 'mass' (kg)");
+    }
+    if (d.has("density")) body.density = d.positive("density", 0);
+    else body.mass = d.positive("mass", 0);
+    const auto finiteVector = [&d](const char* key, const char* unit) {
+        const Vec3d v = vec(d.get<std::array<double, 3>>(key, {0, 0, 0}));
+        if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+            d.failValue(key, msg("expected [x, y, z] in ", unit, ", finite numbers"));
+        return v;
+    };
+    body.velocity = finiteVector("velocity", "m/s");
+    body.angularVelocity = finiteVector("angular_velocity", "rad/s");
+    body.restitution = d.inRange("restitution", body.restitution, 0, 1);
+    body.friction = d.nonNegative("friction", body.friction);
+    d.finish();
+    return body;
+}
+
+/// A dynamic solid moves by the liquid and its contacts alone: a `velocity`, a `motion` or a
+/// `sequence` of shapes beside `dynamic` is refused, naming the key.
+void refuseDrivenDynamic(const JsonObject& o)
+{
+    const char* why = "a dynamic solid is moved by the liquid and its contacts: expected no ";
+    if (o.has("velocity"))
+        o.fail("velocity", msg(why, "'velocity' beside 'dynamic' (its start velocity is "
+                                    "dynamic.velocity)"));
+    if (o.has("motion")) o.fail("motion", msg(why, "'motion' beside 'dynamic'"));
+    if (o.has("sequence"))
+        o.fail("sequence", msg(why, "'sequence' beside 'dynamic' (its shape sets its mass)"));
+}
+
 SceneSolid readSolid(const JsonObject& o, const Scene& scene)
 {
+    if (o.has("dynamic")) {
+        refuseDrivenDynamic(o);
+        SceneSolid solid = readShaped<SceneSolid>(o, scene, Sampled::Band);
+        solid.dynamic = readDynamic(o.object("dynamic"));
+        o.finish();
+        return solid;
+    }
     SceneSolid solid = readShaped<SceneSolid>(o, scene, Sampled::Band);
     solid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
     if (auto motion = o.optionalObject("motion")) {
@@ -727,6 +791,7 @@ Scene readScene(const std::string& path, const std::vector<std::string>& overrid
     }
     if (auto outputs = root.optionalObject("outputs")) readOutputs(*outputs, scene.outputs);
     root.finish();
+    checkSolidGridNames(scene);
 
     // What the method's medium can simulate (gas sources without liquid, heaters with it) is
     // checked by the program's method registry (cmd/Methods.cc), which knows the methods.

@@ -2,6 +2,8 @@
 /// @brief  Per-step statistics in HDF5 and CSV (layout in Stats.h), HDF5 1.10 C++ API.
 #include <ghostfx/vdbio/Stats.h>
 
+#include "BodyTableH5.h"
+
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/AtomicFile.h>
 
@@ -49,7 +51,7 @@ void writeStringAttribute(H5::H5Object& object, const std::string& name, const s
     attr.write(type, value);
 }
 
-void writeH5(const std::string& file, const StatsTable& table)
+void writeH5(const std::string& file, const StatsTable& table, const std::vector<BodyRow>& bodies)
 {
     H5::H5File h5(file, H5F_ACC_TRUNC);
     writeStringAttribute(h5, "format", FORMAT);
@@ -76,6 +78,7 @@ void writeH5(const std::string& file, const StatsTable& table)
         if (rows > 0) set.write(values.data(), H5::PredType::NATIVE_DOUBLE);
         writeStringAttribute(set, "unit", statsUnit(table.columns[c]));
     }
+    writeBodiesGroup(h5, bodies);
 }
 
 void writeCsv(const std::string& file, const StatsTable& table)
@@ -222,7 +225,7 @@ void StatsWriter::flush()
     H5::Exception::dontPrint();
     writeAtomically(mH5Path, [&](const std::string& tmp) {
         try {
-            writeH5(tmp, mTable);
+            writeH5(tmp, mTable, mBodies);
         } catch (const H5::Exception& e) {
             throw IoError(msg("statistics '", mH5Path, "': cannot write it (", detailOf(e), ")"));
         }

@@ -68,6 +68,18 @@ struct SceneShape
     sph::LevelSet shape;
 };
 
+/// A solid's `dynamic` object: a uniform rigid body the liquid moves and that moves it
+/// (ghost::DynamicSolid), given by exactly one of its density or its mass.
+struct SceneDynamic
+{
+    double density = 0;            ///< kg/m^3; 0 when the mass is given
+    double mass = 0;               ///< kg; 0 when the density is given
+    sph::Vec3d velocity{0};        ///< initial, of the centre of mass (m/s)
+    sph::Vec3d angularVelocity{0}; ///< initial (rad/s)
+    double restitution = 0.2;      ///< of the normal velocity at a contact, 0 to 1
+    double friction = 0.5;         ///< Coulomb coefficient of its contacts, >= 0
+};
+
 struct SceneSolid : SceneShape
 {
     using SceneShape::SceneShape;
@@ -76,11 +88,15 @@ struct SceneSolid : SceneShape
     sph::KeyedMotion motion;     ///< keyed rigid motion (empty: constant velocity)
     /// Per-frame shapes (deforming solid): file pattern with $F and grid name; empty if static.
     std::string sequenceFile, sequenceGrid;
+    /// A rigid body moved by the liquid and its contacts (no velocity, motion or sequence);
+    /// empty: the solid follows its velocity or motion.
+    std::optional<SceneDynamic> dynamic;
 
     /// Neither moves nor changes shape.
     bool isStatic() const
     {
-        return sequenceFile.empty() && motion.keys.empty() && velocity == sph::Vec3d(0.0);
+        return !dynamic && sequenceFile.empty() && motion.keys.empty()
+               && velocity == sph::Vec3d(0.0);
     }
 };
 
@@ -155,6 +171,8 @@ struct SceneOutputs
     SurfaceMethod surfaceMethod = SurfaceMethod::Spheres; ///< of the liquid surface
     double voxelSize = 0;        ///< of the surface; 0: half the particle spacing
     double densityVoxelSize = 0; ///< of density, vel, temperature; 0: the particle spacing
+    /// Also every solid's level set where it is at the frame, a grid named after the solid.
+    bool volumeSolids = false;
     // Liquid surface as a triangle mesh (MeshFile.h), .ply or .obj by the name's extension;
     // the volume's surface, whether or not the volume file is written. Empty: off.
     std::string meshFile;

@@ -10,13 +10,16 @@
 ///          `units` (the naming convention below, as text); group `/steps` with one 1-D double
 ///          dataset per column (each with a `unit` attribute) and the attribute `columns`, the
 ///          column names in order. CSV: a header line with the column names, then one line per
-///          row, numbers in the shortest form that reads back to the same double.
+///          row, numbers in the shortest form that reads back to the same double. A run with
+///          dynamic solids adds the group `/bodies` (BodyTable.h), given by setBodies().
 ///
 ///          Units follow the column name (statsUnit): `time`, `dt` and `t_*` in s (`t_*` are
 ///          wall-clock seconds of a solver phase), `*speed*` in m/s, `count_*`, `frame`, `step`
 ///          dimensionless counts, `density_error_*` relative to the rest density, `bytes*` in
 ///          bytes; anything else has no unit recorded ("").
 #pragma once
+
+#include <ghostfx/vdbio/BodyTable.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -68,6 +71,10 @@ public:
     /// flush(). Throws IoError if the file exists but cannot be read or has no "step" column.
     void resumeFrom(std::int64_t step);
 
+    /// The dynamic solids' rows (BodyTable.h) the HDF5 file holds from the next flush() on,
+    /// as the group `/bodies`; none: no such group.
+    void setBodies(std::vector<BodyRow> rows) { mBodies = std::move(rows); }
+
     std::size_t rows() const { return mTable.rows.size(); }
     const StatsTable& table() const { return mTable; }
     const std::string& h5Path() const { return mH5Path; }
@@ -76,6 +83,7 @@ public:
 private:
     std::string mH5Path, mCsvPath;
     StatsTable mTable;
+    std::vector<BodyRow> mBodies;
 };
 
 } // namespace vdbio
