@@ -121,11 +121,6 @@ public:
     {
         addSceneEmitter(*mSolver, emitter);
     }
-    std::size_t addDynamicSolid(const vdbio::SceneSolid& solid,
-                                const ghost::DynamicSolid& body) override
-    {
-        return mSolver->addDynamicSolid(solid.shape, body);
-    }
     const sph::RigidBody* body(std::size_t index) const override
     {
         return mSolver->isDynamic(index) ? &mSolver->body(index) : nullptr;

@@ -58,13 +58,6 @@ void Simulation::addSolid(const vdbio::SceneSolid& solid)
                      + "': adding solids from a script is supported in liquid scenes only");
 }
 
-std::size_t Simulation::addDynamicSolid(const vdbio::SceneSolid& solid,
-                                        const ghost::DynamicSolid& /*body*/)
-{
-    throw ValueError("body '" + solid.name
-                     + "': dynamic solids are supported in liquid scenes (method ghost) only");
-}
-
 std::pair<sph::Vec3d, sph::Vec3d> Simulation::liquidForceOn(std::size_t index) const
 {
     throw ValueError(msg("solid ", index, " is not a dynamic solid"));

@@ -22,9 +22,6 @@
 #include <vector>
 
 namespace ghostfx {
-namespace ghost {
-struct DynamicSolid;
-}
 namespace cmd {
 
 /// Particles of one medium and how to turn them into output files.
@@ -139,13 +136,10 @@ public:
     virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity);
     virtual void addEmitter(const vdbio::SceneEmitter& emitter);
     virtual void addGasSource(const vdbio::SceneGasSource& source);
-    /// Dynamic solids (rigid bodies the liquid moves, ghost::GhostSolver::addDynamicSolid), for
-    /// scripts: add one beside the scene's solids (returns its solid index), read its body and
-    /// the liquid's force and torque on it in the last step, push it (force N at the centre of
-    /// mass, torque N m, world axes) in every step until clearBodyForces(). Liquid scenes only:
-    /// the others refuse adding one with a ValueError naming the shape and have none.
-    virtual std::size_t addDynamicSolid(const vdbio::SceneSolid& solid,
-                                        const ghost::DynamicSolid& body);
+    /// Dynamic solids (rigid bodies the liquid moves, added as solids with `dynamic`), for
+    /// scripts: read the body of solid `index` and the liquid's force and torque on it in the
+    /// last step, push it (force N at the centre of mass, torque N m, world axes) in every step
+    /// until clearBodyForces(). Liquid scenes only: the others have none.
     /// The body of solid `index`, or null where it is not a dynamic solid.
     virtual const sph::RigidBody* body(std::size_t /*index*/) const { return nullptr; }
     virtual std::pair<sph::Vec3d, sph::Vec3d> liquidForceOn(std::size_t index) const;

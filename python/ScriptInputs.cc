@@ -74,25 +74,22 @@ Json keysJson(const sph::KeyedMotion& motion)
 }
 
 /// A dynamic solid's making: density or mass, initial velocities, material.
-Json bodyJson(const ghost::DynamicSolid& b)
+Json bodyJson(const vdbio::SceneDynamic& b)
 {
-    return Json{{"density", b.density},
-                {"mass", b.mass},
-                {"velocity", vec(b.velocity)},
-                {"angular_velocity", vec(b.angularVelocity)},
-                {"restitution", b.material.restitution},
-                {"friction", b.material.friction}};
+    return Json{{"density", b.density},         {"mass", b.mass},
+                {"velocity", vec(b.velocity)},  {"angular_velocity", vec(b.angularVelocity)},
+                {"restitution", b.restitution}, {"friction", b.friction}};
 }
 
-ghost::DynamicSolid readBody(const Json& j)
+vdbio::SceneDynamic readBody(const Json& j)
 {
-    ghost::DynamicSolid b;
+    vdbio::SceneDynamic b;
     b.density = j.at("density");
     b.mass = j.at("mass");
     b.velocity = vec(j.at("velocity"));
     b.angularVelocity = vec(j.at("angular_velocity"));
-    b.material.restitution = j.at("restitution");
-    b.material.friction = j.at("friction");
+    b.restitution = j.at("restitution");
+    b.friction = j.at("friction");
     return b;
 }
 
@@ -102,12 +99,10 @@ Json inputsJson(const ScriptInputs& in, ShapeWriter& shapes)
              {"emitters", Json::array()},
              {"gas_sources", Json::array()},
              {"solid_velocities", Json::array()}};
-    for (std::size_t i = 0; i < in.solids.size(); ++i) {
-        const vdbio::SceneSolid& s = in.solids[i];
+    for (const vdbio::SceneSolid& s : in.solids) {
         Json e = shapes.entry(s);
         e.update({{"velocity", vec(s.velocity)}, {"keys", keysJson(s.motion)}});
-        const auto body = in.bodies.find(i);
-        if (body != in.bodies.end()) e["dynamic"] = bodyJson(body->second);
+        if (s.dynamic) e["dynamic"] = bodyJson(*s.dynamic);
         doc["solids"].push_back(e);
     }
     for (const vdbio::SceneEmitter& s : in.emitters) {
@@ -198,7 +193,7 @@ ScriptInputs readInputs(const Json& doc, const std::vector<openvdb::FloatGrid::P
         vdbio::SceneSolid s = shapedEntry<vdbio::SceneSolid>(e, shapes);
         s.velocity = vec(e.at("velocity"));
         s.motion = readKeys(e);
-        if (e.contains("dynamic")) in.bodies[in.solids.size()] = readBody(e.at("dynamic"));
+        if (e.contains("dynamic")) s.dynamic = readBody(e.at("dynamic"));
         in.solids.push_back(s);
     }
     for (const Json& e : doc.at("emitters"))

@@ -11,7 +11,6 @@
 ///          shapes, and "script_shapes.vdb", the shapes as an OpenVDB stream, bit for bit.
 #pragma once
 
-#include <ghostfx/ghost/GhostSolver.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/vdbio/Checkpoint.h>
 #include <ghostfx/vdbio/Scene.h>
@@ -35,13 +34,11 @@ struct SolidVelocity
     sph::RigidMotion motion() const;
 };
 
-/// The additions to a scene: the entries past the scene's own, the solid velocities set (by
-/// solid index, scene solids first), and which added solids are dynamic ones (rigid bodies, by
-/// index in `solids`; their entries there hold their shape and name, at rest).
+/// The additions to a scene: the entries past the scene's own (solids with `dynamic` are rigid
+/// bodies), and the solid velocities set (by solid index, scene solids first).
 struct ScriptInputs
 {
     std::vector<vdbio::SceneSolid> solids;
-    std::map<std::size_t, ghost::DynamicSolid> bodies;
     std::vector<vdbio::SceneEmitter> emitters;
     std::vector<vdbio::SceneGasSource> gasSources;
     std::map<std::size_t, SolidVelocity> velocities;

@@ -414,21 +414,20 @@ public:
                                  "simulation has taken ",
                                  mSim->stepCount(), ")"));
         }
-        ghost::DynamicSolid spec;
-        spec.density = density.is_none() ? 0.0 : density.cast<double>();
-        spec.mass = mass.is_none() ? 0.0 : mass.cast<double>();
-        spec.velocity = vec3(velocity);
-        spec.angularVelocity = vec3(angularVelocity);
-        spec.material.restitution = restitution;
-        spec.material.friction = friction;
         // The shape takes the body's name, which the solver's messages give.
-        const vdbio::SceneSolid solid(n, "add_body", sph::makeLevelSet(sph::gridOf(shape), n));
+        vdbio::SceneSolid solid(n, "add_body", sph::makeLevelSet(sph::gridOf(shape), n));
+        vdbio::SceneDynamic& d = solid.dynamic.emplace();
+        d.density = density.is_none() ? 0.0 : density.cast<double>();
+        d.mass = mass.is_none() ? 0.0 : mass.cast<double>();
+        d.velocity = vec3(velocity);
+        d.angularVelocity = vec3(angularVelocity);
+        d.restitution = restitution;
+        d.friction = friction;
         {
             py::gil_scoped_release release;
-            mSim->addDynamicSolid(solid, spec);
+            mSim->addSolid(solid);
         }
         mScene->solids.push_back(solid);
-        mInputs.bodies[mInputs.solids.size()] = spec;
         mInputs.solids.push_back(solid);
     }
 
@@ -667,22 +666,10 @@ private:
         auto append = [](auto& to, const auto& from) {
             to.insert(to.end(), from.begin(), from.end());
         };
-        // The added solids before the first dynamic one go in with the scene's; from that one
-        // on they are added after, each as the script added it, so each keeps its index.
-        const std::size_t firstBody =
-            mInputs.bodies.empty() ? mInputs.solids.size() : mInputs.bodies.begin()->first;
-        mScene->solids.insert(mScene->solids.end(), mInputs.solids.begin(),
-                              mInputs.solids.begin() + std::ptrdiff_t(firstBody));
+        append(mScene->solids, mInputs.solids);
         append(mScene->emitters, mInputs.emitters);
         append(mScene->gasSources, mInputs.gasSources);
         mSim = cmd::makeSimulation(*mScene, states);
-        for (std::size_t i = firstBody; i < mInputs.solids.size(); ++i) {
-            const vdbio::SceneSolid& solid = mInputs.solids[i];
-            const auto body = mInputs.bodies.find(i);
-            if (body != mInputs.bodies.end()) mSim->addDynamicSolid(solid, body->second);
-            else mSim->addSolid(solid);
-            mScene->solids.push_back(solid);
-        }
         for (const auto& [index, v] : mInputs.velocities) mSim->setSolidMotion(index, v.motion());
         observe();
     }

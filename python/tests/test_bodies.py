@@ -214,8 +214,8 @@ def test_bodies_need_a_ghost_sph_liquid(tmp_path):
     sim = ghostfx.Simulation(gas)
     with pytest.raises(ValueError) as e:
         sim.add_body(box(*IN_AIR, "crate"), density=500)
-    assert str(e.value) == ("body 'crate': dynamic solids are supported in liquid scenes "
-                            "(method ghost) only")
+    assert str(e.value) == ("solid 'crate': adding solids from a script is supported in liquid "
+                            "scenes only")
     with pytest.raises(ValueError) as e:
         sim.body("crate")
     assert str(e.value) == "body 'crate': the simulation has no body of that name (bodies: none)"
