@@ -121,6 +121,19 @@ public:
     {
         addSceneEmitter(*mSolver, emitter);
     }
+    const sph::RigidBody* body(std::size_t index) const override
+    {
+        return mSolver->isDynamic(index) ? &mSolver->body(index) : nullptr;
+    }
+    std::pair<sph::Vec3d, sph::Vec3d> liquidForceOn(std::size_t index) const override
+    {
+        return mSolver->liquidForceOn(index);
+    }
+    void addBodyForce(std::size_t index, const sph::Vec3d& force, const sph::Vec3d& torque) override
+    {
+        mSolver->addBodyForce(index, force, torque);
+    }
+    void clearBodyForces() override { mSolver->clearBodyForces(); }
     WritableParticles writableParticles(ParticleKind kind) override
     {
         if (kind != ParticleKind::Liquid) return {};

@@ -58,6 +58,17 @@ void Simulation::addSolid(const vdbio::SceneSolid& solid)
                      + "': adding solids from a script is supported in liquid scenes only");
 }
 
+std::pair<sph::Vec3d, sph::Vec3d> Simulation::liquidForceOn(std::size_t index) const
+{
+    throw ValueError(msg("solid ", index, " is not a dynamic solid"));
+}
+
+void Simulation::addBodyForce(std::size_t index, const sph::Vec3d& /*force*/,
+                              const sph::Vec3d& /*torque*/)
+{
+    throw ValueError(msg("solid ", index, " is not a dynamic solid"));
+}
+
 void Simulation::addEmitter(const vdbio::SceneEmitter& emitter)
 {
     throw ValueError("emitter '" + emitter.name

@@ -18,6 +18,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ghostfx {
@@ -135,6 +136,15 @@ public:
     virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity);
     virtual void addEmitter(const vdbio::SceneEmitter& emitter);
     virtual void addGasSource(const vdbio::SceneGasSource& source);
+    /// Dynamic solids (rigid bodies the liquid moves, added as solids with `dynamic`), for
+    /// scripts: read the body of solid `index` and the liquid's force and torque on it in the
+    /// last step, push it (force N at the centre of mass, torque N m, world axes) in every step
+    /// until clearBodyForces(). Liquid scenes only: the others have none.
+    /// The body of solid `index`, or null where it is not a dynamic solid.
+    virtual const sph::RigidBody* body(std::size_t /*index*/) const { return nullptr; }
+    virtual std::pair<sph::Vec3d, sph::Vec3d> liquidForceOn(std::size_t index) const;
+    virtual void addBodyForce(std::size_t index, const sph::Vec3d& force, const sph::Vec3d& torque);
+    virtual void clearBodyForces() {}
     /// The particles of `kind` a script may set (liquid and gas particles; ghosts are derived
     /// from them and cannot be set); the default: none.
     virtual WritableParticles writableParticles(sph::ParticleKind kind);

@@ -73,6 +73,26 @@ Json keysJson(const sph::KeyedMotion& motion)
     return keys;
 }
 
+/// A dynamic solid's making: density or mass, initial velocities, material.
+Json bodyJson(const vdbio::SceneDynamic& b)
+{
+    return Json{{"density", b.density},         {"mass", b.mass},
+                {"velocity", vec(b.velocity)},  {"angular_velocity", vec(b.angularVelocity)},
+                {"restitution", b.restitution}, {"friction", b.friction}};
+}
+
+vdbio::SceneDynamic readBody(const Json& j)
+{
+    vdbio::SceneDynamic b;
+    b.density = j.at("density");
+    b.mass = j.at("mass");
+    b.velocity = vec(j.at("velocity"));
+    b.angularVelocity = vec(j.at("angular_velocity"));
+    b.restitution = j.at("restitution");
+    b.friction = j.at("friction");
+    return b;
+}
+
 Json inputsJson(const ScriptInputs& in, ShapeWriter& shapes)
 {
     Json doc{{"solids", Json::array()},
@@ -82,6 +102,7 @@ Json inputsJson(const ScriptInputs& in, ShapeWriter& shapes)
     for (const vdbio::SceneSolid& s : in.solids) {
         Json e = shapes.entry(s);
         e.update({{"velocity", vec(s.velocity)}, {"keys", keysJson(s.motion)}});
+        if (s.dynamic) e["dynamic"] = bodyJson(*s.dynamic);
         doc["solids"].push_back(e);
     }
     for (const vdbio::SceneEmitter& s : in.emitters) {
@@ -172,6 +193,7 @@ ScriptInputs readInputs(const Json& doc, const std::vector<openvdb::FloatGrid::P
         vdbio::SceneSolid s = shapedEntry<vdbio::SceneSolid>(e, shapes);
         s.velocity = vec(e.at("velocity"));
         s.motion = readKeys(e);
+        if (e.contains("dynamic")) s.dynamic = readBody(e.at("dynamic"));
         in.solids.push_back(s);
     }
     for (const Json& e : doc.at("emitters"))

@@ -34,8 +34,8 @@ struct SolidVelocity
     sph::RigidMotion motion() const;
 };
 
-/// The additions to a scene: the entries past the scene's own, and the solid velocities set
-/// (by solid index, scene solids first).
+/// The additions to a scene: the entries past the scene's own (solids with `dynamic` are rigid
+/// bodies), and the solid velocities set (by solid index, scene solids first).
 struct ScriptInputs
 {
     std::vector<vdbio::SceneSolid> solids;

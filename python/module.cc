@@ -206,6 +206,17 @@ sph::KeyedMotion motionFromPython(const py::object& motion, const std::string& w
 using FloatArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 sph::Vec3d vec3(const std::array<double, 3>& v) { return sph::Vec3d(v[0], v[1], v[2]); }
+std::array<double, 3> array3(const sph::Vec3d& v) { return {v[0], v[1], v[2]}; }
+
+py::array_t<double> matrix3(const openvdb::math::Mat3d& m)
+{
+    py::array_t<double> out({3, 3});
+    auto w = out.mutable_unchecked<2>();
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) w(i, j) = m(i, j);
+    }
+    return out;
+}
 
 /// What the step observer calls besides the statistics: on_step(sim, dt) callbacks, those of
 /// sim.on_step() and the one of the run() in progress; `self` is the Python object of the
@@ -310,6 +321,11 @@ public:
     void setSolidVelocity(const std::string& name, const std::array<double, 3>& velocity)
     {
         const std::size_t index = solidIndex(name);
+        if (mSim->body(index)) {
+            throw ValueError("solid '" + name
+                             + "' is a body: the liquid, gravity and its contacts move it; push "
+                               "it with apply_force");
+        }
         python::SolidVelocity v;
         v.time = mSim->time();
         v.start = motionOf(index)(v.time);
@@ -378,6 +394,84 @@ public:
     {
         py::gil_scoped_release release;
         return mSim->addLiquid(shape, sph::Vec3(vec3(velocity)));
+    }
+
+    /// Add a rigid body (a dynamic solid) of `shape` before the first step; `density` (kg/m^3)
+    /// or `mass` (kg), one of them.
+    void addBody(const sph::LevelSet& shape, const py::object& name, const py::object& density,
+                 const py::object& mass, const std::array<double, 3>& velocity,
+                 const std::array<double, 3>& angularVelocity, double restitution, double friction)
+    {
+        const std::string n = name.is_none() ? shape.name() : name.cast<std::string>();
+        refuseDuplicate(mScene->solids, n, "body");
+        if (density.is_none() == mass.is_none()) {
+            throw ValueError("body '" + n + "': give density=... (kg/m^3) or mass=... (kg), "
+                             + (density.is_none() ? "one of them" : "not both"));
+        }
+        if (mSim->stepCount() > 0) {
+            throw ValueError(msg("body '", n,
+                                 "': bodies are added before the first step (this "
+                                 "simulation has taken ",
+                                 mSim->stepCount(), ")"));
+        }
+        // The shape takes the body's name, which the solver's messages give.
+        vdbio::SceneSolid solid(n, "add_body", sph::makeLevelSet(sph::gridOf(shape), n));
+        vdbio::SceneDynamic& d = solid.dynamic.emplace();
+        d.density = density.is_none() ? 0.0 : density.cast<double>();
+        d.mass = mass.is_none() ? 0.0 : mass.cast<double>();
+        d.velocity = vec3(velocity);
+        d.angularVelocity = vec3(angularVelocity);
+        d.restitution = restitution;
+        d.friction = friction;
+        {
+            py::gil_scoped_release release;
+            mSim->addSolid(solid);
+        }
+        mScene->solids.push_back(solid);
+        mInputs.solids.push_back(solid);
+    }
+
+    /// The solid index of the body `name`, or a ValueError naming the bodies there are.
+    std::size_t bodyIndex(const std::string& name) const
+    {
+        std::string known;
+        for (std::size_t i = 0; i < mScene->solids.size(); ++i) {
+            if (!mSim->body(i)) continue;
+            if (mScene->solids[i].name == name) return i;
+            known += (known.empty() ? "'" : ", '") + mScene->solids[i].name + "'";
+        }
+        throw ValueError("body '" + name + "': the simulation has no body of that name (bodies: "
+                         + (known.empty() ? "none" : known) + ")");
+    }
+
+    /// The body `name` now: its state, mass properties and the liquid's push of the last step.
+    py::dict body(const std::string& name) const
+    {
+        const std::size_t index = bodyIndex(name);
+        const sph::RigidBody& b = *mSim->body(index);
+        const sph::RigidBodyState& s = b.state();
+        const auto [force, torque] = mSim->liquidForceOn(index);
+        const sph::Quatd& q = s.orientation;
+        return py::dict(
+            py::arg("position") = array3(s.position),
+            py::arg("orientation") = std::array<double, 4>{q.w(), q.x(), q.y(), q.z()},
+            py::arg("rotation") = matrix3(b.rotation()), py::arg("velocity") = array3(s.velocity),
+            py::arg("angular_velocity") = array3(b.angularVelocity()), py::arg("mass") = b.mass(),
+            py::arg("volume") = b.massProperties().volume,
+            py::arg("inertia") = matrix3(b.worldInertia()), py::arg("liquid_force") = array3(force),
+            py::arg("liquid_torque") = array3(torque));
+    }
+
+    /// Push the body `name` with `force` (N, at its centre of mass) and `torque` (N m) over
+    /// the next frame.
+    void applyForce(const std::string& name, const std::array<double, 3>& force,
+                    const std::array<double, 3>& torque)
+    {
+        const sph::Vec3d f = vec3(force), t = vec3(torque);
+        if (!sph::isFinite(sph::Vec3(f)) || !sph::isFinite(sph::Vec3(t))) {
+            throw ValueError("body '" + name + "': the force or torque is not finite");
+        }
+        mSim->addBodyForce(bodyIndex(name), f, t);
     }
 
     /// Replace the positions or velocities of the particles of `kind`, in the order of
@@ -454,6 +548,12 @@ public:
     {
         mHooks->self = self.ptr();
         py::gil_scoped_release release;
+        // The forces apply_force gave act over this frame only, however it ends.
+        struct ClearForces
+        {
+            cmd::Simulation& sim;
+            ~ClearForces() { sim.clearBodyForces(); }
+        } clear{*mSim};
         mSim->beforeFrame(mSim->frame() + 1);
         mSim->advanceFrame();
     }
@@ -724,6 +824,45 @@ void bindScripting(PySimulationClass& c)
             "(N, 3) array in the order of positions(kind)");
 }
 
+/// Simulation: rigid bodies (dynamic solids) a script adds, reads and pushes.
+void bindBodies(PySimulationClass& c)
+{
+    const auto zero = std::array<double, 3>{0, 0, 0};
+    c.def("add_body", &PySimulation::addBody, py::arg("level_set"), py::arg("name") = py::none(),
+          py::arg("density") = py::none(), py::arg("mass") = py::none(), py::arg("velocity") = zero,
+          py::arg("angular_velocity") = zero, py::arg("restitution") = 0.2,
+          py::arg("friction") = 0.5,
+          "Add a rigid body (a dynamic solid) beside the scene's solids, before the first "
+          "step: the level set filled with `density` (kg/m^3) or of total `mass` (kg), one of "
+          "them, starting at `velocity` (m/s, its centre of mass) and `angular_velocity` "
+          "(rad/s); gravity, the liquid and its contacts (`restitution` 0 to 1, Coulomb "
+          "`friction`) move it. `name` (default: the level set's) must be new; body() reads "
+          "it, apply_force pushes it, previews draw it, checkpoints keep it. Liquid scenes "
+          "(method ghost)")
+        .def("apply_force", &PySimulation::applyForce, py::arg("name"), py::arg("force"),
+             py::arg("torque") = zero,
+             "Push the body `name` with `force` (N, world axes, at its centre of mass) and "
+             "`torque` (N m, about its centre of mass) in every step of the next frame (of the "
+             "frame in progress, called from on_step); it adds to gravity and the liquid's "
+             "force and is cleared when that frame ends. Calls add up. Checkpoints do not keep "
+             "it")
+        .def(
+            "apply_torque",
+            [](PySimulation& s, const std::string& name, const std::array<double, 3>& torque) {
+        s.applyForce(name, {0, 0, 0}, torque);
+            },
+            py::arg("name"), py::arg("torque"),
+            "apply_force(name, (0, 0, 0), torque): a torque (N m, world axes) over the next "
+            "frame")
+        .def("body", &PySimulation::body, py::arg("name"),
+             "The rigid body (dynamic solid) `name` now, a dict: position (its centre of "
+             "mass, m), orientation (unit quaternion w, x, y, z turning its level set's frame "
+             "into the world), rotation (the same as a 3x3 array), velocity (m/s), "
+             "angular_velocity (rad/s), mass (kg), volume (m^3), inertia (3x3, kg m^2, world "
+             "axes, about the centre of mass), liquid_force (N) and liquid_torque (N m, about "
+             "the centre of mass): what the liquid gave it in the last step");
+}
+
 /// Simulation: what a script reads.
 void bindReading(PySimulationClass& c)
 {
@@ -756,6 +895,7 @@ void bindSimulation(py::module_& m)
                         "builds them");
     bindRunning(c);
     bindScripting(c);
+    bindBodies(c);
     bindReading(c);
 }
 
