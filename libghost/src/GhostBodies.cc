@@ -55,9 +55,13 @@ using namespace detail;
 namespace {
 
 /// The state keys of a body in SolverState::reals: "body_E_x", ... (E the solid's index).
-constexpr const char* BODY_KEYS[] = {"x",  "y",  "z",  "qw", "qx", "qy", "qz",
-                                     "vx", "vy", "vz", "lx", "ly", "lz", "fx",
-                                     "fy", "fz", "tx", "ty", "tz"};
+/// The state (centre, quaternion, velocity, angular momentum), the filter's liquid force and
+/// torque, and the mass properties (kept, not found again from the shape: a shape read back
+/// from a script's attachment can differ in its last bits, and the run with it).
+constexpr const char* BODY_KEYS[] = {"x",   "y",   "z",   "qw",  "qx",  "qy",     "qz",  "vx",
+                                     "vy",  "vz",  "lx",  "ly",  "lz",  "fx",     "fy",  "fz",
+                                     "tx",  "ty",  "tz",  "mass", "volume", "cx", "cy",  "cz",
+                                     "ixx", "ixy", "ixz", "iyy", "iyz", "izz"};
 constexpr std::size_t BODY_VALUES = sizeof(BODY_KEYS) / sizeof(BODY_KEYS[0]);
 
 std::string bodyKey(std::size_t solid, const char* key)
@@ -127,27 +131,36 @@ std::size_t GhostSolver::addDynamicSolid(const LevelSet& solid, const DynamicSol
     body->rigid.setVelocity(spec.velocity);
     body->rigid.setAngularVelocity(spec.angularVelocity);
     const std::size_t index = mSolids.size();
-    if (index < mRestoredSolids) {
-        if (index >= mRestoredBodies.size() || mRestoredBodies[index].empty()) {
-            throw ValueError(msg("restoreState: solid ", index, " ('", name,
-                                 "') is dynamic here but was not in the saved run"));
-        }
-        const std::vector<double>& v = mRestoredBodies[index];
-        RigidBodyState restored;
-        restored.position = Vec3d(v[0], v[1], v[2]);
-        restored.orientation = Quatd(v[4], v[5], v[6], v[3]);
-        restored.velocity = Vec3d(v[7], v[8], v[9]);
-        restored.angularMomentum = Vec3d(v[10], v[11], v[12]);
-        restored.time = mRun.time;
-        body->rigid.setState(restored);
-        body->liquidForce = Vec3d(v[13], v[14], v[15]);
-        body->liquidTorque = Vec3d(v[16], v[17], v[18]);
-    }
+    if (index < mRestoredSolids) restoreBody(*body, index, name);
     Body* raw = body.get();
     RigidMotion motion = [raw](double t) { return raw->rigid.placementAt(t); };
     addSolidBody(solid, std::move(motion), true, std::move(body));
     findContactPoints(index);
     return index;
+}
+
+void GhostSolver::restoreBody(Body& body, std::size_t index, const std::string& name) const
+{
+    if (index >= mRestoredBodies.size() || mRestoredBodies[index].empty()) {
+        throw ValueError(msg("restoreState: solid ", index, " ('", name,
+                             "') is dynamic here but was not in the saved run"));
+    }
+    const std::vector<double>& v = mRestoredBodies[index];
+    MassProperties p;
+    p.mass = v[19];
+    p.volume = v[20];
+    p.centre = Vec3d(v[21], v[22], v[23]);
+    p.inertia = Mat3d(v[24], v[25], v[26], v[25], v[27], v[28], v[26], v[28], v[29]);
+    body.rigid = RigidBody(p, body.rigid.material());
+    RigidBodyState restored;
+    restored.position = Vec3d(v[0], v[1], v[2]);
+    restored.orientation = Quatd(v[4], v[5], v[6], v[3]);
+    restored.velocity = Vec3d(v[7], v[8], v[9]);
+    restored.angularMomentum = Vec3d(v[10], v[11], v[12]);
+    restored.time = mRun.time;
+    body.rigid.setState(restored);
+    body.liquidForce = Vec3d(v[13], v[14], v[15]);
+    body.liquidTorque = Vec3d(v[16], v[17], v[18]);
 }
 
 bool GhostSolver::isDynamic(std::size_t solidIndex) const
@@ -230,12 +243,17 @@ void GhostSolver::saveBodies(SolverState& state) const
         if (!b) continue;
         const RigidBodyState& s = b->rigid.state();
         const Quatd& q = s.orientation;
+        const MassProperties& p = b->rigid.massProperties();
+        const Mat3d& I = p.inertia;
         const double values[BODY_VALUES] = {
             s.position[0],        s.position[1],        s.position[2],        q.w(),
             q.x(),                q.y(),                q.z(),                s.velocity[0],
             s.velocity[1],        s.velocity[2],        s.angularMomentum[0], s.angularMomentum[1],
             s.angularMomentum[2], b->liquidForce[0],    b->liquidForce[1],    b->liquidForce[2],
-            b->liquidTorque[0],   b->liquidTorque[1],   b->liquidTorque[2]};
+            b->liquidTorque[0],   b->liquidTorque[1],   b->liquidTorque[2],   p.mass,
+            p.volume,             p.centre[0],          p.centre[1],          p.centre[2],
+            I(0, 0),              I(0, 1),              I(0, 2),              I(1, 1),
+            I(1, 2),              I(2, 2)};
         for (std::size_t k = 0; k < BODY_VALUES; ++k) state.reals[bodyKey(e, BODY_KEYS[k])] = values[k];
     }
 }

@@ -190,14 +190,11 @@ def test_resume_continues_an_added_body_bit_for_bit(tmp_path):
         assert np.array_equal(resumed.positions(kind), straight.positions(kind)), kind
         assert np.array_equal(resumed.velocities(kind), straight.velocities(kind)), kind
     a, b = resumed.body("crate"), straight.body("crate")
-    for key in ("position", "velocity", "mass", "volume", "liquid_force", "liquid_torque"):
+    # Bit for bit: the checkpoint keeps the body's mass properties with its state, so the shape
+    # its attachment stream gives back (which can differ in its last bits) does not enter.
+    for key in ("position", "velocity", "mass", "volume", "liquid_force", "liquid_torque",
+                "orientation", "rotation", "angular_velocity", "inertia"):
         assert np.array_equal(a[key], b[key]), key
-    # The resumed body's inertia is the one of its shape as the checkpoint's attachment stream
-    # gives it back, which differs from the added shape's in its last bits (3.6e-17 kg m^2 of
-    # about 7e-4); the angular velocity I^-1 L, and from it the turn, agree to 1e-12 after 4
-    # frames (1e-15 measured), while the particles and the rest of the body stay bit for bit.
-    for key in ("orientation", "rotation", "angular_velocity", "inertia"):
-        np.testing.assert_allclose(a[key], b[key], rtol=0, atol=1e-12, err_msg=key)
     # The solids keep their names and order: the second post is still a static solid.
     with pytest.raises(ValueError):
         resumed.body("post2")

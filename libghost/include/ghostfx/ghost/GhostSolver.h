@@ -46,6 +46,7 @@
 #include <ghostfx/sph/ParticleExchange.h>
 #include <ghostfx/sph/ParticleSet.h>
 #include <ghostfx/sph/RigidBody.h>
+#include <ghostfx/sph/RigidContact.h>
 #include <ghostfx/sph/RigidMotion.h>
 #include <ghostfx/sph/SampleStore.h>
 #include <ghostfx/sph/SolverState.h>
@@ -483,6 +484,8 @@ private:
     [[noreturn]] void throwStuckInSolid(std::size_t i) const;
     // Dynamic solids (GhostBodies.cc) ----------------------------------------------------------
     Body& bodyOf(std::size_t solidIndex) const;
+    /// A restored dynamic solid's body: its state and mass properties from mRestoredBodies.
+    void restoreBody(Body& body, std::size_t index, const std::string& name) const;
     bool hasBodies() const;
     /// Each solid's place among the dynamic solids (0, 1, ... in solid order), -1 for others.
     std::vector<int> bodySlots() const;
@@ -499,6 +502,9 @@ private:
     /// Each body over the step: forces, contacts, then its motion.
     void advanceBodies(Real dt);
     void resolveBodyContacts(Real dt);
+    /// One sweep of dynamic solid e's contacts: with the bodies after it, or with the solids.
+    /// Returns the contact points touching.
+    int contactsOf(std::size_t e, bool bodies, Real dt, sph::ContactSettings settings);
     /// The momentum the collision projection took from liquid particles hitting each body.
     void giveCollisionImpulses(const std::vector<Vec3>& impulse,
                                const std::vector<std::uint32_t>& hit);
