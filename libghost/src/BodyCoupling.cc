@@ -58,6 +58,15 @@ std::vector<int> GhostSolver::bodySlots() const
     return slot;
 }
 
+std::vector<Vec3d> GhostSolver::bodyCentres(const std::vector<int>& slot) const
+{
+    std::vector<Vec3d> centre;
+    for (std::size_t e = 0; e < mSolids.size(); ++e) {
+        if (slot[e] >= 0) centre.push_back(mSolids[e]->body->rigid.state().position);
+    }
+    return centre;
+}
+
 void GhostSolver::gatherBodyForces(Real dt)
 {
     // Each pair of a liquid particle i and a body's ghost s pushed i by the model's pressure
@@ -81,10 +90,7 @@ void GhostSolver::gatherBodyForces(Real dt)
     const double M = mMass, rho0 = mSettings.restDensity, share = terms.share;
     const Real epsSolid = mSettings.solidEpsilonForStep(dt, fastestOwnedLiquid());
     const Vec3 g = mSettings.gravity;
-    std::vector<Vec3d> centre(bodies);
-    for (std::size_t e = 0; e < mSolids.size(); ++e) {
-        if (slot[e] >= 0) centre[std::size_t(slot[e])] = mSolids[e]->body->rigid.state().position;
-    }
+    const std::vector<Vec3d> centre = bodyCentres(slot);
     auto solidTerm = [&](Index s, std::size_t i) -> double {
         switch (terms.solid) {
         case SolidPairPressure::SolidTerm::Own: return double(pS[s] / sqr(rhoS[s]));
@@ -119,7 +125,6 @@ void GhostSolver::gatherBodyForces(Real dt)
         mSolids[e]->body->gatheredForce = totals[std::size_t(slot[e])].force;
         mSolids[e]->body->gatheredTorque = totals[std::size_t(slot[e])].torque;
     }
-    measureWetShares(slot);
 }
 
 void GhostSolver::measureWetShares(const std::vector<int>& slot)
@@ -232,10 +237,7 @@ void GhostSolver::giveCollisionImpulses(const std::vector<Vec3>& impulse,
     // on the body it hit; then its ghosts take its new velocity.
     const std::vector<int> slot = bodySlots();
     const std::size_t bodies = std::size_t(*std::max_element(slot.begin(), slot.end()) + 1);
-    std::vector<Vec3d> centre(bodies);
-    for (std::size_t e = 0; e < mSolids.size(); ++e) {
-        if (slot[e] >= 0) centre[std::size_t(slot[e])] = mSolids[e]->body->rigid.state().position;
-    }
+    const std::vector<Vec3d> centre = bodyCentres(slot);
     const auto& x = mParticles.positions();
     const std::vector<Wrench> totals = parallel::reduceInOrder(
         0, impulse.size(), std::vector<Wrench>(bodies),

@@ -288,6 +288,16 @@ void sinkAlong(std::vector<Vec3>& points, const std::vector<Vec3>& normals, Real
 
 } // namespace
 
+void GhostSolver::startSolidIds(ParticleSet& set)
+{
+    // Solid particles take their ids from the same counter as the liquid, so ids stay unique
+    // across the sets. Over several processes every one samples the same solid: its particles
+    // take the same ids everywhere, above every id any process has given.
+    ParticleId firstId = std::max(set.nextId(), mParticles.nextId());
+    if (mExchange) firstId = ParticleId(mExchange->maxOf(double(firstId)));
+    set.setNextId(firstId);
+}
+
 void GhostSolver::sampleSolid(std::size_t solidIndex)
 {
     const Solid& body = *mSolids[solidIndex];
@@ -325,12 +335,7 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
         locals = &set.addVectorChannel(SOLID_LOCAL);
         solidV = &set.addVectorChannel(SOLID_VELOCITY);
     }
-    // Solid particles take their ids from the same counter as the liquid, so ids stay unique
-    // across the sets. Over several processes every one samples the same solid: its particles
-    // take the same ids everywhere, above every id any process has given.
-    ParticleId firstId = std::max(set.nextId(), mParticles.nextId());
-    if (mExchange) firstId = ParticleId(mExchange->maxOf(double(firstId)));
-    set.setNextId(firstId);
+    startSolidIds(set);
     std::vector<Vec3> positions(local);
     for (Vec3& x : positions) x = xf.toWorld(x);
     const ParticleKind kind =

@@ -310,7 +310,10 @@ void GhostSolver::finishGhostStep(Real dt, const std::vector<Vec3>& gradMass)
     const auto t0 = std::chrono::steady_clock::now();
     resizeStepArray(mScratch, mParticles.size());
     extrapolateSolidVelocity();
-    if (hasBodies()) gatherBodyForces(dt);
+    if (hasBodies()) {
+        gatherBodyForces(dt);
+        measureWetShares(bodySlots());
+    }
     applyXsph(dt);
     // Halo liquid's new velocities, for the air near the cut that takes one of them.
     if (mExchange) {

@@ -424,6 +424,8 @@ private:
     ParticleSet restingParticles(const SolidBlock& block) const;
     void prepareSolidBlocks();
     void sampleSolid(std::size_t solidIndex);
+    /// A solid block's set gives its next particles ids above every id given so far.
+    void startSolidIds(ParticleSet& set);
     void claimRestoredSolid(std::size_t solidIndex);
     /// Algorithm 3 line 1: new liquid from every emitter open now ([SB12] Sec. 4.5.2).
     void emit();
@@ -489,6 +491,8 @@ private:
     bool hasBodies() const;
     /// Each solid's place among the dynamic solids (0, 1, ... in solid order), -1 for others.
     std::vector<int> bodySlots() const;
+    /// The bodies' centres of mass, in slot order.
+    std::vector<sph::Vec3d> bodyCentres(const std::vector<int>& slot) const;
     /// The world box of a body's contact points where it is, grown by `margin` (m).
     sph::Aabb bodyBox(const Body& b, double margin) const;
     /// The fastest owned liquid particle (m/s), over every process.
