@@ -61,7 +61,7 @@ namespace {
 constexpr const char* BODY_KEYS[] = {"x",   "y",   "z",   "qw",  "qx",  "qy",     "qz",  "vx",
                                      "vy",  "vz",  "lx",  "ly",  "lz",  "fx",     "fy",  "fz",
                                      "tx",  "ty",  "tz",  "mass", "volume", "cx", "cy",  "cz",
-                                     "ixx", "ixy", "ixz", "iyy", "iyz", "izz"};
+                                     "ixx", "ixy", "ixz", "iyx", "iyy", "iyz", "izx", "izy", "izz"};
 constexpr std::size_t BODY_VALUES = sizeof(BODY_KEYS) / sizeof(BODY_KEYS[0]);
 
 std::string bodyKey(std::size_t solid, const char* key)
@@ -150,7 +150,8 @@ void GhostSolver::restoreBody(Body& body, std::size_t index, const std::string& 
     p.mass = v[19];
     p.volume = v[20];
     p.centre = Vec3d(v[21], v[22], v[23]);
-    p.inertia = Mat3d(v[24], v[25], v[26], v[25], v[27], v[28], v[26], v[28], v[29]);
+    // All nine: the sums give the tensor symmetric only to rounding.
+    p.inertia = Mat3d(v[24], v[25], v[26], v[27], v[28], v[29], v[30], v[31], v[32]);
     body.rigid = RigidBody(p, body.rigid.material());
     RigidBodyState restored;
     restored.position = Vec3d(v[0], v[1], v[2]);
@@ -252,8 +253,9 @@ void GhostSolver::saveBodies(SolverState& state) const
             s.angularMomentum[2], b->liquidForce[0],    b->liquidForce[1],    b->liquidForce[2],
             b->liquidTorque[0],   b->liquidTorque[1],   b->liquidTorque[2],   p.mass,
             p.volume,             p.centre[0],          p.centre[1],          p.centre[2],
-            I(0, 0),              I(0, 1),              I(0, 2),              I(1, 1),
-            I(1, 2),              I(2, 2)};
+            I(0, 0),              I(0, 1),              I(0, 2),              I(1, 0),
+            I(1, 1),              I(1, 2),              I(2, 0),              I(2, 1),
+            I(2, 2)};
         for (std::size_t k = 0; k < BODY_VALUES; ++k) state.reals[bodyKey(e, BODY_KEYS[k])] = values[k];
     }
 }
