@@ -200,8 +200,9 @@ void GhostSolver::setSolidShape(std::size_t solidIndex, const LevelSet& shape)
                              mSolids.size(), " solids)"));
     }
     if (mSolids[solidIndex]->body) {
-        throw ValueError(msg("setSolidShape: solid '", mSolids[solidIndex]->shape.name(),
-                             "' is dynamic: its shape sets its mass and inertia, and cannot change"));
+        throw ValueError(
+            msg("setSolidShape: solid '", mSolids[solidIndex]->shape.name(),
+                "' is dynamic: its shape sets its mass and inertia, and cannot change"));
     }
     // Drop the old particles of this solid, then sample the new shape.
     restSolidValues(blockOf(solidIndex)); // its indices are about to change
@@ -280,12 +281,6 @@ std::vector<Vec3> bandNormals(const SampleSet& samples, const LevelSet& solid, R
     return normals;
 }
 
-/// Move each point `depth` (m) against its normal.
-void sinkAlong(std::vector<Vec3>& points, const std::vector<Vec3>& normals, Real depth)
-{
-    for (std::size_t k = 0; k < points.size(); ++k) points[k] -= depth * normals[k];
-}
-
 } // namespace
 
 void GhostSolver::startSolidIds(ParticleSet& set)
@@ -311,17 +306,22 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     // [SB12] Sec. 4.4 / 4.5: ghost solid particles in a band one kernel radius deep, sampled
     // like liquid (surface, relaxation, interior, relaxation). Basic SPH uses the same layer as
     // its boundary particles.
+    // A dynamic solid's ghosts are sampled in the shape half a spacing inside its surface: the
+    // liquid ends half a spacing beyond its particles' centres, so its boundary is then the
+    // body's surface and the volume it displaces is the body's own (on a static solid's
+    // surface layer it keeps half a spacing off). Sampled in the eroded shape, not moved in
+    // from the surface: moving the samples of a 10 cm box in by 1 cm packed its ghosts 44 %
+    // denser than the liquid, which held the liquid off it and floated a box of 500 kg/m^3
+    // 1.5 cm high.
+    const LevelSet ghostShape =
+        body.body ? erodedLevelSet(solid, Real(0.5) * mSettings.spacing) : solid;
     PoissonSettings ps = bodySampling(mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step);
     ps.bandDepth = mSettings.supportRadius();
-    const SampleSet samples = sph::sampleVolumeStored(ps, solid, mSampleStore);
+    const SampleSet samples = sph::sampleVolumeStored(ps, ghostShape, mSampleStore);
 
-    const std::vector<Vec3> localNormals = bandNormals(samples, solid, mSettings.supportRadius());
-    // A dynamic solid's ghosts sit half a spacing deeper: the liquid ends half a spacing beyond
-    // its particles' centres, so its boundary is then the body's surface and the volume it
-    // displaces is the body's own (on a static solid's surface layer the liquid would keep
-    // half a spacing off, and a floating box's draft would come out 1 cm short at 2 cm).
-    std::vector<Vec3> local(samples.positions);
-    if (body.body) sinkAlong(local, localNormals, Real(0.5) * mSettings.spacing);
+    const std::vector<Vec3> localNormals =
+        bandNormals(samples, ghostShape, mSettings.supportRadius());
+    const std::vector<Vec3>& local = samples.positions;
 
     SolidBlock& target = blockOf(solidIndex);
     ParticleSet& set = target.block.particles();
@@ -609,8 +609,7 @@ std::vector<Vec3> GhostSolver::emitterFill(std::size_t e, const std::vector<Vec3
     std::vector<Vec3> fresh;
     if (seeds.empty()) {
         // Nothing to grow from: fill the emitter as an initial liquid body ([SB12] Sec. 4.5).
-        const PoissonSettings ps =
-            bodySampling(mSettings.seed + 31337ULL * (e + 1) + mRun.step);
+        const PoissonSettings ps = bodySampling(mSettings.seed + 31337ULL * (e + 1) + mRun.step);
         for (const Vec3& local : PoissonDiskSampler(ps).sampleVolume(em.shape).positions) {
             const Vec3 x = em.placedPoint(local);
             bool clear = !blockedBySolid(x);
