@@ -68,6 +68,12 @@ public:
     /// The solves' pressure terms k_density + k_divergence of the solved particles, with the
     /// wall's share and the mirrored ghosts' hydrostatic part (DfsphPressure.cc).
     void solidPairPressure(LiquidStep& step, SolidPairPressure& out) const override;
+    /// The incompressible liquid answers a body's acceleration within the step. Measured: a
+    /// box of 100 kg/m^3 under water answers with m_a = 3.75 rho0 V in its first steps (the
+    /// mirrored ghosts' wall share doubles it); the filter is stable while m_a < 2 m + 4 m~,
+    /// and at a share of 1 it rang up to 6.8 m/s before settling, at 2 it rises at most at
+    /// 0.85 m/s.
+    double addedMassShare() const override { return 2; }
 
 private:
     /// The share of [SB12]'s air resampling period the step spans (DfsphSettings::

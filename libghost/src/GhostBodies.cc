@@ -17,22 +17,29 @@
 ///          any thread count gives the same bodies.
 ///
 ///          Coupling a light body explicitly (the force of this step's pressure, which answered
-///          last step's body velocity) diverges through the added mass: the liquid the body
-///          must push aside answers its acceleration of one step with a force of m_a a the
-///          next, and when m_a exceeds the body's mass m the response overshoots and grows (a
-///          floating box of density 100 has m_a of several m). The liquid's force is therefore
-///          taken through the added-mass filter of partitioned fluid-structure coupling
-///          (e.g. Förster, Wall and Ramm 2007, CMAME 196): with an estimate m~ of the added
-///          mass, (m + m~) a_{n+1} = F_{n+1} + m~ a_n, which applies
-///              F'_{n+1} = (F_{n+1} + r F'_n) / (1 + r),   r = m~ / m,
-///          the same for the torque. It is stable while the true added mass is below
-///          m + 2 m~, it leaves a steady force (floating, resting, a constant push) exact, and
-///          it changes a body's total momentum only by m~ (a_end - a_start) dt over a run. m~
-///          is rho0 V times the share of the body's ghosts the liquid reaches (a body out of
-///          the liquid falls freely; a sunken box's true added mass along a face is 0.5-1.2
-///          rho0 V). The DFSPH pressure solve treats the body's ghosts as moving at the body's
-///          velocity at the step's start; the filter gives it the stability that taking the
-///          body into the solve (Gissler et al. 2019) would, at no cost in the solve.
+///          last step's body velocity) diverges through the added mass where the liquid is
+///          incompressible: the liquid the body must push aside answers its acceleration of one
+///          step with a force of m_a a the next, and when m_a exceeds the body's mass m the
+///          response overshoots and grows (a floating box of density 100 has m_a of several m).
+///          The liquid's force is therefore taken through the added-mass filter of partitioned
+///          fluid-structure coupling (e.g. Förster, Wall and Ramm 2007, CMAME 196): with an
+///          estimate m~ of the added mass, (m + m~) a_{n+1} = F_{n+1} + m~ a_n, applied as
+///              F'_{n+1} = (F_{n+1} + J_n / dt) / (1 + r),   J_{n+1} = r dt F'_{n+1},
+///          r = m~ / m, J the impulse gathered and not yet applied (the same for the torque).
+///          It is stable while the true added mass is below m + 2 m~, it leaves a steady force
+///          (floating, resting, a constant push) exact, and every impulse the liquid gives is
+///          applied once: the body's momentum lags by J, which vanishes when the push ends.
+///          m~ is PressureSolver::addedMassShare() times rho0 V times the share of the body's
+///          ghosts the liquid reaches (a body out of the liquid falls freely): 2 for DFSPH,
+///          whose solve treats the body's ghosts as moving at the body's velocity at the step's
+///          start (the filter gives it the stability that taking the body into the solve,
+///          Gissler et al. 2019, would, at no cost in the solve); 0 for the Tait step, whose
+///          liquid answers through pressure waves that its acoustic step resolves. In the Tait
+///          step a body's ghosts take no pressure of their own (GhostSolver::bodyGhostFlags),
+///          so the pair force is the gradient of the liquid's energy.
+///
+///          A dynamic solid's ghosts are sampled half a spacing inside its surface
+///          (sph::erodedLevelSet), so the liquid's boundary lies on the body's surface.
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "GhostInternal.h"
@@ -56,12 +63,12 @@ namespace {
 
 /// The state keys of a body in SolverState::reals: "body_E_x", ... (E the solid's index).
 /// The state (centre, quaternion, velocity, angular momentum), the filter's liquid force and
-/// torque, and the mass properties (kept, not found again from the shape: a shape read back
+/// torque, the mass properties, and the filter's withheld impulse and angular impulse (kept, not found again from the shape: a shape read back
 /// from a script's attachment can differ in its last bits, and the run with it).
-constexpr const char* BODY_KEYS[] = {"x",   "y",   "z",   "qw",  "qx",  "qy",     "qz",  "vx",
-                                     "vy",  "vz",  "lx",  "ly",  "lz",  "fx",     "fy",  "fz",
-                                     "tx",  "ty",  "tz",  "mass", "volume", "cx", "cy",  "cz",
-                                     "ixx", "ixy", "ixz", "iyx", "iyy", "iyz", "izx", "izy", "izz"};
+constexpr const char* BODY_KEYS[] = {
+    "x",   "y",   "z",   "qw",  "qx",  "qy",  "qz",   "vx",     "vy", "vz", "lx", "ly",  "lz",
+    "fx",  "fy",  "fz",  "tx",  "ty",  "tz",  "mass", "volume", "cx", "cy", "cz", "ixx", "ixy",
+    "ixz", "iyx", "iyy", "iyz", "izx", "izy", "izz",  "jx",     "jy", "jz", "hx", "hy",  "hz"};
 constexpr std::size_t BODY_VALUES = sizeof(BODY_KEYS) / sizeof(BODY_KEYS[0]);
 
 std::string bodyKey(std::size_t solid, const char* key)
@@ -82,8 +89,9 @@ MassProperties bodyMassProperties(const LevelSet& shape, const DynamicSolid& spe
     const bool byDensity = spec.density > 0, byMass = spec.mass > 0;
     if (byDensity == byMass || !std::isfinite(spec.density) || !std::isfinite(spec.mass)
         || spec.density < 0 || spec.mass < 0) {
-        throw ValueError(msg("dynamic solid '", name, "': density ", spec.density, " kg/m^3 and mass ",
-                             spec.mass, " kg: expected exactly one of them, finite and > 0"));
+        throw ValueError(msg("dynamic solid '", name, "': density ", spec.density,
+                             " kg/m^3 and mass ", spec.mass,
+                             " kg: expected exactly one of them, finite and > 0"));
     }
     MassProperties p = massProperties(shape, byDensity ? spec.density : 1.0);
     if (byMass) {
@@ -98,15 +106,16 @@ void checkMaterial(const std::string& name, const DynamicSolid& spec)
 {
     const RigidBodyMaterial& m = spec.material;
     if (!(m.restitution >= 0 && m.restitution <= 1)) {
-        throw ValueError(msg("dynamic solid '", name, "': restitution ", m.restitution,
-                             ": expected 0 to 1"));
+        throw ValueError(
+            msg("dynamic solid '", name, "': restitution ", m.restitution, ": expected 0 to 1"));
     }
     if (!(m.friction >= 0) || !std::isfinite(m.friction)) {
         throw ValueError(msg("dynamic solid '", name, "': friction ", m.friction,
                              ": expected a finite value >= 0"));
     }
     if (!isFinite(Vec3(spec.velocity)) || !isFinite(Vec3(spec.angularVelocity))) {
-        throw ValueError(msg("dynamic solid '", name, "': velocity or angular velocity is not finite"));
+        throw ValueError(
+            msg("dynamic solid '", name, "': velocity or angular velocity is not finite"));
     }
 }
 
@@ -116,7 +125,8 @@ std::size_t GhostSolver::addDynamicSolid(const LevelSet& solid, const DynamicSol
 {
     const std::string& name = solid.name();
     if (mSettings.method != Method::Ghost) {
-        throw ValueError(msg("dynamic solid '", name, "': dynamic solids need method 'ghost', not '",
+        throw ValueError(msg("dynamic solid '", name,
+                             "': dynamic solids need method 'ghost', not '",
                              methodName(mSettings.method), "'"));
     }
     if (mExchange) {
@@ -162,6 +172,8 @@ void GhostSolver::restoreBody(Body& body, std::size_t index, const std::string& 
     body.rigid.setState(restored);
     body.liquidForce = Vec3d(v[13], v[14], v[15]);
     body.liquidTorque = Vec3d(v[16], v[17], v[18]);
+    body.withheldImpulse = Vec3d(v[33], v[34], v[35]);
+    body.withheldAngularImpulse = Vec3d(v[36], v[37], v[38]);
 }
 
 bool GhostSolver::isDynamic(std::size_t solidIndex) const
@@ -172,8 +184,8 @@ bool GhostSolver::isDynamic(std::size_t solidIndex) const
 GhostSolver::Body& GhostSolver::bodyOf(std::size_t solidIndex) const
 {
     if (!isDynamic(solidIndex)) {
-        throw ValueError(msg("solid ", solidIndex, " is not a dynamic solid (", mSolids.size(),
-                             " solids)"));
+        throw ValueError(
+            msg("solid ", solidIndex, " is not a dynamic solid (", mSolids.size(), " solids)"));
     }
     return *mSolids[solidIndex]->body;
 }
@@ -246,17 +258,47 @@ void GhostSolver::saveBodies(SolverState& state) const
         const Quatd& q = s.orientation;
         const MassProperties& p = b->rigid.massProperties();
         const Mat3d& I = p.inertia;
-        const double values[BODY_VALUES] = {
-            s.position[0],        s.position[1],        s.position[2],        q.w(),
-            q.x(),                q.y(),                q.z(),                s.velocity[0],
-            s.velocity[1],        s.velocity[2],        s.angularMomentum[0], s.angularMomentum[1],
-            s.angularMomentum[2], b->liquidForce[0],    b->liquidForce[1],    b->liquidForce[2],
-            b->liquidTorque[0],   b->liquidTorque[1],   b->liquidTorque[2],   p.mass,
-            p.volume,             p.centre[0],          p.centre[1],          p.centre[2],
-            I(0, 0),              I(0, 1),              I(0, 2),              I(1, 0),
-            I(1, 1),              I(1, 2),              I(2, 0),              I(2, 1),
-            I(2, 2)};
-        for (std::size_t k = 0; k < BODY_VALUES; ++k) state.reals[bodyKey(e, BODY_KEYS[k])] = values[k];
+        const double values[BODY_VALUES] = {s.position[0],
+                                            s.position[1],
+                                            s.position[2],
+                                            q.w(),
+                                            q.x(),
+                                            q.y(),
+                                            q.z(),
+                                            s.velocity[0],
+                                            s.velocity[1],
+                                            s.velocity[2],
+                                            s.angularMomentum[0],
+                                            s.angularMomentum[1],
+                                            s.angularMomentum[2],
+                                            b->liquidForce[0],
+                                            b->liquidForce[1],
+                                            b->liquidForce[2],
+                                            b->liquidTorque[0],
+                                            b->liquidTorque[1],
+                                            b->liquidTorque[2],
+                                            p.mass,
+                                            p.volume,
+                                            p.centre[0],
+                                            p.centre[1],
+                                            p.centre[2],
+                                            I(0, 0),
+                                            I(0, 1),
+                                            I(0, 2),
+                                            I(1, 0),
+                                            I(1, 1),
+                                            I(1, 2),
+                                            I(2, 0),
+                                            I(2, 1),
+                                            I(2, 2),
+                                            b->withheldImpulse[0],
+                                            b->withheldImpulse[1],
+                                            b->withheldImpulse[2],
+                                            b->withheldAngularImpulse[0],
+                                            b->withheldAngularImpulse[1],
+                                            b->withheldAngularImpulse[2]};
+        for (std::size_t k = 0; k < BODY_VALUES; ++k)
+            state.reals[bodyKey(e, BODY_KEYS[k])] = values[k];
     }
 }
 

@@ -92,16 +92,19 @@ struct GhostSolver::Body
     explicit Body(const sph::RigidBody& rigid_) : rigid(rigid_) {}
 
     sph::RigidBody rigid;
-    /// The liquid's force and torque as applied last step (the added-mass filter's memory).
+    /// The liquid's force and torque as applied last step, after the added-mass filter.
     sph::Vec3d liquidForce{0.0}, liquidTorque{0.0};
+    /// The filter's memory: the liquid's impulse (N s) and angular impulse (N m s) gathered and
+    /// not yet applied, r dt times the last applied force and torque.
+    sph::Vec3d withheldImpulse{0.0}, withheldAngularImpulse{0.0};
     /// This step's, as gathered (before the filter).
     sph::Vec3d gatheredForce{0.0}, gatheredTorque{0.0};
     /// Share of its ghosts the liquid reached this step (the added mass's share).
     double wetShare = 0;
     sph::Vec3d externalForce{0.0}, externalTorque{0.0}; ///< addBodyForce's
-    std::vector<sph::Vec3d> contactPoints; ///< its surface ghosts, in its own frame
-    std::size_t ghosts = 0; ///< its ghost particles
-    double radius = 0;      ///< the farthest contact point from the centre of mass (m)
+    std::vector<sph::Vec3d> contactPoints;              ///< its surface ghosts, in its own frame
+    std::size_t ghosts = 0;                             ///< its ghost particles
+    double radius = 0; ///< the farthest contact point from the centre of mass (m)
 };
 
 namespace detail {

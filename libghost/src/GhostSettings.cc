@@ -68,11 +68,11 @@ Real GhostSettings::shifting() const
     return stiffness > Real(20000) ? Real(2) : Real(0);
 }
 
-int GhostSettings::relaxationPasses() const
+int GhostSettings::relaxationPasses(bool bodies) const
 {
     if (initialRelaxation >= 0) return initialRelaxation;
     // DFSPH holds the density to a fraction of a percent: the sampled error is a kick.
-    if (pressure == PressureModel::Dfsph) return 20;
+    if (pressure == PressureModel::Dfsph || bodies) return 20;
     return stiffness > Real(20000) ? 20 : 0;
 }
 

@@ -151,7 +151,7 @@ void GhostSolver::relaxInitialLiquid()
     // Each pass: the neighbours with every ghost in place, then each liquid particle moves down
     // its density gradient (relaxationShift), a step of particle shifting with no flow; the air
     // layer is resampled around the moved liquid every 5 passes and at the end.
-    const int passes = mSettings.relaxationPasses();
+    const int passes = mSettings.relaxationPasses(hasBodies());
     if (passes <= 0) return;
     const Real rho0 = mSettings.restDensity;
     // Every other pass keeps the last pass's lists (Verlet lists without a skin). A pass moves

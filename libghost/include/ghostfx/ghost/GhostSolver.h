@@ -76,8 +76,8 @@ using sph::RigidTransform;
 /// uniform rigid body given by its density or its mass.
 struct DynamicSolid
 {
-    double density = 0; ///< kg/m^3; or 0 and a mass
-    double mass = 0;    ///< kg; or 0 and a density
+    double density = 0;              ///< kg/m^3; or 0 and a mass
+    double mass = 0;                 ///< kg; or 0 and a density
     sph::Vec3d velocity{0.0};        ///< initial, of the centre of mass (m/s)
     sph::Vec3d angularVelocity{0.0}; ///< initial (rad/s)
     sph::RigidBodyMaterial material; ///< restitution and friction of its contacts
@@ -489,6 +489,8 @@ private:
     /// A restored dynamic solid's body: its state and mass properties from mRestoredBodies.
     void restoreBody(Body& body, std::size_t index, const std::string& name) const;
     bool hasBodies() const;
+    /// Per particle of the moving block: 1 for a dynamic solid's ghost (empty with no bodies).
+    std::vector<char> bodyGhostFlags() const;
     /// Each solid's place among the dynamic solids (0, 1, ... in solid order), -1 for others.
     std::vector<int> bodySlots() const;
     /// The bodies' centres of mass, in slot order.
@@ -533,9 +535,9 @@ private:
     /// This step, over several processes only: 1 for the liquid and air this process owns
     /// (their lists; on one process every particle of mParticles is one).
     std::vector<std::uint8_t> mQueryMask;
-    std::vector<Real> mScratch;            ///< per particle scratch of a pass
-    SolidBlock mStatic, mMoving;           ///< solid particles of static and of moving solids
-    ParticleSet mPendingSolids;            ///< restored solid particles until their solid is added
+    std::vector<Real> mScratch;  ///< per particle scratch of a pass
+    SolidBlock mStatic, mMoving; ///< solid particles of static and of moving solids
+    ParticleSet mPendingSolids;  ///< restored solid particles until their solid is added
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Emitter>> mEmitters;
     std::uint64_t mRestoredFromSolids = 0;
