@@ -148,6 +148,23 @@ void GhostSolver::addSolidBody(const LevelSet& solid, RigidMotion motion, bool m
     const std::size_t index = mSolids.size() - 1;
     if (index < mRestoredSolids) claimRestoredSolid(index);
     else sampleSolid(index);
+    if (!mRun.initialized && !mRestored) clearLiquidFrom(index);
+}
+
+void GhostSolver::clearLiquidFrom(std::size_t solidIndex)
+{
+    // Liquid added before the solid and inside it (a script's solid over a scene's liquid) is
+    // removed as addLiquid would have left it out (blockedBySolid's clearance): deeper than the
+    // solid's band it could not be projected out, and the first steps stopped on it.
+    const Solid& solid = *mSolids[solidIndex];
+    const Real clearance = Real(0.5) * mSettings.spacing;
+    std::vector<std::uint8_t> remove(mParticles.size(), 0);
+    bool any = false;
+    for (std::size_t i = 0; i < mParticles.size(); ++i) {
+        if (mParticles.kinds()[i] != ParticleKind::Liquid) continue;
+        if (solid.phi(mParticles.positions()[i], mRun.time) < clearance) remove[i] = any = true;
+    }
+    if (any) mParticles.removeIf(remove);
 }
 
 GhostSolver::SolidBlock& GhostSolver::blockOf(std::size_t solidIndex)

@@ -427,6 +427,8 @@ private:
     /// A solid block's set gives its next particles ids above every id given so far.
     void startSolidIds(ParticleSet& set);
     void claimRestoredSolid(std::size_t solidIndex);
+    /// Remove the liquid within half a spacing of the inside of solid `solidIndex`.
+    void clearLiquidFrom(std::size_t solidIndex);
     /// Algorithm 3 line 1: new liquid from every emitter open now ([SB12] Sec. 4.5.2).
     void emit();
     void emitFrom(std::size_t emitter);
