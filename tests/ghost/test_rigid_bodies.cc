@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <string>
 
 using namespace ghostfx;
 using namespace ghostfx::sph;
@@ -330,6 +331,17 @@ TEST(RigidBodies, BadBodiesAreRefusedInOneLine)
     ok.density = 500;
     EXPECT_THROW(basic.addDynamicSolid(scene.body(H), ok), ValueError);
     EXPECT_THROW(solver.body(0), ValueError);
+    // A plate thinner than a spacing has no inside half a spacing deep for its ghosts.
+    const LevelSet plate = makeLevelSet(
+        makeBoxLevelSet(Vec3(-0.1f, 0.2f, -0.1f), Vec3(0.1f, 0.21f, 0.1f), H / 4), "plate");
+    try {
+        GhostSolver thin(tankSettings(PressureModel::Tait));
+        thin.addDynamicSolid(plate, ok);
+        ADD_FAILURE() << "a 1 cm plate at 2 cm spacing was taken";
+    } catch (const ValueError& e) {
+        EXPECT_EQ(std::string(e.what()), "level set 'plate': nothing is left of it 0.01 m inside "
+                                         "its surface: expected a shape thicker than 0.02 m");
+    }
 }
 
 // A body of the liquid's density placed under the surface is neutral: the liquid's mean force
