@@ -84,16 +84,10 @@ void GhostSolver::gatherBodyForces(Real dt)
     const Vec3 g = mSettings.gravity;
     const std::vector<Vec3d> centre = bodyCentres(slot);
     auto solidTerm = [&](Index s, std::size_t i) -> double {
-        switch (terms.solid) {
-        case SolidPairPressure::SolidTerm::Own:
-            return double(pS[s] / sqr(rhoS[s]));
-        case SolidPairPressure::SolidTerm::Mirror: {
-            const Vec3& gs = terms.wallGravity ? (*terms.wallGravity)[s] : g;
-            return double(gs.dot(xs[s] - x[i])) / rho0;
-        }
-        default:
-            return 0.0;
-        }
+        if (terms.solid == SolidPairPressure::SolidTerm::Own) return double(pS[s] / sqr(rhoS[s]));
+        if (terms.solid != SolidPairPressure::SolidTerm::Mirror) return 0.0;
+        const Vec3& gs = terms.wallGravity ? (*terms.wallGravity)[s] : g;
+        return double(gs.dot(xs[s] - x[i])) / rho0;
     };
     const std::vector<Wrench> totals = parallel::reduceInOrder(
         0, mParticles.size(), std::vector<Wrench>(bodies),

@@ -310,6 +310,19 @@ void GhostSolver::startSolidIds(ParticleSet& set)
     set.setNextId(firstId);
 }
 
+LevelSet GhostSolver::ghostShapeOf(const Solid& solid) const
+{
+    // A dynamic solid's ghosts are sampled in the shape half a spacing inside its surface: the
+    // liquid ends half a spacing beyond its particles' centres, so its boundary is then the
+    // body's surface and the volume it displaces is the body's own (on a static solid's
+    // surface layer it keeps half a spacing off). Sampled in the eroded shape, not moved in
+    // from the surface: moving the samples of a 10 cm box in by 1 cm packed its ghosts 44 %
+    // denser than the liquid, which held the liquid off it and floated a box of 500 kg/m^3
+    // 1.5 cm high.
+    if (!solid.body) return solid.shape;
+    return erodedLevelSet(solid.shape, Real(0.5) * mSettings.spacing);
+}
+
 void GhostSolver::sampleSolid(std::size_t solidIndex)
 {
     const Solid& body = *mSolids[solidIndex];
@@ -323,19 +336,10 @@ void GhostSolver::sampleSolid(std::size_t solidIndex)
     // [SB12] Sec. 4.4 / 4.5: ghost solid particles in a band one kernel radius deep, sampled
     // like liquid (surface, relaxation, interior, relaxation). Basic SPH uses the same layer as
     // its boundary particles.
-    // A dynamic solid's ghosts are sampled in the shape half a spacing inside its surface: the
-    // liquid ends half a spacing beyond its particles' centres, so its boundary is then the
-    // body's surface and the volume it displaces is the body's own (on a static solid's
-    // surface layer it keeps half a spacing off). Sampled in the eroded shape, not moved in
-    // from the surface: moving the samples of a 10 cm box in by 1 cm packed its ghosts 44 %
-    // denser than the liquid, which held the liquid off it and floated a box of 500 kg/m^3
-    // 1.5 cm high.
-    const LevelSet ghostShape =
-        body.body ? erodedLevelSet(solid, Real(0.5) * mSettings.spacing) : solid;
+    const LevelSet ghostShape = ghostShapeOf(body);
     PoissonSettings ps = bodySampling(mSettings.seed + 1000003ULL * (solidIndex + 1) + mRun.step);
     ps.bandDepth = mSettings.supportRadius();
     const SampleSet samples = sph::sampleVolumeStored(ps, ghostShape, mSampleStore);
-
     const std::vector<Vec3> localNormals =
         bandNormals(samples, ghostShape, mSettings.supportRadius());
     const std::vector<Vec3>& local = samples.positions;

@@ -15,12 +15,13 @@ LevelSet erodedLevelSet(const LevelSet& shape, Real depth)
 {
     const std::string& name = shape.name();
     const Real voxel = shape.voxelSize();
-    // The surface phi = -depth must lie inside the band with a voxel to spare, so that the
-    // values on both sides of it are distances, not the clamp.
-    if (!(depth >= Real(0)) || depth > shape.bandWidth() - voxel) {
+    // The surface phi = -depth must lie inside the band with half a voxel to spare, so that
+    // the values on both sides of it are distances, not the clamp.
+    const Real deepest = shape.bandWidth() - Real(0.5) * voxel;
+    if (!(depth >= Real(0)) || depth > deepest) {
         throw ValueError(msg("level set '", name, "': cannot erode it by ", depth,
-                             " m: expected 0 to its band width less a voxel (",
-                             shape.bandWidth() - voxel, " m)"));
+                             " m: expected 0 to its band width less half a voxel (", deepest,
+                             " m)"));
     }
     const openvdb::FloatGrid::ConstPtr grid = gridOf(shape);
     const float halfWidthVoxels = float(shape.bandWidth() / voxel);

@@ -424,6 +424,8 @@ private:
     ParticleSet restingParticles(const SolidBlock& block) const;
     void prepareSolidBlocks();
     void sampleSolid(std::size_t solidIndex);
+    /// The level set a solid's ghosts are sampled in: its own, or a dynamic solid's eroded.
+    LevelSet ghostShapeOf(const Solid& solid) const;
     /// A solid block's set gives its next particles ids above every id given so far.
     void startSolidIds(ParticleSet& set);
     void claimRestoredSolid(std::size_t solidIndex);

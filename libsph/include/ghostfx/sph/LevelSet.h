@@ -126,7 +126,7 @@ private:
 /// The shape `depth` (m) inside `shape`'s surface (its inner parallel surface), as a new
 /// narrow band of the same voxel size and band width (OpenVDB's levelSetRebuild of the
 /// isosurface phi = -depth; LevelSetOffset.cc). Throws ValueError naming the level set when
-/// `depth` is beyond its band less a voxel, or when nothing of the shape is that deep.
+/// `depth` is beyond its band less half a voxel, or when nothing of the shape is that deep.
 LevelSet erodedLevelSet(const LevelSet& shape, Real depth);
 
 } // namespace sph
