@@ -91,11 +91,19 @@ double secondsPerStep(const Options& opt, bool dynamic)
     const Real fixed = Real(0.2) * h / s.soundSpeed();
     auto dt = [&] { return s.pressure == PressureModel::Dfsph ? solver.stableTimeStep() : fixed; };
     for (int k = 0; k < opt.warmup; ++k) solver.step(dt());
+    const PressureSolveStats before = solver.pressureSolveStats();
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; k < opt.steps; ++k) solver.step(dt());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("  %s: %zu liquid, %.2f ms/step\n", dynamic ? "dynamic" : "keyed  ",
-                solver.count(ParticleKind::Liquid), 1e3 * seconds / opt.steps);
+    // The solves' iterations per step: a dynamic box moves otherwise than the keyed one, and
+    // DFSPH's cost follows its iterations.
+    const PressureSolveStats& after = solver.pressureSolveStats();
+    const double iterations = double(after.densityIterations + after.divergenceIterations
+                                     - before.densityIterations - before.divergenceIterations)
+                              / opt.steps;
+    std::printf("  %s: %zu liquid, %.2f ms/step, %.1f solve iterations/step\n",
+                dynamic ? "dynamic" : "keyed  ", solver.count(ParticleKind::Liquid),
+                1e3 * seconds / opt.steps, iterations);
     return seconds / opt.steps;
 }
 
