@@ -51,7 +51,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <string>
+#include <vector>
 
 namespace ghostfx {
 namespace ghost {
@@ -257,46 +259,22 @@ void GhostSolver::saveBodies(SolverState& state) const
         const RigidBodyState& s = b->rigid.state();
         const Quatd& q = s.orientation;
         const MassProperties& p = b->rigid.massProperties();
-        const Mat3d& I = p.inertia;
-        const double values[BODY_VALUES] = {s.position[0],
-                                            s.position[1],
-                                            s.position[2],
-                                            q.w(),
-                                            q.x(),
-                                            q.y(),
-                                            q.z(),
-                                            s.velocity[0],
-                                            s.velocity[1],
-                                            s.velocity[2],
-                                            s.angularMomentum[0],
-                                            s.angularMomentum[1],
-                                            s.angularMomentum[2],
-                                            b->liquidForce[0],
-                                            b->liquidForce[1],
-                                            b->liquidForce[2],
-                                            b->liquidTorque[0],
-                                            b->liquidTorque[1],
-                                            b->liquidTorque[2],
-                                            p.mass,
-                                            p.volume,
-                                            p.centre[0],
-                                            p.centre[1],
-                                            p.centre[2],
-                                            I(0, 0),
-                                            I(0, 1),
-                                            I(0, 2),
-                                            I(1, 0),
-                                            I(1, 1),
-                                            I(1, 2),
-                                            I(2, 0),
-                                            I(2, 1),
-                                            I(2, 2),
-                                            b->withheldImpulse[0],
-                                            b->withheldImpulse[1],
-                                            b->withheldImpulse[2],
-                                            b->withheldAngularImpulse[0],
-                                            b->withheldAngularImpulse[1],
-                                            b->withheldAngularImpulse[2]};
+        // In BODY_KEYS' order.
+        std::vector<double> values;
+        auto put = [&values](std::initializer_list<double> v) { values.insert(values.end(), v); };
+        auto putVector = [&put](const Vec3d& v) { put({v[0], v[1], v[2]}); };
+        putVector(s.position);
+        put({q.w(), q.x(), q.y(), q.z()});
+        putVector(s.velocity);
+        putVector(s.angularMomentum);
+        putVector(b->liquidForce);
+        putVector(b->liquidTorque);
+        put({p.mass, p.volume});
+        putVector(p.centre);
+        for (int r = 0; r < 3; ++r)
+            putVector(Vec3d(p.inertia(r, 0), p.inertia(r, 1), p.inertia(r, 2)));
+        putVector(b->withheldImpulse);
+        putVector(b->withheldAngularImpulse);
         for (std::size_t k = 0; k < BODY_VALUES; ++k)
             state.reals[bodyKey(e, BODY_KEYS[k])] = values[k];
     }
