@@ -123,6 +123,14 @@ std::vector<LiquidRow> liquidRows()
         LiquidRow::number("rest_density", "restDensity", &G::restDensity, sph::positive(), "kg/m^3",
                           "rest density rho0"),
         LiquidRow::vector("gravity", "gravity", &G::gravity, "m/s^2", "gravity"),
+        LiquidRow::number("viscosity", "viscosity", &G::viscosity, sph::between(0, 1e5), "m^2/s",
+                          "kinematic viscosity nu, solved implicitly; 0 = none"),
+        LiquidRow::number("viscosity_error", "viscosityError", &G::viscosityError,
+                          sph::between(1e-10, 0.1), "",
+                          "relative residual the viscosity solve stops at"),
+        LiquidRow::number("viscosity_max_iterations", "viscosityMaxIterations",
+                          &G::viscosityMaxIterations, sph::between(1, 100000), "",
+                          "iteration cap of each viscosity solve"),
         LiquidRow::number("kernel_support", "supportFactor", &G::supportFactor,
                           sph::between(1.5, 5), "h", "kernel support radius / h ([SB12]: 3)"),
         LiquidRow::number("xsph_epsilon", "xsphEpsilon", &G::xsphEpsilon, sph::between(0, 1), "",
@@ -226,6 +234,11 @@ const sph::SettingTable<DfsphSettings>& dfsphSettingTable()
 void GhostSettings::validate() const
 {
     sph::validateTable(liquidSettingTable(), *this);
+    if (viscosity > Real(0) && method != Method::Ghost) {
+        throw ValueError(msg("liquid setting viscosity = ", viscosity,
+                             " m^2/s with method 'basic': expected 0 (Basic SPH has its own "
+                             "artificial viscosity, basic_viscosity_alpha)"));
+    }
     if (pressure != PressureModel::Dfsph) return;
     if (method != Method::Ghost) {
         throw ValueError("liquid setting pressure = 'dfsph' with method 'basic': "

@@ -6,6 +6,7 @@
 #include "ghostfx/ghost/GhostSolver.h"
 
 #include "GhostInternal.h"
+#include "ImplicitViscosity.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
@@ -42,6 +43,10 @@ GhostSolver::GhostSolver(const GhostSettings& settings, std::unique_ptr<Pressure
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
+    if (mSettings.viscosity > Real(0)) {
+        mViscosity = std::make_unique<ImplicitViscosity>();
+        mParticles.addVectorChannel(ImplicitViscosity::CHANNEL);
+    }
     sph::ensureBirthTimes(mParticles, mRun.time);
 }
 
@@ -52,6 +57,12 @@ const PressureSolveStats& GhostSolver::pressureSolveStats() const
     static const PressureSolveStats none;
     const PressureSolveStats* stats = mPressure->solveStats();
     return stats ? *stats : none;
+}
+
+const ViscositySolveStats& GhostSolver::viscositySolveStats() const
+{
+    static const ViscositySolveStats none;
+    return mViscosity ? mViscosity->stats() : none;
 }
 
 void GhostSolver::setParticleMass(Real mass)
@@ -1000,6 +1011,7 @@ void GhostSolver::restoreState(const SolverState& state)
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
+    if (mViscosity) mParticles.addVectorChannel(ImplicitViscosity::CHANNEL);
     mRun = run;
     sph::ensureBirthTimes(mParticles, mRun.time);
     mAirPhase = airPhase;

@@ -4,6 +4,7 @@
 #include "ghostfx/ghost/LiquidStep.h"
 
 #include "GhostInternal.h"
+#include "ImplicitViscosity.h"
 
 namespace ghostfx {
 namespace ghost {
@@ -44,6 +45,11 @@ void LiquidStep::searchAndDensity(const DensityPass& pass)
 void LiquidStep::pressureToSolids() { mSolver.pressureToSolids(); }
 void LiquidStep::setMaxAcceleration(Real a) { mSolver.mRun.maxAcceleration = a; }
 Real LiquidStep::maxAcceleration() const { return mSolver.mRun.maxAcceleration; }
+
+void LiquidStep::applyViscosity(Real dt)
+{
+    if (mSolver.mViscosity) mSolver.mViscosity->apply(*this, dt);
+}
 
 void LiquidStep::finish(Real dt, const std::vector<Vec3>& gradMass)
 {

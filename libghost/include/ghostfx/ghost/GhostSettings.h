@@ -196,6 +196,14 @@ struct GhostSettings
     Real stiffness = Real(2000);     ///< Tait k (Pa): p = k ((rho / rho0)^7 - 1) ([SB12]: 2000)
     Vec3 gravity{0, Real(-9.81), 0}; ///< (m/s^2)
 
+    /// Kinematic viscosity nu (m^2/s) of the liquid: water 1e-6, honey about 1e-2 to 10; 0 =
+    /// none (the default: [SB12]'s liquid, whose XSPH alone smooths it). Solved implicitly
+    /// ([WKBB18], ImplicitViscosity.h), stable at the flow's step whatever nu is.
+    Real viscosity = Real(0);
+    /// The viscosity solve stops when |r| <= viscosityError |b| (its momenta, relative).
+    Real viscosityError = Real(1e-4);
+    int viscosityMaxIterations = 500; ///< iteration cap of each viscosity solve
+
     // Ghost SPH ([SB12] Sec. 4) ------------------------------------------------------------------
     Real xsphEpsilon = Real(0.05); ///< epsilon of Eq. 2 (XSPH on velocities)
     /// Epsilon of Eq. 2 for ghost-solid neighbours: the wall drag of one reference step

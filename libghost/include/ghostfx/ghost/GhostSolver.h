@@ -98,6 +98,19 @@ struct PhaseTimings
     std::uint64_t steps = 0;
 };
 
+/// What the implicit viscosity's solves did (GhostSettings::viscosity > 0).
+struct ViscositySolveStats
+{
+    std::uint64_t solves = 0;      ///< steps with a solve
+    std::uint64_t iterations = 0;  ///< conjugate-gradient iterations, all steps
+    std::uint64_t unconverged = 0; ///< solves stopped at GhostSettings::viscosityMaxIterations
+    int lastIterations = 0;        ///< the last step's
+    double lastResidual = 0;       ///< the last step's |r| / |b| at its end
+    double seconds = 0;            ///< wall time of the solves
+};
+
+class ImplicitViscosity;
+
 class GhostSolver
 {
 public:
@@ -328,6 +341,8 @@ public:
     /// The implicit pressure solves' iterations and errors (settings.pressure = dfsph; zeros
     /// for a model without solves).
     const PressureSolveStats& pressureSolveStats() const;
+    /// The implicit viscosity's statistics (all zero without GhostSettings::viscosity).
+    const ViscositySolveStats& viscositySolveStats() const;
     /// Mean number of neighbours per liquid particle in the last density pass (self included).
     double meanNeighbors() const { return mRun.meanNeighbors; }
     /// Liquid-neighbour pairs in the last neighbour search, solid neighbours included.
@@ -559,6 +574,8 @@ private:
     /// Whether this step sets the pressure channel (step()'s reportPressure).
     bool mReportPressure = true;
     std::unique_ptr<PressureSolver> mPressure;
+    /// The implicit viscosity, with GhostSettings::viscosity > 0 (ImplicitViscosity.h).
+    std::unique_ptr<ImplicitViscosity> mViscosity;
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;

@@ -92,6 +92,10 @@ public:
     /// The liquid's largest acceleration this step (m/s^2): the next step's force limit.
     void setMaxAcceleration(Real a);
     Real maxAcceleration() const;
+    /// The liquid's viscosity (GhostSettings::viscosity), implicitly: v* becomes the
+    /// velocities one backward Euler step of the viscous force gives from it. Nothing without
+    /// viscosity. A model calls it once its other non-pressure forces are in v*.
+    void applyViscosity(Real dt);
     /// Lines 15-28 from v* (VSTAR): ghost solid velocities (Eq. 3), XSPH (Eq. 2), air
     /// velocities, positions, and, with `gradMass` (sum_j m_j grad W_ij of each particle),
     /// particle shifting (GhostSettings::shiftingCoefficient).
