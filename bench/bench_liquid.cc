@@ -61,6 +61,8 @@ struct Options
     int warmup = 20;               ///< steps before the measurement (>= 1)
     double cfl = 0;                ///< > 0: CFL-limited dt with this number instead of PAPER_DT
     double stiffness = 0;          ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
+    double viscosity = 0;          ///< kinematic viscosity nu (m^2/s), no-slip walls when > 0
+    double viscosityError = 0;     ///< > 0: settings.viscosity_error instead of the default
     double kernelSupport = 0;      ///< > 0: kernel support / h instead of the default ([SB12]: 3)
     double shifting = -1;          ///< >= 0: particle shifting coefficient instead of the default
     std::string airWeights;        ///< "matched" or "complete" instead of the default
@@ -206,6 +208,7 @@ struct RunResult
     Method method = Method::Ghost;
     PressureModel pressure = PressureModel::Tait;
     PressureSolveStats solve; ///< DFSPH iterations over the measured steps
+    double viscosityIterations = 0, viscositySeconds = 0; ///< per measured step
     bool ok = false;
     std::string error;
     std::size_t liquid = 0, air = 0, solid = 0;                  ///< at the end of the measurement
@@ -342,6 +345,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
     double sum = 0, lo = 1e30, hi = 0, nbrs = 0, simulated = 0;
     std::vector<double> times;
     bool measuring = false;
+    ViscositySolveStats viscosityAtStart;
     try {
         if (solver.count(ParticleKind::Liquid) == 0) {
             solver.addLiquidParticles(liquidPositions, scene.liquidVelocity);
@@ -358,6 +362,7 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
         for (int s = 1; s < opt.warmup; ++s) solver.step(nextDt());
 
         solver.resetTimings();
+        viscosityAtStart = solver.viscositySolveStats();
         measuring = true;
         // As a run's frames do: the reported pressure (DFSPH) on the steps that end a frame.
         const double frame = 1.0 / double(solver.settings().frameRate);
@@ -393,6 +398,9 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
         out.meanNeighbors = nbrs / out.steps;
         out.phases = solver.timings();
         out.solve = solver.pressureSolveStats();
+        const ViscositySolveStats& v = solver.viscositySolveStats();
+        out.viscosityIterations = double(v.iterations - viscosityAtStart.iterations) / out.steps;
+        out.viscositySeconds = (v.seconds - viscosityAtStart.seconds) / out.steps;
     }
 
     if (opt.halo && out.steps > 0) {
@@ -494,6 +502,11 @@ void printRun(const RunResult& r)
     std::printf("  mean neighbours %.1f; %.2f ns per particle-neighbour pair; %.1f wall s per "
                 "simulated s\n",
                 r.meanNeighbors, 1e9 * r.meanStep / pairs, r.meanStep / r.dt);
+    if (r.viscositySeconds > 0) {
+        std::printf("  viscosity: %.1f iterations and %.1f ms per step (%.1f %% of the step)\n",
+                    r.viscosityIterations, 1e3 * r.viscositySeconds,
+                    percent(r.viscositySeconds, r.meanStep));
+    }
     if (r.pressure == PressureModel::Dfsph) {
         const PressureSolveStats& st = r.solve;
         std::printf("  DFSPH: %.1f density + %.1f divergence iterations per step, last errors "
@@ -515,6 +528,11 @@ std::vector<RunResult> runScene(const Scene& scene, const Options& opt)
     settings.seed = opt.seed;
     if (opt.cfl > 0) settings.cflNumber = Real(opt.cfl);
     if (opt.stiffness > 0) settings.stiffness = Real(opt.stiffness);
+    if (opt.viscosity > 0) {
+        settings.viscosity = Real(opt.viscosity);
+        settings.solidSlip = ghost::SolidSlip::NoSlip;
+    }
+    if (opt.viscosityError > 0) settings.viscosityError = Real(opt.viscosityError);
     if (opt.kernelSupport > 0) settings.supportFactor = Real(opt.kernelSupport);
     if (opt.shifting >= 0) settings.shiftingCoefficient = Real(opt.shifting);
     if (!opt.airWeights.empty()) {
@@ -618,6 +636,12 @@ void addSettingOptions(CLI::App& app, Options& opt)
         ->check(CLI::IsMember({"matched", "complete"}));
     app.add_option("--stiffness", opt.stiffness, "Tait stiffness k (Pa; default: [SB12] 2000)")
         ->check(CLI::PositiveNumber);
+    app.add_option("--viscosity", opt.viscosity,
+                   "kinematic viscosity nu (m^2/s) with no-slip walls (default 0: none)")
+        ->check(CLI::Range(0.0, 1e5));
+    app.add_option("--viscosity-error", opt.viscosityError,
+                   "relative residual of the viscosity solve (default: the settings' 1e-4)")
+        ->check(CLI::Range(1e-10, 0.1));
     app.add_option("--kernel-support", opt.kernelSupport,
                    "kernel support radius / h (default: [SB12] 3; SPlisHSPlasH uses 2)")
         ->check(CLI::Range(1.5, 6.0));

@@ -52,8 +52,9 @@ private:
         double a[6] = {0, 0, 0, 0, 0, 0};
     };
     void prepare(LiquidStep& step, Real dt);
-    /// mScale: each liquid particle's Laplacian made whole where neighbours are left out.
-    void scaleForMissingNeighbours(LiquidStep& step);
+    /// The liquid pairs (mStart, mCount, mNeighbour, mCoefficient: V_i V_j W' / r / (r^2 +
+    /// 0.01 h^2)) and mScale, each particle's Laplacian made whole where neighbours are left out.
+    void gatherPairs(LiquidStep& step);
     /// The largest such scale: a particle with a quarter of its neighbourhood (a lone drop).
     static constexpr double MAX_SCALE = 4;
     /// y = A v over the liquid (A the system matrix of the file comment).
@@ -67,6 +68,11 @@ private:
     std::vector<char> mLiquid;    ///< per particle: a liquid particle this process solves for
     std::vector<double> mOverRho; ///< m / rho of each particle (m^3)
     std::vector<double> mScale;   ///< gamma_i (scaleForMissingNeighbours)
+    /// Each liquid particle's liquid neighbours (mNeighbour) and, once prepared, their dt c_ij
+    /// (mCoefficient, s kg), from mStart[i], mCount[i] of them: 8 bytes a liquid pair.
+    std::vector<std::size_t> mStart;
+    std::vector<std::uint32_t> mCount, mNeighbour;
+    std::vector<float> mCoefficient;
     std::vector<Block> mDiagonal, mInverse;
     std::vector<sph::Vec3d> mRhs;
     std::vector<sph::Vec3d> mR, mZ, mP, mAp;
