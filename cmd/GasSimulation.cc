@@ -28,7 +28,8 @@ WritableParticles writableGas(gas::GasSolver& s, ParticleKind kind)
     if (kind != ParticleKind::Gas) return {};
     sph::ParticleSet& p = s.particles();
     return {&p, p.hasScalarChannel(gas::channel::AMBIENT) ? &p.scalarChannel(gas::channel::AMBIENT)
-                                                          : nullptr};
+                                                          : nullptr,
+            {}};
 }
 
 OutputMedium gasMedium(const gas::GasSolver& s, const sph::ParticleSet& visible)

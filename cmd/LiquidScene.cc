@@ -69,6 +69,19 @@ ghost::RigidMotion motionOf(const vdbio::SceneSolid& solid)
     return solid.motion.motion();
 }
 
+/// A liquid's or an emitter's own viscosity, checked: a SceneError names the scene and it.
+template <typename Entry>
+std::optional<Real> ownViscosity(const vdbio::Scene& scene, const char* what, const Entry& e)
+{
+    if (!e.viscosity) return std::nullopt;
+    try {
+        ghost::checkOwnViscosity(Real(*e.viscosity), msg(what, " '", e.name, "'"));
+    } catch (const ValueError& error) {
+        throw SceneError(msg("scene '", scene.file, "': ", error.what()));
+    }
+    return Real(*e.viscosity);
+}
+
 } // namespace
 
 namespace {
@@ -174,6 +187,9 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
     auto solver = std::make_unique<GhostSolver>(settings);
     solver->setSampleStore(processSampleCache());
     if (restored) solver->restoreState(*restored);
+    // Each liquid's and emitter's own viscosity is checked before anything is sampled.
+    for (const vdbio::SceneLiquid& l : scene.liquids) ownViscosity(scene, "liquid", l);
+    for (const vdbio::SceneEmitter& e : scene.emitters) ownViscosity(scene, "emitter", e);
     for (std::size_t i = 0; i < scene.solids.size(); ++i) {
         const vdbio::SceneSolid& solid = scene.solids[i];
         try {
@@ -185,7 +201,7 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
     }
     if (!restored) {
         for (const vdbio::SceneLiquid& liquid : scene.liquids) {
-            const std::size_t n = solver->addLiquid(liquid.shape, Vec3(liquid.velocity));
+            const std::size_t n = addSceneLiquid(*solver, scene, liquid);
             if (n == 0) {
                 throw SceneError(
                     msg("scene '", scene.file, "': liquid '", liquid.name, "' (", liquid.geometry,
@@ -196,6 +212,13 @@ std::unique_ptr<GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
     }
     for (const vdbio::SceneEmitter& e : scene.emitters) addSceneEmitter(*solver, e);
     return solver;
+}
+
+std::size_t addSceneLiquid(GhostSolver& solver, const vdbio::Scene& scene,
+                           const vdbio::SceneLiquid& liquid)
+{
+    const std::optional<Real> viscosity = ownViscosity(scene, "liquid", liquid);
+    return solver.addLiquid(liquid.shape, Vec3(liquid.velocity), viscosity);
 }
 
 void addSceneSolid(GhostSolver& solver, const vdbio::SceneSolid& solid)
@@ -221,11 +244,13 @@ void addSceneSolid(GhostSolver& solver, const vdbio::SceneSolid& solid)
 void addSceneEmitter(GhostSolver& solver, const vdbio::SceneEmitter& emitter)
 {
     const Vec3 velocity(emitter.velocity);
+    const std::optional<Real> viscosity =
+        emitter.viscosity ? std::optional<Real>(Real(*emitter.viscosity)) : std::nullopt;
     if (emitter.motion.keys.empty()) {
-        solver.addEmitter(emitter.shape, velocity, emitter.start, emitter.end);
+        solver.addEmitter(emitter.shape, velocity, emitter.start, emitter.end, viscosity);
     } else {
         solver.addMovingEmitter(emitter.shape, velocity, emitter.motion.motion(), emitter.start,
-                                emitter.end);
+                                emitter.end, viscosity);
     }
 }
 

@@ -36,6 +36,11 @@ std::unique_ptr<ghost::GhostSolver> makeLiquidSolver(const vdbio::Scene& scene,
 /// as makeLiquidSolver adds the scene's.
 void addSceneSolid(ghost::GhostSolver& solver, const vdbio::SceneSolid& solid);
 void addSceneEmitter(ghost::GhostSolver& solver, const vdbio::SceneEmitter& emitter);
+/// Sample one of `scene`'s liquid bodies into a liquid solver with its velocity and its own
+/// viscosity, if it has one; returns the particles added. A bad value is a SceneError naming
+/// the scene and the liquid.
+std::size_t addSceneLiquid(ghost::GhostSolver& solver, const vdbio::Scene& scene,
+                           const vdbio::SceneLiquid& liquid);
 
 /// Refuse a scene with a dynamic solid where the solvers cannot move one (`why` names them:
 /// "a gas scene"): a SceneError naming the solid's key.

@@ -386,9 +386,12 @@ void AirResampler::addNewAir(const std::vector<Vec3>& air)
     mHalo = haloFlags();
     const bool fade = mIn.run.initialized;
     auto& weight = particles.scalarChannel(AIR_WEIGHT);
+    Real* progress =
+        particles.hasScalarChannel(AIR_FADE) ? particles.scalarChannel(AIR_FADE).data() : nullptr;
     auto& v = particles.velocities();
     parallel::forEach(first, particles.size(), [&](std::size_t i) {
         weight[i] = fade ? Real(0) : Real(1);
+        if (progress) progress[i] = weight[i];
         particles.masses()[i] = weight[i] * mIn.mass;
         const Index j = nearestBodyParticle(particles.positions()[i]);
         v[i] = j == INVALID_INDEX ? Vec3(0) : v[j];

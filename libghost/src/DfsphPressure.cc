@@ -775,7 +775,8 @@ void DfsphPressure::solveStep(LiquidStep& step, Real dt)
     parallel::forEach(
         0, n, [&](std::size_t i) { w[i] += dt * g; }, 4096);
     if (mFactors.mirror) applyWallHydrostatics(step, dt);
-    // The other non-pressure force, before the density solve ([BK15] Algorithm 1).
+    // The other non-pressure forces, before the density solve ([BK15] Algorithm 1).
+    step.applySurfaceTension(dt);
     step.applyViscosity(dt);
     double densityError = 0, densityPeak = 0;
     const int densityIterations = solve(step, dt, true, set.scalarChannel(DENSITY_KAPPA),

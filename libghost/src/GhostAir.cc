@@ -51,6 +51,16 @@ void GhostSolver::fadeAir(Real span)
     const auto& target = mParticles.scalarChannel(AIR_TARGET);
     // Faded in or out over one round of the phases.
     const Real rate = span / Real(mSettings.airResampleSteps);
+    if (mParticles.hasScalarChannel(AIR_FADE)) {
+        // The fade's progress, apart from the weight: towards 1 while the air has a weight to
+        // reach, towards 0 once it is replaced.
+        auto& fade = mParticles.scalarChannel(AIR_FADE);
+        for (std::size_t i = 0; i < mParticles.size(); ++i) {
+            if (mParticles.kinds()[i] != ParticleKind::GhostAir) continue;
+            fade[i] = target[i] > Real(0) ? std::min(Real(1), fade[i] + rate)
+                                          : std::max(Real(0), fade[i] - rate);
+        }
+    }
     std::vector<std::uint8_t> remove(mParticles.size(), 0);
     bool anyRemoved = false;
     for (std::size_t i = 0; i < mParticles.size(); ++i) {

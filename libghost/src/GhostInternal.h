@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace ghostfx {
@@ -40,6 +41,8 @@ struct GhostSolver::Emitter : sph::MovingLevelSet
 
     sph::Vec3 velocity; ///< of the liquid leaving it (m/s), in the emitter's frame
     double start, end;
+    /// The new liquid's own kinematic viscosity (m^2/s); none: settings.viscosity.
+    std::optional<sph::Real> viscosity;
     /// The shape's shadow along the velocity (m^2; 0 without velocity): the emitted volume
     /// per second is |velocity| crossSection, in the emitter's frame.
     double crossSection = 0;
@@ -121,6 +124,8 @@ constexpr const char* SOLID_LOCAL = "solid_x";     ///< moving solid particle: p
 constexpr const char* SOLID_LOCAL_NORMAL =
     "solid_n";                                   ///< moving solid particle: normal, solid frame
 constexpr const char* AIR_WEIGHT = "air_weight"; ///< ghost air: fade weight, mass = weight m
+/// Ghost air, with surface tension only: how far it has faded in, 0 to 1 (SurfaceTension.h).
+constexpr const char* AIR_FADE = "air_fade";
 constexpr const char* AIR_TARGET = "air_target"; ///< ghost air: 1 fading in / kept, 0 fading out
 constexpr const char* DENSITY_KAPPA = "dfsph_k"; ///< DFSPH: density solve's p / rho^2 (warm start)
 constexpr const char* DIVERGENCE_KAPPA =

@@ -131,6 +131,9 @@ std::vector<LiquidRow> liquidRows()
         LiquidRow::number("viscosity_max_iterations", "viscosityMaxIterations",
                           &G::viscosityMaxIterations, sph::between(1, 100000), "",
                           "iteration cap of each viscosity solve"),
+        LiquidRow::number("surface_tension", "surfaceTension", &G::surfaceTension,
+                          sph::between(0, 1000), "N/m",
+                          "surface tension coefficient sigma; 0 = none"),
         LiquidRow::number("kernel_support", "supportFactor", &G::supportFactor,
                           sph::between(1.5, 5), "h", "kernel support radius / h ([SB12]: 3)"),
         LiquidRow::number("xsph_epsilon", "xsphEpsilon", &G::xsphEpsilon, sph::between(0, 1), "",
@@ -225,6 +228,18 @@ std::vector<DfsphRow> dfsphRows()
 
 } // namespace
 
+void checkOwnViscosity(Real nu, const std::string& what)
+{
+    const auto& rows = liquidSettingTable().rows;
+    const auto row = std::find_if(rows.begin(), rows.end(), [](const auto& r) {
+        return r.key && std::string(r.key) == "viscosity";
+    });
+    if (!row->range.contains(double(nu))) {
+        throw ValueError(msg(what, ": viscosity = ", nu, ": expected ", row->expected(false),
+                                  ", as settings.viscosity"));
+    }
+}
+
 const sph::SettingTable<DfsphSettings>& dfsphSettingTable()
 {
     static const sph::SettingTable<DfsphSettings> table{"liquid setting", dfsphRows()};
@@ -234,6 +249,11 @@ const sph::SettingTable<DfsphSettings>& dfsphSettingTable()
 void GhostSettings::validate() const
 {
     sph::validateTable(liquidSettingTable(), *this);
+    if (surfaceTension > Real(0) && method != Method::Ghost) {
+        throw ValueError(msg("liquid setting surface_tension = ", surfaceTension,
+                             " N/m with method 'basic': expected 0 (the surface force uses the "
+                             "ghost air, which Basic SPH has not)"));
+    }
     if (viscosity > Real(0) && method != Method::Ghost) {
         throw ValueError(msg("liquid setting viscosity = ", viscosity,
                              " m^2/s with method 'basic': expected 0 (Basic SPH has its own "

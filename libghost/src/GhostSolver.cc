@@ -7,6 +7,7 @@
 
 #include "GhostInternal.h"
 #include "ImplicitViscosity.h"
+#include "SurfaceTension.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/FrameSteps.h>
@@ -43,9 +44,10 @@ GhostSolver::GhostSolver(const GhostSettings& settings, std::unique_ptr<Pressure
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
-    if (mSettings.viscosity > Real(0)) {
-        mViscosity = std::make_unique<ImplicitViscosity>();
-        mParticles.addVectorChannel(ImplicitViscosity::CHANNEL);
+    if (mSettings.viscosity > Real(0)) enableViscosity();
+    if (mSettings.surfaceTension > Real(0)) {
+        mSurfaceTension = std::make_unique<SurfaceTension>();
+        mParticles.addScalarChannel(AIR_FADE, Real(1));
     }
     sph::ensureBirthTimes(mParticles, mRun.time);
 }
@@ -99,6 +101,8 @@ void GhostSolver::setExchange(sph::ParticleExchange* exchange, bool ownPart)
     if (mSettings.method != Method::Ghost) refuse("method basic");
     if (!mRun.initialized) refuse("sharing before prepare()");
     if (hasBodies()) refuse("a dynamic solid");
+    if (mViscosity) refuse("viscosity");
+    if (mSettings.surfaceTension > Real(0)) refuse("surface_tension");
     // A fresh run (or one restored whole): every process has the same particles here; keep
     // what this one owns. A run restored from this process's own part of a checkpoint keeps
     // all of it (the particles that left its region since the last exchange migrate at the
@@ -466,7 +470,8 @@ void GhostSolver::appendSolidPositionsInBox(const Aabb& box, std::vector<Vec3>& 
 
 // Liquid and emitters ----------------------------------------------------------------------------
 
-std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
+std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity,
+                                   std::optional<Real> viscosity)
 {
     if (mRestored) {
         throw ValueError(msg("liquid '", shape.name(),
@@ -484,11 +489,14 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity)
     for (const Vec3& x : samples.positions) {
         if (!blockedBySolid(x)) kept.push_back(x);
     }
+    const Index first = Index(mParticles.size());
     addLiquidParticles(kept, velocity);
+    if (viscosity) giveViscosity(first, *viscosity, msg("liquid '", shape.name(), "'"));
     return kept.size();
 }
 
-void GhostSolver::addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity)
+void GhostSolver::addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity,
+                                     std::optional<Real> viscosity)
 {
     if (mRestored) {
         throw ValueError("cannot add liquid particles after restoreState(); the restored particles "
@@ -501,6 +509,22 @@ void GhostSolver::addLiquidParticles(const std::vector<Vec3>& positions, const V
     }
     const Index first = mParticles.addBatch(positions, mMass, ParticleKind::Liquid);
     std::fill(mParticles.velocities().begin() + first, mParticles.velocities().end(), velocity);
+    if (viscosity) giveViscosity(first, *viscosity, "liquid particles");
+}
+
+void GhostSolver::giveViscosity(Index first, Real nu, const std::string& what)
+{
+    checkOwnViscosity(nu, what);
+    std::vector<Real>& channel =
+        mParticles.addScalarChannel(ImplicitViscosity::NU_CHANNEL, mSettings.viscosity);
+    std::fill(channel.begin() + first, channel.end(), nu);
+    if (nu > Real(0)) enableViscosity();
+}
+
+void GhostSolver::enableViscosity()
+{
+    if (!mViscosity) mViscosity = std::make_unique<ImplicitViscosity>();
+    mParticles.addVectorChannel(ImplicitViscosity::CHANNEL);
 }
 
 bool GhostSolver::blockedBySolid(const Vec3& x) const
@@ -514,7 +538,7 @@ bool GhostSolver::blockedBySolid(const Vec3& x) const
 }
 
 void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime,
-                             double endTime)
+                             double endTime, std::optional<Real> viscosity)
 {
     if (!isFinite(velocity)) {
         throw ValueError(msg("emitter '", shape.name(), "': velocity is not finite"));
@@ -524,6 +548,10 @@ void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double
                              " s: expected 0 <= start < end"));
     }
     auto emitter = std::make_unique<Emitter>(shape, velocity, startTime, endTime);
+    emitter->viscosity = viscosity;
+    // The channel and the solve exist from now on, so a checkpoint made before the emitter
+    // starts holds them.
+    if (viscosity) giveViscosity(Index(mParticles.size()), *viscosity, msg("emitter '", shape.name(), "'"));
     if (velocity.lengthSqr() > Real(0)) {
         // Half the finer of the spacing and the voxel, but at most 512 cells across the shape
         // (a metre-wide emitter at 5 mm would otherwise trace 640k rays): the outline's cells
@@ -540,10 +568,11 @@ void GhostSolver::addEmitter(const LevelSet& shape, const Vec3& velocity, double
 }
 
 void GhostSolver::addMovingEmitter(const LevelSet& shape, const Vec3& velocity, RigidMotion motion,
-                                   double startTime, double endTime)
+                                   double startTime, double endTime,
+                                   std::optional<Real> viscosity)
 {
     if (!motion) throw ValueError(msg("moving emitter '", shape.name(), "': no motion given"));
-    addEmitter(shape, velocity, startTime, endTime);
+    addEmitter(shape, velocity, startTime, endTime, viscosity);
     mEmitters.back()->motion = std::move(motion);
     mEmitters.back()->placeAt(mRun.time);
 }
@@ -630,6 +659,10 @@ void GhostSolver::emitFrom(std::size_t e)
     if (fresh.empty()) return;
     const Index first = mParticles.addBatch(fresh, mMass, ParticleKind::Liquid);
     em.giveVelocities(fresh, mParticles.velocities().data() + first);
+    if (em.viscosity) {
+        std::vector<Real>& nu = mParticles.scalarChannel(ImplicitViscosity::NU_CHANNEL);
+        std::fill(nu.begin() + first, nu.end(), *em.viscosity);
+    }
     mRun.emitted += fresh.size();
 }
 
@@ -1011,7 +1044,10 @@ void GhostSolver::restoreState(const SolverState& state)
         mParticles.addScalarChannel(AIR_TARGET, Real(1));
     }
     for (const std::string& c : mPressure->channels()) mParticles.addScalarChannel(c);
+    // A state whose liquids had their own viscosities keeps them (and its solve).
+    if (mParticles.hasScalarChannel(ImplicitViscosity::NU_CHANNEL)) enableViscosity();
     if (mViscosity) mParticles.addVectorChannel(ImplicitViscosity::CHANNEL);
+    if (mSurfaceTension) mParticles.addScalarChannel(AIR_FADE, Real(1));
     mRun = run;
     sph::ensureBirthTimes(mParticles, mRun.time);
     mAirPhase = airPhase;
@@ -1056,7 +1092,8 @@ Real GhostSolver::stableTimeStep() const
     if (mExchange) vmax = Real(mExchange->maxOf(double(vmax)));
     // A dynamic solid's fastest point moves no farther in a step than the liquid may.
     if (hasBodies()) vmax = std::max(vmax, fastestBody());
-    return mPressure->stableTimeStep(mSettings, vmax, mRun.maxAcceleration);
+    const Real dt = mPressure->stableTimeStep(mSettings, vmax, mRun.maxAcceleration);
+    return mSurfaceTension ? std::min(dt, SurfaceTension::capillaryTimeStep(mSettings)) : dt;
 }
 
 void GhostSolver::advanceFrame()

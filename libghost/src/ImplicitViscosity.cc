@@ -126,18 +126,22 @@ void ImplicitViscosity::prepare(LiquidStep& step, Real dt)
     const std::size_t n = set.size();
     const GhostSettings& s = step.settings();
     mDt = dt;
-    mMu = double(s.viscosity) * double(s.restDensity);
     mEps2 = 0.01 * double(s.spacing) * double(s.spacing);
     const auto& kind = set.kinds();
     const auto& m = set.masses();
     const auto& rho = set.densities();
     const auto& x = set.positions();
     const auto& w = set.vectorChannel(VSTAR);
+    const std::vector<Real>* nu = set.hasScalarChannel(NU_CHANNEL)
+                                      ? &set.scalarChannel(NU_CHANNEL)
+                                      : nullptr;
     mLiquid.assign(n, 0);
     mOverRho.assign(n, 0.0);
+    mMu.assign(n, 0.0);
     for (std::size_t i = 0; i < n; ++i) {
         mLiquid[i] = kind[i] == ParticleKind::Liquid;
         mOverRho[i] = double(m[i]) / double(rho[i]);
+        mMu[i] = double(nu ? (*nu)[i] : s.viscosity) * double(s.restDensity);
     }
     gatherPairs(step);
     mDiagonal.assign(n, Block());
@@ -155,7 +159,8 @@ void ImplicitViscosity::prepare(LiquidStep& step, Real dt)
         const Vec3d xi(x[i]);
         for (std::size_t k = mStart[i]; k < mStart[i] + mCount[i]; ++k) {
             const Index j = mNeighbour[k];
-            const double c = 5 * mMu * (mScale[i] + mScale[j]) * double(mCoefficient[k]);
+            const double mu = 0.5 * (mMu[i] + mMu[j]);
+            const double c = 5 * mu * (mScale[i] + mScale[j]) * double(mCoefficient[k]);
             addOuter(d, -double(dt) * c, xi - Vec3d(x[j]));
             mCoefficient[k] = float(double(dt) * c);
         }
@@ -169,7 +174,7 @@ void ImplicitViscosity::prepare(LiquidStep& step, Real dt)
                 for (Index k : step.solidLists(b)[i]) {
                     const Vec3d xis = xi - Vec3d(xs[k]);
                     const double r2 = xis.lengthSqr(), r = std::sqrt(r2);
-                    const double c = 10 * mMu * mScale[i] * mOverRho[i] * (M / double(rhoS[k]))
+                    const double c = 10 * mMu[i] * mScale[i] * mOverRho[i] * (M / double(rhoS[k]))
                                      * double(kernel.gradFactor(Real(r))) / (r2 + mEps2);
                     addOuter(d, -double(dt) * c, xis);
                     if (vs) rhs -= xis * (double(dt) * c * xis.dot(Vec3d(vs[k])));

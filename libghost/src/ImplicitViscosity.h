@@ -38,6 +38,12 @@ class ImplicitViscosity
 public:
     /// The particle channel of each liquid particle's last viscous velocity change (m/s).
     static constexpr const char* CHANNEL = "viscosity_dv";
+    /// Each liquid particle's own kinematic viscosity nu (m^2/s), where a liquid or an
+    /// emitter has its own (GhostSolver::addLiquid); without it every particle has
+    /// settings.viscosity. A pair of liquid particles couples with the mean of their dynamic
+    /// viscosities (which keeps the system symmetric), a particle and a no-slip solid with the
+    /// particle's.
+    static constexpr const char* NU_CHANNEL = GhostSolver::VISCOSITY_CHANNEL;
 
     /// Replace the liquid's v* (LiquidStep::VELOCITY_STAR) by the velocities one backward
     /// Euler step of length dt (s) of the viscous force gives from it. Throws NumericalError
@@ -64,7 +70,8 @@ private:
     int solve(LiquidStep& step, std::vector<sph::Vec3d>& v, double& residual);
 
     Real mDt = 0;
-    double mMu = 0, mEps2 = 0;    ///< nu rho0 (Pa s); 0.01 h^2 (m^2)
+    double mEps2 = 0;             ///< 0.01 h^2 (m^2)
+    std::vector<double> mMu;      ///< nu rho0 of each particle (Pa s)
     std::vector<char> mLiquid;    ///< per particle: a liquid particle this process solves for
     std::vector<double> mOverRho; ///< m / rho of each particle (m^3)
     std::vector<double> mScale;   ///< gamma_i (scaleForMissingNeighbours)

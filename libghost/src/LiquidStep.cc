@@ -5,6 +5,7 @@
 
 #include "GhostInternal.h"
 #include "ImplicitViscosity.h"
+#include "SurfaceTension.h"
 
 namespace ghostfx {
 namespace ghost {
@@ -45,6 +46,11 @@ void LiquidStep::searchAndDensity(const DensityPass& pass)
 void LiquidStep::pressureToSolids() { mSolver.pressureToSolids(); }
 void LiquidStep::setMaxAcceleration(Real a) { mSolver.mRun.maxAcceleration = a; }
 Real LiquidStep::maxAcceleration() const { return mSolver.mRun.maxAcceleration; }
+
+void LiquidStep::applySurfaceTension(Real dt)
+{
+    if (mSolver.mSurfaceTension) mSolver.mSurfaceTension->apply(*this, dt);
+}
 
 void LiquidStep::applyViscosity(Real dt)
 {

@@ -107,6 +107,7 @@ void TaitPressure::step(LiquidStep& step, Real dt)
     std::vector<Vec3> gradMass(shifting ? step.particles().size() : 0, Vec3(0));
     accelerate(step, dt, gradMass);
     step.timings().pressureForce += secondsSince(t0);
+    step.applySurfaceTension(dt);
     step.applyViscosity(dt);
     if (ParticleExchange* exchange = step.exchange()) {
         const auto t = std::chrono::steady_clock::now();

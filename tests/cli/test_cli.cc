@@ -280,6 +280,9 @@ TEST_F(Cli, BadInputGetsOneClearLine)
          "settings.gas: gas settings need a gas method or heaters (boiling)"},
         {" -D 'liquids[0].geometry={\"file\":\"none.vdb\",\"grid\":\"x\"}'",
          "none.vdb' does not exist"},
+        {" -D liquids[0].viscosity=-1", "liquid 'water': viscosity = -1: expected a number in "
+                                        "[0, 100000] (m^2/s), as settings.viscosity"},
+        {" -D 'liquids[0].viscosity=\"thick\"'", "liquids[0].viscosity"},
         {" --frames 5-2", "--frames '5-2': expected 1 <= first <= last"},
         // Frame numbers that do not fit: refused, not wrapped into "nothing to do" with exit 0.
         {" --frames 1-3000000000", "--frames '1-3000000000': expected A-B (e.g. 1-48) or a last "

@@ -111,7 +111,9 @@ TEST(GhostSolver, ASolidAddedAfterTheLiquidRemovesTheLiquidInIt)
     EXPECT_EQ(after, solidFirst.count(ParticleKind::Liquid));
     const ParticleSet& p = liquidFirst.particles();
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] == ParticleKind::Liquid) ASSERT_GE(post.phi(p.positions()[i]), H / 2);
+        if (p.kinds()[i] == ParticleKind::Liquid) {
+            ASSERT_GE(post.phi(p.positions()[i]), H / 2);
+        }
     }
 }
 

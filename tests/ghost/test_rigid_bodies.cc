@@ -183,8 +183,9 @@ TEST(RigidBodies, ABoxFloatsAtItsArchimedesDraftWithEitherPressure)
             std::printf("[measured] %s, box of %.0f kg/m^3: hydrostatic draft %.4f m, geometric "
                         "%.4f m (Archimedes %.4f)\n",
                         name, rho, d.hydrostatic, d.geometric, expected);
-            if (pm == PressureModel::Dfsph)
+            if (pm == PressureModel::Dfsph) {
                 EXPECT_NEAR(d.hydrostatic, expected, 0.03 * 0.1) << name << rho;
+            }
             EXPECT_NEAR(expected - d.geometric, 0.5 * double(H), 0.25 * double(H)) << name << rho;
         }
     }

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -225,4 +226,130 @@ TEST(Viscosity, AResumedViscousRunIsBitIdenticalAndBadSettingsAreRefused)
     GhostSettings negative;
     negative.viscosity = Real(-1);
     EXPECT_THROW(GhostSolver{negative}, ghostfx::ValueError);
+}
+
+namespace {
+
+GhostSettings columnSettings(PressureModel pm)
+{
+    GhostSettings s;
+    s.spacing = Real(0.02);
+    s.pressure = pm;
+    s.stiffness = Real(20000);
+    s.substeps = 0;
+    s.seed = 3;
+    s.solidSlip = SolidSlip::NoSlip;
+    return s;
+}
+
+/// A 10 x 20 x 10 cm column at the left wall of a closed 40 x 30 x 10 cm tank whose inside
+/// starts at x = `x0`.
+void addColumnTank(GhostSolver& solver, float x0, std::optional<Real> nu)
+{
+    solver.addSolid(makeLevelSet(closedTankGrid(Vec3(x0, 0, 0), Vec3(x0 + 0.4f, 0.3f, 0.1f),
+                                                0.08, Real(0.01)),
+                                 "tank"));
+    solver.addLiquid(box(Vec3(x0, 0, 0), Vec3(x0 + 0.1f, 0.2f, 0.1f), "column"), Vec3(0), nu);
+}
+
+/// The 99th percentile of x - x0 over the liquid with x0 <= x < x0 + 0.5 (m).
+double frontFrom(const ParticleSet& p, double x0)
+{
+    std::vector<double> x;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const double xi = double(p.positions()[i][0]);
+        if (p.kinds()[i] == ParticleKind::Liquid && xi >= x0 - 0.01 && xi < x0 + 0.5)
+            x.push_back(xi - x0);
+    }
+    std::sort(x.begin(), x.end());
+    return x[std::size_t(0.99 * double(x.size() - 1))];
+}
+
+} // namespace
+
+// Two liquids of different thickness in one scene (GhostSolver::addLiquid's own viscosity,
+// the "viscosity" channel):
+//  - a liquid given nu = 1 m^2/s of its own moves bit for bit as the same liquid under
+//    settings.viscosity = 1 (the pair's mean of two equal viscosities is that viscosity);
+//  - water and a liquid of 100 m^2/s collapsing side by side in one run (two tanks) move as
+//    each does alone (ACollapsingColumnIsStableFromWaterToPitch's bounds: the water's front
+//    runs more than 10 cm in 0.2 s, the thick one's less than 1 cm);
+//  - a resumed run keeps each particle's viscosity (bit for bit), an emitter's new liquid
+//    takes the emitter's, and a viscosity out of settings.viscosity's range is refused in one
+//    line naming the liquid.
+TEST(Viscosity, EachLiquidCanHaveItsOwnViscosity)
+{
+    for (const PressureModel pm : {PressureModel::Dfsph, PressureModel::Tait}) {
+        GhostSettings s = columnSettings(pm);
+        s.viscosity = Real(1);
+        GhostSolver global(s);
+        addColumnTank(global, 0, std::nullopt);
+        s.viscosity = Real(0);
+        GhostSolver own(s);
+        addColumnTank(own, 0, Real(1));
+        for (int f = 0; f < 3; ++f) {
+            global.advanceFrame();
+            own.advanceFrame();
+        }
+        EXPECT_TRUE(ghostfx::testing::sameBytes(global.particles().positions(),
+                                                own.particles().positions()));
+        EXPECT_TRUE(ghostfx::testing::sameBytes(global.particles().velocities(),
+                                                own.particles().velocities()));
+    }
+    GhostSolver both(columnSettings(PressureModel::Dfsph));
+    addColumnTank(both, 0, std::nullopt);
+    addColumnTank(both, 1, Real(100));
+    both.prepare();
+    const double water0 = frontFrom(both.particles(), 0), thick0 = frontFrom(both.particles(), 1);
+    for (int f = 0; f < 6; ++f) both.advanceFrame();
+    const double water = frontFrom(both.particles(), 0) - water0;
+    const double thick = frontFrom(both.particles(), 1) - thick0;
+    std::printf("[measured] one run, two liquids: the water's front moved %.4f m, the 100 m^2/s "
+                "liquid's %.4f m in 0.2 s\n",
+                water, thick);
+    EXPECT_GT(water, 0.1);
+    EXPECT_LT(thick, 0.01);
+}
+
+TEST(Viscosity, OwnViscositiesResumeAndBadOnesAreRefused)
+{
+    GhostSettings s = columnSettings(PressureModel::Dfsph);
+    auto start = [&](GhostSolver& solver) {
+        solver.addSolid(makeLevelSet(
+            closedTankGrid(Vec3(0, 0, 0), Vec3(0.4f, 0.3f, 0.1f), 0.08, Real(0.01)), "tank"));
+        solver.addEmitter(box(Vec3(0.2f, 0.1f, 0), Vec3(0.26f, 0.16f, 0.1f), "tap"),
+                          Vec3(0, -0.5f, 0), 0, 1, Real(2));
+    };
+    GhostSolver whole(s);
+    start(whole);
+    whole.addLiquid(box(Vec3(0, 0, 0), Vec3(0.1f, 0.2f, 0.1f), "column"), Vec3(0), Real(0.5));
+    for (int f = 0; f < 2; ++f) whole.advanceFrame();
+    const auto saved = whole.saveState();
+    for (int f = 0; f < 2; ++f) whole.advanceFrame();
+    GhostSolver resumed(s);
+    resumed.restoreState(saved);
+    start(resumed);
+    for (int f = 0; f < 2; ++f) resumed.advanceFrame();
+    EXPECT_EQ(ghostfx::testing::firstDifference(whole.saveState(), resumed.saveState()), "");
+    // The column's particles keep 0.5, the tap's new ones have 2 (the tap is 6 cm left of the
+    // column's 10 cm, and its liquid falls away from it).
+    const ParticleSet& p = whole.particles();
+    const std::vector<Real>& nu = p.scalarChannel(GhostSolver::VISCOSITY_CHANNEL);
+    std::size_t fromTap = 0, fromColumn = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kinds()[i] != ParticleKind::Liquid) continue;
+        fromTap += nu[i] == Real(2);
+        fromColumn += nu[i] == Real(0.5);
+    }
+    EXPECT_GT(fromTap, 0u);
+    EXPECT_GT(fromColumn, 0u);
+    EXPECT_EQ(fromTap + fromColumn, p.count(ParticleKind::Liquid));
+    GhostSolver refused(s);
+    try {
+        refused.addLiquid(box(Vec3(0, 0, 0), Vec3(0.1f, 0.2f, 0.1f), "lava"), Vec3(0), Real(-1));
+        ADD_FAILURE() << "a negative viscosity was taken";
+    } catch (const ghostfx::ValueError& e) {
+        EXPECT_EQ(std::string(e.what()), "liquid 'lava': viscosity = -1: expected a number in "
+                                         "[0, 100000] (m^2/s), as settings.viscosity");
+    }
 }

@@ -741,6 +741,7 @@ void readLiquidEntries(const JsonObject& root, Scene& scene)
     for (const JsonObject& o : root.objects("liquids")) {
         SceneLiquid liquid = readShaped<SceneLiquid>(o, scene, Sampled::Volume);
         liquid.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
+        if (o.has("viscosity")) liquid.viscosity = o.require<double>("viscosity");
         o.finish();
         scene.liquids.push_back(std::move(liquid));
     }
@@ -748,6 +749,7 @@ void readLiquidEntries(const JsonObject& root, Scene& scene)
         SceneEmitter emitter = readShaped<SceneEmitter>(o, scene, Sampled::Volume);
         emitter.velocity = vec(o.get<std::array<double, 3>>("velocity", {0, 0, 0}));
         readInterval(o, emitter.start, emitter.end);
+        if (o.has("viscosity")) emitter.viscosity = o.require<double>("viscosity");
         if (auto motion = o.optionalObject("motion")) emitter.motion = readMotion(*motion);
         o.finish();
         scene.emitters.push_back(std::move(emitter));

@@ -203,6 +203,9 @@ struct GhostSettings
     /// The viscosity solve stops when |r| <= viscosityError |b| (its momenta, relative).
     Real viscosityError = Real(1e-4);
     int viscosityMaxIterations = 500; ///< iteration cap of each viscosity solve
+    /// Surface tension coefficient sigma (N/m): water 0.072; 0 = none (the default). A
+    /// continuum surface force over the liquid and its ghost air (SurfaceTension.h).
+    Real surfaceTension = Real(0);
 
     // Ghost SPH ([SB12] Sec. 4) ------------------------------------------------------------------
     Real xsphEpsilon = Real(0.05); ///< epsilon of Eq. 2 (XSPH on velocities)
@@ -303,6 +306,10 @@ struct GhostSettings
 const sph::SettingTable<GhostSettings>& liquidSettingTable();
 /// The settings of scene object `settings.dfsph`.
 const sph::SettingTable<DfsphSettings>& dfsphSettingTable();
+
+/// Throws ValueError "<what>: viscosity = <nu>: expected <settings.viscosity's range>" for a
+/// liquid's own kinematic viscosity `nu` (m^2/s) outside settings.viscosity's range.
+void checkOwnViscosity(Real nu, const std::string& what);
 
 } // namespace ghost
 } // namespace ghostfx

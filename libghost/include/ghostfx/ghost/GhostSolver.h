@@ -58,6 +58,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -110,10 +111,16 @@ struct ViscositySolveStats
 };
 
 class ImplicitViscosity;
+class SurfaceTension;
 
 class GhostSolver
 {
 public:
+    /// The particle channel of a liquid particle's own kinematic viscosity (m^2/s), where a
+    /// liquid or an emitter has one (addLiquid()); without it every particle has
+    /// settings.viscosity.
+    static constexpr const char* VISCOSITY_CHANNEL = "viscosity";
+
     /// Called at the end of every step() with the solver and the step's dt (s), e.g. for
     /// progress, statistics or an interrupt (an exception thrown here leaves step() after a
     /// complete step, so the state stays consistent).
@@ -175,7 +182,11 @@ public:
     /// Sample a liquid body from a level set ([SB12] Sec. 4.5 - 4.6) with initial velocity
     /// `velocity` (m/s). Returns the number of particles added. Throws ValueError after
     /// restoreState(): the restored particles already hold the liquid.
-    std::size_t addLiquid(const LevelSet& shape, const Vec3& velocity = Vec3(0));
+    /// A `viscosity` (m^2/s, in settings.viscosity's range) is this liquid's own: its
+    /// particles carry it in the channel ImplicitViscosity::NU_CHANNEL, and every other
+    /// liquid particle has settings.viscosity (two liquids of different thickness in a scene).
+    std::size_t addLiquid(const LevelSet& shape, const Vec3& velocity = Vec3(0),
+                          std::optional<Real> viscosity = std::nullopt);
 
     /// Continuous emission ([SB12] Sec. 4.5.2): from `startTime` to `endTime` (s) the emitter
     /// volume is kept full of liquid moving at `velocity` (m/s); new particles grow from the
@@ -184,9 +195,10 @@ public:
     /// times the emitter's cross-section (the shadow of its level set along the velocity):
     /// the fills are capped by that rate, since gaps filled a few millimetres a step pack
     /// more tightly than rest density. An emitter with zero velocity has no rate and keeps
-    /// its shape full.
+    /// its shape full. A `viscosity` is the new liquid's own, as addLiquid()'s.
     void addEmitter(const LevelSet& shape, const Vec3& velocity, double startTime = 0,
-                    double endTime = std::numeric_limits<double>::infinity());
+                    double endTime = std::numeric_limits<double>::infinity(),
+                    std::optional<Real> viscosity = std::nullopt);
     /// An emitter moving rigidly (a hose sweeping a floor): at time t its level set (given in
     /// its own frame) sits at `motion(t)`, and `velocity` is the liquid's in that frame. The
     /// liquid in it, and the new liquid, move at `velocity` rotated with the emitter plus the
@@ -194,7 +206,8 @@ public:
     /// frame. Motions are not part of saveState(): a restored run uses what its caller adds.
     void addMovingEmitter(const LevelSet& shape, const Vec3& velocity, RigidMotion motion,
                           double startTime = 0,
-                          double endTime = std::numeric_limits<double>::infinity());
+                          double endTime = std::numeric_limits<double>::infinity(),
+                          std::optional<Real> viscosity = std::nullopt);
     /// Each emitter's cross-section (m^2, the shadow of its shape along its velocity; 0 without
     /// velocity) and the mass it pours per second (kg/s, rho0 |velocity| times that), in the
     /// order added.
@@ -206,7 +219,8 @@ public:
 
     /// Add liquid particles at given positions (m), e.g. a lattice for a test. Throws
     /// ValueError after restoreState(), like addLiquid().
-    void addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity = Vec3(0));
+    void addLiquidParticles(const std::vector<Vec3>& positions, const Vec3& velocity = Vec3(0),
+                            std::optional<Real> viscosity = std::nullopt);
 
     /// Advance one frame: `substeps` fixed steps, or CFL-limited steps up to the frame end.
     /// With settings.pressure = dfsph the pressure channel is set by the frame's last step
@@ -468,6 +482,13 @@ private:
     /// A step with no liquid: time, the solids and (`accrue`) the emitters' credit advance.
     void stepWithoutLiquid(Real dt, std::chrono::steady_clock::time_point start, bool accrue);
     bool blockedBySolid(const Vec3& x) const;
+    /// Give the liquid particles from `first` on their own kinematic viscosity `nu` (checked
+    /// against settings.viscosity's range; `what` names them in the error), making the
+    /// channel and the viscosity solve where the run has none yet.
+    void giveViscosity(Index first, Real nu, const std::string& what);
+    /// The viscosity solve and its channels, where settings.viscosity or a liquid's own asks
+    /// for one.
+    void enableViscosity();
     void appendSolidPositionsInBox(const sph::Aabb& box, std::vector<Vec3>& out) const;
     /// Resample the air in the blocks of `count` phases from `phase` on (phase < 0:
     /// everywhere), see AirResampling.h.
@@ -576,6 +597,8 @@ private:
     std::unique_ptr<PressureSolver> mPressure;
     /// The implicit viscosity, with GhostSettings::viscosity > 0 (ImplicitViscosity.h).
     std::unique_ptr<ImplicitViscosity> mViscosity;
+    /// The surface tension, with GhostSettings::surfaceTension > 0 (SurfaceTension.h).
+    std::unique_ptr<SurfaceTension> mSurfaceTension;
     InitialDensityError mInitialError;
     std::size_t mPairCount = 0;
     StepObserver mObserver;

@@ -92,6 +92,9 @@ public:
     /// The liquid's largest acceleration this step (m/s^2): the next step's force limit.
     void setMaxAcceleration(Real a);
     Real maxAcceleration() const;
+    /// The surface tension's acceleration (GhostSettings::surfaceTension) added to v* times
+    /// dt. Nothing without surface tension.
+    void applySurfaceTension(Real dt);
     /// The liquid's viscosity (GhostSettings::viscosity), implicitly: v* becomes the
     /// velocities one backward Euler step of the viscous force gives from it. Nothing without
     /// viscosity. A model calls it once its other non-pressure forces are in v*.

@@ -105,6 +105,9 @@ struct SceneLiquid : SceneShape
     using SceneShape::SceneShape;
 
     sph::Vec3d velocity{0};
+    /// The liquid's own kinematic viscosity (m^2/s); none: settings.viscosity. The solver
+    /// checks its range (settings.viscosity's).
+    std::optional<double> viscosity;
 };
 
 struct SceneEmitter : SceneShape
@@ -113,6 +116,7 @@ struct SceneEmitter : SceneShape
 
     sph::Vec3d velocity{0}; ///< of the liquid leaving it, in its own frame (m/s)
     double start = 0, end = std::numeric_limits<double>::infinity();
+    std::optional<double> viscosity; ///< of the new liquid, as SceneLiquid's
     sph::KeyedMotion motion; ///< a moving emitter (a hose sweeping a floor); empty: static
 };
 
