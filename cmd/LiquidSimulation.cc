@@ -34,6 +34,7 @@ OutputMedium liquidMedium(const GhostSolver& s)
     m.support = s.settings().supportRadius();
     m.restDensity = s.settings().restDensity;
     m.gravity = s.settings().gravity;
+    m.viscosity = s.settings().viscosity;
     m.liquid = true;
     m.pendingMass = [&s] { return s.initialized() ? 0.0 : double(s.startParticleMass()); };
     return m;

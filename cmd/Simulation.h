@@ -36,6 +36,7 @@ struct OutputMedium
     std::function<sph::ParticleSet()> withGhosts;
     double spacing = 0, support = 0, restDensity = 0;
     sph::Vec3 gravity{0}; ///< the medium's gravity (m/s^2)
+    double viscosity = 0; ///< a liquid's kinematic viscosity settings.viscosity (m^2/s)
     bool liquid = true;   ///< liquids get a surface; gases get temperature
     /// A gas's ambient temperature (K): its temperature grid's background; NaN: none.
     double ambientTemperature = std::numeric_limits<double>::quiet_NaN();

@@ -1,6 +1,7 @@
 /// @file   StudyMetrics.cc
 /// @brief  The study's error metrics: density deviation, volume and mass drift, hydrostatic
-///         pressure, free fall, the zero-gravity cube, the dam-break surge front and the plume top.
+///         pressure, free fall, the zero-gravity cube, the dam-break surge front, the plume top
+///         and plane Poiseuille flow.
 #include "StudyMetrics.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -417,6 +418,73 @@ private:
     double mExtent0 = 1, mError = NAN, mExtentChange = NAN;
 };
 
+// poiseuille --------------------------------------------------------------------------------------
+// Plane Poiseuille flow: a liquid between no-slip plates at y = 0 and y = gap, driven along x by
+// the scene's gravity (its x component g), has the steady profile u(y) = g y (gap - y) / (2 nu).
+// Over the last part of the run (from `from` of it), the liquid within `x_window` of x = 0 and
+// `z_window` of z = 0 is cut into layers one spacing thick; each layer's mean x-velocity at its
+// mean height is compared with u there. The error is the largest difference over the profile's
+// peak g gap^2 / (8 nu).
+
+class Poiseuille : public Metric
+{
+public:
+    Poiseuille(double gap, double from, double xWindow, double zWindow)
+        : Metric("poiseuille")
+        , mGap(gap)
+        , mFrom(from)
+        , mX(xWindow)
+        , mZ(zWindow)
+    {}
+
+    void start(const MetricSample& s) override
+    {
+        if (!(s.medium->viscosity > 0) || s.medium->gravity[0] == 0) {
+            throw SceneError("metric poiseuille: expects a viscous liquid (settings.viscosity > 0) "
+                             "driven along x (settings.gravity[0] != 0)");
+        }
+        const std::size_t layers = std::size_t(std::lround(mGap / s.medium->spacing));
+        mU.assign(layers, 0.0);
+        mY.assign(layers, 0.0);
+        mCount.assign(layers, 0.0);
+    }
+
+    void frame(const MetricSample& s) override
+    {
+        if (double(s.frame) < mFrom * double(s.lastFrame)) return;
+        const sph::ParticleSet& p = *s.medium->particles;
+        const double h = mGap / double(mU.size());
+        for (std::size_t i : members(*s.medium)) {
+            const Vec3& x = p.positions()[i];
+            if (std::abs(x[0]) > mX || std::abs(x[2]) > mZ) continue;
+            const std::size_t k =
+                std::size_t(std::clamp(std::floor(double(x[1]) / h), 0.0, double(mU.size() - 1)));
+            mU[k] += double(p.velocities()[i][0]);
+            mY[k] += double(x[1]);
+            mCount[k] += 1;
+        }
+        const double g = s.medium->gravity[0], nu = s.medium->viscosity;
+        const double peak = std::abs(g) * mGap * mGap / (8 * nu);
+        mError = 0;
+        for (std::size_t k = 0; k < mU.size(); ++k) {
+            if (mCount[k] == 0) continue;
+            const double y = mY[k] / mCount[k];
+            const double exact = g * y * (mGap - y) / (2 * nu);
+            mError = std::max(mError, std::abs(mU[k] / mCount[k] - exact) / peak);
+        }
+    }
+
+    std::vector<std::pair<std::string, double>> values() const override
+    {
+        return {{"poiseuille_error", mError}};
+    }
+
+private:
+    double mGap, mFrom, mX, mZ;
+    std::vector<double> mU, mY, mCount;
+    double mError = NAN;
+};
+
 // surge_front and plume_rise ----------------------------------------------------------------------
 // A position along a direction, taken as a high percentile over the medium's particles (so one
 // stray droplet or puff does not set it), after every frame: the dam break's surge front along
@@ -461,7 +529,7 @@ const std::vector<std::string>& metricNames()
 {
     static const std::vector<std::string> names = {
         "density_error", "volume_drift", "hydrostatic_pressure", "free_fall", "cube_shape",
-        "surge_front",   "plume_rise"};
+        "surge_front",   "plume_rise",   "poiseuille"};
     return names;
 }
 
@@ -472,7 +540,8 @@ std::string primaryErrorColumn(const std::string& metric, bool haveReference)
         {"volume_drift", "volume_error"},
         {"hydrostatic_pressure", "hydrostatic_pressure_error"},
         {"free_fall", "free_fall_com_error"},
-        {"cube_shape", "cube_shape_error"}};
+        {"cube_shape", "cube_shape_error"},
+        {"poiseuille", "poiseuille_error"}};
     auto it = primary.find(metric);
     if (it != primary.end()) return it->second;
     return haveReference ? metric + "_error" : metric + "_final";
@@ -492,6 +561,11 @@ std::unique_ptr<Metric> makeMetric(const MetricSpec& spec, const std::string& wh
         metric = std::make_unique<FreeFall>();
     } else if (spec.name == "cube_shape") {
         metric = std::make_unique<CubeShape>();
+    } else if (spec.name == "poiseuille") {
+        metric = std::make_unique<Poiseuille>(o.number("gap", 0.1, 1e-6, 1e6),
+                                              o.number("from", 0.5, 0, 1),
+                                              o.number("x_window", 0.1, 0, 1e6),
+                                              o.number("z_window", 0.03, 0, 1e6));
     } else if (spec.name == "surge_front") {
         metric = std::make_unique<Front>("surge_front", "liquid",
                                          o.direction("direction", Vec3(1, 0, 0)),

@@ -260,7 +260,7 @@ TEST_F(Study, BadStudyFilesGetOneClearLine)
             "ghostfx: error: study '" + file
                 + "': metrics[0] = \"free_fal\": unknown metric "
                   "(expected one of density_error, volume_drift, hydrostatic_pressure, free_fall, "
-                  "cube_shape, surge_front, plume_rise)\n");
+                  "cube_shape, surge_front, plume_rise, poiseuille)\n");
     }
     {
         Json s = baseStudy();
@@ -358,6 +358,32 @@ TEST_F(Study, HydrostaticTankPressureFollowsRhoGD)
     // Single particles scatter more than the layer means: the noise bounds the profile error.
     EXPECT_GE(num(rows[0], "hydrostatic_pressure_noise"),
               num(rows[0], "hydrostatic_pressure_error"));
+}
+
+// The poiseuille metric on the shipped study's scene (examples/studies/poiseuille/) at 1.25 cm
+// spacing (eight layers across the 10 cm gap), DFSPH at nu = 0.5 m^2/s: the profile within the
+// issue's 3 % of the parabola's peak (the study measured 1.2 % at this spacing, 8 % at 2 cm,
+// where five layers do not resolve the parabola: docs/study.md); a
+// liquid without viscosity is refused in one line, since the metric has no answer for it.
+TEST_F(Study, PoiseuilleMetricReadsTheParabola)
+{
+    Json s = baseStudy();
+    s["scene"] = (fs::path(GHOSTFX_SOURCE_DIR) / "examples/studies/poiseuille/scene.json").string();
+    s["set"] = {{"settings.spacing", 0.0125}};
+    s["metrics"] = Json::parse(R"([ { "metric": "poiseuille", "gap": 0.1 } ])");
+    const Result r = run("study " + writeStudy(s).string() + " --threads 2");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(mDir / "out" / "study.csv");
+    ASSERT_EQ(rows.size(), 1u);
+    ASSERT_EQ(rows[0].at("status"), "ok") << rows[0].at("note");
+    std::printf("[measured] study Poiseuille, 1.25 cm: profile error %.4f of the peak\n",
+                num(rows[0], "poiseuille_error"));
+    EXPECT_LT(num(rows[0], "poiseuille_error"), 0.03);
+    fs::remove_all(mDir / "out");
+    s["set"]["settings.viscosity"] = 0;
+    const Result refused = run("study " + writeStudy(s).string() + " --threads 2");
+    EXPECT_NE(refused.err.find("metric poiseuille: expects a viscous liquid"), std::string::npos)
+        << refused.err;
 }
 
 TEST_F(Study, CasesRunAsSeparateJobsInAnyOrderThenCollectGiveTheLocalTable)
