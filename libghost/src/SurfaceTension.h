@@ -19,6 +19,13 @@
 ///          before the density solve, whose pressure then carries the jump; with the Tait step
 ///          it is added after the pressure force.
 ///
+///          Why a continuum surface force and not Akinci et al. 2013's cohesion and curvature
+///          forces: Akinci's cohesion kernel and its particle-count correction give a tension
+///          whose size depends on the kernel and the spacing, so sigma in N/m would need a
+///          calibration per spacing, and the tests measure sigma itself (Laplace's
+///          jump, Rayleigh's period). The CSF force is sigma kappa n by construction, and the
+///          ghost air gives it the whole neighbourhood that its curvature needs.
+///
 ///          A capillary wave of the spacing's length is resolved when dt <= sqrt(rho0 h^3 /
 ///          (2 pi sigma)) (Brackbill et al. Eq. 61): GhostSolver::stableTimeStep takes it.
 #pragma once
