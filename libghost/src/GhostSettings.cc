@@ -108,8 +108,8 @@ using Relaxation = sph::PoissonSettings::Relaxation;
 const sph::EnumName<Relaxation> RELAXATION_NAMES[] = {{Relaxation::Sb12, "sb12"},
                                                       {Relaxation::Packing, "packing"}};
 
-/// The rows of the liquid's own keys (discretisation, liquid, ghosts, Basic SPH, sampling).
-std::vector<LiquidRow> liquidRows()
+/// The rows of the liquid itself: spacing, frames, pressure model and its material.
+std::vector<LiquidRow> materialRows()
 {
     return {
         LiquidRow::number(nullptr, "spacing", &G::spacing, sph::positive(), "m",
@@ -134,6 +134,13 @@ std::vector<LiquidRow> liquidRows()
         LiquidRow::number("surface_tension", "surfaceTension", &G::surfaceTension,
                           sph::between(0, 1000), "N/m",
                           "surface tension coefficient sigma; 0 = none"),
+    };
+}
+
+/// The rows of the method's own keys (kernel, XSPH, ghosts, Basic SPH, sampling).
+std::vector<LiquidRow> methodRows()
+{
+    return {
         LiquidRow::number("kernel_support", "supportFactor", &G::supportFactor,
                           sph::between(1.5, 5), "h", "kernel support radius / h ([SB12]: 3)"),
         LiquidRow::number("xsph_epsilon", "xsphEpsilon", &G::xsphEpsilon, sph::between(0, 1), "",
@@ -169,6 +176,15 @@ std::vector<LiquidRow> liquidRows()
         LiquidRow::flag("tiled_sampling", "tiledSampling", &G::tiledSampling,
                         "sample deep interiors from a relaxed periodic tile"),
     };
+}
+
+/// The rows of the liquid's own keys, in the order scenes and docs list them.
+std::vector<LiquidRow> liquidRows()
+{
+    std::vector<LiquidRow> rows = materialRows();
+    const std::vector<LiquidRow> method = methodRows();
+    rows.insert(rows.end(), method.begin(), method.end());
+    return rows;
 }
 
 } // namespace

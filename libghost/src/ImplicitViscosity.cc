@@ -118,20 +118,14 @@ void ImplicitViscosity::gatherPairs(LiquidStep& step)
         256);
 }
 
-void ImplicitViscosity::prepare(LiquidStep& step, Real dt)
+void ImplicitViscosity::gatherParticles(LiquidStep& step)
 {
-    // The diagonal blocks m I - dt sum c x x^T (liquid and no-slip solid pairs), their
-    // inverses, and the right-hand side m w - dt sum_s c_is x_is (x_is . v_s).
-    ParticleSet& set = step.particles();
+    const ParticleSet& set = step.particles();
     const std::size_t n = set.size();
     const GhostSettings& s = step.settings();
-    mDt = dt;
-    mEps2 = 0.01 * double(s.spacing) * double(s.spacing);
     const auto& kind = set.kinds();
     const auto& m = set.masses();
     const auto& rho = set.densities();
-    const auto& x = set.positions();
-    const auto& w = set.vectorChannel(VSTAR);
     const std::vector<Real>* nu = set.hasScalarChannel(NU_CHANNEL)
                                       ? &set.scalarChannel(NU_CHANNEL)
                                       : nullptr;
@@ -143,13 +137,51 @@ void ImplicitViscosity::prepare(LiquidStep& step, Real dt)
         mOverRho[i] = double(m[i]) / double(rho[i]);
         mMu[i] = double(nu ? (*nu)[i] : s.viscosity) * double(s.restDensity);
     }
+}
+
+Vec3d ImplicitViscosity::addWalls(LiquidStep& step, std::size_t i, double* d) const
+{
+    // The no-slip solids' pairs: their part of the diagonal block, and their known velocities'
+    // part of the right-hand side (returned, to subtract).
+    const CubicSplineKernel& kernel = step.kernel();
+    const double M = double(step.particleMass());
+    const Vec3d xi(step.particles().positions()[i]);
+    Vec3d known(0.0);
+    for (const LiquidStep::Block b : {LiquidStep::STATIC, LiquidStep::MOVING}) {
+        const ParticleSet& solids = step.solids(b);
+        const Vec3* vs = solidVelocities(solids);
+        const auto& xs = solids.positions();
+        const auto& rhoS = solids.densities();
+        for (Index k : step.solidLists(b)[i]) {
+            const Vec3d xis = xi - Vec3d(xs[k]);
+            const double r2 = xis.lengthSqr(), r = std::sqrt(r2);
+            const double c = 10 * mMu[i] * mScale[i] * mOverRho[i] * (M / double(rhoS[k]))
+                             * double(kernel.gradFactor(Real(r))) / (r2 + mEps2);
+            addOuter(d, -double(mDt) * c, xis);
+            if (vs) known += xis * (double(mDt) * c * xis.dot(Vec3d(vs[k])));
+        }
+    }
+    return known;
+}
+
+void ImplicitViscosity::prepare(LiquidStep& step, Real dt)
+{
+    // The diagonal blocks m I - dt sum c x x^T (liquid and no-slip solid pairs), their
+    // inverses, and the right-hand side m w - dt sum_s c_is x_is (x_is . v_s).
+    ParticleSet& set = step.particles();
+    const std::size_t n = set.size();
+    const GhostSettings& s = step.settings();
+    mDt = dt;
+    mEps2 = 0.01 * double(s.spacing) * double(s.spacing);
+    const auto& m = set.masses();
+    const auto& x = set.positions();
+    const auto& w = set.vectorChannel(VSTAR);
+    gatherParticles(step);
     gatherPairs(step);
     mDiagonal.assign(n, Block());
     mInverse.assign(n, Block());
     mRhs.assign(n, Vec3d(0.0));
     const bool noSlip = s.solidSlip == SolidSlip::NoSlip;
-    const CubicSplineKernel& kernel = step.kernel();
-    const double M = double(step.particleMass());
     parallel::forEach(
         0, n,
         [&](std::size_t i) {
@@ -165,22 +197,7 @@ void ImplicitViscosity::prepare(LiquidStep& step, Real dt)
             mCoefficient[k] = float(double(dt) * c);
         }
         Vec3d rhs = Vec3d(w[i]) * double(m[i]);
-        if (noSlip) {
-            for (const LiquidStep::Block b : {LiquidStep::STATIC, LiquidStep::MOVING}) {
-                const ParticleSet& solids = step.solids(b);
-                const Vec3* vs = solidVelocities(solids);
-                const auto& xs = solids.positions();
-                const auto& rhoS = solids.densities();
-                for (Index k : step.solidLists(b)[i]) {
-                    const Vec3d xis = xi - Vec3d(xs[k]);
-                    const double r2 = xis.lengthSqr(), r = std::sqrt(r2);
-                    const double c = 10 * mMu[i] * mScale[i] * mOverRho[i] * (M / double(rhoS[k]))
-                                     * double(kernel.gradFactor(Real(r))) / (r2 + mEps2);
-                    addOuter(d, -double(dt) * c, xis);
-                    if (vs) rhs -= xis * (double(dt) * c * xis.dot(Vec3d(vs[k])));
-                }
-            }
-        }
+        if (noSlip) rhs -= addWalls(step, i, d);
         mRhs[i] = rhs;
         invertSymmetric(d, mInverse[i].a);
         },

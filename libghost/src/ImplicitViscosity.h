@@ -58,6 +58,11 @@ private:
         double a[6] = {0, 0, 0, 0, 0, 0};
     };
     void prepare(LiquidStep& step, Real dt);
+    /// mLiquid, mOverRho and mMu of every particle.
+    void gatherParticles(LiquidStep& step);
+    /// Add liquid particle i's no-slip solid pairs to its diagonal block `d`; returns their
+    /// known part of its right-hand side, dt sum_s c_is x_is (x_is . v_s).
+    sph::Vec3d addWalls(LiquidStep& step, std::size_t i, double* d) const;
     /// The liquid pairs (mStart, mCount, mNeighbour, mCoefficient: V_i V_j W' / r / (r^2 +
     /// 0.01 h^2)) and mScale, each particle's Laplacian made whole where neighbours are left out.
     void gatherPairs(LiquidStep& step);

@@ -126,12 +126,36 @@ TEST(Viscosity, PlanePoiseuilleFlowHasTheParabolicProfile)
 
 namespace {
 
-/// The 99th percentile of x over the liquid (m): the front of a collapsing column.
-double front(const ParticleSet& p)
+GhostSettings columnSettings(PressureModel pm)
+{
+    GhostSettings s;
+    s.spacing = Real(0.02);
+    s.pressure = pm;
+    s.stiffness = Real(20000);
+    s.substeps = 0;
+    s.seed = 3;
+    s.solidSlip = SolidSlip::NoSlip;
+    return s;
+}
+
+/// A 10 x 20 x 10 cm column at the left wall of a closed 40 x 30 x 10 cm tank whose inside
+/// starts at x = `x0`.
+void addColumnTank(GhostSolver& solver, float x0, std::optional<Real> nu)
+{
+    solver.addSolid(makeLevelSet(closedTankGrid(Vec3(x0, 0, 0), Vec3(x0 + 0.4f, 0.3f, 0.1f),
+                                                0.08, Real(0.01)),
+                                 "tank"));
+    solver.addLiquid(box(Vec3(x0, 0, 0), Vec3(x0 + 0.1f, 0.2f, 0.1f), "column"), Vec3(0), nu);
+}
+
+/// The 99th percentile of x - x0 over the liquid with x0 <= x < x0 + 0.5 (m).
+double frontFrom(const ParticleSet& p, double x0)
 {
     std::vector<double> x;
     for (std::size_t i = 0; i < p.size(); ++i) {
-        if (p.kinds()[i] == ParticleKind::Liquid) x.push_back(p.positions()[i][0]);
+        const double xi = double(p.positions()[i][0]);
+        if (p.kinds()[i] == ParticleKind::Liquid && xi >= x0 - 0.01 && xi < x0 + 0.5)
+            x.push_back(xi - x0);
     }
     std::sort(x.begin(), x.end());
     return x[std::size_t(0.99 * double(x.size() - 1))];
@@ -151,22 +175,14 @@ TEST(Viscosity, ACollapsingColumnIsStableFromWaterToPitch)
     for (const PressureModel pm : {PressureModel::Dfsph, PressureModel::Tait}) {
         double previous = 1e9;
         for (const double nu : {1e-6, 1e-3, 1.0, 100.0}) {
-            GhostSettings s;
-            s.spacing = Real(0.02);
-            s.pressure = pm;
-            s.stiffness = Real(20000);
-            s.substeps = 0;
-            s.seed = 3;
+            GhostSettings s = columnSettings(pm);
             s.viscosity = Real(nu);
-            s.solidSlip = SolidSlip::NoSlip;
             GhostSolver solver(s);
-            solver.addSolid(makeLevelSet(
-                closedTankGrid(Vec3(0, 0, 0), Vec3(0.4f, 0.3f, 0.1f), 0.08, Real(0.01)), "tank"));
-            solver.addLiquid(box(Vec3(0, 0, 0), Vec3(0.1f, 0.2f, 0.1f), "column"));
+            addColumnTank(solver, 0, std::nullopt);
             solver.prepare();
-            const double start = front(solver.particles());
+            const double start = frontFrom(solver.particles(), 0);
             for (int f = 0; f < 6; ++f) solver.advanceFrame();
-            const double moved = front(solver.particles()) - start;
+            const double moved = frontFrom(solver.particles(), 0) - start;
             const ViscositySolveStats& v = solver.viscositySolveStats();
             std::printf("[measured] %s, nu = %g m^2/s: front moved %.4f m in 0.2 s; %llu solves, "
                         "%.1f iterations each, %llu unconverged\n",
@@ -228,44 +244,6 @@ TEST(Viscosity, AResumedViscousRunIsBitIdenticalAndBadSettingsAreRefused)
     EXPECT_THROW(GhostSolver{negative}, ghostfx::ValueError);
 }
 
-namespace {
-
-GhostSettings columnSettings(PressureModel pm)
-{
-    GhostSettings s;
-    s.spacing = Real(0.02);
-    s.pressure = pm;
-    s.stiffness = Real(20000);
-    s.substeps = 0;
-    s.seed = 3;
-    s.solidSlip = SolidSlip::NoSlip;
-    return s;
-}
-
-/// A 10 x 20 x 10 cm column at the left wall of a closed 40 x 30 x 10 cm tank whose inside
-/// starts at x = `x0`.
-void addColumnTank(GhostSolver& solver, float x0, std::optional<Real> nu)
-{
-    solver.addSolid(makeLevelSet(closedTankGrid(Vec3(x0, 0, 0), Vec3(x0 + 0.4f, 0.3f, 0.1f),
-                                                0.08, Real(0.01)),
-                                 "tank"));
-    solver.addLiquid(box(Vec3(x0, 0, 0), Vec3(x0 + 0.1f, 0.2f, 0.1f), "column"), Vec3(0), nu);
-}
-
-/// The 99th percentile of x - x0 over the liquid with x0 <= x < x0 + 0.5 (m).
-double frontFrom(const ParticleSet& p, double x0)
-{
-    std::vector<double> x;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        const double xi = double(p.positions()[i][0]);
-        if (p.kinds()[i] == ParticleKind::Liquid && xi >= x0 - 0.01 && xi < x0 + 0.5)
-            x.push_back(xi - x0);
-    }
-    std::sort(x.begin(), x.end());
-    return x[std::size_t(0.99 * double(x.size() - 1))];
-}
-
-} // namespace
 
 // Two liquids of different thickness in one scene (GhostSolver::addLiquid's own viscosity,
 // the "viscosity" channel):
