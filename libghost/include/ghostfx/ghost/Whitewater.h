@@ -61,14 +61,14 @@ enum class WhitewaterType : std::int32_t
 struct WhitewaterSettings
 {
     /// Trapped-air potential clamp (m/s).
-    Real trappedAirMin = Real(0.2), trappedAirMax = Real(1);
+    Real trappedAirMin = Real(0.5), trappedAirMax = Real(2);
     /// Wave-crest potential clamp: the surface's curvature (1/m).
     Real waveCrestMin = Real(20), waveCrestMax = Real(80);
     /// A crest is a surface particle moving out of the liquid at least this fast (m/s)
     /// relative to its neighbours' mean (and within 53 degrees of the normal).
     Real waveCrestSpeed = Real(0.2);
     /// Energy potential clamp: specific kinetic energy (J/kg).
-    Real energyMin = Real(0.1), energyMax = Real(2);
+    Real energyMin = Real(0.5), energyMax = Real(5);
     /// Particles made per m^3 of liquid per second at full potentials (trapped air, crests).
     Real trappedAirRate = Real(2e7), waveCrestRate = Real(2e7);
     /// Liquid fraction c below which a particle is spray, above which it is a bubble.
@@ -76,9 +76,11 @@ struct WhitewaterSettings
     /// Spray's drag towards still air (1/s).
     Real sprayDrag = Real(0.5);
     /// A bubble's buoyancy as a multiple of -gravity, and its drag towards the liquid (1/s).
-    Real bubbleBuoyancy = Real(2), bubbleDrag = Real(10);
+    /// (With the defaults a bubble rises through still liquid at 1.5 g / 50 = 0.29 m/s, as
+    /// millimetre air bubbles in water do.)
+    Real bubbleBuoyancy = Real(1.5), bubbleDrag = Real(50);
     /// Foam dissolves after a lifetime drawn uniformly from [min, max] (s).
-    Real foamLifetimeMin = Real(2), foamLifetimeMax = Real(5);
+    Real foamLifetimeMin = Real(1), foamLifetimeMax = Real(3);
     std::uint64_t seed = 0;
 
     /// Throws ValueError naming the first field out of range or a min above its max.
