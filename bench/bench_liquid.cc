@@ -22,6 +22,7 @@
 ///
 ///          Run: build/bench/bench_liquid [--liquid 100000] [--steps 30] [--warmup 20]
 #include <ghostfx/ghost/GhostSolver.h>
+#include <ghostfx/ghost/Whitewater.h>
 #include <ghostfx/sph/DomainDecomposition.h>
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/sph/Kernels.h>
@@ -63,6 +64,7 @@ struct Options
     double stiffness = 0;          ///< > 0: Tait k (Pa) instead of the default ([SB12]: 2000)
     double viscosity = 0;          ///< kinematic viscosity nu (m^2/s), no-slip walls when > 0
     double viscosityError = 0;     ///< > 0: settings.viscosity_error instead of the default
+    bool whitewater = false;       ///< also time ghost::Whitewater after each measured step
     double kernelSupport = 0;      ///< > 0: kernel support / h instead of the default ([SB12]: 3)
     double shifting = -1;          ///< >= 0: particle shifting coefficient instead of the default
     std::string airWeights;        ///< "matched" or "complete" instead of the default
@@ -209,6 +211,8 @@ struct RunResult
     PressureModel pressure = PressureModel::Tait;
     PressureSolveStats solve; ///< DFSPH iterations over the measured steps
     double viscosityIterations = 0, viscositySeconds = 0; ///< per measured step
+    double whitewaterSeconds = 0;  ///< per measured step: the snapshot and Whitewater::step
+    std::size_t whitewaterMade = 0, whitewaterLeft = 0;
     bool ok = false;
     std::string error;
     std::size_t liquid = 0, air = 0, solid = 0;                  ///< at the end of the measurement
@@ -346,6 +350,8 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
     std::vector<double> times;
     bool measuring = false;
     ViscositySolveStats viscosityAtStart;
+    Whitewater white{WhitewaterSettings()};
+    double whiteSum = 0;
     try {
         if (solver.count(ParticleKind::Liquid) == 0) {
             solver.addLiquidParticles(liquidPositions, scene.liquidVelocity);
@@ -381,6 +387,14 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
             nbrs += solver.meanNeighbors();
             ++out.steps;
             if (opt.trace) traceStep(solver, dt, elapsed);
+            if (opt.whitewater) {
+                t0 = std::chrono::steady_clock::now();
+                const GhostSettings& gs = solver.settings();
+                white.step(LiquidSnapshot::fromParticles(solver.particles(), gs.spacing,
+                                                         gs.supportFactor, gs.gravity),
+                           dt);
+                whiteSum += seconds(t0);
+            }
         }
         out.ok = true;
     } catch (const NumericalError& e) {
@@ -401,6 +415,9 @@ void runMethod(const Scene& scene, Method method, const std::vector<Vec3>& liqui
         const ViscositySolveStats& v = solver.viscositySolveStats();
         out.viscosityIterations = double(v.iterations - viscosityAtStart.iterations) / out.steps;
         out.viscositySeconds = (v.seconds - viscosityAtStart.seconds) / out.steps;
+        out.whitewaterSeconds = whiteSum / out.steps;
+        out.whitewaterMade = std::size_t(white.made());
+        out.whitewaterLeft = white.size();
     }
 
     if (opt.halo && out.steps > 0) {
@@ -506,6 +523,11 @@ void printRun(const RunResult& r)
         std::printf("  viscosity: %.1f iterations and %.1f ms per step (%.1f %% of the step)\n",
                     r.viscosityIterations, 1e3 * r.viscositySeconds,
                     percent(r.viscositySeconds, r.meanStep));
+    }
+    if (r.whitewaterSeconds > 0) {
+        std::printf("  whitewater: %.1f ms per step (%.1f %% of the step), %zu made, %zu at the end\n",
+                    1e3 * r.whitewaterSeconds, percent(r.whitewaterSeconds, r.meanStep),
+                    r.whitewaterMade, r.whitewaterLeft);
     }
     if (r.pressure == PressureModel::Dfsph) {
         const PressureSolveStats& st = r.solve;
@@ -639,6 +661,9 @@ void addSettingOptions(CLI::App& app, Options& opt)
     app.add_option("--viscosity", opt.viscosity,
                    "kinematic viscosity nu (m^2/s) with no-slip walls (default 0: none)")
         ->check(CLI::Range(0.0, 1e5));
+    app.add_flag("--whitewater", opt.whitewater,
+                 "also time the whitewater (ghost::Whitewater) after each measured step, apart "
+                 "from the step");
     app.add_option("--viscosity-error", opt.viscosityError,
                    "relative residual of the viscosity solve (default: the settings' 1e-4)")
         ->check(CLI::Range(1e-10, 0.1));
