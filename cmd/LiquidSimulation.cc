@@ -141,9 +141,11 @@ public:
         GhostSolver* solver = mSolver.get();
         return {&solver->particles(), nullptr, [solver] { solver->liquidMoved(); }};
     }
-    std::size_t addLiquid(const sph::LevelSet& shape, const Vec3& velocity) override
+    std::size_t addLiquid(const sph::LevelSet& shape, const Vec3& velocity,
+                          std::optional<double> viscosity) override
     {
-        return mSolver->addLiquid(shape, velocity);
+        return mSolver->addLiquid(shape, velocity,
+                                  viscosity ? std::optional<Real>(Real(*viscosity)) : std::nullopt);
     }
 
     vdbio::StatsRow statsRow(int frame, double dt) override

@@ -84,7 +84,8 @@ void Simulation::addGasSource(const vdbio::SceneGasSource& source)
 
 WritableParticles Simulation::writableParticles(ParticleKind /*kind*/) { return {}; }
 
-std::size_t Simulation::addLiquid(const sph::LevelSet& shape, const Vec3& /*velocity*/)
+std::size_t Simulation::addLiquid(const sph::LevelSet& shape, const Vec3& /*velocity*/,
+                                  std::optional<double> /*viscosity*/)
 {
     throw ValueError("liquid '" + shape.name()
                      + "': adding liquid from a script is supported in liquid scenes only");

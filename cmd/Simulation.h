@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -130,11 +131,13 @@ public:
     virtual void setSolidMotion(std::size_t index, sph::RigidMotion motion);
     /// Add a solid (static without velocity or keys, as a scene solid), a liquid body, a liquid
     /// emitter or a gas source beside the scene's (scripts), as the scene's own are added;
-    /// addLiquid returns the liquid particles added. Solids, liquid bodies and emitters: liquid
+    /// addLiquid returns the liquid particles added; a `viscosity` (m^2/s) is the liquid's own
+    /// (GhostSolver::addLiquid). Solids, liquid bodies and emitters: liquid
     /// scenes only; gas sources: gas scenes and the vapour of boiling ones. The others refuse
     /// with a ValueError naming the shape.
     virtual void addSolid(const vdbio::SceneSolid& solid);
-    virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity);
+    virtual std::size_t addLiquid(const sph::LevelSet& shape, const sph::Vec3& velocity,
+                                  std::optional<double> viscosity = std::nullopt);
     virtual void addEmitter(const vdbio::SceneEmitter& emitter);
     virtual void addGasSource(const vdbio::SceneGasSource& source);
     /// Dynamic solids (rigid bodies the liquid moves, added as solids with `dynamic`), for

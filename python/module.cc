@@ -357,7 +357,8 @@ public:
     }
 
     void addEmitter(const sph::LevelSet& shape, const std::array<double, 3>& velocity, double start,
-                    double end, const py::object& name, const py::object& motion)
+                    double end, const py::object& name, const py::object& motion,
+                    std::optional<double> viscosity)
     {
         vdbio::SceneEmitter e(name.is_none() ? shape.name() : name.cast<std::string>(),
                               "add_emitter", shape);
@@ -365,6 +366,7 @@ public:
         e.velocity = vec3(velocity);
         e.start = start;
         e.end = end;
+        e.viscosity = viscosity;
         if (!motion.is_none()) e.motion = motionFromPython(motion, "add_emitter('" + e.name + "')");
         mSim->addEmitter(e);
         mScene->emitters.push_back(e);
@@ -390,10 +392,11 @@ public:
         mInputs.gasSources.push_back(g);
     }
 
-    std::size_t addLiquid(const sph::LevelSet& shape, const std::array<double, 3>& velocity)
+    std::size_t addLiquid(const sph::LevelSet& shape, const std::array<double, 3>& velocity,
+                          std::optional<double> viscosity)
     {
         py::gil_scoped_release release;
-        return mSim->addLiquid(shape, sph::Vec3(vec3(velocity)));
+        return mSim->addLiquid(shape, sph::Vec3(vec3(velocity)), viscosity);
     }
 
     /// Add a rigid body (a dynamic solid) of `shape` before the first step; `density` (kg/m^3)
@@ -785,17 +788,19 @@ void bindScripting(PySimulationClass& c)
              "(default: the level set's) must be new; set_solid_velocity finds it, previews draw "
              "it, checkpoints keep it. Its ghosts are sampled now. Liquid scenes")
         .def("add_liquid", &PySimulation::addLiquid, py::arg("level_set"),
-             py::arg("velocity") = zero,
+             py::arg("velocity") = zero, py::arg("viscosity") = py::none(),
              "Sample a liquid body into the simulation before its first frame; returns the "
-             "particles added. Liquid scenes")
+             "particles added. `viscosity` (m^2/s) is its own, in settings.viscosity's range "
+             "(default: settings.viscosity). Liquid scenes")
         .def("add_emitter", &PySimulation::addEmitter, py::arg("level_set"), py::arg("velocity"),
              py::arg("start") = 0.0, py::arg("end") = never, py::arg("name") = py::none(),
-             py::arg("motion") = py::none(),
+             py::arg("motion") = py::none(), py::arg("viscosity") = py::none(),
              "Add a liquid emitter, as a scene emitter: from `start` to `end` (s) its volume is "
              "kept full of liquid moving at `velocity` (m/s, in the emitter's own frame), pouring "
              "rho0 |velocity| times its cross-section in kg/s. `motion`: keys as add_solid's, "
              "moving and turning the emitter (a sweeping hose); the liquid leaves at `velocity` "
-             "turned with it plus the emitter's own velocity. Kept in checkpoints. Liquid scenes")
+             "turned with it plus the emitter's own velocity. `viscosity` (m^2/s): the new "
+             "liquid's own. Kept in checkpoints. Liquid scenes")
         .def("add_gas_source", &PySimulation::addGasSource, py::arg("level_set"),
              py::arg("velocity") = zero, py::arg("temperature") = 373.15, py::arg("rate") = 0.0,
              py::arg("start") = 0.0, py::arg("end") = never, py::arg("name") = py::none(),

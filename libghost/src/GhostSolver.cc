@@ -479,6 +479,8 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity,
                              "the restored particles already hold the liquid (skip liquid "
                              "bodies when resuming)"));
     }
+    const std::string what = msg("liquid '", shape.name(), "'");
+    if (viscosity) checkOwnViscosity(*viscosity, what); // before anything is added
     const PoissonSettings ps =
         bodySampling(mSettings.seed + 7919ULL * (mParticles.count(ParticleKind::Liquid) + 1));
     const SampleSet samples = sph::sampleVolumeStored(ps, shape, mSampleStore);
@@ -491,7 +493,7 @@ std::size_t GhostSolver::addLiquid(const LevelSet& shape, const Vec3& velocity,
     }
     const Index first = Index(mParticles.size());
     addLiquidParticles(kept, velocity);
-    if (viscosity) giveViscosity(first, *viscosity, msg("liquid '", shape.name(), "'"));
+    if (viscosity) giveViscosity(first, *viscosity, what);
     return kept.size();
 }
 
@@ -502,6 +504,7 @@ void GhostSolver::addLiquidParticles(const std::vector<Vec3>& positions, const V
         throw ValueError("cannot add liquid particles after restoreState(); the restored particles "
                          "already hold the liquid (skip liquid bodies when resuming)");
     }
+    if (viscosity) checkOwnViscosity(*viscosity, "liquid particles");
     for (std::size_t k = 0; k < positions.size(); ++k) {
         if (!isFinite(positions[k])) {
             throw ValueError(msg("liquid particle ", k, " has a non-finite position"));

@@ -344,10 +344,19 @@ def test_scene_from_a_dict_and_bodies_added_from_level_sets(tmp_path):
     drop2 = ghostfx.LevelSet.from_array(
         np.linalg.norm(origin + voxel * np.indices((40, 40, 40)).transpose(1, 2, 3, 0) - [0.0, 0.1, 0.0], axis=-1) - 0.04,
         voxel, tuple(origin), "drop2")
-    added = sim.add_liquid(drop2, (0, -0.5, 0))
+    # A liquid's own viscosity outside settings.viscosity's range is refused in one line.
+    before = sim.positions("liquid").shape[0]
+    with pytest.raises(ValueError, match="viscosity = -1: expected a number in"):
+        sim.add_liquid(drop2, (0, -0.5, 0), viscosity=-1)
+    assert sim.positions("liquid").shape[0] == before  # nothing was added
+    added = sim.add_liquid(drop2, (0, -0.5, 0), viscosity=0.5)
     # A 4 cm ball at 2 cm spacing: volume / spacing^3 = 33.5 particles, within the sampler's packing.
     assert 20 < added < 60
     n = sim.positions("liquid").shape[0]
+    # The second drop carries its own viscosity in the 'viscosity' channel, the scene's drop the
+    # settings' (0).
+    nu = sim.channel("liquid", "viscosity")
+    assert (nu == 0.5).sum() == added and (nu == 0).sum() == n - added
     sim.run()
     # In 1/3 s both drops reach the floor slab (top at y = -0.02; free fall from y = 0.06 takes
     # 0.13 s). Some splash off its edges and fall on; none is inside it: collision projection

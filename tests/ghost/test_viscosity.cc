@@ -330,4 +330,5 @@ TEST(Viscosity, OwnViscositiesResumeAndBadOnesAreRefused)
         EXPECT_EQ(std::string(e.what()), "liquid 'lava': viscosity = -1: expected a number in "
                                          "[0, 100000] (m^2/s), as settings.viscosity");
     }
+    EXPECT_EQ(refused.particles().size(), 0u); // nothing was added
 }
