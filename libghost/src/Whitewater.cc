@@ -7,10 +7,12 @@
 #include <ghostfx/sph/NeighborGrid.h>
 #include <ghostfx/sph/Parallel.h>
 #include <ghostfx/sph/Random.h>
+#include <ghostfx/sph/SettingSpec.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <tuple>
 
 namespace ghostfx {
 namespace ghost {
@@ -27,13 +29,6 @@ double clampPotential(double value, double lo, double hi)
     return (std::min(value, hi) - std::min(value, lo)) / (hi - lo);
 }
 
-void requireRange(bool ok, const char* field, double value, const char* expected)
-{
-    if (!ok) {
-        throw ValueError(msg("whitewater setting ", field, " = ", value, ": expected ", expected));
-    }
-}
-
 /// Two unit vectors normal to the unit vector a.
 void basisAround(const Vec3d& a, Vec3d& e1, Vec3d& e2)
 {
@@ -45,30 +40,76 @@ void basisAround(const Vec3d& a, Vec3d& e1, Vec3d& e2)
 
 } // namespace
 
+namespace {
+
+using Row = sph::SettingSpec<WhitewaterSettings>;
+using W = WhitewaterSettings;
+
+std::vector<Row> whitewaterRows()
+{
+    using sph::between;
+    using sph::nonNegative;
+    using sph::positive;
+    return {
+        Row::number("trapped_air_min", "trappedAirMin", &W::trappedAirMin, nonNegative(), "m/s",
+                    "trapped-air potential: relative speed of neighbours where it starts"),
+        Row::number("trapped_air_max", "trappedAirMax", &W::trappedAirMax, positive(), "m/s",
+                    "trapped-air potential: relative speed where it is full"),
+        Row::number("wave_crest_min", "waveCrestMin", &W::waveCrestMin, nonNegative(), "1/m",
+                    "wave-crest potential: surface curvature where it starts"),
+        Row::number("wave_crest_max", "waveCrestMax", &W::waveCrestMax, positive(), "1/m",
+                    "wave-crest potential: surface curvature where it is full"),
+        Row::number("wave_crest_speed", "waveCrestSpeed", &W::waveCrestSpeed, nonNegative(), "m/s",
+                    "a crest moves out of the liquid at least this fast"),
+        Row::number("energy_min", "energyMin", &W::energyMin, nonNegative(), "J/kg",
+                    "kinetic-energy potential: |v|^2 / 2 where it starts"),
+        Row::number("energy_max", "energyMax", &W::energyMax, positive(), "J/kg",
+                    "kinetic-energy potential: |v|^2 / 2 where it is full"),
+        Row::number("trapped_air_rate", "trappedAirRate", &W::trappedAirRate, nonNegative(),
+                    "1/(m^3 s)", "particles per m^3 of liquid per second at full trapped air"),
+        Row::number("wave_crest_rate", "waveCrestRate", &W::waveCrestRate, nonNegative(),
+                    "1/(m^3 s)", "particles per m^3 of liquid per second on full crests"),
+        Row::number("spray_below", "sprayBelow", &W::sprayBelow, between(0, 1), "",
+                    "liquid fraction below which a particle is spray"),
+        Row::number("bubble_above", "bubbleAbove", &W::bubbleAbove, between(0, 1), "",
+                    "liquid fraction above which a particle is a bubble"),
+        Row::number("spray_drag", "sprayDrag", &W::sprayDrag, nonNegative(), "1/s",
+                    "spray's drag towards still air"),
+        Row::number("bubble_buoyancy", "bubbleBuoyancy", &W::bubbleBuoyancy, nonNegative(), "g",
+                    "a bubble's buoyancy as a multiple of -gravity"),
+        Row::number("bubble_drag", "bubbleDrag", &W::bubbleDrag, nonNegative(), "1/s",
+                    "a bubble's drag towards the liquid's velocity"),
+        Row::number("foam_lifetime_min", "foamLifetimeMin", &W::foamLifetimeMin, nonNegative(),
+                    "s", "shortest foam lifetime"),
+        Row::number("foam_lifetime_max", "foamLifetimeMax", &W::foamLifetimeMax, positive(), "s",
+                    "longest foam lifetime"),
+        Row::seed("seed", "seed", &W::seed, "random seed of the whitewater made"),
+    };
+}
+
+} // namespace
+
+const sph::SettingTable<WhitewaterSettings>& whitewaterSettingTable()
+{
+    static const sph::SettingTable<WhitewaterSettings> table{"whitewater setting",
+                                                             whitewaterRows()};
+    return table;
+}
+
 void WhitewaterSettings::validate() const
 {
-    const std::pair<const char*, std::pair<Real, Real>> clamps[] = {
-        {"trapped_air", {trappedAirMin, trappedAirMax}},
-        {"wave_crest", {waveCrestMin, waveCrestMax}},
-        {"energy", {energyMin, energyMax}},
-        {"foam_lifetime", {foamLifetimeMin, foamLifetimeMax}}};
-    for (const auto& [name, range] : clamps) {
-        requireRange(std::isfinite(range.first) && range.first >= 0, name, range.first,
-                     "a minimum >= 0");
-        requireRange(std::isfinite(range.second) && range.second > range.first, name,
-                     range.second, "a maximum above the minimum");
+    sph::validateTable(whitewaterSettingTable(), *this);
+    const sph::SettingCheck check("whitewater setting");
+    // Each maximum above its minimum: {max's field, min's field, max, min}.
+    const std::tuple<const char*, const char*, Real, Real> pairs[] = {
+        {"trappedAirMax", "trappedAirMin", trappedAirMax, trappedAirMin},
+        {"waveCrestMax", "waveCrestMin", waveCrestMax, waveCrestMin},
+        {"energyMax", "energyMin", energyMax, energyMin},
+        {"foamLifetimeMax", "foamLifetimeMin", foamLifetimeMax, foamLifetimeMin},
+        {"bubbleAbove", "sprayBelow", bubbleAbove, sprayBelow}};
+    for (const auto& [high, low, hi, lo] : pairs) {
+        check.require(hi > lo, high, hi, msg("a number above ", low, " (", lo, ")").c_str());
     }
-    for (const auto& [name, v] : {std::pair<const char*, Real>{"trapped_air_rate", trappedAirRate},
-                                  {"wave_crest_speed", waveCrestSpeed},
-                                  {"wave_crest_rate", waveCrestRate},
-                                  {"spray_drag", sprayDrag},
-                                  {"bubble_buoyancy", bubbleBuoyancy},
-                                  {"bubble_drag", bubbleDrag}}) {
-        requireRange(std::isfinite(v) && v >= 0, name, v, "a number >= 0");
-    }
-    requireRange(sprayBelow >= 0 && sprayBelow < bubbleAbove, "spray_below", sprayBelow,
-                 "a number in [0, bubble_above)");
-    requireRange(bubbleAbove <= 1, "bubble_above", bubbleAbove, "a number in (spray_below, 1]");
 }
 
 LiquidSnapshot LiquidSnapshot::fromParticles(const sph::ParticleSet& particles, Real spacing,
@@ -176,6 +217,49 @@ void Whitewater::step(const LiquidSnapshot& liquid, Real dt)
     remove();
     classify(field);
     ++mGeneration;
+}
+
+sph::SolverState Whitewater::saveState() const
+{
+    sph::SolverState state;
+    state.solver = "whitewater";
+    sph::ParticleSet& p = state.particles;
+    for (std::size_t k = 0; k < mPositions.size(); ++k)
+        p.add(mPositions[k], mVelocities[k], Real(0), sph::ParticleKind::Liquid);
+    p.ids() = mIds;
+    p.setNextId(mNextId);
+    std::vector<Real>& types = p.addScalarChannel("type");
+    for (std::size_t k = 0; k < mTypes.size(); ++k) types[k] = Real(int(mTypes[k]));
+    p.addScalarChannel("age") = mAges;
+    p.addScalarChannel("life") = mLives;
+    state.integers["generation"] = std::int64_t(mGeneration);
+    return state;
+}
+
+void Whitewater::restoreState(const sph::SolverState& state)
+{
+    if (state.solver != "whitewater") {
+        throw ValueError(msg("whitewater: cannot continue from a '", state.solver, "' state"));
+    }
+    const sph::ParticleSet& p = state.particles;
+    for (const char* channel : {"type", "age", "life"}) {
+        if (!p.hasScalarChannel(channel)) {
+            throw ValueError(msg("whitewater state: no particle channel '", channel, "'"));
+        }
+    }
+    mGeneration = std::uint64_t(state.count("generation"));
+    mNextId = p.nextId();
+    mPositions = p.positions();
+    mVelocities = p.velocities();
+    mIds = p.ids();
+    mTypes.clear();
+    for (Real t : p.scalarChannel("type")) {
+        if (!(t == Real(0) || t == Real(1) || t == Real(2)))
+            throw ValueError(msg("whitewater state: particle type ", t, ": expected 0, 1 or 2"));
+        mTypes.push_back(WhitewaterType(int(t)));
+    }
+    mAges = p.scalarChannel("age");
+    mLives = p.scalarChannel("life");
 }
 
 void Whitewater::advect(const Field& field, Real dt)

@@ -110,7 +110,8 @@ TEST(Whitewater, ADropMakesNoneInFreeFallAndSprayWhereItHits)
 }
 
 // The same liquid in another order, and at 1 and 2 threads, gives the same whitewater bit for
-// bit (the liquid is sorted by id; each particle's random numbers are seeded by its id).
+// bit (the liquid is sorted by id; each particle's random numbers are seeded by its id); so does
+// a whitewater continued from its saved state halfway.
 TEST(Whitewater, TheLiquidsOrderAndTheThreadCountChangeNothing)
 {
     GhostSolver solver(liquidSettings());
@@ -122,10 +123,16 @@ TEST(Whitewater, TheLiquidsOrderAndTheThreadCountChangeNothing)
         solver.advanceFrame();
         frames.push_back(snapshot(solver));
     }
-    auto run = [&](bool shuffled, int threads) {
+    auto run = [&](bool shuffled, int threads, std::size_t resumeAt = 0) {
         parallel::ThreadLimit limit(threads);
         Whitewater white{WhitewaterSettings()};
-        for (LiquidSnapshot liquid : frames) {
+        for (std::size_t f = 0; f < frames.size(); ++f) {
+            LiquidSnapshot liquid = frames[f];
+            if (f == resumeAt && f > 0) {
+                Whitewater resumed{WhitewaterSettings()};
+                resumed.restoreState(white.saveState());
+                white = resumed;
+            }
             if (shuffled) {
                 std::vector<std::size_t> order(liquid.ids.size());
                 for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
@@ -142,15 +149,18 @@ TEST(Whitewater, TheLiquidsOrderAndTheThreadCountChangeNothing)
         }
         return white;
     };
-    const Whitewater a = run(false, 2), b = run(true, 2), c = run(false, 1);
+    const Whitewater a = run(false, 2), b = run(true, 2), c = run(false, 1), d = run(false, 2, 4);
     std::printf("[measured] determinism: %zu whitewater particles\n", a.size());
     ASSERT_GT(a.size(), 0u);
-    for (const Whitewater* other : {&b, &c}) {
+    for (const Whitewater* other : {&b, &c, &d}) {
         ASSERT_EQ(other->size(), a.size());
         EXPECT_TRUE(std::equal(a.positions().begin(), a.positions().end(),
                                other->positions().begin()));
         EXPECT_TRUE(std::equal(a.ids().begin(), a.ids().end(), other->ids().begin()));
         EXPECT_TRUE(std::equal(a.types().begin(), a.types().end(), other->types().begin()));
+        EXPECT_TRUE(std::equal(a.ages().begin(), a.ages().end(), other->ages().begin()));
+        EXPECT_TRUE(std::equal(a.velocities().begin(), a.velocities().end(),
+                               other->velocities().begin()));
     }
 }
 
@@ -180,7 +190,7 @@ TEST(Whitewater, ParticlesInSolidsOrOutsideTheKillBoxAreRemoved)
         ADD_FAILURE() << "energy max below min was taken";
     } catch (const ghostfx::ValueError& e) {
         EXPECT_EQ(std::string(e.what()),
-                  "whitewater setting energy = 0.05: expected a maximum above the minimum");
+                  "whitewater setting energyMax = 0.05: expected a number above energyMin (0.5)");
     }
 }
 

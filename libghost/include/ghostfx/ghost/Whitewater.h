@@ -38,6 +38,8 @@
 #pragma once
 
 #include <ghostfx/sph/ParticleSet.h>
+#include <ghostfx/sph/SettingSpec.h>
+#include <ghostfx/sph/SolverState.h>
 #include <ghostfx/sph/Types.h>
 
 #include <cstdint>
@@ -87,6 +89,10 @@ struct WhitewaterSettings
     void validate() const;
 };
 
+/// The whitewater settings, each declared once: the keys of a scene's `settings.whitewater`,
+/// their ranges, units and meanings (docs/scene-format.md lists them).
+const sph::SettingTable<WhitewaterSettings>& whitewaterSettingTable();
+
 /// The liquid a whitewater step reads: positions and velocities as single-precision numbers
 /// (as points files hold them, so that a run inline and a post-process over its files see the
 /// same liquid) and particle ids.
@@ -127,6 +133,14 @@ public:
     const std::vector<Real>& ages() const { return mAges; }
     /// Particles made so far, all steps.
     std::uint64_t made() const { return std::uint64_t(mNextId); }
+
+    /// Everything a run needs to continue exactly (solver "whitewater"): the particles with
+    /// their channels "type", "age" and "life" (the foam lifetime left), the next id and the
+    /// generation count.
+    sph::SolverState saveState() const;
+    /// Continue from saveState()'s state (of a Whitewater with the same settings). ValueError
+    /// for another solver's state or a damaged one.
+    void restoreState(const sph::SolverState& state);
 
 private:
     struct Field; // the liquid's neighbour grid and per-particle sums (Whitewater.cc)
