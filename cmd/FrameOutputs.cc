@@ -1,8 +1,9 @@
 /// @file   FrameOutputs.cc
 /// @brief  A frame's files from its snapshot (FrameWriter.h, writeFrameOutputs): each medium's
-///         points and volume files, the liquid's mesh, and the preview of the scene with its
+///         points and volume files, the liquid's mesh and whitewater, and the preview of the scene with its
 ///         solids where they are.
 #include "FrameWriter.h"
+#include "SceneWhitewater.h"
 #include "SolidGrids.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -189,6 +190,24 @@ std::optional<vdbio::PreviewLayer> mediumLayer(const OutputMedium& m,
     return std::nullopt;
 }
 
+/// The whitewater as a white fog layer: every class's volume fraction (WhitewaterFile.h) at the
+/// fog output's voxel size, else h / 2, with the extinction of spheres of its radius r: spheres
+/// much larger than the wavelength remove light over twice their cross-section pi r^2, which is
+/// 1.5 / r per metre at volume fraction 1.
+vdbio::PreviewLayer whitewaterLayer(const vdbio::Scene& scene, const vdbio::WhitewaterPoints& w)
+{
+    const double fog = scene.outputs.whitewaterFogVoxelSize;
+    const double radius = whitewaterRadius(scene);
+    vdbio::PreviewLayer layer;
+    layer.name = "whitewater";
+    layer.grid = vdbio::makeWhitewaterFog(w, -1, fog > 0 ? fog : scene.spacing / 2, radius,
+                                          "whitewater");
+    layer.kind = vdbio::PreviewLayer::Kind::Fog;
+    layer.albedo = vdbio::WHITEWATER_ALBEDO;
+    layer.extinction = 1.5 / radius;
+    return layer;
+}
+
 /// The camera and image of outputs.preview.
 vdbio::PreviewOptions previewOptions(const vdbio::SceneOutputs& out)
 {
@@ -255,6 +274,12 @@ std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,
         if (auto layer = mediumLayer(m, grids, out.previewGrid, namedGridFound))
             media.push_back(*layer);
     }
+    if (snapshot.whitewater && !out.whitewaterFile.empty()) {
+        writeWhitewaterFiles(scene, *snapshot.whitewater, inFolder(out.whitewaterFile),
+                             out.whitewaterFogVoxelSize > 0 ? inFolder(out.whitewaterFogFile)
+                                                            : std::string(),
+                             fileMeta);
+    }
     if (out.previewFile.empty()) return notes;
     // checkOutputs() refused this before the first step; a medium's grids can still be missing
     // (a frame written by a script).
@@ -263,6 +288,7 @@ std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,
                              out.previewGrid.empty() ? "(default)" : out.previewGrid,
                              "': the volume output has no such grid"));
     }
+    if (snapshot.whitewater) media.push_back(whitewaterLayer(scene, *snapshot.whitewater));
     writePreview(scene, snapshot, media, inFolder(out.previewFile), previewCache);
     return notes;
 }

@@ -96,6 +96,8 @@ FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation
         }
         s.media.push_back(std::move(m));
     }
+    if (std::optional<vdbio::WhitewaterPoints> w = sim.whitewater())
+        s.whitewater = std::make_shared<const vdbio::WhitewaterPoints>(std::move(*w));
     return s;
 }
 

@@ -52,6 +52,8 @@ struct FrameSnapshot
     /// Where each solid is at `time` (Simulation::solidPlacements), for the preview; empty:
     /// where the scene's motion puts it.
     std::vector<sph::RigidTransform> solidPlacements;
+    /// The whitewater (Simulation::whitewater); null: the scene makes none.
+    std::shared_ptr<const vdbio::WhitewaterPoints> whitewater;
 };
 
 /// The options a medium's points and volume outputs are built with, from the scene's outputs
@@ -71,8 +73,8 @@ bool volumeHoldsMeshGrids(const vdbio::VolumeOptions& vo);
 /// points output asks for them).
 FrameSnapshot snapshotFrame(const vdbio::SceneOutputs& outputs, const Simulation& sim, int frame);
 
-/// Write the scene's outputs of a snapshot into `folder` (points, volume, mesh and preview
-/// files, as the scene's `outputs` name them); every file atomically. `previewCache` keeps the
+/// Write the scene's outputs of a snapshot into `folder` (points, volume, mesh, whitewater and
+/// preview files, as the scene's `outputs` name them); every file atomically. `previewCache` keeps the
 /// static solids' preview hits from one frame to the next (the pictures are the same without
 /// it). Returns lines for the run's log: what each mesh file holds.
 std::vector<std::string> writeFrameOutputs(const vdbio::Scene& scene,

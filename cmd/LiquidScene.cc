@@ -35,6 +35,9 @@ ghost::GhostSettings liquidSettings(const vdbio::Scene& scene, ghost::Method met
         d.finish();
     }
     g.killBox = scene.killBox;
+    // settings.whitewater: read by whitewaterSettings (SceneWhitewater.h); boiling scenes make
+    // no whitewater, so theirs stays an unknown key.
+    if (scene.heaters.empty()) s.has("whitewater");
     s.finish();
     validateSceneSettings(scene.file, g);
     if (g.method != ghost::Method::Ghost) {

@@ -2,6 +2,7 @@
 /// @brief  A liquid scene ([SB12] Ghost SPH or the Basic SPH baseline) behind Simulation.
 #include "LiquidScene.h"
 #include "OneSolverSimulation.h"
+#include "SceneWhitewater.h"
 #include "SimulationParts.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -45,17 +46,41 @@ namespace {
 class LiquidSimulation : public OneSolverSimulation<GhostSolver>
 {
 public:
+    /// `restored`: the liquid's state, then the whitewater's where the checkpoint has it (a
+    /// scene that asks for whitewater after its checkpoint starts it there).
     LiquidSimulation(const vdbio::Scene& scene, ghost::Method method,
-                     const sph::SolverState* restored)
-        : OneSolverSimulation(makeLiquidSolver(scene, liquidSettings(scene, method), restored))
+                     const std::vector<sph::SolverState>* restored)
+        : OneSolverSimulation(makeLiquidSolver(scene, liquidSettings(scene, method),
+                                               restored ? &restored->front() : nullptr))
         , mScene(scene)
-    {}
+    {
+        if (scene.outputs.whitewaterFile.empty()) return;
+        mWhitewater = std::make_unique<SceneWhitewater>(scene, mSolver->settings());
+        if (restored && restored->size() > 1) mWhitewater->restoreState(restored->at(1));
+    }
 
     void advanceFrame() override
     {
         const std::uint64_t unconverged = mSolver->pressureSolveStats().unconverged;
         const std::uint64_t recomputed = mSolver->pressureSolveStats().recomputedSteps;
         mSolver->advanceFrame();
+        if (mWhitewater) {
+            mWhitewater->step(liquidPointsOf(liquidMedium(*mSolver), mScene.outputs,
+                                             mSolver->time()),
+                              mSolver->frame(), mSolver->time(), solidPlacements(), "whitewater");
+        }
+        warnAboutSolves(unconverged, recomputed);
+    }
+    std::optional<vdbio::WhitewaterPoints> whitewater() const override
+    {
+        if (!mWhitewater) return std::nullopt;
+        return mWhitewater->points();
+    }
+
+    /// The warnings of the frame's DFSPH solves: the first recomputed gradients of the run,
+    /// and solves that stopped above their error limit.
+    void warnAboutSolves(std::uint64_t unconverged, std::uint64_t recomputed)
+    {
         const ghost::PressureSolveStats& st = mSolver->pressureSolveStats();
         if (st.recomputedSteps > recomputed && !mWarnedRecomputed) {
             // Once a run: from here on the steps are slower, not wrong.
@@ -212,7 +237,12 @@ public:
         return {{"liquid", mSolver->count(ParticleKind::Liquid)}};
     }
 
-    std::vector<sph::SolverState> saveStates() const override { return {mSolver->saveState()}; }
+    std::vector<sph::SolverState> saveStates() const override
+    {
+        std::vector<sph::SolverState> states{mSolver->saveState()};
+        if (mWhitewater) states.push_back(mWhitewater->saveState());
+        return states;
+    }
 
     std::vector<Vec3> prepareToShare() override
     {
@@ -225,6 +255,11 @@ public:
     }
     void share(sph::ParticleExchange& exchange, bool ownPart) override
     {
+        if (mWhitewater) {
+            throw SceneError(msg("scene '", mScene.file, "': outputs.whitewater: whitewater is "
+                                 "made on one process: run this scene without mpirun, or make "
+                                 "it afterwards with 'ghostfx whitewater' over its points files"));
+        }
         try {
             mSolver->setExchange(&exchange, ownPart);
         } catch (const ValueError& e) {
@@ -237,6 +272,7 @@ private:
     ghost::PhaseTimings mBefore;
     ghost::PressureSolveStats mSolveBefore;
     bool mWarnedRecomputed = false; ///< the kept-gradient limit's warning was printed
+    std::unique_ptr<SceneWhitewater> mWhitewater; ///< null: the scene asks for none
 };
 
 } // namespace
@@ -245,14 +281,17 @@ std::unique_ptr<Simulation> makeLiquidSimulation(const vdbio::Scene& scene, ghos
                                                  const std::vector<sph::SolverState>* restored)
 {
     if (!scene.heaters.empty()) return makeBoilingSimulation(scene, method, restored);
-    return std::make_unique<LiquidSimulation>(scene, method,
-                                              restored ? &restored->front() : nullptr);
+    return std::make_unique<LiquidSimulation>(scene, method, restored);
 }
 
 void checkLiquidSimulation(const vdbio::Scene& scene, ghost::Method method)
 {
-    if (!scene.heaters.empty()) checkBoilingSimulation(scene, method);
-    else liquidSettings(scene, method);
+    if (!scene.heaters.empty()) {
+        checkBoilingSimulation(scene, method);
+        return;
+    }
+    liquidSettings(scene, method);
+    whitewaterSettings(scene);
 }
 
 } // namespace cmd

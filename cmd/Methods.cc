@@ -69,6 +69,12 @@ void checkMedium(const vdbio::Scene& scene, const Method& method)
                           " scene takes static or rigidly moving solids ('velocity' or 'motion')"));
         }
     }
+    if ((gas || boiling) && !scene.outputs.whitewaterFile.empty()) {
+        root.fail("outputs.whitewater",
+                  msg("whitewater is made from a liquid's splashes in liquid scenes; this ",
+                      gas ? "gas" : "boiling", " scene makes none (switch outputs.whitewater "
+                      "off)"));
+    }
     if (gas) {
         if (!scene.liquids.empty() || !scene.emitters.empty() || !scene.heaters.empty()) {
             root.fail(scene.liquids.empty() ? (scene.emitters.empty() ? "heaters" : "emitters")

@@ -91,7 +91,24 @@ std::size_t Simulation::addLiquid(const sph::LevelSet& shape, const Vec3& /*velo
                      + "': adding liquid from a script is supported in liquid scenes only");
 }
 
-std::size_t stateCount(const vdbio::Scene& scene) { return scene.heaters.empty() ? 1 : 3; }
+std::size_t stateCount(const vdbio::Scene& scene)
+{
+    if (!scene.heaters.empty()) return 3;
+    return scene.outputs.whitewaterFile.empty() ? 1 : 2;
+}
+
+namespace {
+
+/// A liquid checkpoint with or without its whitewater fits a liquid scene either way: whitewater
+/// asked for after the checkpoint starts at the resumed frame, and a whitewater state is
+/// dropped once the scene asks for none.
+bool liquidStatesFit(const vdbio::Scene& scene, const std::vector<sph::SolverState>& restored)
+{
+    if (!scene.heaters.empty() || restored.empty() || restored.size() > 2) return false;
+    return restored.size() == 1 || restored[1].solver == "whitewater";
+}
+
+} // namespace
 
 void checkSimulationSettings(const vdbio::Scene& scene) { methodOf(scene).check(scene); }
 
@@ -99,7 +116,7 @@ std::unique_ptr<Simulation> makeSimulation(const vdbio::Scene& scene,
                                            const std::vector<sph::SolverState>* restored)
 {
     const Method& method = methodOf(scene);
-    if (restored && restored->size() != stateCount(scene)) {
+    if (restored && restored->size() != stateCount(scene) && !liquidStatesFit(scene, *restored)) {
         throw SceneError(msg("scene '", scene.file, "': the checkpoint holds ", restored->size(),
                              " solver states, the scene needs ", stateCount(scene),
                              scene.heaters.empty() ? "" : " (a boiling liquid, its vapour and "

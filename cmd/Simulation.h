@@ -13,6 +13,7 @@
 #include <ghostfx/sph/SolverState.h>
 #include <ghostfx/vdbio/Scene.h>
 #include <ghostfx/vdbio/Stats.h>
+#include <ghostfx/vdbio/WhitewaterFile.h>
 
 #include <functional>
 #include <limits>
@@ -114,6 +115,9 @@ public:
     virtual std::size_t memoryBytes() const = 0;
 
     virtual std::vector<OutputMedium> media() const = 0;
+    /// The whitewater particles now, where the scene asks for whitewater (liquid scenes with
+    /// outputs.whitewater); none otherwise.
+    virtual std::optional<vdbio::WhitewaterPoints> whitewater() const { return std::nullopt; }
     /// The particles of each medium of media(), by its name ("liquid": liquid particles, no
     /// ghosts; "gas": the visible gas), without copying them.
     struct MediumCount

@@ -430,6 +430,30 @@ void readMesh(const JsonObject& o, SceneOutputs& out)
     });
 }
 
+/// outputs.whitewater: its points file, its fog file and voxel size, the points' radius;
+/// `true` for the defaults.
+void readWhitewater(const JsonObject& o, SceneOutputs& out)
+{
+    const char* const fallback = "whitewater.$F4.vdb";
+    const Json* v = o.raw("whitewater");
+    if (v && v->is_boolean() && v->get<bool>()) out.whitewaterFile = fallback;
+    readSection(o, "whitewater", out.whitewaterFile, [&](const JsonObject& s) {
+        out.whitewaterFile = outputFile(s, "file", fallback, {".vdb"}, "OpenVDB points");
+        out.whitewaterFogFile =
+            outputFile(s, "fog_file", out.whitewaterFogFile, {".vdb"}, "OpenVDB grids");
+        out.whitewaterFogVoxelSize = s.nonNegative("fog_voxel_size", out.whitewaterFogVoxelSize);
+        out.whitewaterRadius = s.nonNegative("radius", out.whitewaterRadius);
+        const std::pair<const char*, const std::string*> files[] = {
+            {"file", &out.whitewaterFile}, {"fog_file", &out.whitewaterFogFile}};
+        for (const auto& [key, file] : files) {
+            if (!hasFrameToken(*file)) {
+                s.failValue(key, "expected a frame pattern with $F (e.g. whitewater.$F4.vdb): "
+                                 "every frame writes its own");
+            }
+        }
+    });
+}
+
 void readOutputs(const JsonObject& o, SceneOutputs& out)
 {
     const std::vector<std::string> vdb{".vdb"}, h5{".h5", ".hdf5"};
@@ -441,6 +465,7 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     });
     readSection(o, "volume", out.volumeFile, [&](const JsonObject& s) { readVolume(s, out); });
     readMesh(o, out);
+    readWhitewater(o, out);
     readSection(o, "gas_points", out.gasPointsFile, [&](const JsonObject& s) {
         out.gasPointsFile = outputFile(s, "file", out.gasPointsFile, vdb, "OpenVDB points");
         out.gasPointChannels = s.get<std::vector<std::string>>("channels", out.gasPointChannels);

@@ -448,11 +448,13 @@ private:
             if (isEmpty(mBoxes.local[k]) || !local.intersects(mBoxes.local[k], tin, tout)) continue;
             tout = std::min(tout, nearest);
             const double step = FOG_STEP_VOXELS * mLayers[k].grid->voxelSize()[0];
+            const double extinction =
+                mLayers[k].extinction > 0 ? mLayers[k].extinction : mOptions.extinction;
             const double before = transmittance;
             for (double t = std::max(tin, 0.0) + 0.5 * step; t < tout; t += step) {
                 const double d = tracers.fogs[k]->wsSample(local(t));
                 if (!(d > 0)) continue;
-                const double pass = std::exp(-mOptions.extinction * d * step);
+                const double pass = std::exp(-extinction * d * step);
                 const float scattered = float(transmittance * (1 - pass)) * FOG_SHADE;
                 light.fr += scattered * mLayers[k].albedo[0];
                 light.fg += scattered * mLayers[k].albedo[1];

@@ -30,7 +30,8 @@
 ///             mean of its neighbours'); bubbles rise against gravity and are dragged towards the
 ///             liquid's velocity. Foam ages and dissolves after a lifetime drawn at birth
 ///             between `foamLifetimeMin` and `foamLifetimeMax` (its age counts only while it is
-///             foam). Particles outside the kill box or inside a solid are removed.
+///             foam). Particles outside the kill box or inside a solid, or whose path over dt
+///             went through one, are removed.
 ///
 ///          Deterministic whatever the input's order and the thread count: the liquid is sorted
 ///          by particle id first, and the random numbers of liquid particle i at generation
@@ -63,7 +64,7 @@ enum class WhitewaterType : std::int32_t
 struct WhitewaterSettings
 {
     /// Trapped-air potential clamp (m/s).
-    Real trappedAirMin = Real(0.5), trappedAirMax = Real(2);
+    Real trappedAirMin = Real(0.2), trappedAirMax = Real(1);
     /// Wave-crest potential clamp: the surface's curvature (1/m).
     Real waveCrestMin = Real(20), waveCrestMax = Real(80);
     /// A crest is a surface particle moving out of the liquid at least this fast (m/s)
@@ -72,7 +73,7 @@ struct WhitewaterSettings
     /// Energy potential clamp: specific kinetic energy (J/kg).
     Real energyMin = Real(0.5), energyMax = Real(5);
     /// Particles made per m^3 of liquid per second at full potentials (trapped air, crests).
-    Real trappedAirRate = Real(2e7), waveCrestRate = Real(2e7);
+    Real trappedAirRate = Real(1e8), waveCrestRate = Real(1e8);
     /// Liquid fraction c below which a particle is spray, above which it is a bubble.
     Real sprayBelow = Real(0.2), bubbleAbove = Real(0.7);
     /// Spray's drag towards still air (1/s).
@@ -145,6 +146,8 @@ public:
 private:
     struct Field; // the liquid's neighbour grid and per-particle sums (Whitewater.cc)
     void advect(const Field& field, Real dt);
+    /// Whether the straight path from `from` to `to` passes through a solid (h: the spacing).
+    bool crossesSolid(const Vec3& from, const Vec3& to, double h) const;
     void classify(const Field& field);
     void remove();
     void generate(const Field& field, Real dt);

@@ -185,6 +185,14 @@ struct SceneOutputs
     /// in outputs.mesh only where no volume file is written (or to the same values).
     SurfaceMethod meshSurfaceMethod = SurfaceMethod::Spheres;
     double meshVoxelSize = 0;
+    // Whitewater (liquid scenes): spray, foam and bubbles made from the liquid each frame
+    // (ghost::Whitewater), as points; empty: off (no whitewater is simulated).
+    std::string whitewaterFile;
+    /// Their fog grids "spray", "foam", "bubbles" in a file of their own (volume files hold no
+    /// points), at this voxel size (m); 0: no fog file.
+    std::string whitewaterFogFile = "whitewater_fog.$F4.vdb";
+    double whitewaterFogVoxelSize = 0;
+    double whitewaterRadius = 0; ///< "pscale" of the points (m); 0: a quarter of the spacing
     // Gas (gas scenes and boiling): points and volumes of the gas particles.
     std::string gasPointsFile = "gas_points.$F4.vdb";
     std::vector<std::string> gasPointChannels{"v", "id", "temperature"};

@@ -33,6 +33,8 @@ struct PreviewLayer
     openvdb::FloatGrid::ConstPtr grid; ///< a level set (Surface) or a fog volume (Fog)
     Kind kind = Kind::Surface;
     std::array<float, 3> albedo{{0.6f, 0.6f, 0.6f}}; ///< linear RGB
+    /// Fog layers: extinction at density 1 (1/m); 0: PreviewOptions::extinction.
+    double extinction = 0;
     /// Rigid placement of the grid's frame in the world, x_world = rotation x + translation (a
     /// moving solid's shape lives in its own frame); identity for grids already in the world.
     openvdb::math::Mat3d rotation = openvdb::math::Mat3d::identity();
@@ -65,10 +67,11 @@ struct PreviewCache
     std::size_t reused = 0, computed = 0; ///< previews that used the hits, that computed them
 };
 
-/// The colours `ghostfx run` gives solids, a liquid (surface or density) and gas.
+/// The colours `ghostfx run` gives solids, a liquid (surface or density), gas and whitewater.
 constexpr std::array<float, 3> SOLID_ALBEDO{{0.62f, 0.58f, 0.52f}};
 constexpr std::array<float, 3> LIQUID_ALBEDO{{0.18f, 0.42f, 0.85f}};
 constexpr std::array<float, 3> GAS_ALBEDO{{0.92f, 0.92f, 0.95f}};
+constexpr std::array<float, 3> WHITEWATER_ALBEDO{{1.0f, 1.0f, 1.0f}};
 
 struct ScenePreviewSummary
 {
