@@ -49,6 +49,7 @@ Command addInfoCommand(CLI::App& parent);
 Command addPreviewCommand(CLI::App& parent);
 Command addMesh2SdfCommand(CLI::App& parent);
 Command addStudyCommand(CLI::App& parent);
+Command addWhitewaterCommand(CLI::App& parent);
 
 } // namespace cmd
 } // namespace ghostfx

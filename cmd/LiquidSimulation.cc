@@ -67,7 +67,7 @@ public:
         if (mWhitewater) {
             mWhitewater->step(liquidPointsOf(liquidMedium(*mSolver), mScene.outputs,
                                              mSolver->time()),
-                              mSolver->frame(), mSolver->time(), solidPlacements(), "whitewater");
+                              mSolver->frame(), solidPlacements(), "whitewater");
         }
         warnAboutSolves(unconverged, recomputed);
     }

@@ -44,9 +44,6 @@ namespace fs = std::filesystem;
 using sph::ParticleKind;
 using Clock = std::chrono::steady_clock;
 
-namespace {
-
-/// Parse "--frames A-B" or "--frames B" (whole numbers in [1, MAX_FRAME], first <= last).
 void parseFrames(const std::string& text, int& first, int& last)
 {
     // One whole number at p, no sign, at most MAX_FRAME; returns the end of it or nullptr.
@@ -77,6 +74,9 @@ void parseFrames(const std::string& text, int& first, int& last)
     first = int(a);
     last = int(b);
 }
+
+namespace {
+
 
 /// `text` as one shell word: as it is when it holds only characters no shell treats specially,
 /// else in single quotes.

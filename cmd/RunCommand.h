@@ -29,6 +29,10 @@ struct RunOptions
     std::string sampleCache;
 };
 
+/// Parse "--frames A-B" or "--frames B" (whole numbers in [1, MAX_FRAME], first <= last) into
+/// `first` and `last` (B alone keeps `first`); ValueError naming the text otherwise.
+void parseFrames(const std::string& text, int& first, int& last);
+
 /// Run a scene; returns the exit code: 0, or 128 + the signal's number for a run that SIGINT,
 /// SIGTERM or SIGUSR1 stopped after a frame and its checkpoint (StopSignals.h). Throws
 /// ghostfx::Error on bad input.

@@ -6,6 +6,8 @@
 #include "SolidGrids.h"
 
 #include <ghostfx/sph/Exceptions.h>
+#include <ghostfx/sph/MassProperties.h>
+#include <ghostfx/sph/RigidBody.h>
 #include <ghostfx/vdbio/FrameFiles.h>
 
 #include <algorithm>
@@ -90,6 +92,35 @@ vdbio::PointsData liquidPointsOf(const OutputMedium& liquid, const vdbio::SceneO
     return vdbio::readPointsGrid(*grid, "whitewater");
 }
 
+std::vector<sph::RigidTransform> bodyPlacements(const vdbio::Scene& scene,
+                                                const std::vector<vdbio::BodyRow>& rows,
+                                                int frame, const std::string& csv)
+{
+    std::vector<sph::RigidTransform> placements(scene.solids.size());
+    for (std::size_t i = 0; i < scene.solids.size(); ++i) {
+        const vdbio::SceneSolid& solid = scene.solids[i];
+        if (!solid.dynamic) continue;
+        const auto row = std::find_if(rows.begin(), rows.end(), [&](const vdbio::BodyRow& r) {
+            return r.frame == frame && r.name == solid.name;
+        });
+        if (row == rows.end()) {
+            throw IoError(msg("ghostfx whitewater: '", csv, "' has no row of dynamic solid '",
+                              solid.name, "' at frame ", frame));
+        }
+        // A body row is its centre of mass x and orientation q: world = R(q) (p - c) + x, c the
+        // centre of mass of the geometry as given (BodyTable.h).
+        const auto& v = row->values;
+        const sph::Mat3d R = sph::rotationOf(sph::Quatd(v[4], v[5], v[6], v[3]));
+        const sph::Vec3d c = sph::massProperties(solid.shape, 1.0).centre;
+        const sph::Vec3d t = sph::Vec3d(v[0], v[1], v[2]) - R * c;
+        for (int r = 0; r < 3; ++r) {
+            for (int k = 0; k < 3; ++k) placements[i].rotation(r, k) = Real(R(r, k));
+        }
+        placements[i].translation = Vec3(t);
+    }
+    return placements;
+}
+
 double whitewaterRadius(const vdbio::Scene& scene)
 {
     const double r = scene.outputs.whitewaterRadius;
@@ -104,13 +135,13 @@ SceneWhitewater::SceneWhitewater(const vdbio::Scene& scene, const ghost::GhostSe
     mWhitewater.setKillBox(scene.killBox);
 }
 
-void SceneWhitewater::step(const vdbio::PointsData& points, int frame, double time,
+void SceneWhitewater::step(const vdbio::PointsData& points, int frame,
                            const std::vector<sph::RigidTransform>& placements,
                            const std::string& where)
 {
     FrameSnapshot at;
     at.frame = frame;
-    at.time = time;
+    at.time = double(frame) / mScene.frameRate;
     std::vector<PlacedSolid> solids;
     for (std::size_t i = 0; i < mScene.solids.size(); ++i) {
         // Only a dynamic solid takes the solver's placement: the scene's motion places the

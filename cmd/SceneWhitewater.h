@@ -14,6 +14,7 @@
 
 #include <ghostfx/ghost/GhostSettings.h>
 #include <ghostfx/ghost/Whitewater.h>
+#include <ghostfx/vdbio/BodyTable.h>
 #include <ghostfx/vdbio/Readers.h>
 #include <ghostfx/vdbio/Scene.h>
 #include <ghostfx/vdbio/WhitewaterFile.h>
@@ -38,6 +39,13 @@ ghost::LiquidSnapshot liquidOfPoints(const vdbio::PointsData& points,
 vdbio::PointsData liquidPointsOf(const OutputMedium& liquid, const vdbio::SceneOutputs& out,
                                  double time);
 
+/// Where a run's dynamic solids were at `frame`, from its bodies.csv `rows`: a placement per
+/// scene solid (identity for the others). IoError naming `csv` for a dynamic solid without a
+/// row at that frame.
+std::vector<sph::RigidTransform> bodyPlacements(const vdbio::Scene& scene,
+                                                const std::vector<vdbio::BodyRow>& rows,
+                                                int frame, const std::string& csv);
+
 /// The points radius ("pscale", m) of outputs.whitewater: its `radius`, else h / 4.
 double whitewaterRadius(const vdbio::Scene& scene);
 
@@ -46,11 +54,11 @@ class SceneWhitewater
 public:
     SceneWhitewater(const vdbio::Scene& scene, const ghost::GhostSettings& liquid);
 
-    /// Move and make whitewater over the frame that ends at `time` (s), in the liquid of
-    /// `points` (liquidPointsOf, or a points file). `placements`: where the solver put each
-    /// solid; used for dynamic solids only (the others are where the scene's motion puts
-    /// them, as a post-process places them).
-    void step(const vdbio::PointsData& points, int frame, double time,
+    /// Move and make whitewater over frame `frame` (it ends at frame / frame_rate), in the
+    /// liquid of `points` (liquidPointsOf, or a points file; `where` names it in errors).
+    /// `placements`: where the solver put each solid; used for dynamic solids only (the
+    /// others are where the scene's motion puts them, as a post-process places them).
+    void step(const vdbio::PointsData& points, int frame,
               const std::vector<sph::RigidTransform>& placements, const std::string& where);
 
     const ghost::Whitewater& whitewater() const { return mWhitewater; }

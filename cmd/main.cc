@@ -33,7 +33,8 @@ int main(int argc, char** argv)
     using namespace ghostfx::cmd;
     const std::vector<Command> commands = {addRunCommand(app),     addInfoCommand(app),
                                            addPreviewCommand(app), addMesh2SdfCommand(app),
-                                           addSampleCommand(app),  addStudyCommand(app)};
+                                           addSampleCommand(app),  addStudyCommand(app),
+                                           addWhitewaterCommand(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

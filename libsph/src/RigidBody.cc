@@ -9,9 +9,6 @@
 namespace ghostfx {
 namespace sph {
 
-namespace {
-
-/// R(q) for a unit quaternion, acting on column vectors (R * v), element (i, j) = R_ij.
 Mat3d rotationOf(const Quatd& q)
 {
     const double x = q.x(), y = q.y(), z = q.z(), w = q.w();
@@ -19,6 +16,8 @@ Mat3d rotationOf(const Quatd& q)
                  2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
                  2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y));
 }
+
+namespace {
 
 /// The quaternion of a turn by the rotation vector `angle` (rad; its direction the axis).
 Quatd turnBy(const Vec3d& angle)

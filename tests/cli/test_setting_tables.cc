@@ -5,6 +5,7 @@
 #include <ghostfx/gas/GasSettings.h>
 #include <ghostfx/gas/PhaseTransition.h>
 #include <ghostfx/ghost/GhostSettings.h>
+#include <ghostfx/ghost/Whitewater.h>
 #include <ghostfx/sph/SettingSpec.h>
 
 #include <gtest/gtest.h>
@@ -106,6 +107,12 @@ TEST(SettingTables, DfsphSettingsAreDocumentedAsDeclared)
 {
     expectDocMatches("### settings.dfsph (liquids with `pressure` `dfsph`)",
                      ghost::dfsphSettingTable());
+}
+
+TEST(SettingTables, WhitewaterSettingsAreDocumentedAsDeclared)
+{
+    expectDocMatches("### settings.whitewater (liquid scenes with `outputs.whitewater`)",
+                     ghost::whitewaterSettingTable());
 }
 
 TEST(SettingTables, GasSettingsAreDocumentedAsDeclared)

@@ -29,6 +29,9 @@ namespace sph {
 using Mat3d = openvdb::math::Mat3d;
 using Quatd = openvdb::math::Quatd;
 
+/// R(q) for a unit quaternion, acting on column vectors (R * v), element (i, j) = R_ij.
+Mat3d rotationOf(const Quatd& q);
+
 /// What a body is made of and how it touches others.
 struct RigidBodyMaterial
 {
