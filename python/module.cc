@@ -659,6 +659,37 @@ public:
                            "channel)");
     }
 
+    /// The whitewater now by class: {"spray": {...}, "foam": {...}, "bubbles": {...}}, each
+    /// with "positions", "velocities" (N, 3 float64), "ids" (int64) and "ages" (float64).
+    py::dict whitewater() const
+    {
+        const std::optional<vdbio::WhitewaterPoints> w = mSim->whitewater();
+        if (!w) {
+            throw ValueError(msg("whitewater: scene '", mScene->file, "' makes none (expected "
+                                 "outputs.whitewater in a liquid scene)"));
+        }
+        py::dict out;
+        for (std::int32_t type = 0; type < 3; ++type) {
+            std::vector<sph::Vec3> x, v;
+            std::vector<std::int64_t> ids;
+            std::vector<double> ages;
+            for (std::size_t k = 0; k < w->ids.size(); ++k) {
+                if (w->types[k] != type) continue;
+                x.push_back(w->positions[k]);
+                v.push_back(w->velocities[k]);
+                ids.push_back(w->ids[k]);
+                ages.push_back(double(w->ages[k]));
+            }
+            out[vdbio::WHITEWATER_FOG_NAMES[type]] =
+                py::dict(py::arg("positions") = vectors(x), py::arg("velocities") = vectors(v),
+                         py::arg("ids") = py::array_t<std::int64_t>(py::ssize_t(ids.size()),
+                                                                    ids.data()),
+                         py::arg("ages") = py::array_t<double>(py::ssize_t(ages.size()),
+                                                               ages.data()));
+        }
+        return out;
+    }
+
 private:
     /// A simulation of its own copy of `scene` with `inputs` added, fresh or from `states`.
     PySimulation(std::shared_ptr<const vdbio::Scene> scene, python::ScriptInputs inputs,
@@ -887,6 +918,10 @@ void bindReading(PySimulationClass& c)
              "'boundary'), an (N, 3) float64 copy")
         .def("velocities", &PySimulation::velocities, py::arg("kind") = "liquid",
              "Velocities (m/s), an (N, 3) float64 copy")
+        .def("whitewater", &PySimulation::whitewater,
+             "The whitewater now (scenes with outputs.whitewater), by class: a dict with "
+             "'spray', 'foam' and 'bubbles', each a dict of 'positions' and 'velocities' "
+             "((N, 3) float64, m and m/s), 'ids' (int64) and 'ages' (float64, s), copies")
         .def("channel", &PySimulation::channel, py::arg("kind"), py::arg("name"),
              "A per-particle quantity ('density', 'pressure', 'mass', 'id' or a solver channel), "
              "a copy. Before the first step 'mass' is the mass the first step gives (the mass "

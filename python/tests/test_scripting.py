@@ -316,3 +316,32 @@ def test_the_command_line_refuses_a_checkpoint_with_a_scripts_additions(tmp_path
     assert f"--resume '{checkpoint}': the checkpoint holds what a Python script added" in lines[0]
     assert "ghostfx.Simulation.resume(scene," in lines[0]
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_whitewater_by_class_is_what_the_frame_file_holds(tmp_path):
+    # The example's dam break, 12 frames: its surge hits the far wall at about 0.35 s (frame 11)
+    # and throws spray (tests/cli/test_whitewater_output.cc checks the counts' timing).
+    scene = ghostfx.load_scene(DAM, {"settings.frame_range": [1, 12], "outputs.whitewater": True,
+                                     "outputs.volume": False, "outputs.preview": False})
+    sim = ghostfx.Simulation(scene)
+    sim.run()
+    white = sim.whitewater()
+    assert set(white) == {"spray", "foam", "bubbles"}
+    total = sum(len(c["ids"]) for c in white.values())
+    assert total > 100
+    for c in white.values():
+        n = len(c["ids"])
+        assert c["positions"].shape == (n, 3) and c["velocities"].shape == (n, 3)
+        assert c["ids"].dtype == np.int64 and c["ages"].shape == (n,)
+    # The file of the frame holds the same particles with their class as "type" (0, 1, 2).
+    sim.write_frame(str(tmp_path))
+    points = ghostfx.read_points(str(tmp_path / "whitewater.0012.vdb"), "whitewater")
+    for type_, name in enumerate(("spray", "foam", "bubbles")):
+        mine = np.sort(points["id"][points["type"] == type_])
+        assert np.array_equal(mine, np.sort(white[name]["ids"]))
+    order = np.argsort(white["foam"]["ids"])
+    in_file = points["P"][points["type"] == 1][np.argsort(points["id"][points["type"] == 1])]
+    # Positions go through float offsets from their voxel's centre: 1e-7 of a voxel.
+    assert np.allclose(in_file, white["foam"]["positions"][order], rtol=0, atol=1e-6)
+    with pytest.raises(ValueError, match="makes none"):
+        ghostfx.Simulation(ghostfx.load_scene(DAM, {"settings.frame_range": [1, 1]})).whitewater()
