@@ -83,8 +83,8 @@ vdbio::PointsData liquidPointsOf(const OutputMedium& liquid, const vdbio::SceneO
 {
     vdbio::PointsOptions options = pointsOptions(liquid, out, time);
     const bool ghosts = options.kinds.size() > 1;
-    options.channels = ghosts ? std::vector<std::string>{"v", "id", "kind"}
-                              : std::vector<std::string>{"v", "id"};
+    options.channels =
+        ghosts ? std::vector<std::string>{"v", "id", "kind"} : std::vector<std::string>{"v", "id"};
     const openvdb::GridBase::Ptr grid =
         ghosts && liquid.withGhosts
             ? vdbio::makePointsGrid(liquid.withGhosts(), options, "whitewater")
@@ -93,8 +93,8 @@ vdbio::PointsData liquidPointsOf(const OutputMedium& liquid, const vdbio::SceneO
 }
 
 std::vector<sph::RigidTransform> bodyPlacements(const vdbio::Scene& scene,
-                                                const std::vector<vdbio::BodyRow>& rows,
-                                                int frame, const std::string& csv)
+                                                const std::vector<vdbio::BodyRow>& rows, int frame,
+                                                const std::string& csv)
 {
     std::vector<sph::RigidTransform> placements(scene.solids.size());
     for (std::size_t i = 0; i < scene.solids.size(); ++i) {
@@ -153,7 +153,8 @@ void SceneWhitewater::step(const vdbio::PointsData& points, int frame,
     mWhitewater.setSolids([solids = std::move(solids)](const Vec3& x) {
         Real nearest = std::numeric_limits<Real>::max();
         for (const PlacedSolid& s : solids) {
-            const openvdb::Vec3d local = s.rotation.transpose() * (openvdb::Vec3d(x) - s.translation);
+            const openvdb::Vec3d local =
+                s.rotation.transpose() * (openvdb::Vec3d(x) - s.translation);
             nearest = std::min(nearest, s.shape.phi(Vec3(local)));
         }
         return nearest;

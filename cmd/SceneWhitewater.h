@@ -43,8 +43,8 @@ vdbio::PointsData liquidPointsOf(const OutputMedium& liquid, const vdbio::SceneO
 /// scene solid (identity for the others). IoError naming `csv` for a dynamic solid without a
 /// row at that frame.
 std::vector<sph::RigidTransform> bodyPlacements(const vdbio::Scene& scene,
-                                                const std::vector<vdbio::BodyRow>& rows,
-                                                int frame, const std::string& csv);
+                                                const std::vector<vdbio::BodyRow>& rows, int frame,
+                                                const std::string& csv);
 
 /// The points radius ("pscale", m) of outputs.whitewater: its `radius`, else h / 4.
 double whitewaterRadius(const vdbio::Scene& scene);

@@ -18,11 +18,11 @@
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <regex>
-#include <cstring>
 
 namespace ghostfx {
 namespace cmd {
@@ -33,11 +33,11 @@ namespace {
 
 struct WhitewaterArgs
 {
-    std::string folder;                 ///< the run's output folder
+    std::string folder; ///< the run's output folder
     std::string from = "liquid_points.$F4.vdb";
-    std::string scene;                  ///< "": the points files' ghostfx_scene
-    std::string out;                    ///< "": `folder`
-    std::string frames;                 ///< "A-B"; "": every frame found
+    std::string scene;  ///< "": the points files' ghostfx_scene
+    std::string out;    ///< "": `folder`
+    std::string frames; ///< "A-B"; "": every frame found
     std::vector<std::string> defines;
     int threads = 0;
     bool quiet = false;
@@ -53,12 +53,13 @@ std::map<int, std::string> framesIn(const std::string& folder, const std::string
             expression += "([0-9]+)";
             i += padded ? 2 : 1;
         } else {
-            expression += std::string(std::strchr(".^$|()[]{}*+?\\", pattern[i]) ? "\\" : "")
-                          + pattern[i];
+            expression +=
+                std::string(std::strchr(".^$|()[]{}*+?\\", pattern[i]) ? "\\" : "") + pattern[i];
         }
     }
     if (expression.find("([0-9]+)") == std::string::npos) {
-        throw ValueError(msg("--from '", pattern, "': expected a frame pattern with $F (e.g. "
+        throw ValueError(msg("--from '", pattern,
+                             "': expected a frame pattern with $F (e.g. "
                              "liquid_points.$F4.vdb)"));
     }
     const std::regex re(expression);
@@ -82,7 +83,8 @@ std::string fileMetadata(const std::string& path, const std::string& key)
     try {
         file.open(false);
     } catch (const openvdb::Exception& e) {
-        throw IoError(msg("ghostfx whitewater: '", path, "': not a readable .vdb (", e.what(), ")"));
+        throw IoError(
+            msg("ghostfx whitewater: '", path, "': not a readable .vdb (", e.what(), ")"));
     }
     const openvdb::MetaMap::Ptr meta = file.getMetadata();
     file.close();
@@ -97,7 +99,8 @@ vdbio::Scene whitewaterScene(const WhitewaterArgs& a, const std::string& firstFi
     std::string file = a.scene;
     if (file.empty()) file = fileMetadata(firstFile, "ghostfx_scene");
     if (file.empty()) {
-        throw SceneError(msg("ghostfx whitewater: '", firstFile, "' does not name its scene "
+        throw SceneError(msg("ghostfx whitewater: '", firstFile,
+                             "' does not name its scene "
                              "(metadata ghostfx_scene): give it with --scene"));
     }
     vdbio::Scene scene = vdbio::readScene(file, a.defines);
@@ -124,8 +127,8 @@ std::map<int, std::string> chosenFrames(const WhitewaterArgs& a, std::map<int, s
         const auto it = found.find(f);
         if (it == found.end()) {
             throw IoError(msg("ghostfx whitewater: frame ", f, " ('",
-                              vdbio::expandFramePattern(a.from, f), "') is missing in '",
-                              a.folder, "': whitewater steps through every frame"));
+                              vdbio::expandFramePattern(a.from, f), "') is missing in '", a.folder,
+                              "': whitewater steps through every frame"));
         }
         chosen.insert(*it);
     }
@@ -149,9 +152,8 @@ int runWhitewater(const WhitewaterArgs& a)
     vdbio::ensureWritableDirectory(outFolder);
     const vdbio::SceneOutputs& out = scene.outputs;
     const std::string csv = (fs::path(a.folder) / "bodies.csv").string();
-    const std::vector<vdbio::BodyRow> bodies = hasDynamicSolids(scene)
-                                                   ? vdbio::readBodiesCsv(csv)
-                                                   : std::vector<vdbio::BodyRow>();
+    const std::vector<vdbio::BodyRow> bodies =
+        hasDynamicSolids(scene) ? vdbio::readBodiesCsv(csv) : std::vector<vdbio::BodyRow>();
     const auto start = std::chrono::steady_clock::now();
     for (const auto& [frame, path] : frames) {
         const auto frameStart = std::chrono::steady_clock::now();

@@ -840,8 +840,13 @@ void bindScripting(PySimulationClass& c)
              "source): from `start` to `end` (s) its volume is "
              "kept full of gas at `temperature` (K) moving at `velocity` (m/s), at most `rate` "
              "particles per second (0: as many as fit). Kept in checkpoints. Gas scenes and the "
-             "vapour of boiling ones")
-        .def(
+             "vapour of boiling ones");
+}
+
+/// Simulation: the particles a script sets.
+void bindSetters(PySimulationClass& c)
+{
+    c.def(
             "set_positions",
             [](PySimulation& s, const std::string& kind, const FloatArray& v) {
         s.setVectors(kind, v, true);
@@ -935,6 +940,7 @@ void bindSimulation(py::module_& m)
                         "builds them");
     bindRunning(c);
     bindScripting(c);
+    bindSetters(c);
     bindBodies(c);
     bindReading(c);
 }

@@ -88,7 +88,8 @@ protected:
 
     void runInto(const std::string& scene, const fs::path& out, const std::string& args = "")
     {
-        const Result r = run("run " + scene + " --out " + out.string() + " --progress none " + args);
+        const Result r =
+            run("run " + scene + " --out " + out.string() + " --progress none " + args);
         ASSERT_EQ(r.code, 0) << r.err;
     }
 };
@@ -122,7 +123,8 @@ TEST_F(WhitewaterOutput, InlinePostProcessAndResumeMakeTheSameParticles)
     for (int f = 1; f <= 14; ++f) {
         const auto inline_ = readWhitewater(a / frameName("whitewater", f));
         EXPECT_TRUE(readWhitewater(post / frameName("whitewater", f)) == inline_) << f;
-        if (f > 7) EXPECT_TRUE(readWhitewater(resumed / frameName("whitewater", f)) == inline_) << f;
+        if (f > 7)
+            EXPECT_TRUE(readWhitewater(resumed / frameName("whitewater", f)) == inline_) << f;
     }
     const vdbio::ActiveVoxels foam =
         vdbio::readActiveVoxels((a / frameName("whitewater_fog", 14)).string(), "foam", "test");
