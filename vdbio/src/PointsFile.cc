@@ -8,6 +8,7 @@
 ///          through the same index grid so the attribute arrays follow the point order of "P".
 ///          Only this translation unit instantiates the points templates (STACK.md).
 #include "FrameGridsDetail.h"
+#include "PointGridBuild.h"
 #include "RenderAttributes.h"
 
 #include <ghostfx/sph/Exceptions.h>
@@ -32,7 +33,6 @@ namespace {
 using openvdb::points::PointDataGrid;
 using openvdb::points::PointDataTree;
 using openvdb::tools::PointIndexGrid;
-using openvdb::tools::PointIndexTree;
 
 /// Particle kinds known to this build, in value order (ParticleKind values are stored in files).
 constexpr sph::ParticleKind ALL_KINDS[] = {sph::ParticleKind::Liquid, sph::ParticleKind::GhostAir,
@@ -40,18 +40,6 @@ constexpr sph::ParticleKind ALL_KINDS[] = {sph::ParticleKind::Liquid, sph::Parti
                                            sph::ParticleKind::Boundary};
 
 const char* const BUILTIN_CHANNELS[] = {"v", "id", "density", "pressure", "mass", "kind"};
-
-/// Append attribute `name` of type T holding `data` (one value per selected particle, in the
-/// order of the position array) and route it through the index grid like "P".
-template <typename T>
-void addAttribute(PointDataTree& tree, const PointIndexTree& indexTree, const std::string& name,
-                  const std::vector<T>& data)
-{
-    openvdb::points::appendAttribute<T>(tree, name);
-    openvdb::points::populateAttribute<PointDataTree, PointIndexTree,
-                                       openvdb::points::PointAttributeVector<T>>(
-        tree, indexTree, name, openvdb::points::PointAttributeVector<T>(data));
-}
 
 /// Values of the selected particles: out[k] = T(src[selection[k]]).
 template <typename T, typename S>
@@ -88,35 +76,35 @@ std::string kindNamesList()
 
 /// Append channel `name` (checked by checkPointsOutput) of the selected particles: a built-in,
 /// a named channel of the set, else a render attribute.
-void addChannel(PointDataTree& tree, const PointIndexTree& indexTree,
+void addChannel(detail::PointGridBuild& build,
                 const sph::ParticleSet& particles, const std::vector<sph::Index>& selection,
                 const PointsOptions& options, const std::string& name)
 {
     if (name == "v") {
-        addAttribute(tree, indexTree, name, gatherSelected3(particles.velocities(), selection));
+        detail::addAttribute(build, name, gatherSelected3(particles.velocities(), selection));
     } else if (name == "id") {
-        addAttribute(tree, indexTree, name,
+        detail::addAttribute(build, name,
                      gatherSelected<std::int64_t>(particles.ids(), selection));
     } else if (name == "density") {
-        addAttribute(tree, indexTree, name, gatherSelected<float>(particles.densities(), selection));
+        detail::addAttribute(build, name, gatherSelected<float>(particles.densities(), selection));
     } else if (name == "pressure") {
-        addAttribute(tree, indexTree, name, gatherSelected<float>(particles.pressures(), selection));
+        detail::addAttribute(build, name, gatherSelected<float>(particles.pressures(), selection));
     } else if (name == "mass") {
-        addAttribute(tree, indexTree, name, gatherSelected<float>(particles.masses(), selection));
+        detail::addAttribute(build, name, gatherSelected<float>(particles.masses(), selection));
     } else if (name == "kind") {
         std::vector<std::int32_t> kinds(selection.size());
         for (std::size_t k = 0; k < selection.size(); ++k) {
             kinds[k] = std::int32_t(particles.kinds()[selection[k]]);
         }
-        addAttribute(tree, indexTree, name, kinds);
+        detail::addAttribute(build, name, kinds);
     } else if (particles.hasScalarChannel(name)) {
-        addAttribute(tree, indexTree, name,
+        detail::addAttribute(build, name,
                      gatherSelected<float>(particles.scalarChannel(name), selection));
     } else if (particles.hasVectorChannel(name)) {
-        addAttribute(tree, indexTree, name,
+        detail::addAttribute(build, name,
                      gatherSelected3(particles.vectorChannel(name), selection));
     } else {
-        addAttribute(tree, indexTree, name,
+        detail::addAttribute(build, name,
                      detail::renderAttribute(particles, selection, options, name));
     }
 }
@@ -176,6 +164,19 @@ void checkPointsOutput(const sph::ParticleSet& particles, const PointsOptions& o
     }
 }
 
+detail::PointGridBuild detail::buildPointGrid(const std::vector<openvdb::Vec3d>& positions,
+                                              double voxelSize)
+{
+    const openvdb::points::PointAttributeVector<openvdb::Vec3d> positionArray(positions);
+    const openvdb::math::Transform::Ptr xform =
+        openvdb::math::Transform::createLinearTransform(voxelSize);
+    PointGridBuild build;
+    build.index = openvdb::tools::createPointIndexGrid<PointIndexGrid>(positionArray, *xform);
+    build.grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
+        *build.index, positionArray, *xform);
+    return build;
+}
+
 openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
                                       const PointsOptions& options, const std::string& where)
 {
@@ -193,27 +194,17 @@ openvdb::GridBase::Ptr makePointsGrid(const sph::ParticleSet& particles,
         positions[k] = openvdb::Vec3d(x[0], x[1], x[2]);
         },
         4096);
-    const openvdb::points::PointAttributeVector<openvdb::Vec3d> positionArray(positions);
-
     double voxelSize = options.voxelSize;
     if (voxelSize == 0.0) {
+        const openvdb::points::PointAttributeVector<openvdb::Vec3d> positionArray(positions);
         voxelSize = double(
             openvdb::points::computeVoxelSize(positionArray, PointsOptions::AUTO_POINTS_PER_VOXEL));
     }
-    const openvdb::math::Transform::Ptr xform =
-        openvdb::math::Transform::createLinearTransform(voxelSize);
-
-    const PointIndexGrid::Ptr indexGrid =
-        openvdb::tools::createPointIndexGrid<PointIndexGrid>(positionArray, *xform);
-    PointDataGrid::Ptr grid =
-        openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
-            *indexGrid, positionArray, *xform);
-    PointDataTree& tree = grid->tree();
-    const PointIndexTree& indexTree = indexGrid->tree();
-
+    detail::PointGridBuild build = detail::buildPointGrid(positions, voxelSize);
     for (const std::string& name : options.channels)
-        addChannel(tree, indexTree, particles, selection, options, name);
+        addChannel(build, particles, selection, options, name);
 
+    PointDataGrid::Ptr grid = build.grid;
     grid->setName("particles");
     grid->setCreator("ghostfx");
     grid->insertMeta("kind_names", openvdb::StringMetadata(kindNamesList()));

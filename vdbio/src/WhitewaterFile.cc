@@ -5,6 +5,7 @@
 ///          The fog is a serial trilinear splat whose contributions are sorted before they are
 ///          summed, so the grids do not depend on the particles' order (WhitewaterFile.h).
 #include "FrameGridsDetail.h"
+#include "PointGridBuild.h"
 
 #include <ghostfx/sph/Exceptions.h>
 #include <ghostfx/vdbio/FrameFiles.h>
@@ -24,9 +25,6 @@ namespace vdbio {
 namespace {
 
 using openvdb::points::PointDataGrid;
-using openvdb::points::PointDataTree;
-using openvdb::tools::PointIndexGrid;
-using openvdb::tools::PointIndexTree;
 
 constexpr const char* WHERE = "whitewater output";
 /// Class values run from 0 to this (spray, foam, bubble).
@@ -57,18 +55,6 @@ void checkPoints(const WhitewaterPoints& p)
     }
 }
 
-/// Append attribute `name` of type T holding `data` (in the order of the position array) and
-/// route it through the index grid like "P" (PointsFile.cc's addAttribute).
-template <typename T>
-void addAttribute(PointDataTree& tree, const PointIndexTree& indexTree, const std::string& name,
-                  const std::vector<T>& data)
-{
-    openvdb::points::appendAttribute<T>(tree, name);
-    openvdb::points::populateAttribute<PointDataTree, PointIndexTree,
-                                       openvdb::points::PointAttributeVector<T>>(
-        tree, indexTree, name, openvdb::points::PointAttributeVector<T>(data));
-}
-
 std::vector<openvdb::Vec3s> toVec3s(const std::vector<sph::Vec3>& v)
 {
     std::vector<openvdb::Vec3s> out(v.size());
@@ -85,26 +71,16 @@ openvdb::GridBase::Ptr makeWhitewaterPointsGrid(const WhitewaterPoints& p,
     std::vector<openvdb::Vec3d> positions(p.positions.size());
     for (std::size_t k = 0; k < positions.size(); ++k)
         positions[k] = openvdb::Vec3d(p.positions[k][0], p.positions[k][1], p.positions[k][2]);
-    const openvdb::points::PointAttributeVector<openvdb::Vec3d> positionArray(positions);
-
     const double voxelSize =
         options.pointsVoxelSize > 0.0 ? options.pointsVoxelSize : autoPointsVoxelSize(p.positions);
-    const openvdb::math::Transform::Ptr xform =
-        openvdb::math::Transform::createLinearTransform(voxelSize);
-    const PointIndexGrid::Ptr indexGrid =
-        openvdb::tools::createPointIndexGrid<PointIndexGrid>(positionArray, *xform);
-    PointDataGrid::Ptr grid =
-        openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
-            *indexGrid, positionArray, *xform);
-    PointDataTree& tree = grid->tree();
-    const PointIndexTree& indexTree = indexGrid->tree();
-
-    addAttribute(tree, indexTree, "v", toVec3s(p.velocities));
-    addAttribute(tree, indexTree, "id", p.ids);
-    addAttribute(tree, indexTree, "type", p.types);
-    addAttribute(tree, indexTree, "age", p.ages);
+    detail::PointGridBuild build = detail::buildPointGrid(positions, voxelSize);
+    detail::addAttribute(build, "v", toVec3s(p.velocities));
+    detail::addAttribute(build, "id", p.ids);
+    detail::addAttribute(build, "type", p.types);
+    detail::addAttribute(build, "age", p.ages);
     // One radius for all: a uniform array, one value per leaf.
-    openvdb::points::appendAttribute<float>(tree, "pscale", float(options.pscale));
+    const PointDataGrid::Ptr grid = build.grid;
+    openvdb::points::appendAttribute<float>(grid->tree(), "pscale", float(options.pscale));
 
     grid->setName("whitewater");
     grid->setCreator("ghostfx");
