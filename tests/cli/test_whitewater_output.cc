@@ -147,6 +147,14 @@ TEST_F(WhitewaterOutput, BadInputIsRefusedInOneLine)
     EXPECT_CONTAINS(errorLine("run " + write(scene) + " --out " + out.string()),
                     "outputs.whitewater.file = \"white.vdb\": expected a frame pattern with $F");
     EXPECT_FALSE(fs::exists(out / frameName("liquid_points", 1)));
+    const Json gas = Json::parse(R"({
+        "ghostfx_scene": 1, "settings": { "method": "gas", "spacing": 0.04 },
+        "gas_sources": [ { "name": "burner", "temperature": 600,
+                           "geometry": { "sphere": { "center": [0, 0.1, 0], "radius": 0.1 } } } ],
+        "outputs": { "whitewater": true } })");
+    EXPECT_CONTAINS(errorLine("run " + write(gas, "gas.json") + " --out " + out.string()),
+                    "outputs.whitewater: whitewater is made from a liquid's splashes in liquid "
+                    "scenes; this gas scene makes none");
 
     // A post-process needs the liquid's velocities and ids in the points files.
     scene = damBreak();
