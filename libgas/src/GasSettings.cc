@@ -111,6 +111,8 @@ std::vector<Row> gasRows()
                     sph::nonNegative(), "m", "beta of Eq. 25"),
         Row::number("vorticity_strength", "vorticityStrength", &G::vorticityStrength,
                     sph::nonNegative(), "1/s", "scale of Eq. 26's vortex velocity"),
+        Row::number("entrainment", "entrainment", &G::entrainment, sph::between(0, 1), "",
+                    "alpha: ambient air joins the gas boundary at alpha |v|; 0 = off"),
         Row::number("life_strength", "lifeStrength", &G::lifeStrength, sph::nonNegative(), "s",
                     "how long an isolated particle lives (Sec. 5); 0 = forever"),
     };
@@ -213,6 +215,15 @@ void GasSettings::validate() const
     check.require(buoyancyDirection.length() > Real(1e-6), "buoyancyDirection",
                   buoyancyDirection.length(), "a finite non-zero vector");
     validateAttractors(attractors);
+    if (entrainment > Real(0) && method != Method::Fast) {
+        throw ValueError(msg("gas setting entrainment = ", entrainment, " with method '",
+                             methodName(method), "': expected 0 (",
+                             method == Method::Ambient
+                                 ? "the ambient baseline simulates the air it draws in"
+                                 : "entrainment finds the gas's boundary by the fast method's "
+                                   "density correction, which this method leaves out",
+                             ")"));
+    }
     if (method == Method::Ambient) {
         const Vec3 e = domain.extent();
         check.require(

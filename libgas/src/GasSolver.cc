@@ -64,6 +64,7 @@ GasSolver::GasSolver(const GasSettings& settings)
     , mCompensation(mSettings)
     , mTemperature(mSettings)
     , mVorticity(mSettings)
+    , mEntrainment(mSettings)
     , mGrid(settings.supportRadius())
 {
     mParticles.addScalarChannel(channel::TEMPERATURE, mSettings.ambientTemperature);
@@ -740,12 +741,15 @@ void GasSolver::integrate(Real dt, const std::vector<Vec3>& accel)
     auto& T = mParticles.scalarChannel(channel::TEMPERATURE);
     std::vector<Vec3>* omega =
         mVorticity.enabled() ? &mParticles.vectorChannel(channel::VORTICITY) : nullptr;
+    auto& m = mParticles.masses();
+    const bool entrains = mEntrainment.enabled() && mCompensation.enabled();
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) return;
         v[i] += dt * accel[i];
         x[i] += dt * v[i];
         mTemperature.advance(T, i, dt);
         if (omega) mVorticity.advance(*omega, i, dt);
+        if (entrains) mEntrainment.entrain(m[i], v[i], T[i], mCompensation.normal(i), dt);
     });
     Real amax = 0;
     for (std::size_t i = 0; i < n; ++i) {

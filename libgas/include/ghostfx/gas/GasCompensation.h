@@ -61,6 +61,10 @@ public:
         F += Pa * nI;
     }
 
+    /// n_bar_i of Eq. 5 (1/m) from the last density pass: the gradient of the gas's colour
+    /// field, pointing into the gas; its length is the boundary's area per volume.
+    const Vec3& normal(std::size_t i) const { return mNbar[i]; }
+
     /// Eq. 14 added to the acceleration a (m/s^2) of a particle at velocity vi (m/s).
     void damp(Vec3& a, const Vec3& vi, bool surface) const
     {

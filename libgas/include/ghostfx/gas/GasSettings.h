@@ -157,6 +157,11 @@ struct GasSettings
     /// into an acceleration. [RYY15] calls Eq. 26 a force without giving its units.
     Real vorticityStrength = Real(5);
 
+    // Entrainment of ambient air (GasEntrainment.h) ----------------------------------------------
+    /// alpha, the entrainment coefficient of Morton, Taylor and Turner 1956: ambient air at rest
+    /// joins the gas through its boundary at alpha times the gas's speed. 0 = off.
+    Real entrainment = Real(0);
+
     // Force fields ------------------------------------------------------------------------------
     /// Point attractors acting on the visible gas in the force stage, added to Eq. 24 (the
     /// magic attractor of [RYY15] Fig. 7; see Attractor for the formula). Empty by default.

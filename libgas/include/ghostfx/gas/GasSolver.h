@@ -44,6 +44,7 @@
 
 #include <ghostfx/gas/GasChannels.h>
 #include <ghostfx/gas/GasCompensation.h>
+#include <ghostfx/gas/GasEntrainment.h>
 #include <ghostfx/gas/GasSettings.h>
 #include <ghostfx/gas/GasTemperature.h>
 #include <ghostfx/gas/GasVorticity.h>
@@ -268,6 +269,7 @@ private:
     GasCompensation mCompensation; ///< Eqs. 5, 8, 10, 13, 14 (Method::Fast)
     GasTemperature mTemperature;   ///< Eqs. 15 - 17
     GasVorticity mVorticity;       ///< Eqs. 25 - 26
+    GasEntrainment mEntrainment;   ///< ambient air mixed in at the boundary ([MTT56])
     ParticleSet mParticles;
     sph::NeighborGrid mGrid;
     /// Each gas particle's neighbours (gas and boundary) within the grid's cell size, searched
