@@ -16,7 +16,7 @@ GasCompensation::GasCompensation(const GasSettings& settings)
     , mDelta(settings.delta)
     , mAtmosphericPressure(settings.atmosphericPressure)
     , mInteriorPressureScale(settings.interiorPressureScale)
-    , mDamping(settings.damping)
+    , mDamping(settings.boundaryDamping())
 {}
 
 Real GasCompensation::correctedDensity(const NeighborLists& lists, const std::vector<Vec3>& x,

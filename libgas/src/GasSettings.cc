@@ -91,7 +91,8 @@ std::vector<Row> gasRows()
         Row::number("normal_threshold", "normalThreshold", &G::normalThreshold, sph::above(0, 10),
                     "", "C_N of Eq. 14, on |n| h"),
         Row::number("damping", "damping", &G::damping, sph::nonNegative(), "1/s",
-                    "C_d of Eq. 14: the drag of the air not simulated"),
+                    "C_d of Eq. 14: the drag of the air not simulated")
+            .automaticWhenNegative(),
         Row::number("viscosity", "viscosity", &G::viscosity, sph::nonNegative(), "Pa s",
                     "dynamic viscosity of Eq. 22"),
         Row::vector("gravity", "gravity", &G::gravity, "m/s^2",

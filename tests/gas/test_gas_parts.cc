@@ -90,7 +90,8 @@ TEST(GasCompensation, OnlyTheFastMethodCompensatesAndItsForcesFollowEqs13And14)
     Vec3 a(0), b(0);
     part.damp(a, v, true);
     part.damp(b, v, false);
-    EXPECT_EQ(a, -(s.damping * v));
+    EXPECT_EQ(a, -(s.boundaryDamping() * v));
+    EXPECT_EQ(s.boundaryDamping(), Real(7)); // automatic without entrainment
     EXPECT_EQ(b, Vec3(0));
 }
 

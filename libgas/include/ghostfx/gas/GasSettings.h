@@ -123,8 +123,9 @@ struct GasSettings
     /// C_d of Eq. 14 (1/s): a_damp = -C_d v on boundary particles, the drag of the air that is
     /// not simulated. Not given by [RYY15]. 7 makes the shipped plume (examples/gas_plume) rise
     /// as the ambient-air baseline's does (top and centroid within 15 %, tests/python): 1 rose
-    /// 1.36x as high on average, 3 1.29x, 10 0.93x (docs/study.md, gas plume).
-    Real damping = Real(7);
+    /// 1.36x as high on average, 3 1.29x, 10 0.93x (docs/study.md, gas plume). Negative (the
+    /// default): automatic, boundaryDamping().
+    Real damping = Real(-1);
     /// Dynamic viscosity mu (Pa s) of the viscosity force F_v of Eq. 22 (Mueller et al. 2003
     /// Laplacian kernel). Not given by [RYY15]; small enough that dt mu / (rho0 h^2) < 0.1 at
     /// the defaults.
@@ -156,6 +157,15 @@ struct GasSettings
     /// Scale (1/s) turning the vortex velocity of Eq. 26, sum_j V_j (omega_j x r_ij) W_ij (m/s),
     /// into an acceleration. [RYY15] calls Eq. 26 a force without giving its units.
     Real vorticityStrength = Real(5);
+
+    /// C_d in use: `damping`, or where it is automatic 7 /s, and 0 with `entrainment` (the
+    /// entrained air's momentum is then the air's drag; with both, a plume slowed as
+    /// w ~ z^-1.07 against [MTT56]'s z^-1/3, tests/gas/test_gas_entrainment.cc).
+    Real boundaryDamping() const
+    {
+        if (damping >= Real(0)) return damping;
+        return entrainment > Real(0) ? Real(0) : Real(7);
+    }
 
     // Entrainment of ambient air (GasEntrainment.h) ----------------------------------------------
     /// alpha, the entrainment coefficient of Morton, Taylor and Turner 1956: ambient air at rest
