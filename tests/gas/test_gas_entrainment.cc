@@ -203,3 +203,92 @@ TEST(GasEntrainment, OnlyTheFastMethodTakesIt)
     bad.entrainment = Real(1.5);
     EXPECT_THROW(bad.validate(), ValueError);
 }
+
+namespace {
+
+/// A thermal's centroid height (m) and radius R = sqrt(5/3 <|x - c|^2>) (m, mass-weighted: a
+/// uniform ball of radius R has <|x - c|^2> = 3/5 R^2) at time t (s).
+struct ThermalSample
+{
+    double t, z, R;
+};
+
+std::vector<ThermalSample> thermal(Real spacing, Real entrainment, Real temperature)
+{
+    GasSettings s;
+    s.spacing = spacing;
+    s.substeps = 2;
+    s.seed = 1;
+    s.entrainment = entrainment;
+    s.domain = Aabb{Vec3(-1.5f, -0.05f, -1.5f), Vec3(1.5f, 5.0f, 1.5f)};
+    GasSolver solver(s);
+    solver.addGas(
+        makeLevelSet(makeSphereLevelSet(Vec3(0, Real(0.3), 0), Real(0.1), spacing / 2), "thermal"),
+        Vec3(0), temperature);
+    std::vector<ThermalSample> out;
+    for (int f = 1; f <= 66; ++f) {
+        solver.advanceFrame();
+        if (f % 6) continue;
+        const ParticleSet& p = solver.particles();
+        double m = 0;
+        openvdb::math::Vec3<double> c(0.0);
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            if (p.kinds()[i] != ParticleKind::Gas) continue;
+            m += double(p.masses()[i]);
+            c += openvdb::math::Vec3<double>(p.positions()[i]) * double(p.masses()[i]);
+        }
+        c /= m;
+        double r2 = 0;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            if (p.kinds()[i] != ParticleKind::Gas) continue;
+            r2 += double(p.masses()[i])
+                  * (openvdb::math::Vec3<double>(p.positions()[i]) - c).lengthSqr();
+        }
+        out.push_back({solver.time(), c[1], std::sqrt(5.0 / 3.0 * r2 / m)});
+    }
+    return out;
+}
+
+} // namespace
+
+// A thermal (a 10 cm ball of gas at 600 K released at rest) entraining air grows with its radius
+// proportional to its height, R = e (z - z_v), and rises as (t - t_v)^(1/2) (MTT 1956: its
+// buoyancy is conserved, so w ~ (z - z_v)^-1). Scorer 1957 measured e about 0.25: the bound is a
+// factor 1.5 either way, that constant being less certain than the exponents; the time exponent
+// (from w ~ (z - z_v)^n: z ~ t^(1 / (1 - n))) within 30 % of 1/2. Fitted from 0.8 to 2 s (the
+// ball rolls up into a thermal in the first 0.6 s), at 3 and 2 cm spacing. Measured e 0.175 and
+// 0.208, z ~ t^0.54 and t^0.56. Without entrainment it keeps its size.
+TEST(GasEntrainment, AThermalGrowsWithItsHeightAndRisesAsTheSquareRootOfTime)
+{
+    for (Real spacing : {Real(0.03), Real(0.02)}) {
+        const std::vector<ThermalSample> column = thermal(spacing, Real(0), Real(600));
+        const std::vector<ThermalSample> grown = thermal(spacing, Real(0.12), Real(600));
+        std::vector<double> z, R, logZ, logW;
+        for (std::size_t k = 1; k + 1 < grown.size(); ++k) {
+            if (grown[k].t < 0.79 || grown[k].t > 2.01) continue;
+            z.push_back(grown[k].z);
+            R.push_back(grown[k].R);
+        }
+        const auto [e, intercept] = fitLine(z, R);
+        const double zv = -intercept / e;
+        for (std::size_t k = 1; k + 1 < grown.size(); ++k) {
+            if (grown[k].t < 0.79 || grown[k].t > 2.01) continue;
+            const double w = (grown[k + 1].z - grown[k - 1].z) / (grown[k + 1].t - grown[k - 1].t);
+            logZ.push_back(std::log(grown[k].z - zv));
+            logW.push_back(std::log(w));
+        }
+        const double n = fitLine(logZ, logW).first, timeExponent = 1 / (1 - n);
+        std::printf("[measured] thermal, %.0f cm: dR/dz = %.3f (virtual origin %.2f m), w ~ "
+                    "(z - z_v)^%.2f: z ~ t^%.2f; R from %.3f to %.3f m while z rose from %.2f to "
+                    "%.2f m; without entrainment R %.3f to %.3f m\n",
+                    100 * double(spacing), e, zv, n, timeExponent, R.front(), R.back(), z.front(),
+                    z.back(), column[3].R, column[9].R);
+        EXPECT_GE(e, 0.25 / 1.5);
+        EXPECT_LE(e, 0.25 * 1.5);
+        EXPECT_NEAR(timeExponent, 0.5, 0.15);
+        // Over the same frames (0.8 to 2 s) it doubles its radius; the ball without entrainment
+        // grows 6 to 11 % (its particles spreading, not air drawn in).
+        EXPECT_GT(R.back() / R.front(), 1.5);
+        EXPECT_LT(column[9].R / column[3].R, 1.2);
+    }
+}
