@@ -5,6 +5,11 @@
 #include "OneSolverSimulation.h"
 #include "SimulationParts.h"
 
+#include <ghostfx/gas/GasFlowStats.h>
+
+#include <cmath>
+#include <limits>
+
 namespace ghostfx {
 namespace cmd {
 
@@ -57,6 +62,12 @@ std::vector<std::pair<std::string, double>> gasStats(const gas::GasSolver& s,
                                            : nullptr;
     const FieldStats f = fieldStats(p, ParticleKind::Gas, s.settings().restDensity, ambient);
     const gas::GasTimings& t = s.timings();
+    // The flow's statistics once a frame, in the row of its last step (a step ends a frame
+    // exactly on its time); NaN in the other rows.
+    const double frames = s.time() * double(s.settings().frameRate);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    gas::GasFlowStats flow{nan, nan, nan};
+    if (std::abs(frames - std::round(frames)) < 1e-6) flow = gas::gasFlowStats(p, s.settings());
     return {
         {"count_gas", double(f.count)},
         {"count_ambient", double(s.ambientCount())},
@@ -64,6 +75,9 @@ std::vector<std::pair<std::string, double>> gasStats(const gas::GasSolver& s,
         {"gas_max_speed", f.maxSpeed},
         {"gas_density_error_mean", f.errorMean},
         {"gas_density_error_max", f.errorMax},
+        {"gas_kinetic_energy", flow.kineticEnergy},
+        {"gas_enstrophy", flow.enstrophy},
+        {"gas_spread_rate", flow.spreadRate},
         {"t_gas_emission", t.emission - before.emission},
         {"t_gas_neighbors", t.neighbors - before.neighbors},
         {"t_gas_density", t.density - before.density},
