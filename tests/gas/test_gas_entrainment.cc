@@ -21,7 +21,7 @@ using namespace ghostfx::gas;
 namespace {
 
 /// A steady plume from a burner: the examples/gas_plume scene (a sphere burner blowing 0.4 m/s,
-/// its centre 12 cm above a floor) in a 3.4 m tall kill box, 6 s at 30 frames per second.
+/// its centre 12 cm above a floor) in a 3.4 m tall kill box, 5 s at 30 frames per second.
 struct Plume
 {
     Real spacing = Real(0.03);
@@ -30,7 +30,7 @@ struct Plume
     Real radius = Real(0.1);      ///< of the burner (m)
 };
 
-/// What a plume measured over the frames from 5 to 6 s, in 10 cm height bins from 1 to 3 m (5 to
+/// What a plume measured over the frames from 4 to 5 s, in 10 cm height bins from 1 to 3 m (5 to
 /// 15 burner diameters): the top-hat radius b(z) = sqrt(2) r_rms (r_rms the mass-weighted RMS
 /// distance from the bin's centre of mass in the horizontal plane: a uniform disc of radius b
 /// has r_rms = b / sqrt(2)), the mass-weighted mean vertical velocity w and excess temperature
@@ -110,9 +110,9 @@ Spread measure(const Plume& plume)
     constexpr int BINS = 20;
     std::vector<double> sums(3 * BINS, 0.0);
     int frames = 0;
-    for (int f = 1; f <= 180; ++f) {
+    for (int f = 1; f <= 150; ++f) {
         solver.advanceFrame();
-        if (f < 150) continue;
+        if (f < 120) continue;
         addBins(solver.particles(), sums);
         ++frames;
     }
@@ -153,22 +153,23 @@ void print(const char* what, const Spread& s)
 // a top-hat radius b = (6/5) alpha (z - z_v), a velocity w ~ (z - z_v)^(-1/3) and a buoyancy
 // ~ (z - z_v)^(-5/3). The air-free gas without entrainment rises as a column. With alpha = 0.12
 // (and so no boundary damping), over 5 to 15 burner diameters: db/dz within 0.08 to 0.16, the
-// range of measured plumes, and within 25 % at 2 and 3 cm spacing (3.4 times the particles);
+// range of measured plumes, and within 25 % at 4 and 3 cm spacing (2.4 times the particles);
 // both exponents within 30 % of MTT's (the bounds); at 600 and 400 K and for burners of
-// 10 and 7 cm. Measured db/dz 0.095-0.100, below MTT's 0.144 at this alpha: a particle's own
-// speed along the boundary, which draws the air in here, is below the plume's top-hat speed.
+// 10 and 7 cm. Measured db/dz 0.089-0.102 (0.114 at 2 cm in a 6 s run), below MTT's 0.144 at
+// this alpha: a particle's own speed along the boundary, which draws the air in here, is below
+// the plume's top-hat speed.
 TEST(GasEntrainment, APlumeSpreadsAndSlowsAsMttSayWhateverTheSpacing)
 {
-    const Spread column = measure(Plume{Real(0.03), Real(0)});
-    print("plume without entrainment, 3 cm", column);
+    const Spread column = measure(Plume{Real(0.04), Real(0)});
+    print("plume without entrainment, 4 cm", column);
     EXPECT_LT(std::abs(column.slope), 0.03);
     std::vector<Spread> runs;
-    const Plume plumes[] = {{},
-                            {Real(0.02)},
-                            {Real(0.03), Real(0.12), Real(400)},
+    const Plume plumes[] = {{Real(0.04)},
+                            {Real(0.03)},
+                            {Real(0.04), Real(0.12), Real(400)},
                             {Real(0.03), Real(0.12), Real(600), Real(0.07)}};
-    const char* names[] = {"alpha 0.12, 3 cm", "alpha 0.12, 2 cm", "alpha 0.12, 400 K",
-                           "alpha 0.12, 7 cm burner"};
+    const char* names[] = {"alpha 0.12, 4 cm", "alpha 0.12, 3 cm", "alpha 0.12, 4 cm, 400 K",
+                           "alpha 0.12, 3 cm, 7 cm burner"};
     for (std::size_t k = 0; k < 4; ++k) {
         runs.push_back(measure(plumes[k]));
         print(names[k], runs.back());
