@@ -57,6 +57,14 @@ vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutp
         vo.scalarChannels.push_back("temperature");
         vo.ambientTemperature = m.ambientTemperature;
     }
+    if (!m.liquid && wants("smoke")) {
+        if (!m.particles->hasScalarChannel("smoke")) {
+            throw SceneError(msg("outputs.gas_volume.grids: grid 'smoke' asked for, but the gas "
+                                 "carries no smoke share without entrainment (expected "
+                                 "settings.gas.entrainment > 0)"));
+        }
+        vo.scalarChannels.push_back("smoke");
+    }
     return vo;
 }
 

@@ -79,6 +79,7 @@ void GasSolver::addStepChannels()
     mParticles.addVectorChannel(channel::NORMAL);
     mParticles.addScalarChannel(channel::LIFE, mSettings.lifeStrength);
     if (mSettings.method == Method::Ambient) mParticles.addScalarChannel(channel::AMBIENT, Real(0));
+    if (mEntrainment.enabled()) mParticles.addScalarChannel(channel::SMOKE, Real(1));
     mVorticity.addChannel(mParticles);
 }
 
@@ -743,13 +744,16 @@ void GasSolver::integrate(Real dt, const std::vector<Vec3>& accel)
         mVorticity.enabled() ? &mParticles.vectorChannel(channel::VORTICITY) : nullptr;
     auto& m = mParticles.masses();
     const bool entrains = mEntrainment.enabled() && mCompensation.enabled();
+    std::vector<Real>* smoke = entrains ? &mParticles.scalarChannel(channel::SMOKE) : nullptr;
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) return;
         v[i] += dt * accel[i];
         x[i] += dt * v[i];
         mTemperature.advance(T, i, dt);
         if (omega) mVorticity.advance(*omega, i, dt);
-        if (entrains) mEntrainment.entrain(m[i], v[i], T[i], mCompensation.normal(i), dt);
+        if (smoke) {
+            mEntrainment.entrain(m[i], v[i], T[i], (*smoke)[i], mCompensation.normal(i), dt);
+        }
     });
     Real amax = 0;
     for (std::size_t i = 0; i < n; ++i) {

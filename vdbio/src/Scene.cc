@@ -473,7 +473,7 @@ void readOutputs(const JsonObject& o, SceneOutputs& out)
     readSection(o, "gas_volume", out.gasVolumeFile, [&](const JsonObject& s) {
         out.gasVolumeFile = outputFile(s, "file", out.gasVolumeFile, vdb, "OpenVDB grids");
         out.gasVolumeGrids =
-            readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature"});
+            readGridNames(s, out.gasVolumeGrids, {"density", "vel", "temperature", "smoke"});
         out.gasVoxelSize = s.nonNegative("voxel_size", out.gasVoxelSize);
     });
     out.previewFile.clear();

@@ -15,7 +15,9 @@
 ///          mixes into the particle: its momentum m v and its buoyancy m (T - T_a) are kept, so
 ///          it slows and cools as [MTT56]'s top-hat plume does, and the buoyancy flux of a
 ///          plume is conserved. The particle's volume grows with its mass (its support follows,
-///          GasSolver::expandSupports), so the gas widens: [MTT56] b = 6/5 alpha z.
+///          GasSolver::expandSupports), so the gas widens: [MTT56] b = 6/5 alpha z. Its share of
+///          smoke (channel::SMOKE, 1 as emitted) falls as the air dilutes it, so sum_i m_i c_i
+///          stays the mass emitted; the "smoke" volume grid draws the plume thinning.
 #pragma once
 
 #include <ghostfx/gas/GasSettings.h>
@@ -35,9 +37,9 @@ public:
 
     bool enabled() const { return mAlpha > Real(0); }
 
-    /// Mix the air a particle of mass m (kg), velocity v (m/s) and temperature T (K) with the
-    /// colour gradient n (1/m) entrains over dt (s) into it.
-    void entrain(Real& m, Vec3& v, Real& T, const Vec3& n, Real dt) const
+    /// Mix the air a particle of mass m (kg), velocity v (m/s), temperature T (K) and smoke
+    /// share c (channel::SMOKE) with the colour gradient n (1/m) entrains over dt (s) into it.
+    void entrain(Real& m, Vec3& v, Real& T, Real& c, const Vec3& n, Real dt) const
     {
         const double length = double(n.length());
         if (!(length > 0)) return;
@@ -51,6 +53,7 @@ public:
         const double keep = double(m) / total;
         T = Real(double(mAmbient) + (double(T) - double(mAmbient)) * keep);
         v = Vec3(openvdb::math::Vec3<double>(v) * keep);
+        c = Real(double(c) * keep);
         m = Real(total);
     }
 
