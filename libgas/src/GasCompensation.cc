@@ -19,13 +19,10 @@ GasCompensation::GasCompensation(const GasSettings& settings)
     , mDamping(settings.boundaryDamping())
 {}
 
-Real GasCompensation::correctedDensity(const NeighborLists& lists, const std::vector<Vec3>& x,
-                                       const std::vector<Real>& m, const std::vector<Real>& h,
-                                       const std::vector<Real>& rhoBar, std::size_t i)
+void GasCompensation::storeNormal(const NeighborLists& lists, const std::vector<Vec3>& x,
+                                  const std::vector<Real>& m, const std::vector<Real>& h,
+                                  const std::vector<Real>& rhoBar, std::size_t i)
 {
-    // Eq. 5: V_0 = |sum_j m_j / rho_bar_j grad W_ij| / |grad W_ik|, with the uncorrected
-    // neighbour densities as in Eq. 4 and the derivation of Eqs. 7 - 8 (Appendix A); the virtual
-    // particle k sits delta h_i away (Sec. 3.1), so |grad W_ik| and W_ik use the particle's own h.
     Vec3d nbar(0.0);
     forEachListed(lists, x, i, [&](Index j, const Vec3& xij, Real r) {
         if (j == i) return;
@@ -36,6 +33,16 @@ Real GasCompensation::correctedDensity(const NeighborLists& lists, const std::ve
         accumulate(nbar, g * Real(vj));
     });
     mNbar[i] = sph::toVec3(nbar);
+}
+
+Real GasCompensation::correctedDensity(const NeighborLists& lists, const std::vector<Vec3>& x,
+                                       const std::vector<Real>& m, const std::vector<Real>& h,
+                                       const std::vector<Real>& rhoBar, std::size_t i)
+{
+    // Eq. 5: V_0 = |sum_j m_j / rho_bar_j grad W_ij| / |grad W_ik|, with the uncorrected
+    // neighbour densities as in Eq. 4 and the derivation of Eqs. 7 - 8 (Appendix A); the virtual
+    // particle k sits delta h_i away (Sec. 3.1), so |grad W_ik| and W_ik use the particle's own h.
+    storeNormal(lists, x, m, h, rhoBar, i);
     // Eq. 8: rho_i = rho_bar_i (1 + V_0 W_ik).
     const Real rk = mDelta * h[i];
     const Real V0 = mNbar[i].length() / sph::spikySlope(rk, h[i]);

@@ -216,14 +216,10 @@ void GasSettings::validate() const
     check.require(buoyancyDirection.length() > Real(1e-6), "buoyancyDirection",
                   buoyancyDirection.length(), "a finite non-zero vector");
     validateAttractors(attractors);
-    if (entrainment > Real(0) && method != Method::Fast) {
-        throw ValueError(msg("gas setting entrainment = ", entrainment, " with method '",
-                             methodName(method), "': expected 0 (",
-                             method == Method::Ambient
-                                 ? "the ambient baseline simulates the air it draws in"
-                                 : "entrainment finds the gas's boundary by the fast method's "
-                                   "density correction, which this method leaves out",
-                             ")"));
+    if (entrainment > Real(0) && method == Method::Ambient) {
+        throw ValueError(msg("gas setting entrainment = ", entrainment,
+                             " with method 'ambient': expected 0 (the ambient baseline "
+                             "simulates the air it draws in)"));
     }
     if (method == Method::Ambient) {
         const Vec3 e = domain.extent();

@@ -565,8 +565,10 @@ void GasSolver::correctDensities()
     const Real rho0 = mSettings.restDensity;
     const bool clampTension = mSettings.clampNegativePressure;
 
-    // Eqs. 5 and 8 in the fast method; the baselines use rho_bar as it is (Eq. 21).
-    if (mCompensation.enabled()) mCompensation.beginDensity(n);
+    // Eqs. 5 and 8 in the fast method; the baselines use rho_bar as it is (Eq. 21), the
+    // uncorrected one with Eq. 5's boundary normal where it entrains air.
+    const bool normalOnly = !mCompensation.enabled() && mEntrainment.enabled();
+    if (mCompensation.enabled() || normalOnly) mCompensation.beginDensity(n);
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) {
             rho[i] = rho0;
@@ -576,6 +578,7 @@ void GasSolver::correctDensities()
         const Real rhoI = mCompensation.enabled()
                               ? mCompensation.correctedDensity(mLists, x, m, h, rhoBar, i)
                               : rhoBar[i];
+        if (normalOnly) mCompensation.storeNormal(mLists, x, m, h, rhoBar, i);
         rho[i] = rhoI;
         const Real excess = rhoI - rho0;
         p[i] = mSettings.kappa * (clampTension ? std::max(excess, Real(0)) : excess); // Eq. 11
@@ -743,7 +746,7 @@ void GasSolver::integrate(Real dt, const std::vector<Vec3>& accel)
     std::vector<Vec3>* omega =
         mVorticity.enabled() ? &mParticles.vectorChannel(channel::VORTICITY) : nullptr;
     auto& m = mParticles.masses();
-    const bool entrains = mEntrainment.enabled() && mCompensation.enabled();
+    const bool entrains = mEntrainment.enabled();
     std::vector<Real>* smoke = entrains ? &mParticles.scalarChannel(channel::SMOKE) : nullptr;
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) return;

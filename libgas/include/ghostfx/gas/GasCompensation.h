@@ -40,6 +40,12 @@ public:
                           const std::vector<Real>& m, const std::vector<Real>& h,
                           const std::vector<Real>& rhoBar, std::size_t i);
 
+    /// Eq. 5's n_bar_i alone (no correction), for a method without compensation whose
+    /// entrainment still needs the gas's boundary (GasEntrainment.h); arguments as above.
+    void storeNormal(const sph::NeighborLists& lists, const std::vector<Vec3>& x,
+                     const std::vector<Real>& m, const std::vector<Real>& h,
+                     const std::vector<Real>& rhoBar, std::size_t i);
+
     /// Eqs. 10 and 13 added to the force density F (N/m^3) of gas particle i: pressure pi (Pa),
     /// densities rhoBarI and rhoI (kg/m^3), normal nI (1/m), `surface` when |n_i| h_i > C_N.
     void addForces(Vec3& F, std::size_t i, Real pi, Real rhoBarI, Real rhoI, const Vec3& nI,
