@@ -168,3 +168,27 @@ TEST_F(WhitewaterOutput, BadInputIsRefusedInOneLine)
     EXPECT_CONTAINS(errorLine("whitewater " + out.string() + " --frames 1-2"),
                     "frame 1 ('liquid_points.0001.vdb') is missing in");
 }
+
+// A checkpoint fits the scene with or without whitewater: one written without it resumes with
+// whitewater starting at its frame, one written with it resumes without (its state dropped).
+TEST_F(WhitewaterOutput, ACheckpointResumesWithWhitewaterSwitchedOnOrOff)
+{
+    Json scene = damBreak();
+    scene["settings"]["frame_range"] = Json::array({1, 4});
+    scene["outputs"]["checkpoint"]["every"] = 2;
+    scene["outputs"]["whitewater"] = false;
+    const fs::path plain = mDir / "plain", on = mDir / "on", off = mDir / "off";
+    runInto(write(scene, "plain.json"), plain);
+    EXPECT_FALSE(fs::exists(plain / frameName("whitewater", 2)));
+    scene["outputs"]["whitewater"] = true;
+    const std::string withWhitewater = write(scene, "white.json");
+    runInto(withWhitewater, on, "--resume " + (plain / "checkpoint.0002.h5").string());
+    EXPECT_FALSE(fs::exists(on / frameName("whitewater", 2)));
+    EXPECT_TRUE(fs::exists(on / frameName("whitewater", 3)));
+    EXPECT_TRUE(fs::exists(on / frameName("whitewater", 4)));
+    scene["outputs"]["whitewater"] = false;
+    runInto(write(scene, "off.json"), off,
+            "--resume " + (on / "checkpoint.0004.h5").string() + " --frames 1-6");
+    EXPECT_TRUE(fs::exists(off / frameName("liquid_points", 6)));
+    EXPECT_FALSE(fs::exists(off / frameName("whitewater", 5)));
+}
