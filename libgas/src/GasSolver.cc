@@ -456,25 +456,19 @@ void GasSolver::sortParticles()
     if (!(mGrid.cellSize() == maxH)) mGrid = NeighborGrid(maxH);
     mGrid.sortParticles(mParticles);
     // One search per step: every gas particle's neighbours, reused by density and forces.
-    // A pair interacts within the mean of its two supports, so particle i searches
-    // (h_i + h_max) / 2: a small newborn vapour particle among large ones does not list the
-    // whole cell of the largest support.
+    // A pair interacts within the mean of its two supports; with supports of several sizes
+    // (grown vapour, entrained air) the lists hold only such pairs, so a small particle near a
+    // grown one does not list the whole cell of the largest support.
     const std::size_t n = mParticles.size();
     const auto& kind = mParticles.kinds();
     mQueryMask.resize(n);
-    mQueryRadius.resize(n);
     bool uniform = true;
     for (std::size_t i = 0; i < n && uniform; ++i)
         uniform = kind[i] != ParticleKind::Gas || h[i] == maxH;
     parallel::forEach(
-        0, n,
-        [&](std::size_t i) {
-        mQueryMask[i] = kind[i] == ParticleKind::Gas;
-        mQueryRadius[i] = pairSupport(h[i], maxH);
-        },
-        4096);
+        0, n, [&](std::size_t i) { mQueryMask[i] = kind[i] == ParticleKind::Gas; }, 4096);
     mLists.build(mGrid, mParticles.positions().data(), n, maxH, mQueryMask.data(),
-                 uniform ? nullptr : mQueryRadius.data());
+                 uniform ? nullptr : h.data());
 }
 
 void GasSolver::expandSupports()

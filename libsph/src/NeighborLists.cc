@@ -201,7 +201,7 @@ public:
         Real radius;                ///< m
         const std::uint8_t* select; ///< see buildSelected
         int match;
-        const Real* queryRadius; ///< m, or null
+        const Real* supports; ///< per particle (m), or null: see build()
         bool avx2;               ///< whether to search with searchRangeAvx2
     };
 
@@ -222,7 +222,8 @@ public:
                 ends[q - qFirst] = {std::uint32_t(used), 0};
                 continue;
             }
-            const std::size_t hits = searchStencil(mIn.queries[q], radius2Of(q));
+            std::size_t hits = searchStencil(mIn.queries[q], radius2Of(q));
+            if (mIn.supports) hits = keepPairSupports(q, hits);
             toParticleIndices(hits);
             const Index window = hits > 0 ? store(hits, out, used) : 0;
             if (used >= std::size_t(std::numeric_limits<std::uint32_t>::max())) {
@@ -241,12 +242,36 @@ private:
         return !select || (mIn.match < 0 ? select[q] != 0 : int(select[q]) == mIn.match);
     }
 
-    /// The squared search radius of query q (m^2): the build's, or its own when smaller.
+    /// The squared search radius of query q (m^2): the build's, or with supports, the largest
+    /// pair support of q, (h_q + radius) / 2.
     Real radius2Of(std::size_t q) const
     {
-        if (!mIn.queryRadius) return mIn.radius * mIn.radius;
-        const Real rq = std::min(mIn.queryRadius[q], mIn.radius);
+        if (!mIn.supports) return mIn.radius * mIn.radius;
+        const Real rq = std::min(Real(0.5) * (mIn.supports[q] + mIn.radius), mIn.radius);
         return rq > Real(0) ? rq * rq : Real(0);
+    }
+
+    /// Keep, of query q's `hits` (slots, in order), those within their pair support (with a
+    /// margin of 1e-4 of it, above float rounding, so no pair a pass would use is dropped);
+    /// returns how many are kept. A particle grown among small ones (an entraining gas) makes
+    /// every query near it search its wide support, most of which lies beyond the pairs'.
+    std::size_t keepPairSupports(std::size_t q, std::size_t hits)
+    {
+        constexpr Real MARGIN = Real(1.0001);
+        const Vec3& x = mIn.queries[q];
+        const Real hq = mIn.supports[q];
+        const bool sorted = mIn.targets.identityOrder();
+        Index* found = mFound.data();
+        std::size_t kept = 0;
+        for (std::size_t k = 0; k < hits; ++k) {
+            const Index s = found[k];
+            const Real dx = x[0] - mX[s], dy = x[1] - mY[s], dz = x[2] - mZ[s];
+            const Real ht = mIn.supports[sorted ? s : mIn.targets.particleAt(s)];
+            const Real R = Real(0.5) * (hq + ht) * MARGIN;
+            found[kept] = s;
+            kept += std::size_t(dx * dx + dy * dy + dz * dz < R * R);
+        }
+        return kept;
     }
 
     /// Search the cells around x that its ball of squared radius `radius2` reaches. Reachable
@@ -432,9 +457,9 @@ private:
 };
 
 void NeighborLists::build(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
-                          Real radius, const std::uint8_t* wanted, const Real* queryRadius)
+                          Real radius, const std::uint8_t* wanted, const Real* supports)
 {
-    buildSelected(targets, queries, count, radius, wanted, -1, queryRadius);
+    buildSelected(targets, queries, count, radius, wanted, -1, supports);
 }
 
 void NeighborLists::buildFor(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
@@ -445,7 +470,7 @@ void NeighborLists::buildFor(const NeighborGrid& targets, const Vec3* queries, s
 
 void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queries,
                                   std::size_t count, Real radius, const std::uint8_t* select,
-                                  int match, const Real* queryRadius)
+                                  int match, const Real* supports)
 {
     if (!(radius > Real(0)) || radius > targets.cellSize()) {
         throw ValueError(msg("neighbour lists: radius ", radius,
@@ -462,7 +487,7 @@ void NeighborLists::buildSelected(const NeighborGrid& targets, const Vec3* queri
     const std::size_t chunks = (count + CHUNK - 1) / CHUNK;
     mChunks.resize(chunks); // chunks beyond this build's queries give their memory back
     const ChunkBuilder::Input in{targets, queries, count,       radius,
-                                 select,  match,   queryRadius, wideSimd()};
+                                 select,  match,   supports, wideSimd()};
     parallel::forEach(
         0, chunks,
         [&](std::size_t chunk) {

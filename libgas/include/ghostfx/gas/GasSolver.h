@@ -276,7 +276,6 @@ private:
     /// once per step in sortParticles() and read by the density and force passes.
     sph::NeighborLists mLists;
     std::vector<std::uint8_t> mQueryMask; ///< 1 for gas particles: the queries of mLists
-    std::vector<Real> mQueryRadius;       ///< search radius per particle: (h_i + h_max) / 2
     std::vector<std::unique_ptr<Solid>> mSolids;
     std::vector<std::unique_ptr<Source>> mSources;
     std::vector<std::uint8_t> mIsolated; ///< no neighbour this step (Sec. 5)

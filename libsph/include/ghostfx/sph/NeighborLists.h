@@ -205,10 +205,14 @@ public:
     /// Build the lists of the particles of `targets` closer than `radius` (m, at most the
     /// grid's cell size) to each of `count` query points. Queries with `wanted[q] == 0` get an
     /// empty list (`wanted` may be null: every query is wanted). Sorted queries run fastest.
-    /// `queryRadius` (optional, m): a smaller radius per query (capped at `radius`), for
-    /// particles with their own support radius.
+    /// `supports` (optional, m): for particles with their own support radius h, where the
+    /// queries are the targets' own particles (query q is particle q of the set the grid was
+    /// built over): query q lists target t only when it lies within their pair support
+    /// (h_q + h_t) / 2 (with `radius` at least every h), give or take 1e-4 of it, so a pass
+    /// that tests the pair support itself sees every pair it would have seen in a list of the
+    /// whole radius, in the same order.
     void build(const NeighborGrid& targets, const Vec3* queries, std::size_t count, Real radius,
-               const std::uint8_t* wanted = nullptr, const Real* queryRadius = nullptr);
+               const std::uint8_t* wanted = nullptr, const Real* supports = nullptr);
     /// The same for the queries whose byte `tags[q]` equals `tag`, e.g. the liquid particles of
     /// a set that holds liquid and air, chosen by its kind channel with no mask of their own.
     void buildFor(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
@@ -251,7 +255,7 @@ private:
     /// non-zero (`match` < 0) or equals `match`.
     void buildSelected(const NeighborGrid& targets, const Vec3* queries, std::size_t count,
                        Real radius, const std::uint8_t* select, int match,
-                       const Real* queryRadius);
+                       const Real* supports);
     /// `End::window` of a list kept as 32-bit indices.
     static constexpr Index RAW = ~Index(0);
     /// Searches the queries of one chunk and writes their lists (NeighborLists.cc).
