@@ -36,6 +36,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <memory>
 
 using namespace ghostfx;
@@ -52,6 +53,7 @@ struct Options
     double domain = 1.6, height = 2.4;
     int steps = 20, baselineSteps = 3, maxWarmup = 400;
     std::size_t vapourTarget = 9000;
+    std::string turbulence = "auto"; ///< the fast gas's (the baseline has none)
 };
 
 void report(const char* name, const gas::PhaseTransition& c, const gas::GasSolver& g, double wall,
@@ -169,6 +171,7 @@ int run(const Options& o)
     gs.spacing = H * Real(std::cbrt(1000.0 / 12.0));
     gs.restDensity = Real(1);
     gs.seed = 7;
+    gs.turbulence = gas::turbulenceFromName(o.turbulence);
     gas::GasSolver fastGas(gs);
     const gas::PhaseSettings ps = phaseSettings(H);
     const LevelSet plate = heaterPlate(a, H);
@@ -190,6 +193,7 @@ int run(const Options& o)
     // Baseline: the same liquid, a fresh ambient-air gas solver holding a copy of the vapour.
     gas::GasSettings bs = gs;
     bs.method = gas::Method::Ambient;
+    bs.turbulence = gas::Turbulence::None; // it simulates its air
     const Real half = Real(0.5 * o.domain);
     bs.domain = Aabb{Vec3(-half, Real(-4 * double(H)), -half), Vec3(half, Real(o.height), half)};
     gas::GasSolver ambientGas(bs);
@@ -227,6 +231,8 @@ void addOptions(CLI::App& app, Options& o)
 {
     addPanOptions(app, o);
     addStepOptions(app, o);
+    app.add_option("--turbulence", o.turbulence, "the fast gas's turbulence model (auto, none, "
+                                                 "entrainment)");
     app.add_option("--domain", o.domain, "baseline air box width and depth (m)");
     app.add_option("--height", o.height, "baseline air box height above the pan bottom (m)");
 }

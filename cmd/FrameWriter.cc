@@ -61,7 +61,7 @@ vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutp
         if (!m.particles->hasScalarChannel("smoke")) {
             throw SceneError(msg("outputs.gas_volume.grids: grid 'smoke' asked for, but the gas "
                                  "carries no smoke share without entrainment (expected "
-                                 "settings.gas.entrainment > 0)"));
+                                 "settings.gas.turbulence 'entrainment' or 'auto')"));
         }
         vo.scalarChannels.push_back("smoke");
     }

@@ -20,6 +20,9 @@ namespace {
 
 const sph::EnumName<Method> METHOD_NAMES[] = {
     {Method::Fast, "fast"}, {Method::Ambient, "ambient"}, {Method::Uncorrected, "uncorrected"}};
+const sph::EnumName<Turbulence> TURBULENCE_NAMES[] = {{Turbulence::Automatic, "auto"},
+                                                      {Turbulence::None, "none"},
+                                                      {Turbulence::Entrainment, "entrainment"}};
 const sph::EnumName<Falloff> FALLOFF_NAMES[] = {{Falloff::InverseSquare, "inverse_square"},
                                                 {Falloff::Constant, "constant"}};
 
@@ -30,6 +33,16 @@ const char* methodName(Method method) { return sph::nameOf(METHOD_NAMES, method)
 Method methodFromName(const std::string& name)
 {
     return sph::valueOf(METHOD_NAMES, name, "gas method");
+}
+
+const char* turbulenceName(Turbulence turbulence)
+{
+    return sph::nameOf(TURBULENCE_NAMES, turbulence);
+}
+
+Turbulence turbulenceFromName(const std::string& name)
+{
+    return sph::valueOf(TURBULENCE_NAMES, name, "gas turbulence model");
 }
 
 const char* falloffName(Falloff falloff) { return sph::nameOf(FALLOFF_NAMES, falloff); }
@@ -112,8 +125,11 @@ std::vector<Row> gasRows()
                     sph::nonNegative(), "m", "beta of Eq. 25"),
         Row::number("vorticity_strength", "vorticityStrength", &G::vorticityStrength,
                     sph::nonNegative(), "1/s", "scale of Eq. 26's vortex velocity"),
+        Row::choice<&G::turbulence>("turbulence", "turbulence", sph::choicesOf(TURBULENCE_NAMES),
+                                    "the eddies below the spacing: auto (entrainment; none for "
+                                    "the ambient baseline), none, entrainment"),
         Row::number("entrainment", "entrainment", &G::entrainment, sph::between(0, 1), "",
-                    "alpha: ambient air joins the gas boundary at alpha |v|; 0 = off"),
+                    "alpha of the entrainment model: air joins the gas boundary at alpha |v|"),
         Row::number("life_strength", "lifeStrength", &G::lifeStrength, sph::nonNegative(), "s",
                     "how long an isolated particle lives (Sec. 5); 0 = forever"),
     };
@@ -216,10 +232,10 @@ void GasSettings::validate() const
     check.require(buoyancyDirection.length() > Real(1e-6), "buoyancyDirection",
                   buoyancyDirection.length(), "a finite non-zero vector");
     validateAttractors(attractors);
-    if (entrainment > Real(0) && method == Method::Ambient) {
-        throw ValueError(msg("gas setting entrainment = ", entrainment,
-                             " with method 'ambient': expected 0 (the ambient baseline "
-                             "simulates the air it draws in)"));
+    if (turbulence == Turbulence::Entrainment && method == Method::Ambient) {
+        throw ValueError(msg("gas setting turbulence = 'entrainment' with method 'ambient': "
+                             "expected 'none' or 'auto' (the ambient baseline simulates the air "
+                             "it would draw in)"));
     }
     if (method == Method::Ambient) {
         const Vec3 e = domain.extent();

@@ -742,6 +742,7 @@ void GasSolver::integrate(Real dt, const std::vector<Vec3>& accel)
     auto& m = mParticles.masses();
     const bool entrains = mEntrainment.enabled();
     std::vector<Real>* smoke = entrains ? &mParticles.scalarChannel(channel::SMOKE) : nullptr;
+    const auto& rho = mParticles.densities();
     parallel::forEach(0, n, [&](std::size_t i) {
         if (kind[i] != ParticleKind::Gas) return;
         v[i] += dt * accel[i];
@@ -749,7 +750,8 @@ void GasSolver::integrate(Real dt, const std::vector<Vec3>& accel)
         mTemperature.advance(T, i, dt);
         if (omega) mVorticity.advance(*omega, i, dt);
         if (smoke) {
-            mEntrainment.entrain(m[i], v[i], T[i], (*smoke)[i], mCompensation.normal(i), dt);
+            mEntrainment.entrain(m[i], v[i], T[i], (*smoke)[i], mCompensation.normal(i), rho[i],
+                                 dt);
         }
     });
     Real amax = 0;
@@ -849,8 +851,20 @@ void GasSolver::applyDomain()
             ++killed;
         }
     }
-    if (killed) mParticles.removeIf(remove);
+    if (killed) removeMarked(remove);
     mRun.killed += killed;
+}
+
+void GasSolver::removeMarked(const std::vector<std::uint8_t>& remove)
+{
+    const auto& m = mParticles.masses();
+    const std::vector<Real>* share = mParticles.hasScalarChannel(channel::SMOKE)
+                                         ? &mParticles.scalarChannel(channel::SMOKE)
+                                         : nullptr;
+    for (std::size_t i = 0; i < remove.size(); ++i) {
+        if (remove[i]) mRemovedLastStep += double(m[i]) * (share ? double((*share)[i]) : 1.0);
+    }
+    mParticles.removeIf(remove);
 }
 
 void GasSolver::applyLifeStrength(Real dt)
@@ -874,7 +888,7 @@ void GasSolver::applyLifeStrength(Real dt)
     });
     std::size_t removed = 0;
     for (std::uint8_t r : remove) removed += r;
-    if (removed) mParticles.removeIf(remove);
+    if (removed) removeMarked(remove);
     mIsolatedRemoved += removed;
 }
 
@@ -932,6 +946,7 @@ void GasSolver::step(Real dt)
         throw ValueError(msg("gas step: dt = ", dt, " s: expected a finite value > 0"));
     }
     checkRestoredInputs();
+    mRemovedLastStep = 0;
     // Whatever this step adds (sources, ambient air) is born now.
     sph::stampBirthTimes(mParticles, mRun.time);
     initialize();

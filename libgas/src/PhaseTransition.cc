@@ -425,14 +425,19 @@ void PhaseTransition::restoreState(const sph::SolverState& state)
 
 double PhaseTransition::gasMass() const
 {
+    // The liquid's own mass in the gas: with entrainment a vapour particle also holds the air it
+    // drew in, and its smoke share c is the vapour's part of its mass (GasEntrainment.h).
     const ParticleSet& g = mGas.particles();
     const std::vector<Real>* ambient =
         g.hasScalarChannel(channel::AMBIENT) ? &g.scalarChannel(channel::AMBIENT) : nullptr;
+    const std::vector<Real>* share =
+        g.hasScalarChannel(channel::SMOKE) ? &g.scalarChannel(channel::SMOKE) : nullptr;
     double sum = 0;
     for (std::size_t i = 0; i < g.size(); ++i) {
         if (g.kinds()[i] != ParticleKind::Gas) continue;
         if (ambient && (*ambient)[i] != Real(0)) continue;
-        sum += double(g.masses()[i]);
+        const double m = double(g.masses()[i]);
+        sum += share ? m * double((*share)[i]) : m;
     }
     return sum;
 }
@@ -480,12 +485,8 @@ void PhaseTransition::step(Real dt)
     mTimings.boundary += secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
-    // The gas step only removes gas (no sources in a coupled scene, or their gas is counted as
-    // created by them): the drop of the visible gas mass across it is what it removed.
-    const double before = gasMass();
     mGas.step(dt);
-    const double after = gasMass();
-    if (after < before) mGasRemoved += before - after;
+    mGasRemoved += mGas.removedLastStep();
     mTimings.gas += secondsSince(t0);
     mTimings.total += secondsSince(start);
     ++mTimings.steps;

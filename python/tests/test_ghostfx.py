@@ -417,10 +417,11 @@ def test_dfsph_pressure_runs_the_dam_break_and_its_checkpoint_names_the_model(tm
 PLUME = os.path.join(SOURCE, "examples", "gas_plume", "scene.json")
 
 
-def _plume_per_frame(method):
+def _plume_per_frame(method, turbulence="none"):
     """Visible gas count, centroid height and top (95th percentile of y) after every frame of
-    the shipped plume, run with its default settings and the given method."""
-    scene = ghostfx.load_scene(PLUME, {"settings.method": method, "outputs.preview": None})
+    the shipped plume, run with its default settings, the given method and turbulence model."""
+    scene = ghostfx.load_scene(PLUME, {"settings.method": method, "outputs.preview": None,
+                                       "settings.gas.turbulence": turbulence})
     sim = ghostfx.Simulation(scene)
     rows = []
 
@@ -432,8 +433,9 @@ def _plume_per_frame(method):
     return np.array(rows)
 
 
-def test_shipped_plume_fast_and_ambient_rise_alike_with_default_settings():
-    # [RYY15]'s claim: gas without ambient air looks like gas with it. The measure: per frame,
+def test_shipped_plume_fast_and_ambient_rise_alike_without_turbulence():
+    # [RYY15]'s claim: gas without ambient air looks like gas with it, both without a turbulence
+    # model (settings.gas.turbulence "none": the paper's methods). The measure: per frame,
     # the plume's top (95th percentile height of the visible gas) and centroid height, and the
     # visible gas count, compared while both tops are below 90 % of the kill box's height
     # (1.6 m): above it the fast solver's gas leaves the kill box while the baseline's closed
@@ -442,8 +444,11 @@ def test_shipped_plume_fast_and_ambient_rise_alike_with_default_settings():
     # 0.92-1.21, centroid 0.84-1.14 over 27-28 frames, count 0.97-1.23 from frame 9 (the fast
     # source's first fill is a sampled sphere with its surface layer, 187 particles against the
     # 121 air particles the baseline converts, an offset that the emission then dilutes).
-    # Tolerances: top 25 %, centroid 20 %, count 25 % (from 0.3 s). The default damping
-    # C_d = 7 /s is what makes them agree (C_d = 1 /s: top ratio up to 1.79).
+    # Tolerances: top 25 %, centroid 20 %, count 25 % (from 0.3 s). The automatic damping
+    # without turbulence, C_d = 7 /s, is what makes them agree (C_d = 1 /s: top ratio up to
+    # 1.79). With the default entrainment the fast plume's top is 1.07-1.43 times the
+    # baseline's (docs/study.md): its entrained air stands for a real plume's, which the
+    # baseline's air, as coarse as the gas, does not draw in.
     fast = _plume_per_frame("gas")
     ambient = _plume_per_frame("gas_ambient")
     below = (fast[:, 2] < 0.9 * 1.6) & (ambient[:, 2] < 0.9 * 1.6)

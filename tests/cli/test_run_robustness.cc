@@ -10,7 +10,9 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <string>
+#include <utility>
 
 namespace fs = std::filesystem;
 using namespace ghostfx;
@@ -205,24 +207,63 @@ TEST_F(Robustness, PanThatBoilsAwayRunsToTheEnd)
     EXPECT_TRUE(fs::exists(out / "checkpoint.0004.h5"));
 }
 
-// The boiling pan's vapour entrains air too (settings.gas applies to it): its mass grows beyond
-// the boiled water's by the air drawn in, and its smoke share can be written as a grid.
+namespace {
+
+/// The mean and the least of the active values of the float grid `name` of a .vdb file.
+std::pair<double, double> activeMeanAndMin(const fs::path& file, const std::string& name)
+{
+    openvdb::io::File f(file.string());
+    f.open();
+    const auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid(name));
+    f.close();
+    double sum = 0, count = 0, least = std::numeric_limits<double>::max();
+    for (auto v = grid->cbeginValueOn(); v; ++v) {
+        sum += double(*v) * double(v.getVoxelCount());
+        count += double(v.getVoxelCount());
+        least = std::min(least, double(*v));
+    }
+    return {count > 0 ? sum / count : 0.0, least};
+}
+
+} // namespace
+
+// The boiling pan's vapour entrains air too (settings.gas applies to it; turbulence "auto"
+// is entrainment): the air it draws in dilutes its smoke share, the vapour's part of its mass,
+// at its edge, while the water budget counts the vapour alone. Measured over 0.2 s: a share of
+// 0.92 on average and 0.67 at least (the vapour is born compressed, and a compressed particle's
+// surface is small, so it draws in air only as it expands); bounds 0.97 and 0.8. The pan boils
+// away in both runs, so the water in the gas is the same to the budget's float rounding
+// (PhaseTransition tests: 1e-5).
 TEST_F(Robustness, BoilingVapourEntrainsAir)
 {
     Json scene = boilingPan(5);
+    // An open pan (a floor and four walls): in the closed container the vapour has nowhere to
+    // expand and stays compressed.
+    scene["solids"] = Json::parse(R"([
+        { "name": "floor", "geometry": { "box": { "min": [-0.04, -0.04, -0.04], "max": [0.24, 0, 0.24] } } },
+        { "name": "x0", "geometry": { "box": { "min": [-0.04, 0, -0.04], "max": [0, 0.2, 0.24] } } },
+        { "name": "x1", "geometry": { "box": { "min": [0.2, 0, -0.04], "max": [0.24, 0.2, 0.24] } } },
+        { "name": "z0", "geometry": { "box": { "min": [0, 0, -0.04], "max": [0.2, 0.2, 0] } } },
+        { "name": "z1", "geometry": { "box": { "min": [0, 0, 0.2], "max": [0.2, 0.2, 0.24] } } }
+    ])");
+    scene["settings"]["frame_range"] = {1, 6};
     const fs::path plain = mDir / "plain", mixed = mDir / "mixed";
+    scene["settings"]["gas"]["turbulence"] = "none";
     ASSERT_EQ(run("run " + write(scene, "plain.json") + " --out " + plain.string() + " -q").code, 0);
-    scene["settings"]["gas"]["entrainment"] = 0.12;
+    scene["settings"]["gas"].erase("turbulence");
     scene["outputs"]["gas_volume"]["grids"] = Json::array({"density", "smoke"});
     const Result r = run("run " + write(scene, "mixed.json") + " --out " + mixed.string() + " -q");
     ASSERT_EQ(r.code, 0) << r.err;
     const double before = csvColumn(plain / "stats.csv", "mass_gas").back();
     const double after = csvColumn(mixed / "stats.csv", "mass_gas").back();
-    std::printf("[measured] boiled-away pan, 4 frames: vapour mass %.4g kg, with entrainment "
-                "%.4g kg\n",
-                before, after);
-    EXPECT_GT(after, 1.1 * before);
-    EXPECT_EQ(ghostfx::testing::gridBytes(mixed / "gas.0004.vdb").count("smoke"), 1u);
+    const auto [mean, least] = activeMeanAndMin(mixed / "gas.0006.vdb", "smoke");
+    std::printf("[measured] boiled-away open pan, 6 frames: water in the gas %.6g kg, with "
+                "entrainment %.6g kg; smoke share %.3f on average, %.3f at least\n",
+                before, after, mean, least);
+    EXPECT_NEAR(after / before, 1.0, 1e-5);
+    EXPECT_GT(least, 0.0);
+    EXPECT_LT(mean, 0.97);
+    EXPECT_LT(least, 0.8);
 }
 
 // Checkpoints of a boiling scene -----------------------------------------------------------------

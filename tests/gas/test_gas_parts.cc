@@ -69,6 +69,7 @@ TEST(GasTemperature, BuoyancyFollowsEq17AndRadiationOnlyAtTheBoundaryWithoutAir)
 TEST(GasCompensation, OnlyTheFastMethodCompensatesAndItsForcesFollowEqs13And14)
 {
     GasSettings s;
+    s.turbulence = Turbulence::None; // [RYY15] as published: Eq. 14's automatic C_d is 7 /s
     s.interiorPressureScale = Real(0.25);
     GasCompensation part(s);
     ASSERT_TRUE(part.enabled());
@@ -92,6 +93,7 @@ TEST(GasCompensation, OnlyTheFastMethodCompensatesAndItsForcesFollowEqs13And14)
     part.damp(b, v, false);
     EXPECT_EQ(a, -(s.boundaryDamping() * v));
     EXPECT_EQ(s.boundaryDamping(), Real(7)); // automatic without entrainment
+    EXPECT_EQ(GasSettings().boundaryDamping(), Real(0)); // automatic with it (the default)
     EXPECT_EQ(b, Vec3(0));
 }
 

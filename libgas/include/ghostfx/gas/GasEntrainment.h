@@ -7,11 +7,12 @@
 ///          into it and a plume rises as a column of constant volume. This part adds the air the
 ///          gas would have entrained, as mass: over dt a gas particle i gains
 ///
-///              dm_i = rho0 alpha |v_i| A_i dt,    A_i = |n_i| m_i / rho0,
+///              dm_i = rho0 alpha |v_i| A_i dt,    A_i = |n_i| m_i / rho_i,
 ///
 ///          A_i its share of the gas's boundary area (n_i the colour-field gradient of [RYY15]
 ///          Eq. 5, whose length is the boundary area per volume: its integral over the gas is
-///          the gas's surface area). The air is at rest and at the ambient temperature, and
+///          the gas's surface area; m_i / rho_i its volume, so vapour born compressed, far
+///          denser than rho0, draws in air through the small surface it has). The air is at rest and at the ambient temperature, and
 ///          mixes into the particle: its momentum m v and its buoyancy m (T - T_a) are kept, so
 ///          it slows and cools as [MTT56]'s top-hat plume does, and the buoyancy flux of a
 ///          plume is conserved. The particle's volume grows with its mass (its support follows,
@@ -30,7 +31,7 @@ class GasEntrainment
 {
 public:
     explicit GasEntrainment(const GasSettings& settings)
-        : mAlpha(settings.entrainment)
+        : mAlpha(settings.entrainmentInUse())
         , mRestDensity(settings.restDensity)
         , mAmbient(settings.ambientTemperature)
     {}
@@ -38,12 +39,13 @@ public:
     bool enabled() const { return mAlpha > Real(0); }
 
     /// Mix the air a particle of mass m (kg), velocity v (m/s), temperature T (K) and smoke
-    /// share c (channel::SMOKE) with the colour gradient n (1/m) entrains over dt (s) into it.
-    void entrain(Real& m, Vec3& v, Real& T, Real& c, const Vec3& n, Real dt) const
+    /// share c (channel::SMOKE) with the colour gradient n (1/m) and density rho (kg/m^3)
+    /// entrains over dt (s) into it.
+    void entrain(Real& m, Vec3& v, Real& T, Real& c, const Vec3& n, Real rho, Real dt) const
     {
         const double length = double(n.length());
-        if (!(length > 0)) return;
-        const double area = length * double(m) / double(mRestDensity);
+        if (!(length > 0) || !(rho > Real(0))) return;
+        const double area = length * double(m) / double(rho);
         // The speed along the boundary: the shear that draws the air in.
         const openvdb::math::Vec3<double> vd(v), unit = openvdb::math::Vec3<double>(n) / length;
         const double along = (vd - unit * vd.dot(unit)).length();

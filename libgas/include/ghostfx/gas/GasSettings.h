@@ -46,6 +46,24 @@ const char* methodName(Method method);
 /// Parse a method name; throws ValueError listing the valid names.
 Method methodFromName(const std::string& name);
 
+/// The turbulence model of the gas: what stands for the eddies below its spacing. Chosen by
+/// name in scenes ("auto", "none", "entrainment").
+enum class Turbulence {
+    /// Entrainment for the methods without ambient air (fast, uncorrected, boiling vapour),
+    /// none for the ambient baseline, which simulates its air (the default).
+    Automatic,
+    /// None: [RYY15] as published; a plume from a steady source rises as a column.
+    None,
+    /// Ambient air entrained through the gas boundary at `entrainment` times the gas's speed
+    /// along it ([MTT56]; GasEntrainment.h): plumes widen and slow as measured plumes do.
+    Entrainment,
+};
+
+/// "auto", "none" or "entrainment".
+const char* turbulenceName(Turbulence turbulence);
+/// Parse a turbulence model's name; throws ValueError listing the valid names.
+Turbulence turbulenceFromName(const std::string& name);
+
 /// How an attractor's pull falls off outside its core radius R (Attractor).
 enum class Falloff {
     /// |a| = S (R / r)^2 for r >= R: the gravity of a uniform ball of radius R (the default).
@@ -121,10 +139,10 @@ struct GasSettings
     /// neighbourhood of a Poisson-disk sample about 0.1 - 0.3 (tests/gas measure it).
     Real normalThreshold = Real(0.5);
     /// C_d of Eq. 14 (1/s): a_damp = -C_d v on boundary particles, the drag of the air that is
-    /// not simulated. Not given by [RYY15]. 7 makes the shipped plume (examples/gas_plume) rise
-    /// as the ambient-air baseline's does (top and centroid within 15 %, tests/python): 1 rose
-    /// 1.36x as high on average, 3 1.29x, 10 0.93x (docs/study.md, gas plume). Negative (the
-    /// default): automatic, boundaryDamping().
+    /// not simulated. Not given by [RYY15]. Without turbulence, 7 makes the shipped plume
+    /// (examples/gas_plume) rise as the ambient-air baseline's does (top within 25 %, centroid
+    /// within 20 %, python/tests): 1 rose 1.36x as high on average, 3 1.29x, 10 0.93x
+    /// (docs/study.md, gas plume). Negative (the default): automatic, boundaryDamping().
     Real damping = Real(-1);
     /// Dynamic viscosity mu (Pa s) of the viscosity force F_v of Eq. 22 (Mueller et al. 2003
     /// Laplacian kernel). Not given by [RYY15]; small enough that dt mu / (rho0 h^2) < 0.1 at
@@ -158,19 +176,35 @@ struct GasSettings
     /// into an acceleration. [RYY15] calls Eq. 26 a force without giving its units.
     Real vorticityStrength = Real(5);
 
-    /// C_d in use: `damping`, or where it is automatic 7 /s, and 0 with `entrainment` (the
+    /// C_d in use: `damping`, or where it is automatic 7 /s, and 0 while air is entrained (the
     /// entrained air's momentum is then the air's drag; with both, a plume slowed as
     /// w ~ z^-1.07 against [MTT56]'s z^-1/3, tests/gas/test_gas_entrainment.cc).
     Real boundaryDamping() const
     {
         if (damping >= Real(0)) return damping;
-        return entrainment > Real(0) ? Real(0) : Real(7);
+        return entrainmentInUse() > Real(0) ? Real(0) : Real(7);
     }
 
-    // Entrainment of ambient air (GasEntrainment.h) ----------------------------------------------
-    /// alpha, the entrainment coefficient of Morton, Taylor and Turner 1956: ambient air at rest
-    /// joins the gas through its boundary at alpha times the gas's speed. 0 = off.
-    Real entrainment = Real(0);
+    // Turbulence (GasEntrainment.h) -------------------------------------------------------------
+    /// The model; Automatic: entrainment, except for the ambient baseline (turbulenceInUse()).
+    Turbulence turbulence = Turbulence::Automatic;
+    /// alpha, the entrainment coefficient of Morton, Taylor and Turner 1956 ([MTT56]): ambient
+    /// air at rest joins the gas through its boundary at alpha times the gas's speed along it.
+    /// 0.12 spreads a steady plume at db/dz 0.09-0.11 over 5 to 15 source diameters
+    /// (tests/gas/test_gas_entrainment.cc; measured plumes 0.08-0.16).
+    Real entrainment = Real(0.12);
+
+    /// The turbulence model `turbulence` resolves to for `method`.
+    Turbulence turbulenceInUse() const
+    {
+        if (turbulence != Turbulence::Automatic) return turbulence;
+        return method == Method::Ambient ? Turbulence::None : Turbulence::Entrainment;
+    }
+    /// alpha in use: `entrainment` with the entrainment model, else 0.
+    Real entrainmentInUse() const
+    {
+        return turbulenceInUse() == Turbulence::Entrainment ? entrainment : Real(0);
+    }
 
     // Force fields ------------------------------------------------------------------------------
     /// Point attractors acting on the visible gas in the force stage, added to Eq. 24 (the

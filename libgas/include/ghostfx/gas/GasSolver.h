@@ -205,12 +205,18 @@ public:
     std::size_t killedCount() const { return mRun.killed; }
     /// Isolated particles removed by the life strength rule (Sec. 5).
     std::size_t isolatedRemovedCount() const { return mIsolatedRemoved; }
+    /// The emitted gas's mass the last step removed (kg; kill box, life strength): the sum of
+    /// m_i c_i over the removed particles with entrainment (c_i their smoke share: the air they
+    /// drew in is not counted), of m_i without.
+    double removedLastStep() const { return mRemovedLastStep; }
 
 private:
     struct Solid;
     struct Source;
 
     void initialize();
+    /// Remove the particles marked in `remove`, adding their emitted mass to mRemovedLastStep.
+    void removeMarked(const std::vector<std::uint8_t>& remove);
     void ensureSolidChannels();
     void checkRestoredInputs() const;
     void sampleSolid(std::size_t solidIndex);
@@ -282,6 +288,7 @@ private:
     Real mMass = 0;
     sph::RunCounters mRun; ///< clock and counters
     std::size_t mIsolatedRemoved = 0;
+    double mRemovedLastStep = 0; ///< removedLastStep()
     GasTimings mTimings;
     StepObserver mObserver;
     bool mRestored = false;

@@ -171,12 +171,14 @@ struct PhaseTransitionTimings
     std::uint64_t steps = 0;
 };
 
-/// Mass budget (kg), summed in double in index order.
+/// Mass budget of the liquid's substance (kg), summed in double in index order.
 struct MassBudget
 {
-    double liquid = 0;     ///< liquid particles of the liquid set
-    double gas = 0;        ///< gas particles of the gas solver (not ambient air)
-    double gasRemoved = 0; ///< gas removed by the gas solver (kill box, life strength)
+    double liquid = 0; ///< liquid particles of the liquid set
+    /// The vapour in the gas solver's gas particles (not ambient air, nor the air they
+    /// entrained: sum m_i c_i with channel::SMOKE, GasEntrainment.h)
+    double gas = 0;
+    double gasRemoved = 0; ///< vapour removed by the gas solver (kill box, life strength)
     double total() const { return liquid + gas + gasRemoved; }
 };
 
