@@ -1,6 +1,7 @@
 /// @file   FrameWriter.cc
 #include "FrameWriter.h"
 
+#include <ghostfx/gas/GasChannels.h>
 #include <ghostfx/sph/Exceptions.h>
 
 #include <algorithm>
@@ -42,6 +43,9 @@ vdbio::VolumeOptions volumeOptions(const OutputMedium& m, const vdbio::SceneOutp
         vo.voxelSize = vo.densityVoxelSize = out.gasVoxelSize > 0 ? out.gasVoxelSize : m.spacing;
     }
     vo.kernelSupport = m.support;
+    // A gas particle grown by the air it entrained spreads over its own support.
+    if (!m.liquid && m.particles->hasScalarChannel(gas::channel::SUPPORT))
+        vo.supportChannel = gas::channel::SUPPORT;
     vo.restDensity = m.restDensity;
     vo.particleSpacing = m.spacing;
     vo.kinds = m.kinds;

@@ -29,6 +29,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -244,6 +245,56 @@ TEST(FrameFiles, DensityOfOneParticleConservesMass)
                 worstQuadrature, worstWithCutoff);
     EXPECT_LT(worstQuadrature, 1e-4);                 // lattice quadrature only
     EXPECT_LT(worstWithCutoff, 6.1e-4 + 1e-4 + 1e-4); // analytic tail + quadrature + margin
+}
+
+// VolumeOptions::supportChannel: a particle grown to n times the rest mass at the rest density
+// has a support n^(1/3) R (the gas's "h" after entraining air). Spread over it, its density
+// peak is a rest particle's (W(0, 2R) = W(0, R) / 8 for the eight-fold mass of h = 2R; within
+// 5 %: the particle sits 0.52 voxels from the nearest voxel centre, where the narrower kernel
+// has fallen 3 % more), its grid mass is m to the lattice quadrature (1e-4, as for one
+// particle above), and its fog reaches out to 2R; a support below R is raised to R and one
+// above 2R capped there.
+TEST(FrameFiles, OwnSupportsSpreadAGrownParticleOverItsSupport)
+{
+    const Real m0 = Real(REST_DENSITY * std::pow(SPACING, 3));
+    auto peakAndMass = [&](Real mass, Real h, bool own) {
+        ParticleSet p;
+        p.add(Vec3(Real(0.3 * VOXEL)), Vec3(0), mass, ParticleKind::Liquid);
+        p.addScalarChannel("h", h);
+        vdbio::VolumeOptions o = volumeOptions();
+        o.surface = o.velocity = false;
+        o.densityCutoff = 0;
+        if (own) o.supportChannel = "h";
+        const auto grids = vdbio::makeVolumeGrids(p, o);
+        const auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(grids.at(0));
+        float peak = 0;
+        double reach = 0;
+        for (auto v = density->cbeginValueOn(); v; ++v) {
+            peak = std::max(peak, *v);
+            reach = std::max(reach, (density->indexToWorld(v.getCoord()) - openvdb::Vec3d(0.3 * VOXEL))
+                                        .length());
+        }
+        return std::make_tuple(double(peak), densityMass(*density, REST_DENSITY), reach);
+    };
+    const Real R = Real(SUPPORT);
+    const auto [restPeak, restMass, restReach] = peakAndMass(m0, R, true);
+    const auto [grownPeak, grownMass, grownReach] = peakAndMass(8 * m0, 2 * R, true);
+    const auto [blobPeak, blobMass, blobReach] = peakAndMass(8 * m0, 2 * R, false);
+    const auto [cappedPeak, cappedMass, cappedReach] = peakAndMass(8 * m0, 5 * R, true);
+    const auto [smallPeak, smallMass, smallReach] = peakAndMass(m0, R / 4, true);
+    std::printf("[measured] own supports: peak rho/rho0 rest %.4f, 8 m at 2 R %.4f (%.4f at R), "
+                "mass error %.2e; reach %.3f and %.3f m (R %.3f m)\n",
+                restPeak, grownPeak, blobPeak, std::abs(grownMass - 8 * m0) / (8 * m0), restReach,
+                grownReach, double(R));
+    EXPECT_NEAR(grownPeak / restPeak, 1.0, 0.05);
+    EXPECT_NEAR(blobPeak / restPeak, 8.0, 0.4);
+    EXPECT_LT(std::abs(grownMass - 8 * m0) / (8 * m0), 1e-4);
+    EXPECT_GT(grownReach, 1.8 * double(R));
+    EXPECT_LE(grownReach, 2.0 * double(R) * (1 + 1e-6));
+    EXPECT_EQ(cappedPeak, grownPeak);
+    EXPECT_EQ(cappedReach, grownReach);
+    EXPECT_EQ(smallPeak, restPeak);
+    EXPECT_EQ(smallMass, restMass);
 }
 
 TEST(FrameFiles, DensityGridMassAndSparsity)

@@ -95,12 +95,14 @@ openvdb::FloatGrid::Ptr makeAnisotropicSurfaceGrid(const sph::ParticleSet& parti
                                                    const VolumeOptions& options);
 
 /// Origins (multiples of 8) of the 8^3 leaves whose voxels (centred at (i,j,k) * dx) meet the
-/// box of half side `reach` (m) about any of the particles x[order[k]]. `order` should list
-/// neighbours close together (a NeighborGrid's cell order): the list is built per block of
-/// 4096 and merged, sorted and unique, so it does not depend on the thread count.
+/// box of half side `reach` (m) about any of the particles x[order[k]] (or reaches[order[k]]
+/// where `reaches` is given). `order` should list neighbours close together (a NeighborGrid's
+/// cell order): the list is built per block of 4096 and merged, sorted and unique, so it does
+/// not depend on the thread count.
 std::vector<openvdb::Coord> leavesNearParticles(const std::vector<sph::Vec3>& x,
                                                 const std::vector<sph::Index>& order, double dx,
-                                                double reach);
+                                                double reach,
+                                                const std::vector<sph::Real>* reaches = nullptr);
 
 /// "density", "vel" and the scalar channel grids, as asked by `options` (already validated;
 /// channel names already checked), gathered on one shared sparse topology.

@@ -117,8 +117,12 @@ double volumeReach(const VolumeOptions& o)
             std::max(reach, (1.0 + o.anisotropicSmoothing) * rn + kernel + (w + 2) * o.voxelSize);
     }
     if (o.density || o.velocity || !o.scalarChannels.empty()) {
-        // A gathered voxel sums the particles within the kernel support of its centre.
-        reach = std::max(reach, o.kernelSupport + o.fogVoxelSize());
+        // A gathered voxel sums the particles within the kernel support of its centre (or
+        // their own, up to MAX_SUPPORT_SCALE times it).
+        const double R = o.supportChannel.empty()
+                             ? o.kernelSupport
+                             : VolumeOptions::MAX_SUPPORT_SCALE * o.kernelSupport;
+        reach = std::max(reach, R + o.fogVoxelSize());
     }
     return reach;
 }

@@ -55,6 +55,9 @@ struct Selected
     std::vector<sph::Real> m;              ///< masses (kg)
     std::vector<sph::Vec3> v;              ///< velocities (m/s), if "vel" is asked
     std::vector<std::vector<sph::Real>> a; ///< scalar channels, in the order asked
+    /// Each particle's kernel support (m), with VolumeOptions::supportChannel; else empty.
+    std::vector<sph::Real> R;
+    double maxR = 0; ///< the largest support (m)
 };
 
 /// The leaves of the output grids built for one candidate leaf (null where nothing is active).
@@ -74,7 +77,7 @@ openvdb::math::Transform::Ptr makeTransform(double voxelSize)
 
 std::vector<openvdb::Coord> leavesNearParticles(const std::vector<sph::Vec3>& x,
                                                 const std::vector<sph::Index>& order, double dx,
-                                                double reach)
+                                                double reach, const std::vector<sph::Real>* reaches)
 {
     const std::size_t n = order.size();
     const std::size_t nBlocks = (n + LEAF_KEY_BLOCK - 1) / LEAF_KEY_BLOCK;
@@ -92,9 +95,10 @@ std::vector<openvdb::Coord> leavesNearParticles(const std::vector<sph::Vec3>& x,
         const std::size_t end = std::min(n, (b + 1) * LEAF_KEY_BLOCK);
         for (std::size_t k = b * LEAF_KEY_BLOCK; k < end; ++k) {
             const sph::Vec3& p = x[order[k]];
+            const double r = reaches ? double((*reaches)[order[k]]) : reach;
             int lo[3], hi[3];
             for (int d = 0; d < 3; ++d) {
-                voxelRange(double(p[d]), reach, invDx, lo[d], hi[d]);
+                voxelRange(double(p[d]), r, invDx, lo[d], hi[d]);
                 lo[d] &= mask;
                 hi[d] &= mask;
             }
@@ -222,6 +226,10 @@ Selected selectParticles(const sph::ParticleSet& particles,
     sel.m.resize(n);
     if (wantVel) sel.v.resize(n);
     sel.a.resize(nChannels);
+    const std::vector<sph::Real>* support =
+        options.supportChannel.empty() ? nullptr : &particles.scalarChannel(options.supportChannel);
+    const sph::Real R = sph::Real(options.kernelSupport);
+    if (support) sel.R.resize(n);
     std::vector<const std::vector<sph::Real>*> source(nChannels);
     for (std::size_t c = 0; c < nChannels; ++c) {
         const std::string& name = options.scalarChannels[c];
@@ -238,8 +246,14 @@ Selected selectParticles(const sph::ParticleSet& particles,
         sel.m[k] = particles.masses()[i];
         if (wantVel) sel.v[k] = particles.velocities()[i];
         for (std::size_t c = 0; c < nChannels; ++c) sel.a[c][k] = (*source[c])[i];
+        if (support) {
+            sel.R[k] = std::clamp((*support)[i], R,
+                                  sph::Real(VolumeOptions::MAX_SUPPORT_SCALE * options.kernelSupport));
+        }
         },
         4096);
+    sel.maxR = options.kernelSupport;
+    for (sph::Real r : sel.R) sel.maxR = std::max(sel.maxR, double(r));
     return sel;
 }
 
@@ -269,7 +283,7 @@ public:
         , mWantVel(options.velocity)
         , mChannels(options.scalarChannels.size())
         , mChannelBackgrounds(channelBackgrounds(options))
-        , mSearchRadius(sph::Real(mR + leafHalfDiagonal(mDx)))
+        , mSearchRadius(sph::Real(sel.maxR + leafHalfDiagonal(mDx)))
     {}
 
     /// The output leaves of the leaf at `origin`.
@@ -292,9 +306,13 @@ private:
     void addParticle(sph::Index j, const openvdb::Coord& origin, LeafSums& sums) const
     {
         const double xj[3] = {double(mSel.x[j][0]), double(mSel.x[j][1]), double(mSel.x[j][2])};
-        const double reach[3] = {mR, mR, mR};
+        const bool own = !mSel.R.empty();
+        const double Rj = own ? double(mSel.R[j]) : mR;
+        const double reach[3] = {Rj, Rj, Rj};
         int lo[3], hi[3];
         if (!boxInLeaf(xj, reach, mInvDx, origin, lo, hi)) return;
+        const sph::CubicSplineKernel kernel = own ? sph::CubicSplineKernel(mSel.R[j]) : mKernel;
+        const double R2 = own ? Rj * Rj : mR2;
         const double mj = double(mSel.m[j]);
         for (int a = lo[0]; a <= hi[0]; ++a) {
             const double dxa = (origin.x() + a) * mDx - xj[0];
@@ -302,26 +320,28 @@ private:
             for (int b = lo[1]; b <= hi[1]; ++b) {
                 const double dyb = (origin.y() + b) * mDx - xj[1];
                 const double rab2 = ra2 + dyb * dyb;
-                if (rab2 >= mR2) continue;
-                addRow(j, origin, xj, mj, rab2, (a << 6) | (b << 3), lo[2], hi[2], sums);
+                if (rab2 >= R2) continue;
+                addRow(j, kernel, origin, xj, mj, rab2, (a << 6) | (b << 3), lo[2], hi[2], sums);
             }
         }
     }
 
-    /// Particle j's shares on the voxels [clo, chi] of the leaf row at offset `row`
-    /// (LeafNode::coordToOffset), `rab2` its squared distance (m^2) off the row's axis. The
+    /// Particle j's shares (its kernel `kernel`) on the voxels [clo, chi] of the leaf row at
+    /// offset `row` (LeafNode::coordToOffset), `rab2` its squared distance (m^2) off the row's
+    /// axis. The
     /// whole row of the support's box, weights first (a loop the compiler vectorises: W is
     /// branch-free and 0 outside the support, which adds nothing), then the sums. Cheaper than
     /// finding the row's z range inside the sphere (a square root and two roundings) when rows
     /// are a few voxels.
-    void addRow(sph::Index j, const openvdb::Coord& origin, const double xj[3], double mj,
-                double rab2, int row, int clo, int chi, LeafSums& sums) const
+    void addRow(sph::Index j, const sph::CubicSplineKernel& kernel, const openvdb::Coord& origin,
+                const double xj[3], double mj, double rab2, int row, int clo, int chi,
+                LeafSums& sums) const
     {
         double w[LEAF_DIM];
         for (int c = clo; c <= chi; ++c) {
             const double dzc = (origin.z() + c) * mDx - xj[2];
             const double r = std::sqrt(rab2 + dzc * dzc);
-            w[c] = mj * double(mKernel.W(sph::Real(r)));
+            w[c] = mj * double(kernel.W(sph::Real(r)));
         }
         for (int c = clo; c <= chi; ++c) sums.rho[row | c] += w[c];
         if (mWantVel) {
@@ -404,11 +424,11 @@ openvdb::GridPtrVec makeParticleGrids(const sph::ParticleSet& particles,
     const Selected sel = selectParticles(particles, selection, options);
     if (sel.x.empty()) return grids.asked(options);
 
-    const double R = options.kernelSupport;
-    sph::NeighborGrid grid{sph::Real(R)};
+    sph::NeighborGrid grid{sph::Real(sel.maxR)};
     grid.build(sel.x);
     const std::vector<openvdb::Coord> leaves =
-        leavesNearParticles(sel.x, grid.order(), options.fogVoxelSize(), R);
+        leavesNearParticles(sel.x, grid.order(), options.fogVoxelSize(), options.kernelSupport,
+                            sel.R.empty() ? nullptr : &sel.R);
     std::vector<LeafOutput> results(leaves.size());
     const DensityGather gather(sel, grid, options);
     parallel::forEach(

@@ -164,6 +164,15 @@ struct VolumeOptions
     /// SPH kernel support radius R (m) of the density, velocity and channel grids, required
     /// > 0 (sph::CubicSplineKernel; [SB12] Sec. 3 uses R = 3 h).
     double kernelSupport = 0;
+    /// A scalar channel holding each particle's own support radius (m), or "" (the default):
+    /// every particle spreads over kernelSupport. With a channel a particle spreads over its own
+    /// support, kept within [1, MAX_SUPPORT_SCALE] x kernelSupport, so particles grown by the air
+    /// they entrained (the gas's "h") spread their mass over their own support instead of piling
+    /// it into a blob of the rest size.
+    std::string supportChannel;
+    /// The largest support a particle gets with supportChannel, in kernelSupports (2: eight
+    /// times the rest mass at the rest density); volumeReach() reaches that far.
+    static constexpr double MAX_SUPPORT_SCALE = 2.0;
     /// rho0 (kg/m^3): the density grid stores rho / rho0.
     double restDensity = 1000;
     /// Particle spacing h (m), required > 0: sets the surface sphere radius and the closing.
