@@ -190,7 +190,7 @@ struct GasSettings
     Turbulence turbulence = Turbulence::Automatic;
     /// alpha, the entrainment coefficient of Morton, Taylor and Turner 1956 ([MTT56]): ambient
     /// air at rest joins the gas through its boundary at alpha times the gas's speed along it.
-    /// 0.12 spreads a steady plume at db/dz 0.09-0.11 over 5 to 15 source diameters
+    /// 0.12 spreads a steady plume at db/dz 0.08-0.11 over 5 to 15 source diameters
     /// (tests/gas/test_gas_entrainment.cc; measured plumes 0.08-0.16).
     Real entrainment = Real(0.12);
 
